@@ -1,0 +1,85 @@
+// Run-time API of a controller, and one step of an instance with its publishes.
+#include "system_internal.h"
+
+#include <inttypes.h>
+#include <string.h>
+
+static port* port_of(tx_ctx* c, tx_port p, bool write) {
+  if (p.id < 1 || p.id > c->in->nports) return NULL;
+  port* pt = &c->in->ports[p.id - 1];
+  return pt->write == write ? pt : NULL;
+}
+
+tx_snapshot tx_read(tx_ctx* c, tx_port p) {
+  port* pt = port_of(c, p, false);
+  return pt ? tx_model_acquire(c->sys->model, pt->reader) : (tx_snapshot){0};
+}
+
+void* tx_write(tx_ctx* c, tx_port p) {
+  port* pt = port_of(c, p, true);
+  if (!pt) return NULL;
+  pt->dirty = true;
+  return tx_model_back(c->sys->model, pt->comp);
+}
+
+void* tx_write_copy(tx_ctx* c, tx_port p) {
+  port* pt = port_of(c, p, true);
+  if (!pt) return NULL;
+  pt->dirty = true;
+  return tx_model_back_copy(c->sys->model, pt->comp);
+}
+
+void tx_write_rows(tx_ctx* c, tx_port p, uint32_t rows) {
+  port* pt = port_of(c, p, true);
+  if (pt) tx_model_set_rows(c->sys->model, pt->comp, rows);
+}
+
+int64_t tx_sim_ns(const tx_ctx* c) { return c->sim_ns; }
+uint64_t tx_step_index(const tx_ctx* c) { return c->step; }
+double tx_rate(const tx_ctx* c) { return c->in->rate_hz; }
+
+void tx_warn(tx_ctx* c, tx_warning w) {
+  if (w.id >= 1 && w.id <= c->sys->nwarnings)
+    atomic_fetch_add_explicit(&c->sys->warning_counts[w.id - 1], 1, memory_order_relaxed);
+}
+
+static void trace_publish(tx_system* s, const instance* in, const port* pt) {
+  tx_snapshot snap = tx_model_latest(s->model, pt->comp);
+  const tx_component_def* def = tx_model_def(s->model, pt->comp);
+  uint64_t h = tx_hash(TX_HASH_SEED, snap.data, (size_t)snap.rows * def->cols * tx_type_size(def->type));
+  uint64_t stamp[3] = {(uint64_t)snap.sim_ns, snap.seq, h};
+  s->trace_hash = tx_hash(s->trace_hash, stamp, sizeof stamp);
+  if (s->trace)
+    fprintf(s->trace, "%" PRId64 ",%s,%s,%" PRIu64 ",%u,%016" PRIx64 "\n", snap.sim_ns, in->name, pt->name, snap.seq,
+            snap.rows, h);
+}
+
+// the swap-buffer step: publish every component the instance wrote
+static void publish_written(tx_system* s, instance* in, int64_t sim_ns) {
+  for (int p = 0; p < in->nports; p++) {
+    port* pt = &in->ports[p];
+    if (!pt->dirty) continue;
+    pt->dirty = false;
+    tx_model_publish(s->model, pt->comp, sim_ns);
+    if (s->tracing) trace_publish(s, in, pt);
+  }
+}
+
+int64_t tx_instance_step(tx_system* s, instance* in, int64_t sim_ns) {
+  int64_t t0 = tx_mono_ns();
+  in->ctx.sim_ns = sim_ns;
+  in->ctx.step = in->steps;
+  in->cls->step(&in->ctx, in->self);
+  publish_written(s, in, sim_ns);
+  in->steps++;
+  return tx_mono_ns() - t0;
+}
+
+int tx_instance_init(tx_system* s, instance* in, char* err, size_t n) {
+  in->ctx.sim_ns = 0;
+  in->ctx.step = 0;
+  if (!in->cls->init) return 0;
+  if (in->cls->init(&in->ctx, in->self) != 0) return snprintf(err, n, "controller '%s' failed to initialise", in->name), -1;
+  publish_written(s, in, 0); // what init wrote is the first publish, at time 0
+  return 0;
+}

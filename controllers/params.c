@@ -1,0 +1,149 @@
+// Configure-time API: parameters, declared ports and warnings of one instance.
+// Errors are sticky: the first one is kept and later calls return defaults.
+#include "system_internal.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+const char* tx_setup_name(const tx_setup* s) { return s->in->name; }
+double tx_setup_rate(const tx_setup* s) { return s->in->rate_hz; }
+
+static int vfail(tx_setup* s, const char* key, const char* fmt, va_list ap) {
+  instance* in = s->in;
+  if (in->failed) return -1;
+  in->failed = true;
+  snprintf(in->fault.key, sizeof in->fault.key, "%s%s", key ? "params." : "", key ? key : "");
+  vsnprintf(in->fault.message, sizeof in->fault.message, fmt, ap);
+  return -1;
+}
+
+int tx_setup_fail(tx_setup* s, const char* key, const char* fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  vfail(s, key, fmt, ap);
+  va_end(ap);
+  return -1;
+}
+
+// the value of params.KEY, marked as used; NULL when absent or after an error
+static json_t* param(tx_setup* s, const char* key) {
+  if (s->in->failed || !key) return NULL;
+  json_object_set_new(s->in->used, key, json_true());
+  return s->in->params ? json_object_get(s->in->params, key) : NULL;
+}
+
+static const char* json_kind(const json_t* v) {
+  switch (json_typeof(v)) {
+  case JSON_OBJECT: return "an object";
+  case JSON_ARRAY: return "an array";
+  case JSON_STRING: return "a string";
+  case JSON_INTEGER: case JSON_REAL: return "a number";
+  case JSON_TRUE: case JSON_FALSE: return "a boolean";
+  case JSON_NULL: return "null";
+  }
+  return "?";
+}
+
+double tx_param_num(tx_setup* s, const char* key, double def, double min, double max) {
+  json_t* v = param(s, key);
+  if (!v) return def;
+  if (!json_is_number(v)) return tx_setup_fail(s, key, "expected a number, got %s", json_kind(v)), def;
+  double x = json_number_value(v);
+  if (!isfinite(x) || x < min || x > max)
+    return tx_setup_fail(s, key, "%g is out of range [%g, %g]", x, min, max), def;
+  return x;
+}
+
+int64_t tx_param_int(tx_setup* s, const char* key, int64_t def, int64_t min, int64_t max) {
+  json_t* v = param(s, key);
+  if (!v) return def;
+  if (!json_is_integer(v)) return tx_setup_fail(s, key, "expected an integer, got %s", json_kind(v)), def;
+  int64_t x = json_integer_value(v);
+  if (x < min || x > max)
+    return tx_setup_fail(s, key, "%lld is out of range [%lld, %lld]", (long long)x, (long long)min, (long long)max), def;
+  return x;
+}
+
+bool tx_param_bool(tx_setup* s, const char* key, bool def) {
+  json_t* v = param(s, key);
+  if (!v) return def;
+  if (!json_is_boolean(v)) return tx_setup_fail(s, key, "expected true or false, got %s", json_kind(v)), def;
+  return json_is_true(v);
+}
+
+// keep a copy alive until fini, whatever happens to params
+static const char* keep(tx_setup* s, const char* str) {
+  json_t* copy = json_string(str);
+  if (!copy || json_array_append_new(s->in->strings, copy)) return NULL;
+  return json_string_value(copy);
+}
+
+const char* tx_param_str(tx_setup* s, const char* key, const char* def) {
+  json_t* v = param(s, key);
+  if (!v) return def;
+  if (!json_is_string(v)) return tx_setup_fail(s, key, "expected a string, got %s", json_kind(v)), def;
+  return keep(s, json_string_value(v));
+}
+
+int tx_param_strs(tx_setup* s, const char* key, const char** out, int max) {
+  json_t* v = param(s, key);
+  if (!v) return 0;
+  if (!json_is_array(v)) return tx_setup_fail(s, key, "expected an array of strings, got %s", json_kind(v)), 0;
+  if ((int)json_array_size(v) > max)
+    return tx_setup_fail(s, key, "%zu entries, at most %d allowed", json_array_size(v), max), 0;
+  size_t i;
+  json_t* e;
+  json_array_foreach(v, i, e) {
+    if (!json_is_string(e)) return tx_setup_fail(s, key, "entry %zu: expected a string, got %s", i, json_kind(e)), 0;
+    out[i] = keep(s, json_string_value(e));
+  }
+  return (int)json_array_size(v);
+}
+
+static port* new_port(tx_setup* s, const char* name, bool write) {
+  instance* in = s->in;
+  if (in->failed) return NULL;
+  if (!name || !*name || strlen(name) >= TX_NAME_MAX)
+    return tx_setup_fail(s, NULL, "component name '%s' is empty or too long", name ? name : ""), NULL;
+  for (int i = 0; i < in->nports; i++)
+    if (strcmp(in->ports[i].name, name) == 0)
+      return tx_setup_fail(s, NULL, "component '%s' is declared twice by this controller", name), NULL;
+  if (in->nports == TX_PORTS_MAX) return tx_setup_fail(s, NULL, "more than %d reads and writes", TX_PORTS_MAX), NULL;
+  port* p = &in->ports[in->nports++];
+  *p = (port){.write = write};
+  strcpy(p->name, name);
+  return p;
+}
+
+tx_port tx_setup_write(tx_setup* s, const tx_component_def* def) {
+  if (!def) return tx_setup_fail(s, NULL, "write without a component definition"), (tx_port){0};
+  port* p = new_port(s, def->name, true);
+  if (!p) return (tx_port){0};
+  const char* units = def->units ? def->units : "1";
+  if (strlen(units) >= TX_UNITS_MAX) return tx_setup_fail(s, NULL, "%s: units '%s' too long", def->name, units), (tx_port){0};
+  strcpy(p->units, units);
+  p->def = *def;
+  p->def.name = p->name;
+  p->def.units = p->units;
+  return (tx_port){(uint16_t)s->in->nports};
+}
+
+tx_port tx_setup_read(tx_setup* s, const char* component) {
+  port* p = new_port(s, component, false);
+  return p ? (tx_port){(uint16_t)s->in->nports} : (tx_port){0};
+}
+
+tx_warning tx_setup_warning(tx_setup* s, const char* key) {
+  tx_system* sys = s->sys;
+  char full[TX_WARNING_KEY_MAX];
+  if (!key || snprintf(full, sizeof full, "%s.%s", s->in->name, key) >= (int)sizeof full)
+    return tx_setup_fail(s, NULL, "warning key is missing or too long"), (tx_warning){0};
+  for (int i = 0; i < sys->nwarnings; i++)
+    if (strcmp(sys->warning_keys[i], full) == 0) return (tx_warning){(uint16_t)(i + 1)};
+  if (sys->nwarnings == TX_WARNINGS_MAX) return tx_setup_fail(s, NULL, "more than %d warning keys", TX_WARNINGS_MAX), (tx_warning){0};
+  strcpy(sys->warning_keys[sys->nwarnings], full);
+  atomic_init(&sys->warning_counts[sys->nwarnings], 0);
+  return (tx_warning){(uint16_t)++sys->nwarnings};
+}

@@ -1,0 +1,193 @@
+// Real-time executor: one thread per rate group, absolute deadlines.
+//
+// Tick k of a group starts at t0 + k/rate (clock_nanosleep, TIMER_ABSTIME), so
+// errors never accumulate. A step that ends after the next tick's start is a
+// missed deadline; a group that falls a whole period behind skips the ticks it
+// missed, and each skipped tick counts as missed too. Threads ask for
+// SCHED_FIFO by rate (faster = higher priority) and a CPU each, round-robin,
+// fastest on the last CPU; where either is refused they run without it and
+// the result says so.
+#include "system_internal.h"
+
+#include <errno.h>
+#include <pthread.h>
+#include <sched.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+// the start line: workers report their init done, then wait for t0
+typedef struct gate {
+  pthread_mutex_t mutex;
+  pthread_cond_t cond;
+  int ready;   // workers that finished init
+  bool open;   // t0 and end are set
+  int64_t t0;  // release of tick 0, monotonic ns
+  int64_t end; // no release at or after this
+} gate;
+
+typedef struct worker {
+  tx_system* sys;
+  int group;
+  gate* gate;
+  _Atomic bool* stop;
+  int cpu;        // -1: no pinning
+  int priority;   // SCHED_FIFO priority, 0: none
+  int fifo_error; // errno of the refusal, 0 if granted
+  int pin_error;
+  int init_rc;
+  char init_err[256];
+} worker;
+
+static void sleep_until(int64_t ns) {
+  struct timespec ts = {ns / 1000000000, ns % 1000000000};
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) == EINTR) {}
+}
+
+static void apply_scheduling(worker* w) {
+  if (w->priority > 0) {
+    struct sched_param sp = {.sched_priority = w->priority};
+    w->fifo_error = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
+  }
+  if (w->cpu >= 0) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(w->cpu, &set);
+    w->pin_error = pthread_setaffinity_np(pthread_self(), sizeof set, &set);
+  }
+}
+
+static void* worker_main(void* arg) {
+  worker* w = arg;
+  tx_system* s = w->sys;
+  group* g = &s->groups[w->group];
+  char tname[16];
+  snprintf(tname, sizeof tname, "tx-%.0fHz", g->rate_hz);
+  pthread_setname_np(pthread_self(), tname);
+  apply_scheduling(w);
+  for (int m = 0; m < g->count && w->init_rc == 0; m++)
+    w->init_rc = tx_instance_init(s, s->inst[g->members[m]], w->init_err, sizeof w->init_err);
+  pthread_mutex_lock(&w->gate->mutex);
+  w->gate->ready++;
+  pthread_cond_broadcast(&w->gate->cond);
+  while (!w->gate->open) pthread_cond_wait(&w->gate->cond, &w->gate->mutex);
+  const int64_t t0 = w->gate->t0, end = w->gate->end;
+  pthread_mutex_unlock(&w->gate->mutex);
+
+  int64_t prev_start = 0;
+  uint64_t prev_k = 0;
+  for (uint64_t k = 0; !atomic_load_explicit(w->stop, memory_order_relaxed);) {
+    int64_t release = t0 + tx_tick_ns(g->rate_hz, k);
+    if (release >= end) break;
+    sleep_until(release);
+    int64_t start = tx_mono_ns();
+    int64_t expected = tx_tick_ns(g->rate_hz, k) - tx_tick_ns(g->rate_hz, prev_k);
+    int64_t jitter = start - prev_start - expected;
+    for (int m = 0; m < g->count; m++) {
+      instance* in = s->inst[g->members[m]];
+      if (in->steps == 0) in->first_start_ns = start;
+      else tx_samples_add(&in->jitter, jitter < 0 ? -jitter : jitter);
+      in->last_start_ns = start;
+      tx_samples_add(&in->step_time, tx_instance_step(s, in, release - t0));
+    }
+    prev_start = start;
+    prev_k = k;
+    // deadline: the next tick's release; skip ticks that are already gone
+    int64_t done = tx_mono_ns();
+    uint64_t next = k + 1;
+    while (t0 + tx_tick_ns(g->rate_hz, next) < done) next++;
+    uint64_t missed = (done > t0 + tx_tick_ns(g->rate_hz, k + 1)) + (next - (k + 1));
+    for (int m = 0; m < g->count && missed; m++) s->inst[g->members[m]]->missed += missed;
+    k = next;
+  }
+  return NULL;
+}
+
+static int usable_cpus(int* cpus, int max) {
+  cpu_set_t set;
+  int n = 0;
+  if (sched_getaffinity(0, sizeof set, &set) != 0) return 0;
+  for (int c = 0; c < CPU_SETSIZE && n < max; c++)
+    if (CPU_ISSET(c, &set)) cpus[n++] = c;
+  return n;
+}
+
+static void describe_scheduling(const worker* w, int n, tx_run_result* r) {
+  int fifo_err = 0, pin_err = 0, fifo_asked = 0, pin_asked = 0;
+  for (int i = 0; i < n; i++) {
+    fifo_asked += w[i].priority > 0;
+    pin_asked += w[i].cpu >= 0;
+    if (w[i].priority > 0 && w[i].fifo_error) fifo_err = w[i].fifo_error;
+    if (w[i].cpu >= 0 && w[i].pin_error) pin_err = w[i].pin_error;
+  }
+  r->fifo = fifo_asked && !fifo_err;
+  r->pinned = pin_asked && !pin_err;
+  char fifo[96], pin[96];
+  if (!fifo_asked) snprintf(fifo, sizeof fifo, "SCHED_OTHER (SCHED_FIFO not asked for)");
+  else if (fifo_err) snprintf(fifo, sizeof fifo, "SCHED_OTHER (SCHED_FIFO refused: %s)", strerror(fifo_err));
+  else snprintf(fifo, sizeof fifo, "SCHED_FIFO, priority by rate");
+  if (!pin_asked) snprintf(pin, sizeof pin, "not pinned");
+  else if (pin_err) snprintf(pin, sizeof pin, "not pinned (refused: %s)", strerror(pin_err));
+  else snprintf(pin, sizeof pin, "pinned round-robin");
+  snprintf(r->scheduler, sizeof r->scheduler, "%d threads; %s; %s", n, fifo, pin);
+}
+
+int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r, char* err, size_t n) {
+  const int ng = s->ngroups;
+  worker* w = calloc(ng, sizeof *w);
+  pthread_t* th = calloc(ng, sizeof *th);
+  if (!w || !th) {
+    free(w), free(th);
+    return snprintf(err, n, "out of memory"), -1;
+  }
+  gate gt = {.mutex = PTHREAD_MUTEX_INITIALIZER, .cond = PTHREAD_COND_INITIALIZER};
+  _Atomic bool stop = false;
+  int cpus[CPU_SETSIZE];
+  int ncpu = o->pin_threads ? usable_cpus(cpus, CPU_SETSIZE) : 0;
+  int prio_max = sched_get_priority_max(SCHED_FIFO), prio_min = sched_get_priority_min(SCHED_FIFO);
+
+  int rc = 0, started = 0;
+  for (int g = 0; g < ng; g++) {
+    int prio = prio_max - 10 - 2 * g; // leave the top for the kernel's own threads
+    w[g] = (worker){.sys = s, .group = g, .gate = &gt, .stop = &stop,
+                    .cpu = ncpu > 0 ? cpus[(ncpu - 1) - (g % ncpu)] : -1,
+                    .priority = o->realtime_priority ? (prio < prio_min ? prio_min : prio) : 0};
+    if (pthread_create(&th[g], NULL, worker_main, &w[g]) != 0) {
+      rc = -1;
+      snprintf(err, n, "could not start thread %d of %d", g + 1, ng);
+      break;
+    }
+    started++;
+  }
+
+  // wait for every init, then open the gate with a common t0
+  pthread_mutex_lock(&gt.mutex);
+  while (gt.ready < started) pthread_cond_wait(&gt.cond, &gt.mutex);
+  for (int g = 0; g < started && rc == 0; g++)
+    if (w[g].init_rc) rc = -1, snprintf(err, n, "%s", w[g].init_err);
+  if (rc) atomic_store(&stop, true);
+  gt.t0 = tx_mono_ns() + 2000000; // every first release lies in the future
+  gt.end = gt.t0 + (int64_t)(o->duration_s * 1e9);
+  gt.open = true;
+  pthread_cond_broadcast(&gt.cond);
+  pthread_mutex_unlock(&gt.mutex);
+
+  while (rc == 0 && !atomic_load(&stop)) {
+    int64_t now = tx_mono_ns();
+    if (now >= gt.end) break;
+    sleep_until(now + 100000000 < gt.end ? now + 100000000 : gt.end);
+    if (o->progress && !o->progress((double)(tx_mono_ns() - gt.t0) * 1e-9, o->progress_user)) {
+      r->stopped_early = true;
+      atomic_store(&stop, true);
+    }
+  }
+  for (int g = 0; g < started; g++) pthread_join(th[g], NULL);
+  int64_t finish = tx_mono_ns();
+  r->duration_s = (double)((finish < gt.end ? finish : gt.end) - gt.t0) * 1e-9;
+  describe_scheduling(w, started, r);
+  free(w);
+  free(th);
+  return rc;
+}

@@ -1,0 +1,281 @@
+// A controller system: instances of one scenario, checked and wired to a model.
+#include "system_internal.h"
+
+#include "../model/error.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int fault(tx_fault* f, const char* key, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
+static int fault(tx_fault* f, const char* key, const char* fmt, ...) {
+  if (!f) return -1;
+  snprintf(f->key, sizeof f->key, "%s", key ? key : "");
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(f->message, sizeof f->message, fmt, ap);
+  va_end(ap);
+  return -1;
+}
+
+tx_system* tx_system_create(void) { return calloc(1, sizeof(tx_system)); }
+
+void tx_system_destroy(tx_system* s) {
+  if (!s) return;
+  for (int i = 0; i < s->count; i++) {
+    instance* in = s->inst[i];
+    if (in->configured && in->cls->fini) in->cls->fini(in->self);
+    json_decref(in->params);
+    json_decref(in->used);
+    json_decref(in->strings);
+    tx_samples_free(&in->jitter);
+    tx_samples_free(&in->step_time);
+    free(in);
+  }
+  for (int g = 0; g < s->ngroups; g++) free(s->groups[g].members);
+  free(s->groups);
+  free(s->inst);
+  free(s->declared);
+  free(s->declared_names);
+  free(s->declared_units);
+  tx_model_destroy(s->model);
+  free(s);
+}
+
+static const tx_component_def* declared(const tx_system* s, const char* name) {
+  for (int i = 0; i < s->ndeclared; i++)
+    if (strcmp(s->declared[i].name, name) == 0) return &s->declared[i];
+  return NULL;
+}
+
+int tx_system_declare(tx_system* s, const tx_component_def* def, tx_fault* f) {
+  if (!def->name || !*def->name || strlen(def->name) >= TX_NAME_MAX) return fault(f, "name", "empty or too long");
+  if (declared(s, def->name)) return fault(f, "name", "component '%s' is declared twice", def->name);
+  const char* units = def->units ? def->units : "1";
+  if (strlen(units) >= TX_UNITS_MAX) return fault(f, "units", "'%s' is too long", units);
+  int n = s->ndeclared + 1;
+  tx_component_def* d = realloc(s->declared, n * sizeof *d);
+  if (d) s->declared = d;
+  char(*names)[TX_NAME_MAX] = realloc(s->declared_names, n * sizeof *names);
+  if (names) s->declared_names = names;
+  char(*units_)[TX_UNITS_MAX] = realloc(s->declared_units, n * sizeof *units_);
+  if (units_) s->declared_units = units_;
+  if (!d || !names || !units_) return fault(f, "", "out of memory");
+  strcpy(s->declared_names[s->ndeclared], def->name);
+  strcpy(s->declared_units[s->ndeclared], units);
+  s->ndeclared = n;
+  // names and units are re-pointed in finalize, after the last realloc
+  s->declared[n - 1] = *def;
+  return 0;
+}
+
+static bool valid_instance_name(const char* s) {
+  if (!s || !*s || strlen(s) >= TX_NAME_MAX) return false;
+  for (; *s; s++)
+    if (!((*s >= 'a' && *s <= 'z') || (*s >= '0' && *s <= '9') || *s == '_' || *s == '-')) return false;
+  return true;
+}
+
+int tx_system_add(tx_system* s, const char* name, const char* type, double rate_hz, json_t* params, tx_fault* f) {
+  if (!valid_instance_name(name)) return fault(f, "name", "'%s' must be 1-%d characters of a-z 0-9 _ -", name ? name : "", TX_NAME_MAX - 1);
+  for (int i = 0; i < s->count; i++)
+    if (strcmp(s->inst[i]->name, name) == 0) return fault(f, "name", "a controller named '%s' already exists", name);
+  const tx_controller_class* cls = tx_find_controller(type);
+  if (!cls) return fault(f, "type", "unknown controller type '%s'", type ? type : "");
+  if (!(rate_hz > 0 && rate_hz <= TX_RATE_MAX_HZ))
+    return fault(f, "rate_hz", "%g Hz is out of range (0, %g]", rate_hz, TX_RATE_MAX_HZ);
+  if (params && !json_is_object(params)) return fault(f, "params", "expected an object");
+
+  instance** grown = realloc(s->inst, (s->count + 1) * sizeof *grown);
+  if (!grown) return fault(f, "", "out of memory");
+  s->inst = grown;
+  instance* in = calloc(1, sizeof *in);
+  if (!in) return fault(f, "", "out of memory");
+  s->inst[s->count++] = in;
+  strcpy(in->name, name);
+  in->cls = cls;
+  in->rate_hz = rate_hz;
+  in->params = json_incref(params);
+  in->used = json_object();
+  in->strings = json_array();
+  in->setup = (tx_setup){s, in};
+  in->ctx = (tx_ctx){s, in, 0, 0};
+  if (!in->used || !in->strings) return fault(f, "", "out of memory");
+
+  int rc = cls->configure(&in->setup, &in->self);
+  in->configured = true; // fini frees whatever configure made, even on failure
+  if (in->failed) return *f = in->fault, -1;
+  if (rc != 0) return fault(f, "", "controller '%s' (%s) failed to configure", name, type);
+  // every parameter in the scenario must be one configure asked for
+  const char* key;
+  json_t* value;
+  if (params) json_object_foreach(params, key, value) {
+    if (json_object_get(in->used, key)) continue;
+    char known[256] = "";
+    const char* k;
+    json_t* v;
+    json_object_foreach(in->used, k, v) {
+      size_t len = strlen(known);
+      snprintf(known + len, sizeof known - len, "%s%s", len ? ", " : "", k);
+    }
+    char where[128];
+    snprintf(where, sizeof where, "params.%s", key);
+    return fault(f, where, "unknown parameter for %s (known: %s)", type, *known ? known : "none");
+  }
+  return 0;
+}
+
+static const tx_component_def* writer_def(const tx_system* s, const char* name, int* writer) {
+  for (int i = 0; i < s->count; i++)
+    for (int p = 0; p < s->inst[i]->nports; p++)
+      if (s->inst[i]->ports[p].write && strcmp(s->inst[i]->ports[p].name, name) == 0) {
+        if (writer) *writer = i;
+        return &s->inst[i]->ports[p].def;
+      }
+  return NULL;
+}
+
+static bool same_schema(const tx_component_def* a, const tx_component_def* b) {
+  return a->type == b->type && a->rows == b->rows && a->cols == b->cols && strcmp(a->units, b->units) == 0;
+}
+
+static int cmp_rate_desc(const void* a, const void* b) {
+  double x = ((const group*)a)->rate_hz, y = ((const group*)b)->rate_hz;
+  return (x < y) - (x > y);
+}
+
+static int build_groups(tx_system* s) {
+  s->groups = calloc(s->count ? s->count : 1, sizeof *s->groups);
+  if (!s->groups) return -1;
+  for (int i = 0; i < s->count; i++) {
+    int g = 0;
+    while (g < s->ngroups && s->groups[g].rate_hz != s->inst[i]->rate_hz) g++;
+    if (g == s->ngroups) s->groups[s->ngroups++].rate_hz = s->inst[i]->rate_hz;
+  }
+  qsort(s->groups, s->ngroups, sizeof *s->groups, cmp_rate_desc);
+  for (int g = 0; g < s->ngroups; g++) {
+    s->groups[g].members = malloc(s->count * sizeof(int));
+    if (!s->groups[g].members) return -1;
+    for (int i = 0; i < s->count; i++)
+      if (s->inst[i]->rate_hz == s->groups[g].rate_hz) {
+        s->groups[g].members[s->groups[g].count++] = i;
+        s->inst[i]->group = g;
+      }
+  }
+  return 0;
+}
+
+int tx_system_finalize(tx_system* s, tx_fault* f) {
+  if (s->model) return 0;
+  if (s->count == 0) return fault(f, "", "no controllers");
+  for (int d = 0; d < s->ndeclared; d++) {
+    s->declared[d].name = s->declared_names[d];
+    s->declared[d].units = s->declared_units[d];
+  }
+  // one writer per component, matching any declared schema
+  for (int i = 0; i < s->count; i++) {
+    instance* in = s->inst[i];
+    for (int p = 0; p < in->nports; p++) {
+      if (!in->ports[p].write) continue;
+      int w = -1;
+      writer_def(s, in->ports[p].name, &w);
+      if (w != i)
+        return fault(f, in->name, "'%s' has two writers: %s and %s", in->ports[p].name, s->inst[w]->name, in->name);
+      const tx_component_def* d = declared(s, in->ports[p].name);
+      if (d && !same_schema(d, &in->ports[p].def))
+        return fault(f, in->name, "writes '%s' as %s %ux%u %s, but the model declares %s %ux%u %s", d->name,
+                     tx_type_name(in->ports[p].def.type), in->ports[p].def.rows, in->ports[p].def.cols,
+                     in->ports[p].def.units, tx_type_name(d->type), d->rows, d->cols, d->units);
+    }
+  }
+  // every read has a writer
+  for (int i = 0; i < s->count; i++) {
+    instance* in = s->inst[i];
+    for (int p = 0; p < in->nports; p++) {
+      const char* name = in->ports[p].name;
+      if (in->ports[p].write || writer_def(s, name, NULL)) continue;
+      if (declared(s, name)) return fault(f, in->name, "reads '%s', which no controller writes", name);
+      return fault(f, in->name, "reads unknown component '%s'", name);
+    }
+  }
+  // declared components need a writer too, or nothing could ever fill them
+  for (int d = 0; d < s->ndeclared; d++)
+    if (!writer_def(s, s->declared[d].name, NULL))
+      return fault(f, "", "model component '%s' has no writer", s->declared[d].name);
+
+  s->model = tx_model_create();
+  if (!s->model) return fault(f, "", "out of memory");
+  for (int i = 0; i < s->count; i++)
+    for (int p = 0; p < s->inst[i]->nports; p++) {
+      port* pt = &s->inst[i]->ports[p];
+      if (!pt->write) continue;
+      pt->comp = tx_model_add(s->model, &pt->def);
+      if (!pt->comp.id) return fault(f, s->inst[i]->name, "%s", tx_error());
+    }
+  for (int i = 0; i < s->count; i++)
+    for (int p = 0; p < s->inst[i]->nports; p++) {
+      port* pt = &s->inst[i]->ports[p];
+      if (pt->write) continue;
+      pt->comp = tx_model_find(s->model, pt->name);
+      pt->reader = tx_model_add_reader(s->model, pt->comp);
+      if (!pt->reader.id) return fault(f, s->inst[i]->name, "%s", tx_error());
+    }
+  if (!tx_model_commit(s->model)) return fault(f, "", "%s", tx_error());
+  if (build_groups(s)) return fault(f, "", "out of memory");
+  return 0;
+}
+
+int64_t tx_tick_ns(double rate_hz, uint64_t k) { return (int64_t)llround((double)k * 1e9 / rate_hz); }
+
+bool tx_system_prepare_stats(tx_system* s, double duration_s) {
+  for (int i = 0; i < s->count; i++) {
+    instance* in = s->inst[i];
+    double want = ceil(duration_s * in->rate_hz) + 8;
+    uint64_t cap = want > (double)(1u << 22) ? (1u << 22) : (uint64_t)want;
+    tx_samples_free(&in->jitter);
+    tx_samples_free(&in->step_time);
+    if (!tx_samples_init(&in->jitter, cap) || !tx_samples_init(&in->step_time, cap)) return false;
+    in->steps = in->missed = 0;
+    in->first_start_ns = in->last_start_ns = 0;
+  }
+  for (int w = 0; w < s->nwarnings; w++) atomic_store(&s->warning_counts[w], 0);
+  return true;
+}
+
+int tx_system_run(tx_system* s, const tx_run_options* o, tx_run_result* r, char* err, size_t n) {
+  *r = (tx_run_result){0};
+  if (!s->model) return snprintf(err, n, "the system is not finalized"), -1;
+  if (!(o->duration_s > 0 && o->duration_s <= 86400)) return snprintf(err, n, "duration %g s is out of range (0, 86400]", o->duration_s), -1;
+  if (!tx_system_prepare_stats(s, o->duration_s)) return snprintf(err, n, "out of memory for statistics"), -1;
+  return o->lockstep ? tx_run_lockstep(s, o, r, err, n) : tx_run_realtime(s, o, r, err, n);
+}
+
+int tx_system_count(const tx_system* s) { return s->count; }
+const char* tx_system_name(const tx_system* s, int i) { return s->inst[i]->name; }
+const tx_controller_class* tx_system_class(const tx_system* s, int i) { return s->inst[i]->cls; }
+double tx_system_rate(const tx_system* s, int i) { return s->inst[i]->rate_hz; }
+int tx_system_thread(const tx_system* s, int i) { return s->inst[i]->group; }
+int tx_system_threads(const tx_system* s) { return s->ngroups; }
+int tx_system_ports(const tx_system* s, int i) { return s->inst[i]->nports; }
+tx_model* tx_system_model(tx_system* s) { return s->model; }
+int tx_system_warnings(const tx_system* s) { return s->nwarnings; }
+const char* tx_system_warning_key(const tx_system* s, int w) { return s->warning_keys[w]; }
+uint64_t tx_system_warning_count(const tx_system* s, int w) {
+  return atomic_load(&((tx_system*)s)->warning_counts[w]);
+}
+
+tx_port_info tx_system_port(const tx_system* s, int i, int p) {
+  const port* pt = &s->inst[i]->ports[p];
+  const tx_component_def* def = pt->comp.id ? tx_model_def(s->model, pt->comp) : NULL;
+  return (tx_port_info){pt->write, pt->name, def};
+}
+
+tx_controller_stats tx_system_stats(const tx_system* s, int i) {
+  const instance* in = s->inst[i];
+  tx_controller_stats st = {in->steps, in->missed, 0, tx_samples_percentiles(&in->jitter),
+                            tx_samples_percentiles(&in->step_time)};
+  int64_t span = in->last_start_ns - in->first_start_ns;
+  if (in->steps > 1 && span > 0) st.achieved_hz = (double)(in->steps - 1) * 1e9 / (double)span;
+  return st;
+}

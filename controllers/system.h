@@ -1,0 +1,90 @@
+// Internal: a controller system, the instances of one scenario over one model.
+//
+// The loader adds instances (each is configured at once), finalize resolves
+// reads and builds the model, run executes them in real time or lockstep,
+// and the report reads the statistics back.
+#ifndef TX_CONTROLLERS_SYSTEM_H
+#define TX_CONTROLLERS_SYSTEM_H
+
+#include "stats.h"
+
+#include <tactus/controller.h>
+
+#include <jansson.h>
+#include <stdatomic.h>
+#include <stdio.h>
+
+#define TX_WARNINGS_MAX 256
+#define TX_WARNING_KEY_MAX (2 * TX_NAME_MAX)
+
+typedef struct tx_system tx_system;
+
+// where a configuration error is: a key relative to the instance
+// ("params.work_us", "rate_hz", "" for the instance as a whole) and a message
+typedef struct tx_fault {
+  char key[128];
+  char message[400];
+} tx_fault;
+
+typedef struct tx_port_info {
+  bool write;
+  const char* component;          // name
+  const tx_component_def* def;    // schema, after finalize
+} tx_port_info;
+
+typedef struct tx_controller_stats {
+  uint64_t steps;      // steps run
+  uint64_t missed;     // deadlines missed, skipped ticks included
+  double achieved_hz;  // (steps - 1) / (last start - first start)
+  tx_percentiles jitter_ns; // |actual period - nominal period|
+  tx_percentiles step_ns;   // step time, publishes included
+} tx_controller_stats;
+
+typedef struct tx_run_options {
+  double duration_s;   // > 0
+  bool lockstep;       // one thread, virtual clock
+  FILE* trace;         // lockstep: one line per publish, or NULL
+  bool realtime_priority; // try SCHED_FIFO
+  bool pin_threads;       // try CPU pinning
+  // called about every 100 ms from the main thread; returning false stops the run
+  bool (*progress)(double elapsed_s, void* user);
+  void* progress_user;
+} tx_run_options;
+
+typedef struct tx_run_result {
+  double duration_s;      // simulated (lockstep) or measured (real time)
+  uint64_t trace_hash;    // lockstep: FNV-1a of every publish, in order
+  bool stopped_early;     // progress returned false
+  char scheduler[256];    // how the threads were scheduled, and any fallback
+  bool fifo;              // SCHED_FIFO was in effect on every thread
+  bool pinned;            // every thread was pinned
+} tx_run_result;
+
+tx_system* tx_system_create(void);
+void tx_system_destroy(tx_system* s); // runs fini for configured instances
+
+// a component that no controller creates itself (from the scenario's "model")
+int tx_system_declare(tx_system* s, const tx_component_def* def, tx_fault* f);
+// add and configure one instance; params is borrowed and may be NULL
+int tx_system_add(tx_system* s, const char* name, const char* type, double rate_hz, json_t* params, tx_fault* f);
+// resolve reads, check writers, build and commit the model; f->key names the instance
+int tx_system_finalize(tx_system* s, tx_fault* f);
+// run; on failure (an init failed) returns -1 with a message in err
+int tx_system_run(tx_system* s, const tx_run_options* o, tx_run_result* r, char* err, size_t n);
+
+// introspection, valid after finalize
+int tx_system_count(const tx_system* s);
+const char* tx_system_name(const tx_system* s, int i);
+const tx_controller_class* tx_system_class(const tx_system* s, int i);
+double tx_system_rate(const tx_system* s, int i);
+int tx_system_thread(const tx_system* s, int i); // rate group, 0 = fastest
+int tx_system_threads(const tx_system* s);
+int tx_system_ports(const tx_system* s, int i);
+tx_port_info tx_system_port(const tx_system* s, int i, int p);
+tx_controller_stats tx_system_stats(const tx_system* s, int i);
+tx_model* tx_system_model(tx_system* s);
+int tx_system_warnings(const tx_system* s);
+const char* tx_system_warning_key(const tx_system* s, int w);
+uint64_t tx_system_warning_count(const tx_system* s, int w);
+
+#endif

@@ -1,0 +1,92 @@
+// Internal: the structures behind tx_system, shared by the executors.
+#ifndef TX_CONTROLLERS_SYSTEM_INTERNAL_H
+#define TX_CONTROLLERS_SYSTEM_INTERNAL_H
+
+#include "system.h"
+
+#include <stdatomic.h>
+
+#define TX_PORTS_MAX 64
+
+typedef struct port {
+  bool write;
+  char name[TX_NAME_MAX];
+  char units[TX_UNITS_MAX];
+  tx_component_def def; // writes: the declared schema (name, units point above)
+  tx_comp comp;         // after finalize
+  tx_reader reader;     // reads: this instance's hazard slot
+  bool dirty;           // written during the current step
+} port;
+
+typedef struct instance instance;
+
+struct tx_setup {
+  tx_system* sys;
+  instance* in;
+};
+
+struct tx_ctx {
+  tx_system* sys;
+  instance* in;
+  int64_t sim_ns;  // of the current step
+  uint64_t step;   // index of the current step
+};
+
+struct instance {
+  char name[TX_NAME_MAX];
+  const tx_controller_class* cls;
+  double rate_hz;
+  json_t* params;      // own reference, may be NULL
+  json_t* used;        // keys configure asked for
+  json_t* strings;     // keeps tx_param_str* results alive
+  tx_fault fault;      // first configuration error
+  bool failed;
+  void* self;
+  bool configured;
+  port ports[TX_PORTS_MAX];
+  int nports;
+  int group;
+  tx_setup setup;
+  tx_ctx ctx;
+  tx_samples jitter, step_time;
+  uint64_t steps, missed;
+  int64_t first_start_ns, last_start_ns;
+};
+
+typedef struct group {
+  double rate_hz;
+  int* members; // instance indices, in scenario order
+  int count;
+} group;
+
+struct tx_system {
+  instance** inst;
+  int count;
+  tx_component_def* declared; // from the scenario's "model"
+  char (*declared_names)[TX_NAME_MAX];
+  char (*declared_units)[TX_UNITS_MAX];
+  int ndeclared;
+  tx_model* model;
+  group* groups; // fastest first
+  int ngroups;
+  char warning_keys[TX_WARNINGS_MAX][TX_WARNING_KEY_MAX];
+  _Atomic uint64_t warning_counts[TX_WARNINGS_MAX];
+  int nwarnings;
+  bool tracing;        // lockstep: hash every publish
+  FILE* trace;         // and write it here, if not NULL
+  uint64_t trace_hash; // FNV-1a over every publish, in order
+};
+
+// nominal start of tick k of a group, ns from the run's start
+int64_t tx_tick_ns(double rate_hz, uint64_t k);
+// allocate the statistics of every instance for a run of this length
+bool tx_system_prepare_stats(tx_system* s, double duration_s);
+// run one instance's step at sim_ns and publish what it wrote; returns its duration
+int64_t tx_instance_step(tx_system* s, instance* in, int64_t sim_ns);
+// run init of one instance; 0 or -1 with err filled
+int tx_instance_init(tx_system* s, instance* in, char* err, size_t n);
+
+int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r, char* err, size_t n);
+int tx_run_lockstep(tx_system* s, const tx_run_options* o, tx_run_result* r, char* err, size_t n);
+
+#endif

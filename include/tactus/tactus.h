@@ -1,0 +1,15 @@
+// tactus/tactus.h: everything a controller or a plugin needs.
+//
+// tactus is an extended Model-View-Controller framework for haptic surgical
+// simulation. The model (tactus/model.h) is a set of double-buffered
+// components; controllers (tactus/controller.h) change it, each on a thread
+// at its own rate; views only read it. See docs/architecture.md.
+#ifndef TACTUS_H
+#define TACTUS_H
+
+#include <tactus/controller.h>
+#include <tactus/model.h>
+
+#define TX_VERSION "0.1.0"
+
+#endif

@@ -1,0 +1,265 @@
+// The shared model: components with one writer and hazard-slot buffers.
+//
+// Each component keeps readers + 2 buffers. `latest` names the newest publish.
+// A reader announces the buffer it is about to read in its hazard slot and
+// re-checks `latest`; the writer, after moving `latest` to its back buffer,
+// takes as its next back buffer one that is neither latest nor announced.
+// With sequentially consistent atomics this is the classic hazard-pointer
+// argument: a buffer is never written while a reader may read it.
+#include "error.h"
+
+#include <tactus/model.h>
+
+#include <ctype.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define NO_BUFFER UINT32_MAX
+#define CACHE_LINE 64
+
+typedef struct header { // at the start of every buffer
+  uint64_t seq;         // publish number
+  int64_t sim_ns;       // simulation time, ns
+  int64_t mono_ns;      // monotonic time, ns
+  uint32_t rows;        // rows in use
+} header;
+
+typedef struct hazard { // one per reader, alone on its cache line
+  _Alignas(CACHE_LINE) _Atomic uint32_t buffer;
+} hazard;
+
+typedef struct component {
+  tx_component_def def;          // name and units point into the strings below
+  char name[TX_NAME_MAX];
+  char units[TX_UNITS_MAX];
+  size_t bytes;                  // payload bytes at capacity
+  size_t stride;                 // bytes per buffer, header included
+  uint32_t readers;              // hazard slots
+  uint32_t buffers;              // readers + 2
+  unsigned char* memory;         // buffers x stride
+  hazard* hazards;               // readers
+  _Alignas(CACHE_LINE) _Atomic uint32_t latest;
+  _Alignas(CACHE_LINE) uint32_t back; // writer-private from here on
+  uint32_t next_rows;
+  uint64_t seq;
+} component;
+
+typedef struct reader_slot {
+  uint32_t comp;  // component index
+  uint32_t slot;  // hazard index within it
+} reader_slot;
+
+struct tx_model {
+  component** comps; // count
+  uint32_t count;
+  reader_slot* readers; // reader_count
+  uint32_t reader_count;
+  bool committed;
+};
+
+static size_t header_size(void) { return (sizeof(header) + CACHE_LINE - 1) / CACHE_LINE * CACHE_LINE; }
+
+size_t tx_type_size(tx_type t) {
+  switch (t) {
+  case TX_F32: case TX_I32: case TX_U32: return 4;
+  case TX_F64: return 8;
+  case TX_U8: return 1;
+  }
+  return 0;
+}
+
+static const char* const type_names[] = {NULL, "f32", "f64", "i32", "u32", "u8"};
+
+const char* tx_type_name(tx_type t) {
+  return (t >= TX_F32 && t <= TX_U8) ? type_names[t] : NULL;
+}
+
+tx_type tx_type_from_name(const char* name) {
+  for (int t = TX_F32; name && t <= TX_U8; t++)
+    if (strcmp(name, type_names[t]) == 0) return (tx_type)t;
+  return (tx_type)0;
+}
+
+static bool valid_name(const char* s) {
+  if (!s || !*s || strlen(s) >= TX_NAME_MAX) return false;
+  for (; *s; s++)
+    if (!(islower((unsigned char)*s) || isdigit((unsigned char)*s) || *s == '_' || *s == '.')) return false;
+  return true;
+}
+
+tx_model* tx_model_create(void) { return calloc(1, sizeof(tx_model)); }
+
+void tx_model_destroy(tx_model* m) {
+  if (!m) return;
+  for (uint32_t i = 0; i < m->count; i++) {
+    free(m->comps[i]->memory);
+    free(m->comps[i]->hazards);
+    free(m->comps[i]);
+  }
+  free(m->comps);
+  free(m->readers);
+  free(m);
+}
+
+static component* get(const tx_model* m, tx_comp c) {
+  return (m && c.id >= 1 && c.id <= m->count) ? m->comps[c.id - 1] : NULL;
+}
+
+tx_comp tx_model_find(const tx_model* m, const char* name) {
+  for (uint32_t i = 0; m && name && i < m->count; i++)
+    if (strcmp(m->comps[i]->name, name) == 0) return (tx_comp){i + 1};
+  return (tx_comp){0};
+}
+
+tx_comp tx_model_add(tx_model* m, const tx_component_def* def) {
+  const tx_comp none = {0};
+  if (!m || !def) return tx_set_error("no model or definition"), none;
+  if (m->committed) return tx_set_error("%s: the model is already committed", def->name ? def->name : "?"), none;
+  if (!valid_name(def->name))
+    return tx_set_error("component name '%s' must be 1-%d characters of a-z 0-9 _ .", def->name ? def->name : "",
+                        TX_NAME_MAX - 1), none;
+  if (tx_model_find(m, def->name).id) return tx_set_error("%s: component already exists", def->name), none;
+  if (!tx_type_size(def->type)) return tx_set_error("%s: unknown element type %d", def->name, (int)def->type), none;
+  if (def->rows == 0 || def->cols == 0) return tx_set_error("%s: rows and cols must be at least 1", def->name), none;
+  uint64_t bytes = (uint64_t)def->rows * def->cols * tx_type_size(def->type);
+  if (bytes > (1ull << 32)) return tx_set_error("%s: %llu bytes is larger than 4 GiB", def->name, (unsigned long long)bytes), none;
+  const char* units = def->units ? def->units : "1";
+  if (strlen(units) >= TX_UNITS_MAX) return tx_set_error("%s: units '%s' too long", def->name, units), none;
+
+  component** grown = realloc(m->comps, (m->count + 1) * sizeof *grown);
+  component* c = calloc(1, sizeof *c);
+  if (!grown || !c) {
+    if (grown) m->comps = grown;
+    free(c);
+    return tx_set_error("%s: out of memory", def->name), none;
+  }
+  m->comps = grown;
+  strcpy(c->name, def->name);
+  strcpy(c->units, units);
+  c->def = *def;
+  c->def.name = c->name;
+  c->def.units = c->units;
+  c->bytes = (size_t)bytes;
+  m->comps[m->count++] = c;
+  return (tx_comp){m->count};
+}
+
+tx_reader tx_model_add_reader(tx_model* m, tx_comp id) {
+  component* c = get(m, id);
+  if (!c) return tx_set_error("no such component"), (tx_reader){0};
+  if (m->committed) return tx_set_error("%s: the model is already committed", c->name), (tx_reader){0};
+  reader_slot* grown = realloc(m->readers, (m->reader_count + 1) * sizeof *grown);
+  if (!grown) return tx_set_error("%s: out of memory", c->name), (tx_reader){0};
+  m->readers = grown;
+  m->readers[m->reader_count++] = (reader_slot){id.id - 1, c->readers++};
+  return (tx_reader){m->reader_count};
+}
+
+static header* buffer_header(const component* c, uint32_t b) { return (header*)(c->memory + (size_t)b * c->stride); }
+static void* buffer_data(const component* c, uint32_t b) { return c->memory + (size_t)b * c->stride + header_size(); }
+
+bool tx_model_commit(tx_model* m) {
+  if (!m) return tx_set_error("no model"), false;
+  if (m->committed) return true;
+  for (uint32_t i = 0; i < m->count; i++) {
+    component* c = m->comps[i];
+    c->buffers = c->readers + 2;
+    c->stride = header_size() + (c->bytes + CACHE_LINE - 1) / CACHE_LINE * CACHE_LINE;
+    c->memory = aligned_alloc(CACHE_LINE, c->stride * c->buffers);
+    c->hazards = c->readers ? aligned_alloc(CACHE_LINE, sizeof(hazard) * c->readers) : NULL;
+    if (!c->memory || (c->readers && !c->hazards)) return tx_set_error("%s: out of memory", c->name), false;
+    memset(c->memory, 0, c->stride * c->buffers);
+    for (uint32_t r = 0; r < c->readers; r++) atomic_init(&c->hazards[r].buffer, NO_BUFFER);
+    for (uint32_t b = 0; b < c->buffers; b++) buffer_header(c, b)->rows = c->def.rows;
+    atomic_init(&c->latest, 0);
+    c->back = 1;
+    c->next_rows = c->def.rows;
+  }
+  m->committed = true;
+  return true;
+}
+
+uint32_t tx_model_count(const tx_model* m) { return m ? m->count : 0; }
+tx_comp tx_model_comp(const tx_model* m, uint32_t index) {
+  return (m && index < m->count) ? (tx_comp){index + 1} : (tx_comp){0};
+}
+const tx_component_def* tx_model_def(const tx_model* m, tx_comp id) {
+  component* c = get(m, id);
+  return c ? &c->def : NULL;
+}
+size_t tx_model_bytes(const tx_model* m, tx_comp id) {
+  component* c = get(m, id);
+  return c ? c->bytes : 0;
+}
+
+void* tx_model_back(tx_model* m, tx_comp id) {
+  component* c = get(m, id);
+  return c && c->memory ? buffer_data(c, c->back) : NULL;
+}
+
+void* tx_model_back_copy(tx_model* m, tx_comp id) {
+  component* c = get(m, id);
+  if (!c || !c->memory) return NULL;
+  // only this thread moves `latest`, and it never writes the latest buffer
+  uint32_t latest = atomic_load_explicit(&c->latest, memory_order_relaxed);
+  memcpy(buffer_data(c, c->back), buffer_data(c, latest), c->bytes);
+  c->next_rows = buffer_header(c, latest)->rows;
+  return buffer_data(c, c->back);
+}
+
+void tx_model_set_rows(tx_model* m, tx_comp id, uint32_t rows) {
+  component* c = get(m, id);
+  if (c) c->next_rows = rows < c->def.rows ? rows : c->def.rows;
+}
+
+uint64_t tx_model_publish(tx_model* m, tx_comp id, int64_t sim_ns) {
+  component* c = get(m, id);
+  if (!c || !c->memory) return 0;
+  header* h = buffer_header(c, c->back);
+  *h = (header){++c->seq, sim_ns, tx_mono_ns(), c->next_rows};
+  uint32_t published = c->back;
+  atomic_store(&c->latest, published);
+  // next back buffer: neither latest nor announced by a reader
+  for (uint32_t b = 0; b < c->buffers; b++) {
+    if (b == published) continue;
+    bool held = false;
+    for (uint32_t r = 0; r < c->readers && !held; r++) held = atomic_load(&c->hazards[r].buffer) == b;
+    if (!held) {
+      c->back = b;
+      break;
+    }
+  }
+  return c->seq;
+}
+
+static tx_snapshot snapshot_of(const component* c, uint32_t b) {
+  const header* h = buffer_header(c, b);
+  return (tx_snapshot){buffer_data(c, b), h->rows, c->def.cols, h->seq, h->sim_ns, h->mono_ns};
+}
+
+tx_snapshot tx_model_acquire(tx_model* m, tx_reader r) {
+  if (!m || r.id < 1 || r.id > m->reader_count || !m->committed) return (tx_snapshot){0};
+  component* c = m->comps[m->readers[r.id - 1].comp];
+  _Atomic uint32_t* slot = &c->hazards[m->readers[r.id - 1].slot].buffer;
+  uint32_t b = atomic_load(&c->latest);
+  for (;;) { // announce, then confirm it is still the latest
+    atomic_store(slot, b);
+    uint32_t again = atomic_load(&c->latest);
+    if (again == b) break;
+    b = again;
+  }
+  return snapshot_of(c, b);
+}
+
+tx_snapshot tx_model_latest(tx_model* m, tx_comp id) {
+  component* c = get(m, id);
+  if (!c || !c->memory) return (tx_snapshot){0};
+  return snapshot_of(c, atomic_load_explicit(&c->latest, memory_order_relaxed));
+}
+
+void tx_model_release(tx_model* m, tx_reader r) {
+  if (!m || r.id < 1 || r.id > m->reader_count || !m->committed) return;
+  component* c = m->comps[m->readers[r.id - 1].comp];
+  atomic_store(&c->hazards[m->readers[r.id - 1].slot].buffer, NO_BUFFER);
+}

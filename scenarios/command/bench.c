@@ -1,0 +1,197 @@
+// tactus bench: benchmark tables for the spine. Timings are medians and
+// percentiles of one run on this machine; they are printed, never asserted.
+#include "command.h"
+#include "run.h"
+
+#include "../../controllers/stats.h"
+
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct bench_args {
+  const char* out;
+  double duration_s; // 0: the bench's own
+} bench_args;
+
+static void print_target(const char* what, const char* measured, const char* limit, bool ok) {
+  printf("  %-44s %-24s %-12s %s\n", what, measured, limit, ok ? "met" : "MISSED");
+}
+
+static json_t* find_controller(json_t* report, const char* name) {
+  size_t i;
+  json_t* c;
+  json_array_foreach(json_object_get(report, "controllers"), i, c)
+    if (strcmp(json_string_value(json_object_get(c, "name")), name) == 0) return c;
+  return NULL;
+}
+
+// the rates scenario in real time, with the spine's targets
+static int bench_rates(const bench_args* a) {
+  tx_scenario* sc = tx_load_for_command("rates", NULL, 0);
+  if (!sc) return TX_EXIT_BAD_INPUT;
+  printf("bench rates: %g s in real time, four controllers loading both cores\n",
+         a->duration_s > 0 ? a->duration_s : sc->duration_s);
+  json_t* report = NULL;
+  tx_run_config cfg = {"rates", a->duration_s, false, a->out, false};
+  int rc = tx_run_scenario(sc, &cfg, &report);
+  tx_scenario_free(sc);
+  if (rc) return rc;
+
+  printf("\ntargets:\n");
+  bool all = true;
+  size_t i;
+  json_t* c;
+  char measured[64];
+  json_array_foreach(json_object_get(report, "controllers"), i, c) {
+    double target = json_number_value(json_object_get(c, "target_hz"));
+    double achieved = json_number_value(json_object_get(c, "achieved_hz"));
+    double error = 100 * fabs(achieved - target) / target;
+    char what[96];
+    snprintf(what, sizeof what, "%s rate within 1%% of %g Hz", json_string_value(json_object_get(c, "name")), target);
+    snprintf(measured, sizeof measured, "%.3f Hz (%.3f%%)", achieved, error);
+    print_target(what, measured, "<= 1%", error <= 1.0);
+    all &= error <= 1.0;
+  }
+  json_t* h = find_controller(report, "haptics");
+  if (h) {
+    double p99 = json_number_value(json_object_get(json_object_get(h, "jitter_us"), "p99"));
+    snprintf(measured, sizeof measured, "%.1f us", p99);
+    print_target("haptics (1 kHz) period jitter p99", measured, "<= 100 us", p99 <= 100);
+    double steps = json_number_value(json_object_get(h, "steps")), missed = json_number_value(json_object_get(h, "missed"));
+    double pct = 100 * missed / (steps + missed > 0 ? steps + missed : 1);
+    snprintf(measured, sizeof measured, "%.0f of %.0f (%.3f%%)", missed, steps + missed, pct);
+    print_target("haptics (1 kHz) missed deadlines", measured, "<= 0.1%", pct <= 0.1);
+    all &= p99 <= 100 && pct <= 0.1;
+  }
+  printf("%s\n", all ? "all targets met" : "some targets MISSED");
+  json_decref(report);
+  return 0;
+}
+
+// publish then acquire a 10404 x 3 float component, as the physics-to-collision hand-over does
+static int bench_model(const bench_args* a) {
+  (void)a;
+  enum { ROWS = 10404, COLS = 3, ITER = 20000 };
+  tx_model* m = tx_model_create();
+  tx_comp c = tx_model_add(m, &(tx_component_def){"bench.x", TX_F32, ROWS, COLS, "m"});
+  tx_reader r = tx_model_add_reader(m, c);
+  tx_model_add_reader(m, c); // a second reader holds an older buffer, as graphics would
+  if (!c.id || !r.id || !tx_model_commit(m)) return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
+  float* source = malloc(sizeof(float) * ROWS * COLS);
+  tx_samples swap, full;
+  if (!source || !tx_samples_init(&swap, ITER) || !tx_samples_init(&full, ITER)) return fprintf(stderr, "tactus: out of memory\n"), 1;
+  for (int i = 0; i < ROWS * COLS; i++) source[i] = (float)i;
+  volatile float sink = 0;
+  for (int k = 0; k < ITER; k++) {
+    source[k % (ROWS * COLS)] += 1.0f;
+    int64_t t0 = tx_mono_ns();
+    memcpy(tx_model_back(m, c), source, sizeof(float) * ROWS * COLS);
+    int64_t t1 = tx_mono_ns();
+    tx_model_publish(m, c, k);
+    tx_snapshot s = tx_model_acquire(m, r);
+    sink += ((const float*)s.data)[k % (ROWS * COLS)];
+    int64_t t2 = tx_mono_ns();
+    tx_samples_add(&swap, t2 - t1);
+    tx_samples_add(&full, t2 - t0);
+  }
+  tx_percentiles ps = tx_samples_percentiles(&swap), pf = tx_samples_percentiles(&full);
+  printf("bench model: %d publishes of a %dx%d f32 component (%.0f KiB), 2 readers\n\n", ITER, ROWS, COLS,
+         ROWS * COLS * 4 / 1024.0);
+  printf("  %-40s %10s %10s %10s\n", "operation", "p50 us", "p99 us", "max us");
+  printf("  %-40s %10.2f %10.2f %10.2f\n", "publish + acquire", ps.p50 * 1e-3, ps.p99 * 1e-3, ps.max * 1e-3);
+  printf("  %-40s %10.2f %10.2f %10.2f\n", "fill 122 KiB + publish + acquire", pf.p50 * 1e-3, pf.p99 * 1e-3, pf.max * 1e-3);
+  printf("\ntargets:\n");
+  char measured[64];
+  snprintf(measured, sizeof measured, "%.2f us (with the fill)", pf.p99 * 1e-3);
+  print_target("publish + acquire 10404x3 f32, p99", measured, "<= 20 us", pf.p99 * 1e-3 <= 20);
+  tx_samples_free(&swap);
+  tx_samples_free(&full);
+  free(source);
+  tx_model_destroy(m);
+  return 0;
+}
+
+// a controller that does nothing: what remains is the framework's cost
+static int idle_configure(tx_setup* s, void** self) {
+  (void)s;
+  *self = NULL;
+  return 0;
+}
+static void idle_step(tx_ctx* c, void* self) {
+  (void)c;
+  (void)self;
+}
+static const tx_controller_class idle_class = {"bench.idle", "does nothing", idle_configure, NULL, idle_step, NULL};
+
+static int bench_overhead(const bench_args* a) {
+  (void)a;
+  tx_register_controller(&idle_class);
+  char err[512];
+  const double rate = 100000, lockstep_s = 10, realtime_s = 2;
+  const char* text = "{\"name\":\"overhead\",\"controllers\":[{\"name\":\"idle\",\"type\":\"bench.idle\",\"rate_hz\":100000}]}";
+  tx_scenario* sc = tx_scenario_load_text("overhead", text, strlen(text), NULL, err, sizeof err);
+  if (!sc) return fprintf(stderr, "tactus: %s\n", err), 1;
+  tx_run_result r;
+  tx_run_options lock = {lockstep_s, true, NULL, false, false, NULL, NULL};
+  int64_t t0 = tx_mono_ns();
+  if (tx_system_run(sc->system, &lock, &r, err, sizeof err)) return fprintf(stderr, "tactus: %s\n", err), 1;
+  double wall = (double)(tx_mono_ns() - t0);
+  tx_controller_stats ls = tx_system_stats(sc->system, 0);
+  double per_step = wall / (double)ls.steps;
+
+  tx_run_options rt = {realtime_s, false, NULL, true, true, NULL, NULL};
+  if (tx_system_run(sc->system, &rt, &r, err, sizeof err)) return fprintf(stderr, "tactus: %s\n", err), 1;
+  tx_controller_stats rs = tx_system_stats(sc->system, 0);
+  tx_scenario_free(sc);
+
+  printf("bench overhead: an empty controller at %g Hz\n\n", rate);
+  printf("  %-52s %10s %10s %10s\n", "measure", "p50 us", "p99 us", "max us");
+  printf("  %-52s %10.3f %10s %10s\n", "lockstep: wall time per step (whole executor loop)", per_step * 1e-3, "-", "-");
+  printf("  %-52s %10.3f %10.3f %10.3f\n", "lockstep: step call + publish + bookkeeping", ls.step_ns.p50 * 1e-3,
+         ls.step_ns.p99 * 1e-3, ls.step_ns.max * 1e-3);
+  printf("  %-52s %10.3f %10.3f %10.3f\n", "real time: step call + publish + bookkeeping", rs.step_ns.p50 * 1e-3,
+         rs.step_ns.p99 * 1e-3, rs.step_ns.max * 1e-3);
+  printf("  (real time, %g s: %.1f Hz achieved, %llu missed; %s)\n", realtime_s, rs.achieved_hz,
+         (unsigned long long)rs.missed, r.scheduler);
+  printf("\ntargets:\n");
+  char measured[64];
+  snprintf(measured, sizeof measured, "%.3f us", per_step * 1e-3);
+  print_target("framework overhead of an empty step", measured, "<= 5 us", per_step * 1e-3 <= 5);
+  return 0;
+}
+
+static const struct {
+  const char* name;
+  int (*run)(const bench_args*);
+  const char* what;
+} benches[] = {
+    {"rates", bench_rates, "the rates scenario for 10 s in real time: rates, jitter, missed deadlines"},
+    {"model", bench_model, "publish + acquire of a 10404x3 f32 component"},
+    {"overhead", bench_overhead, "framework cost of an empty controller step"},
+};
+
+int tx_cmd_bench(int argc, char** argv) {
+  static const struct option longs[] = {
+      {"out", required_argument, 0, 'o'}, {"duration", required_argument, 0, 'd'}, {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
+  bench_args a = {0};
+  optind = 1;
+  opterr = 0;
+  for (int c; (c = getopt_long(argc, argv, "", longs, NULL)) != -1;) {
+    if (c == 'o') a.out = optarg;
+    else if (c == 'd') {
+      if (!tx_parse_num(optarg, 0.1, 3600, &a.duration_s)) return tx_bad_input("--duration %s: expected seconds in [0.1, 3600]", optarg);
+    } else if (c == 'h') optind = argc + 1;
+    else return tx_bad_input("bench: unknown or incomplete option '%s'", argv[optind - 1]);
+  }
+  if (optind != argc - 1) {
+    printf("usage: tactus bench NAME [--out DIR] [--duration S]\n\n");
+    for (size_t i = 0; i < sizeof benches / sizeof benches[0]; i++) printf("  %-10s %s\n", benches[i].name, benches[i].what);
+    return optind == argc + 1 ? 0 : TX_EXIT_BAD_INPUT;
+  }
+  for (size_t i = 0; i < sizeof benches / sizeof benches[0]; i++)
+    if (strcmp(argv[optind], benches[i].name) == 0) return benches[i].run(&a);
+  return tx_bad_input("bench %s: unknown benchmark (tactus bench lists them)", argv[optind]);
+}

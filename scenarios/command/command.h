@@ -1,0 +1,30 @@
+// Internal: the subcommands of `tactus` and what they share.
+#ifndef TX_SCENARIOS_COMMAND_H
+#define TX_SCENARIOS_COMMAND_H
+
+#include "../loader.h"
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#define TX_EXIT_BAD_INPUT 2
+
+int tx_cmd_list(int argc, char** argv);
+int tx_cmd_describe(int argc, char** argv);
+int tx_cmd_run(int argc, char** argv);
+int tx_cmd_bench(int argc, char** argv);
+int tx_cmd_study(int argc, char** argv);
+
+// print "tactus: MESSAGE" on one line to stderr; returns TX_EXIT_BAD_INPUT
+int tx_bad_input(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
+// parse a whole number string in [min, max]
+bool tx_parse_num(const char* s, double min, double max, double* out);
+// make the output folder (given, or out/STEM-TIMESTAMP) and check that it takes files
+int tx_out_dir(const char* given, const char* stem, char* dir, size_t n, char* err, size_t en);
+// load a scenario by name or path; prints the error and returns NULL on failure
+tx_scenario* tx_load_for_command(const char* name, const char* const* sets, int nsets);
+// stop requests (SIGINT, SIGTERM) end a run cleanly; the progress callback of a run
+void tx_catch_stop_signals(void);
+bool tx_progress(double elapsed_s, void* total_s);
+
+#endif

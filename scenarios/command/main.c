@@ -1,0 +1,106 @@
+// tactus: the command line. Subcommands list, describe, run, bench and study.
+#include "command.h"
+
+#include <tactus/config.h>
+#include <tactus/tactus.h>
+
+#include <stdio.h>
+#include <string.h>
+
+static const char usage[] =
+    "usage: tactus COMMAND [ARGS]\n"
+    "\n"
+    "  list                       the scenarios on the search path\n"
+    "  describe SCENARIO          controllers, rates, threads, reads and writes\n"
+    "  run SCENARIO [OPTIONS]     run it; writes OUT/report.json (tactus run --help)\n"
+    "  bench NAME [--out DIR]     a benchmark table (tactus bench lists them)\n"
+    "  study NAME [--out DIR]     a study with plots (tactus study lists them)\n"
+    "  version                    version and the optional parts built in\n"
+    "\n"
+    "SCENARIO is a name from `tactus list` or a path to a .json file.\n"
+    "Scenarios are searched in $TACTUS_SCENARIO_PATH (':'-separated), then " TX_SCENARIO_DIR ".\n"
+    "Bad input exits with status 2 and one line naming the file and key.\n";
+
+static void print_scenario(const char* name, const char* path, const char* description, void* user) {
+  (void)path;
+  (void)user;
+  printf("%-20s %s\n", name, description);
+}
+
+int tx_cmd_list(int argc, char** argv) {
+  (void)argv;
+  if (argc > 1) return tx_bad_input("list: takes no arguments");
+  tx_scenario_list(print_scenario, NULL);
+  return 0;
+}
+
+int tx_cmd_describe(int argc, char** argv) {
+  if (argc != 2) return tx_bad_input("describe: expected one SCENARIO (tactus describe rates)");
+  tx_scenario* sc = tx_load_for_command(argv[1], NULL, 0);
+  if (!sc) return TX_EXIT_BAD_INPUT;
+  tx_system* s = sc->system;
+  printf("%s: %s\nfile: %s\ndefault duration: %g s\n\nthreads:\n", sc->name, sc->description, sc->path,
+         sc->duration_s);
+  for (int t = 0; t < tx_system_threads(s); t++) {
+    printf("  t%d:", t);
+    for (int i = 0; i < tx_system_count(s); i++)
+      if (tx_system_thread(s, i) == t) printf(" %s @ %g Hz", tx_system_name(s, i), tx_system_rate(s, i));
+    printf("\n");
+  }
+  printf("\n%-14s %-18s %10s %-6s %-6s %s\n", "controller", "type", "rate Hz", "thread", "access", "component");
+  for (int i = 0; i < tx_system_count(s); i++) {
+    printf("%-14s %-18s %10g t%-5d", tx_system_name(s, i), tx_system_class(s, i)->type, tx_system_rate(s, i),
+           tx_system_thread(s, i));
+    if (tx_system_ports(s, i) == 0) printf(" (reads and writes nothing)\n");
+    for (int p = 0; p < tx_system_ports(s, i); p++) {
+      tx_port_info pi = tx_system_port(s, i, p);
+      if (p) printf("%-14s %-18s %10s %-6s", "", "", "", "");
+      printf(" %-6s %s (%s %ux%u, %s)\n", pi.write ? "writes" : "reads", pi.component, tx_type_name(pi.def->type),
+             pi.def->rows, pi.def->cols, pi.def->units);
+    }
+  }
+  printf("\n");
+  for (int i = 0; i < tx_system_count(s); i++) {
+    const tx_controller_class* cls = tx_system_class(s, i);
+    bool shown = false;
+    for (int j = 0; j < i && !shown; j++) shown = tx_system_class(s, j) == cls;
+    if (!shown) printf("%s: %s\n", cls->type, cls->summary ? cls->summary : "");
+  }
+  tx_scenario_free(sc);
+  return 0;
+}
+
+int tx_cmd_study(int argc, char** argv) {
+  // studies arrive with the scenarios that need them; the command is here first
+  if (argc < 2 || strcmp(argv[1], "--help") == 0) {
+    printf("usage: tactus study NAME [--out DIR]\n\nno studies in this build yet\n");
+    return argc < 2 ? TX_EXIT_BAD_INPUT : 0;
+  }
+  return tx_bad_input("study %s: unknown study (this build has none yet)", argv[1]);
+}
+
+static int version(void) {
+  printf("tactus %s (%s%s%s)\noptional parts:", TX_VERSION, TX_BUILD_TYPE, *TX_SANITIZE ? ", sanitize=" : "",
+         TX_SANITIZE);
+  const struct { const char* name; int on; } parts[] = {
+      {"bullet", TX_WITH_BULLET}, {"ode", TX_WITH_ODE}, {"osmesa", TX_WITH_OSMESA}, {"glfw", TX_WITH_GLFW},
+      {"dds", TX_WITH_DDS}};
+  for (size_t i = 0; i < sizeof parts / sizeof parts[0]; i++) printf(" %s=%s", parts[i].name, parts[i].on ? "on" : "off");
+  printf("\n");
+  return 0;
+}
+
+int main(int argc, char** argv) {
+  setvbuf(stdout, NULL, _IOLBF, 0);
+  tx_register_builtin();
+  if (argc < 2) return fputs(usage, stderr), TX_EXIT_BAD_INPUT;
+  const char* cmd = argv[1];
+  if (!strcmp(cmd, "-h") || !strcmp(cmd, "--help") || !strcmp(cmd, "help")) return fputs(usage, stdout), 0;
+  if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) return version();
+  if (!strcmp(cmd, "list")) return tx_cmd_list(argc - 1, argv + 1);
+  if (!strcmp(cmd, "describe")) return tx_cmd_describe(argc - 1, argv + 1);
+  if (!strcmp(cmd, "run")) return tx_cmd_run(argc - 1, argv + 1);
+  if (!strcmp(cmd, "bench")) return tx_cmd_bench(argc - 1, argv + 1);
+  if (!strcmp(cmd, "study")) return tx_cmd_study(argc - 1, argv + 1);
+  return tx_bad_input("unknown command '%s' (tactus --help lists them)", cmd);
+}

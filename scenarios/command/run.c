@@ -1,0 +1,134 @@
+// tactus run: one scenario, real time or lockstep, ending in a report.
+#include "command.h"
+#include "run.h"
+
+#include "../../views/report.h"
+
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static const char run_usage[] =
+    "usage: tactus run SCENARIO [OPTIONS]\n"
+    "\n"
+    "  --duration S        run length in seconds (default: the scenario's duration_s)\n"
+    "  --lockstep          one thread on a virtual clock: deterministic, writes OUT/trace.csv\n"
+    "  --set KEY=VALUE     override CONTROLLER.PARAM, CONTROLLER.rate_hz or duration_s (repeatable)\n"
+    "  --device SPEC       a haptic device per hand: scripted:NAME|FILE.csv, replay:FILE, sim, udp:HOST:PORT, mouse\n"
+    "  --view SPEC         none|png|window (default none)\n"
+    "  --stereo MODE       mono|sbs|tb|anaglyph|lr (default mono)\n"
+    "  --out DIR           output folder (default out/SCENARIO-TIMESTAMP)\n"
+    "  --quiet             no summary table\n"
+    "\n"
+    "Writes OUT/report.json: per controller achieved rate, missed deadlines, period jitter and step time.\n"
+    "Ctrl-C stops the run early and still writes the report.\n";
+
+static bool one_of(const char* s, const char* const* options) {
+  for (; *options; options++)
+    if (strcmp(s, *options) == 0) return true;
+  return false;
+}
+
+static bool device_spec_valid(const char* s) {
+  static const char* const prefixes[] = {"scripted:", "replay:", "udp:", NULL};
+  if (!strcmp(s, "sim") || !strcmp(s, "mouse")) return true;
+  for (const char* const* p = prefixes; *p; p++)
+    if (!strncmp(s, *p, strlen(*p)) && s[strlen(*p)]) return true;
+  return false;
+}
+
+int tx_run_scenario(tx_scenario* sc, const tx_run_config* cfg, json_t** report_out) {
+  char dir[4096], err[1024];
+  if (tx_out_dir(cfg->out, sc->name, dir, sizeof dir, err, sizeof err)) return tx_bad_input("%s", err);
+  double duration = cfg->duration_s > 0 ? cfg->duration_s : sc->duration_s;
+  FILE* trace = NULL;
+  char trace_path[4200];
+  if (cfg->lockstep) {
+    snprintf(trace_path, sizeof trace_path, "%s/trace.csv", dir);
+    trace = fopen(trace_path, "w");
+    if (!trace) return tx_bad_input("--out %s: cannot write trace.csv", dir);
+    fprintf(trace, "sim_ns,controller,component,seq,rows,fnv1a\n");
+  }
+  tx_catch_stop_signals();
+  tx_run_options o = {duration, cfg->lockstep, trace, true, true, tx_progress, &duration};
+  tx_run_result r;
+  int rc = tx_system_run(sc->system, &o, &r, err, sizeof err);
+  if (trace) fclose(trace);
+  if (isatty(2)) fprintf(stderr, "\r%40s\r", "");
+  if (rc) {
+    fprintf(stderr, "tactus: run %s: %s\n", sc->name, err);
+    return 1;
+  }
+  json_t* report = tx_report_json(&(tx_report){sc->name, cfg->lockstep, &r, sc->system});
+  if (!report || tx_report_save(report, dir, "report.json", err, sizeof err)) {
+    json_decref(report);
+    fprintf(stderr, "tactus: %s\n", report ? err : "out of memory for the report");
+    return 1;
+  }
+  if (!cfg->quiet) {
+    tx_report_print(stdout, report);
+    printf("report: %s/report.json%s\n", dir, cfg->lockstep ? " (and trace.csv)" : "");
+  }
+  if (report_out) *report_out = report;
+  else json_decref(report);
+  return 0;
+}
+
+int tx_cmd_run(int argc, char** argv) {
+  static const struct option longs[] = {
+      {"duration", required_argument, 0, 'd'}, {"lockstep", no_argument, 0, 'l'}, {"set", required_argument, 0, 's'},
+      {"device", required_argument, 0, 'D'},   {"view", required_argument, 0, 'v'}, {"stereo", required_argument, 0, 'S'},
+      {"out", required_argument, 0, 'o'},      {"quiet", no_argument, 0, 'q'},   {"help", no_argument, 0, 'h'},
+      {0, 0, 0, 0}};
+  static const char* const views[] = {"none", "png", "window", NULL};
+  static const char* const stereo[] = {"mono", "sbs", "tb", "anaglyph", "lr", NULL};
+  tx_run_config cfg = {0};
+  const char* sets[64];
+  int nsets = 0, ndevices = 0;
+  const char* view = "none";
+  optind = 1;
+  opterr = 0;
+  // GNU getopt moves operands behind the options, so SCENARIO may stand anywhere
+  for (int c; (c = getopt_long(argc, argv, "", longs, NULL)) != -1;) {
+    switch (c) {
+    case 'd':
+      if (!tx_parse_num(optarg, 1e-3, 86400, &cfg.duration_s))
+        return tx_bad_input("--duration %s: expected seconds in [0.001, 86400]", optarg);
+      break;
+    case 'l': cfg.lockstep = true; break;
+    case 's':
+      if (nsets == 64) return tx_bad_input("--set: at most 64");
+      sets[nsets++] = optarg;
+      break;
+    case 'D':
+      if (++ndevices > 2) return tx_bad_input("--device %s: at most two devices (one per hand)", optarg);
+      if (!device_spec_valid(optarg))
+        return tx_bad_input("--device %s: expected scripted:NAME, scripted:FILE.csv, replay:FILE, sim, udp:HOST:PORT or mouse", optarg);
+      return tx_bad_input("--device %s: no device backends in this build yet", optarg);
+    case 'v':
+      if (!one_of(optarg, views)) return tx_bad_input("--view %s: expected none, png or window", optarg);
+      view = optarg;
+      break;
+    case 'S':
+      if (!one_of(optarg, stereo)) return tx_bad_input("--stereo %s: expected mono, sbs, tb, anaglyph or lr", optarg);
+      break;
+    case 'o': cfg.out = optarg; break;
+    case 'q': cfg.quiet = true; break;
+    case 'h': return fputs(run_usage, stdout), 0;
+    default:
+      return tx_bad_input("run: unknown or incomplete option '%s' (tactus run --help)", argv[optind - 1]);
+    }
+  }
+  if (optind < argc) cfg.scenario = argv[optind++];
+  if (optind < argc) return tx_bad_input("run: unexpected argument '%s'", argv[optind]);
+  if (!cfg.scenario) return tx_bad_input("run: expected a SCENARIO (tactus list shows them)");
+  if (strcmp(view, "none") != 0) return tx_bad_input("--view %s: no graphics views in this build yet", view);
+
+  tx_scenario* sc = tx_load_for_command(cfg.scenario, sets, nsets);
+  if (!sc) return TX_EXIT_BAD_INPUT;
+  int rc = tx_run_scenario(sc, &cfg, NULL);
+  tx_scenario_free(sc);
+  return rc;
+}

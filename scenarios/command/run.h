@@ -1,0 +1,21 @@
+// Internal: running a loaded scenario, shared by `run` and `bench`.
+#ifndef TX_SCENARIOS_COMMAND_RUN_H
+#define TX_SCENARIOS_COMMAND_RUN_H
+
+#include "command.h"
+
+#include <jansson.h>
+
+typedef struct tx_run_config {
+  const char* scenario; // name or path
+  double duration_s;    // 0: the scenario's
+  bool lockstep;
+  const char* out;      // NULL: out/SCENARIO-TIMESTAMP
+  bool quiet;
+} tx_run_config;
+
+// run and report; *report receives the report (caller frees) when not NULL.
+// Returns 0, TX_EXIT_BAD_INPUT for a bad --out, or 1 if the run failed.
+int tx_run_scenario(tx_scenario* sc, const tx_run_config* cfg, json_t** report);
+
+#endif

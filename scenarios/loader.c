@@ -1,0 +1,350 @@
+// Scenario files: JSON (jansson) to a checked, finalized controller system.
+#include "loader.h"
+
+#include <tactus/config.h>
+
+#include <dirent.h>
+#include <dlfcn.h>
+#include <errno.h>
+#include <libgen.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#define SETS_MAX 64
+
+static int fail(char* err, size_t n, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
+static int fail(char* err, size_t n, const char* fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(err, n, fmt, ap);
+  va_end(ap);
+  return -1;
+}
+
+static const char* json_kind(const json_t* v) {
+  if (json_is_object(v)) return "an object";
+  if (json_is_array(v)) return "an array";
+  if (json_is_string(v)) return "a string";
+  if (json_is_number(v)) return "a number";
+  if (json_is_boolean(v)) return "a boolean";
+  return "null";
+}
+
+// every key of obj must be one of known (NULL-terminated)
+static int check_keys(const char* file, const char* where, json_t* obj, const char* const* known, char* err, size_t n) {
+  const char* key;
+  json_t* v;
+  json_object_foreach(obj, key, v) {
+    bool ok = false;
+    for (const char* const* k = known; *k && !ok; k++) ok = strcmp(*k, key) == 0;
+    if (ok) continue;
+    char list[256] = "";
+    for (const char* const* k = known; *k; k++) {
+      size_t len = strlen(list);
+      snprintf(list + len, sizeof list - len, "%s%s", len ? ", " : "", *k);
+    }
+    return fail(err, n, "%s: %s%s%s: unknown key (known: %s)", file, where, *where ? "." : "", key, list);
+  }
+  return 0;
+}
+
+// a --set that changed one controller value, to name it when that value is wrong
+typedef struct set_origin {
+  int controller;
+  char key[128]; // "params.X" or "rate_hz"
+  const char* text;
+} set_origin;
+
+static int apply_sets(const char* file, json_t* root, const tx_load_options* o, set_origin* origins, int* norigins,
+                      char* err, size_t n) {
+  *norigins = 0;
+  for (int i = 0; o && i < o->nsets; i++) {
+    const char* text = o->sets[i];
+    const char* eq = strchr(text, '=');
+    if (!eq || eq == text) return fail(err, n, "--set %s: expected KEY=VALUE", text);
+    char key[128];
+    if ((size_t)(eq - text) >= sizeof key) return fail(err, n, "--set %s: key too long", text);
+    memcpy(key, text, eq - text);
+    key[eq - text] = 0;
+    json_error_t je;
+    json_t* value = json_loads(eq + 1, JSON_DECODE_ANY, &je);
+    if (!value) value = json_string(eq + 1); // bare words are strings
+    if (!value) return fail(err, n, "--set %s: value is not valid UTF-8", text);
+
+    char* dot = strchr(key, '.');
+    if (!dot) {
+      if (strcmp(key, "duration_s") != 0) {
+        json_decref(value);
+        return fail(err, n, "--set %s: unknown key '%s' (use duration_s or CONTROLLER.PARAM)", text, key);
+      }
+      json_object_set_new(root, key, value);
+      continue;
+    }
+    *dot = 0;
+    const char* param = dot + 1;
+    json_t* controllers = json_object_get(root, "controllers");
+    size_t index;
+    json_t* c;
+    int found = -1;
+    json_array_foreach(controllers, index, c) {
+      if (json_is_string(json_object_get(c, "name")) && strcmp(json_string_value(json_object_get(c, "name")), key) == 0)
+        found = (int)index;
+    }
+    if (found < 0 || !*param) {
+      json_decref(value);
+      return fail(err, n, "--set %s: no controller named '%s' in %s", text, key, file);
+    }
+    c = json_array_get(controllers, found);
+    set_origin* so = &origins[(*norigins)++];
+    so->controller = found;
+    so->text = text;
+    if (strcmp(param, "rate_hz") == 0) {
+      json_object_set_new(c, "rate_hz", value);
+      snprintf(so->key, sizeof so->key, "rate_hz");
+    } else {
+      json_t* params = json_object_get(c, "params");
+      if (!params) json_object_set_new(c, "params", params = json_object());
+      if (!json_is_object(params)) {
+        json_decref(value);
+        return fail(err, n, "%s: controllers[%d].params: expected an object", file, found);
+      }
+      json_object_set_new(params, param, value);
+      snprintf(so->key, sizeof so->key, "params.%s", param);
+    }
+  }
+  return 0;
+}
+
+// plugin libraries stay loaded for the life of the process: their classes live there
+static char loaded_plugins[32][PATH_MAX];
+static int nloaded_plugins;
+
+static int load_plugins(const char* file, const char* dir, json_t* plugins, const tx_load_options* o, char* err, size_t n) {
+  if (!plugins) return 0;
+  if (!json_is_array(plugins)) return fail(err, n, "%s: plugins: expected an array of paths", file);
+  size_t i;
+  json_t* p;
+  json_array_foreach(plugins, i, p) {
+    if (!json_is_string(p)) return fail(err, n, "%s: plugins[%zu]: expected a path, got %s", file, i, json_kind(p));
+    if (!o || !o->allow_plugins) return fail(err, n, "%s: plugins[%zu]: plugins are not allowed here", file, i);
+    char path[PATH_MAX], real[PATH_MAX];
+    const char* name = json_string_value(p);
+    snprintf(path, sizeof path, "%s%s%s", name[0] == '/' ? "" : dir, name[0] == '/' ? "" : "/", name);
+    if (!realpath(path, real)) return fail(err, n, "%s: plugins[%zu]: %s: %s", file, i, path, strerror(errno));
+    bool seen = false;
+    for (int k = 0; k < nloaded_plugins && !seen; k++) seen = strcmp(loaded_plugins[k], real) == 0;
+    if (seen) continue;
+    if (nloaded_plugins == 32) return fail(err, n, "%s: plugins[%zu]: more than 32 plugins", file, i);
+    void* lib = dlopen(real, RTLD_NOW | RTLD_LOCAL);
+    if (!lib) return fail(err, n, "%s: plugins[%zu]: %s", file, i, dlerror());
+    int (*entry)(int) = (int (*)(int))dlsym(lib, "tx_plugin_register");
+    if (!entry) {
+      dlclose(lib);
+      return fail(err, n, "%s: plugins[%zu]: %s has no tx_plugin_register", file, i, real);
+    }
+    if (entry(TX_API_VERSION) != 0)
+      return fail(err, n, "%s: plugins[%zu]: %s refused to register: %s", file, i, real, tx_error());
+    strcpy(loaded_plugins[nloaded_plugins++], real);
+  }
+  return 0;
+}
+
+static int declare_model(const char* file, tx_system* sys, json_t* model, char* err, size_t n) {
+  if (!model) return 0;
+  if (!json_is_array(model)) return fail(err, n, "%s: model: expected an array of components", file);
+  static const char* const keys[] = {"name", "type", "rows", "cols", "units", NULL};
+  size_t i;
+  json_t* c;
+  json_array_foreach(model, i, c) {
+    char where[48];
+    snprintf(where, sizeof where, "model[%zu]", i);
+    if (!json_is_object(c)) return fail(err, n, "%s: %s: expected an object, got %s", file, where, json_kind(c));
+    if (check_keys(file, where, c, keys, err, n)) return -1;
+    json_t *name = json_object_get(c, "name"), *type = json_object_get(c, "type"), *rows = json_object_get(c, "rows"),
+           *cols = json_object_get(c, "cols"), *units = json_object_get(c, "units");
+    if (!json_is_string(name)) return fail(err, n, "%s: %s.name: expected a string", file, where);
+    tx_type t = tx_type_from_name(json_string_value(type));
+    if (!t) return fail(err, n, "%s: %s.type: expected one of f32, f64, i32, u32, u8", file, where);
+    if (!json_is_integer(rows) || json_integer_value(rows) < 1 || json_integer_value(rows) > (1 << 26))
+      return fail(err, n, "%s: %s.rows: expected an integer in [1, %d]", file, where, 1 << 26);
+    if (cols && (!json_is_integer(cols) || json_integer_value(cols) < 1 || json_integer_value(cols) > 1024))
+      return fail(err, n, "%s: %s.cols: expected an integer in [1, 1024]", file, where);
+    if (units && !json_is_string(units)) return fail(err, n, "%s: %s.units: expected a string", file, where);
+    tx_component_def d = {json_string_value(name), t, (uint32_t)json_integer_value(rows),
+                          cols ? (uint32_t)json_integer_value(cols) : 1, units ? json_string_value(units) : "1"};
+    tx_fault f;
+    if (tx_system_declare(sys, &d, &f)) return fail(err, n, "%s: %s.%s: %s", file, where, f.key, f.message);
+  }
+  return 0;
+}
+
+static int add_controllers(const char* file, tx_system* sys, json_t* list, const set_origin* origins, int norigins,
+                           char* err, size_t n) {
+  if (!json_is_array(list) || json_array_size(list) == 0)
+    return fail(err, n, "%s: controllers: expected a non-empty array", file);
+  static const char* const keys[] = {"name", "type", "rate_hz", "params", NULL};
+  size_t i;
+  json_t* c;
+  json_array_foreach(list, i, c) {
+    char where[48];
+    snprintf(where, sizeof where, "controllers[%zu]", i);
+    if (!json_is_object(c)) return fail(err, n, "%s: %s: expected an object, got %s", file, where, json_kind(c));
+    if (check_keys(file, where, c, keys, err, n)) return -1;
+    json_t *name = json_object_get(c, "name"), *type = json_object_get(c, "type"), *rate = json_object_get(c, "rate_hz");
+    if (!json_is_string(name)) return fail(err, n, "%s: %s.name: expected a string", file, where);
+    if (!json_is_string(type)) return fail(err, n, "%s: %s.type: expected a string", file, where);
+    tx_fault f = {0};
+    int rc;
+    if (!json_is_number(rate)) rc = -1, snprintf(f.key, sizeof f.key, "rate_hz"), snprintf(f.message, sizeof f.message, "expected a number in Hz, got %s", rate ? json_kind(rate) : "nothing");
+    else rc = tx_system_add(sys, json_string_value(name), json_string_value(type), json_number_value(rate),
+                            json_object_get(c, "params"), &f);
+    if (rc == 0) continue;
+    for (int k = 0; k < norigins; k++)
+      if (origins[k].controller == (int)i && strcmp(origins[k].key, f.key) == 0)
+        return fail(err, n, "--set %s: %s", origins[k].text, f.message);
+    return fail(err, n, "%s: %s%s%s: %s", file, where, *f.key ? "." : "", f.key, f.message);
+  }
+  return 0;
+}
+
+static tx_scenario* load_root(const char* file, const char* dir, json_t* root, const tx_load_options* o, char* err,
+                              size_t n) {
+  tx_register_builtin();
+  if (!json_is_object(root)) return fail(err, n, "%s: expected a JSON object at the top", file), NULL;
+  static const char* const keys[] = {"name", "description", "duration_s", "model", "plugins", "controllers", NULL};
+  if (check_keys(file, "", root, keys, err, n)) return NULL;
+  set_origin origins[SETS_MAX];
+  int norigins = 0;
+  if (o && o->nsets > SETS_MAX) return fail(err, n, "--set: more than %d", SETS_MAX), NULL;
+  if (apply_sets(file, root, o, origins, &norigins, err, n)) return NULL;
+
+  json_t *name = json_object_get(root, "name"), *desc = json_object_get(root, "description"),
+         *duration = json_object_get(root, "duration_s");
+  if (!json_is_string(name) || !*json_string_value(name) || strlen(json_string_value(name)) >= TX_NAME_MAX)
+    return fail(err, n, "%s: name: expected a non-empty string", file), NULL;
+  if (desc && !json_is_string(desc)) return fail(err, n, "%s: description: expected a string", file), NULL;
+  double seconds = 10;
+  if (duration) {
+    seconds = json_number_value(duration);
+    if (!json_is_number(duration) || !(seconds > 0 && seconds <= 86400))
+      return fail(err, n, "%s: duration_s: expected a number in (0, 86400]", file), NULL;
+  }
+  if (load_plugins(file, dir, json_object_get(root, "plugins"), o, err, n)) return NULL;
+
+  tx_scenario* s = calloc(1, sizeof *s);
+  if (!s || !(s->system = tx_system_create())) {
+    free(s);
+    return fail(err, n, "%s: out of memory", file), NULL;
+  }
+  snprintf(s->path, sizeof s->path, "%s", file);
+  snprintf(s->name, sizeof s->name, "%s", json_string_value(name));
+  snprintf(s->description, sizeof s->description, "%s", desc ? json_string_value(desc) : "");
+  s->duration_s = seconds;
+  if (declare_model(file, s->system, json_object_get(root, "model"), err, n) ||
+      add_controllers(file, s->system, json_object_get(root, "controllers"), origins, norigins, err, n)) {
+    tx_scenario_free(s);
+    return NULL;
+  }
+  tx_fault f;
+  if (tx_system_finalize(s->system, &f)) {
+    int index = -1;
+    for (int i = 0; i < tx_system_count(s->system); i++)
+      if (strcmp(tx_system_name(s->system, i), f.key) == 0) index = i;
+    if (index >= 0) fail(err, n, "%s: controllers[%d]: %s", file, index, f.message);
+    else fail(err, n, "%s: %s", file, f.message);
+    tx_scenario_free(s);
+    return NULL;
+  }
+  return s;
+}
+
+static void format_parse_error(const char* file, const json_error_t* e, char* err, size_t n) {
+  if (e->line > 0) fail(err, n, "%s:%d:%d: %s", file, e->line, e->column, e->text);
+  else fail(err, n, "%s: %s", file, e->text);
+}
+
+tx_scenario* tx_scenario_load(const char* path, const tx_load_options* o, char* err, size_t n) {
+  struct stat st;
+  if (stat(path, &st) != 0) return fail(err, n, "%s: %s", path, strerror(errno)), NULL;
+  if (!S_ISREG(st.st_mode)) return fail(err, n, "%s: not a regular file", path), NULL;
+  json_error_t e;
+  json_t* root = json_load_file(path, JSON_REJECT_DUPLICATES, &e);
+  if (!root) return format_parse_error(path, &e, err, n), NULL;
+  char copy[PATH_MAX];
+  snprintf(copy, sizeof copy, "%s", path);
+  tx_scenario* s = load_root(path, dirname(copy), root, o, err, n);
+  json_decref(root);
+  return s;
+}
+
+tx_scenario* tx_scenario_load_text(const char* label, const char* text, size_t len, const tx_load_options* o, char* err,
+                                   size_t n) {
+  json_error_t e;
+  json_t* root = json_loadb(text, len, JSON_REJECT_DUPLICATES, &e);
+  if (!root) return format_parse_error(label, &e, err, n), NULL;
+  tx_scenario* s = load_root(label, ".", root, o, err, n);
+  json_decref(root);
+  return s;
+}
+
+void tx_scenario_free(tx_scenario* s) {
+  if (!s) return;
+  tx_system_destroy(s->system);
+  free(s);
+}
+
+// the directories scenarios are searched in, in order
+static int search_dirs(char dirs[][PATH_MAX], int max) {
+  int count = 0;
+  const char* env = getenv("TACTUS_SCENARIO_PATH");
+  if (env) {
+    char copy[4096];
+    snprintf(copy, sizeof copy, "%s", env);
+    char* save = NULL;
+    for (char* d = strtok_r(copy, ":", &save); d && count < max - 1; d = strtok_r(NULL, ":", &save))
+      snprintf(dirs[count++], PATH_MAX, "%s", d);
+  }
+  snprintf(dirs[count++], PATH_MAX, "%s", TX_SCENARIO_DIR);
+  return count;
+}
+
+int tx_scenario_locate(const char* name, char* path, size_t size, char* err, size_t n) {
+  size_t len = strlen(name);
+  if (strchr(name, '/') || (len > 5 && strcmp(name + len - 5, ".json") == 0)) {
+    if (access(name, R_OK) != 0) return fail(err, n, "%s: %s", name, strerror(errno));
+    snprintf(path, size, "%s", name);
+    return 0;
+  }
+  char dirs[16][PATH_MAX];
+  int count = search_dirs(dirs, 16);
+  for (int d = 0; d < count; d++) {
+    snprintf(path, size, "%s/%s/%s.json", dirs[d], name, name);
+    if (access(path, R_OK) == 0) return 0;
+  }
+  return fail(err, n, "%s: unknown scenario (tactus list shows them; a file needs a .json ending)", name);
+}
+
+void tx_scenario_list(tx_scenario_visit visit, void* user) {
+  char dirs[16][PATH_MAX];
+  int count = search_dirs(dirs, 16);
+  for (int d = 0; d < count; d++) {
+    struct dirent** entries = NULL;
+    int ne = scandir(dirs[d], &entries, NULL, alphasort);
+    for (int i = 0; i < ne; i++) {
+      char path[PATH_MAX];
+      int len = snprintf(path, sizeof path, "%s/%s/%s.json", dirs[d], entries[i]->d_name, entries[i]->d_name);
+      json_t* root = entries[i]->d_name[0] != '.' && len < (int)sizeof path ? json_load_file(path, 0, NULL) : NULL;
+      if (root) {
+        const char* desc = json_string_value(json_object_get(root, "description"));
+        visit(entries[i]->d_name, path, desc ? desc : "", user);
+        json_decref(root);
+      }
+      free(entries[i]);
+    }
+    free(entries);
+  }
+}

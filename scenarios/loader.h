@@ -1,0 +1,39 @@
+// Internal: scenario files. A scenario is a JSON file naming controllers,
+// their rates and parameters, optional model declarations and plugins; see
+// docs/scenario-format.md. Every error is one line naming the file and the
+// line:column (syntax) or the key (meaning), or the --set that caused it.
+#ifndef TX_SCENARIOS_LOADER_H
+#define TX_SCENARIOS_LOADER_H
+
+#include "../controllers/system.h"
+
+#include <limits.h>
+
+typedef struct tx_scenario {
+  char path[PATH_MAX];      // the file, or a label for text
+  char name[TX_NAME_MAX];
+  char description[256];
+  double duration_s;        // default run length
+  tx_system* system;        // finalized
+} tx_scenario;
+
+typedef struct tx_load_options {
+  const char* const* sets;  // "KEY=VALUE" overrides, applied before checking
+  int nsets;
+  bool allow_plugins;       // false where the text is untrusted (the fuzzer)
+} tx_load_options;
+
+// register the built-in controller classes (idempotent)
+void tx_register_builtin(void);
+// a scenario name from `tactus list`, or a path to a .json file, to a path
+int tx_scenario_locate(const char* name_or_path, char* path, size_t size, char* err, size_t n);
+tx_scenario* tx_scenario_load(const char* path, const tx_load_options* o, char* err, size_t n);
+tx_scenario* tx_scenario_load_text(const char* label, const char* text, size_t len, const tx_load_options* o, char* err,
+                                   size_t n);
+void tx_scenario_free(tx_scenario* s);
+
+// every scenario on the search path: $TACTUS_SCENARIO_PATH (':'-separated), then the source tree
+typedef void (*tx_scenario_visit)(const char* name, const char* path, const char* description, void* user);
+void tx_scenario_list(tx_scenario_visit visit, void* user);
+
+#endif

@@ -1,0 +1,88 @@
+// The run report: per-controller rates, jitter and step times, and warnings.
+#include "report.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <string.h>
+
+static json_t* percentiles_us(tx_percentiles p) {
+  return json_pack("{s:f,s:f,s:f}", "p50", p.p50 * 1e-3, "p99", p.p99 * 1e-3, "max", p.max * 1e-3);
+}
+
+json_t* tx_report_json(const tx_report* r) {
+  tx_system* s = r->system;
+  json_t* controllers = json_array();
+  for (int i = 0; i < tx_system_count(s); i++) {
+    tx_controller_stats st = tx_system_stats(s, i);
+    char thread[16];
+    snprintf(thread, sizeof thread, "t%d", tx_system_thread(s, i));
+    json_array_append_new(controllers,
+                          json_pack("{s:s,s:s,s:s,s:f,s:f,s:I,s:I,s:o,s:o}", "name", tx_system_name(s, i), "type",
+                                    tx_system_class(s, i)->type, "thread", thread, "target_hz", tx_system_rate(s, i),
+                                    "achieved_hz", st.achieved_hz, "steps", (json_int_t)st.steps, "missed",
+                                    (json_int_t)st.missed, "jitter_us", percentiles_us(st.jitter_ns), "step_us",
+                                    percentiles_us(st.step_ns)));
+  }
+  json_t* warnings = json_object();
+  for (int w = 0; w < tx_system_warnings(s); w++)
+    json_object_set_new(warnings, tx_system_warning_key(s, w), json_integer((json_int_t)tx_system_warning_count(s, w)));
+  if (!r->lockstep && !r->result->fifo) json_object_set_new(warnings, "scheduler.no_sched_fifo", json_integer(1));
+  if (!r->lockstep && !r->result->pinned) json_object_set_new(warnings, "scheduler.not_pinned", json_integer(1));
+
+  json_t* report = json_pack("{s:s,s:s,s:f,s:o,s:o,s:s}", "scenario", r->scenario, "mode",
+                             r->lockstep ? "lockstep" : "realtime", "duration_s", r->result->duration_s,
+                             "controllers", controllers, "warnings", warnings, "scheduler", r->result->scheduler);
+  if (r->lockstep) {
+    char hash[17];
+    snprintf(hash, sizeof hash, "%016llx", (unsigned long long)r->result->trace_hash);
+    json_object_set_new(report, "trace_hash", json_string(hash));
+  }
+  if (r->result->stopped_early) json_object_set_new(report, "stopped_early", json_true());
+  return report;
+}
+
+int tx_report_save(const json_t* json, const char* dir, const char* name, char* err, size_t n) {
+  char path[4096], tmp[4200];
+  snprintf(path, sizeof path, "%s/%s", dir, name);
+  snprintf(tmp, sizeof tmp, "%s.tmp", path);
+  if (json_dump_file(json, tmp, JSON_INDENT(2) | JSON_REAL_PRECISION(10)) != 0 || rename(tmp, path) != 0) {
+    snprintf(err, n, "%s: %s", path, strerror(errno ? errno : EIO));
+    remove(tmp);
+    return -1;
+  }
+  return 0;
+}
+
+static double num(const json_t* o, const char* a, const char* b) {
+  const json_t* v = json_object_get(o, a);
+  if (b) v = json_object_get(v, b);
+  return json_number_value(v);
+}
+
+void tx_report_print(FILE* f, const json_t* report) {
+  fprintf(f, "%s: %s, %.2f s; %s\n", json_string_value(json_object_get(report, "scenario")),
+          json_string_value(json_object_get(report, "mode")), num(report, "duration_s", NULL),
+          json_string_value(json_object_get(report, "scheduler")));
+  fprintf(f, "%-14s %-6s %10s %12s %9s %7s  %-26s %-26s\n", "controller", "thread", "target Hz", "achieved Hz",
+          "steps", "missed", "jitter us p50/p99/max", "step us p50/p99/max");
+  size_t i;
+  json_t* c;
+  json_array_foreach(json_object_get(report, "controllers"), i, c) {
+    char jit[40], stp[40];
+    snprintf(jit, sizeof jit, "%.1f/%.1f/%.1f", num(c, "jitter_us", "p50"), num(c, "jitter_us", "p99"),
+             num(c, "jitter_us", "max"));
+    snprintf(stp, sizeof stp, "%.1f/%.1f/%.1f", num(c, "step_us", "p50"), num(c, "step_us", "p99"),
+             num(c, "step_us", "max"));
+    fprintf(f, "%-14s %-6s %10.1f %12.3f %9.0f %7.0f  %-26s %-26s\n", json_string_value(json_object_get(c, "name")),
+            json_string_value(json_object_get(c, "thread")), num(c, "target_hz", NULL), num(c, "achieved_hz", NULL),
+            num(c, "steps", NULL), num(c, "missed", NULL), jit, stp);
+  }
+  const char* key;
+  json_t* v;
+  int shown = 0;
+  json_object_foreach(json_object_get(report, "warnings"), key, v) {
+    if (json_integer_value(v) == 0) continue;
+    fprintf(f, "%s %s=%lld", shown++ ? "," : "warnings:", key, (long long)json_integer_value(v));
+  }
+  fprintf(f, "%s\n", shown ? "" : "warnings: none");
+}

@@ -1,0 +1,23 @@
+// Internal: the run report, as OUT/report.json and as a table on a terminal.
+#ifndef TX_VIEWS_REPORT_H
+#define TX_VIEWS_REPORT_H
+
+#include "../controllers/system.h"
+
+#include <jansson.h>
+
+typedef struct tx_report {
+  const char* scenario;
+  bool lockstep;
+  const tx_run_result* result;
+  tx_system* system;
+} tx_report;
+
+// the report as JSON (new reference): scenario, mode, duration_s, controllers, warnings, scheduler
+json_t* tx_report_json(const tx_report* r);
+// write json to DIR/NAME through a temporary file, so that it is whole or absent
+int tx_report_save(const json_t* json, const char* dir, const char* name, char* err, size_t n);
+// the summary table of a report made by tx_report_json
+void tx_report_print(FILE* f, const json_t* report);
+
+#endif
