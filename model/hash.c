@@ -14,5 +14,5 @@ uint64_t tx_hash(uint64_t h, const void* data, size_t n) {
     h = (h ^ w) * prime;
   }
   for (; n; p++, n--) h = (h ^ *p) * prime;
-  return h ^ (h >> 29); // fold the high bits down: low bits of a word product see little
+  return h;
 }

@@ -128,7 +128,8 @@ tx_comp tx_model_add(tx_model* m, const tx_component_def* def) {
   if (strlen(units) >= TX_UNITS_MAX) return tx_set_error("%s: units '%s' too long", def->name, units), none;
 
   component** grown = realloc(m->comps, (m->count + 1) * sizeof *grown);
-  component* c = calloc(1, sizeof *c);
+  component* c = aligned_alloc(CACHE_LINE, sizeof *c); // it holds cache-line aligned atomics
+  if (c) memset(c, 0, sizeof *c);
   if (!grown || !c) {
     if (grown) m->comps = grown;
     free(c);
@@ -149,6 +150,7 @@ tx_reader tx_model_add_reader(tx_model* m, tx_comp id) {
   component* c = get(m, id);
   if (!c) return tx_set_error("no such component"), (tx_reader){0};
   if (m->committed) return tx_set_error("%s: the model is already committed", c->name), (tx_reader){0};
+  if (c->readers == TX_READERS_MAX) return tx_set_error("%s: more than %d readers", c->name, TX_READERS_MAX), (tx_reader){0};
   reader_slot* grown = realloc(m->readers, (m->reader_count + 1) * sizeof *grown);
   if (!grown) return tx_set_error("%s: out of memory", c->name), (tx_reader){0};
   m->readers = grown;
@@ -220,16 +222,19 @@ uint64_t tx_model_publish(tx_model* m, tx_comp id, int64_t sim_ns) {
   *h = (header){++c->seq, sim_ns, tx_mono_ns(), c->next_rows};
   uint32_t published = c->back;
   atomic_store(&c->latest, published);
-  // next back buffer: neither latest nor announced by a reader
-  for (uint32_t b = 0; b < c->buffers; b++) {
-    if (b == published) continue;
-    bool held = false;
-    for (uint32_t r = 0; r < c->readers && !held; r++) held = atomic_load(&c->hazards[r].buffer) == b;
-    if (!held) {
-      c->back = b;
-      break;
-    }
+  // next back buffer: neither latest nor announced by a reader. Each hazard is
+  // read once: re-reading per candidate would let one reader that moves its
+  // slot during the scan block several buffers, and leave none free.
+  // With R readers, R + 2 buffers and one value per slot, one is always free.
+  bool held[TX_READERS_MAX + 2] = {false};
+  for (uint32_t r = 0; r < c->readers; r++) {
+    uint32_t b = atomic_load(&c->hazards[r].buffer);
+    if (b < c->buffers) held[b] = true;
   }
+  held[published] = true;
+  uint32_t b = 0;
+  while (held[b]) b++;
+  c->back = b;
   return c->seq;
 }
 

@@ -31,6 +31,7 @@ extern "C" {
 
 #define TX_NAME_MAX 64  // longest component or controller name, with its NUL
 #define TX_UNITS_MAX 16 // longest units string, with its NUL
+#define TX_READERS_MAX 62 // readers of one component
 
 typedef enum tx_type { TX_F32 = 1, TX_F64, TX_I32, TX_U32, TX_U8 } tx_type;
 
