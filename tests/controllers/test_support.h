@@ -1,0 +1,51 @@
+// Test controllers shared by the controller tests: a counter that writes its
+// step count and a recorder that logs the order of steps.
+#ifndef TX_TESTS_CONTROLLERS_SUPPORT_H
+#define TX_TESTS_CONTROLLERS_SUPPORT_H
+
+#include <tactus/controller.h>
+
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct counter {
+  tx_port out, in;
+  double gain;
+  double seen; // last value read from "in"
+} counter;
+
+// params: "write" (component), "read" (component, optional), "gain"
+static int counter_configure(tx_setup* s, void** self) {
+  counter* c = calloc(1, sizeof *c);
+  *self = c;
+  c->gain = tx_param_num(s, "gain", 1, -1e6, 1e6);
+  const char* out = tx_param_str(s, "write", NULL);
+  const char* in = tx_param_str(s, "read", NULL);
+  if (out) c->out = tx_setup_write(s, &(tx_component_def){out, TX_F64, 1, 2, "1"});
+  if (in) c->in = tx_setup_read(s, in);
+  return 0;
+}
+
+static void counter_step(tx_ctx* x, void* self) {
+  counter* c = self;
+  if (c->in.id) {
+    tx_snapshot s = tx_read(x, c->in);
+    c->seen = ((const double*)s.data)[0];
+  }
+  if (c->out.id) {
+    double* v = tx_write(x, c->out);
+    v[0] = c->gain * (double)(tx_step_index(x) + 1) + 0.5 * c->seen;
+    v[1] = (double)tx_sim_ns(x) * 1e-9;
+  }
+}
+
+static void counter_fini(void* self) { free(self); }
+
+static const tx_controller_class test_counter = {"test.counter", "counts steps", counter_configure, NULL, counter_step,
+                                                 counter_fini};
+
+static inline void register_test_classes(void) {
+  if (!tx_find_controller("test.counter")) tx_register_controller(&test_counter);
+}
+
+#endif

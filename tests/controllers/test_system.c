@@ -1,0 +1,173 @@
+// Controller systems: the checks the loader relies on, parameters, warnings.
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include "controllers/system.h"
+#include "test_support.h"
+
+#include <math.h>
+
+static json_t* params(const char* text) {
+  json_t* p = json_loads(text, 0, NULL);
+  assert_non_null(p);
+  return p;
+}
+
+// add one instance with params text; returns the fault (rc in *rc)
+static tx_fault add(tx_system* s, const char* name, double rate, const char* p, int* rc) {
+  tx_fault f = {0};
+  json_t* js = p ? params(p) : NULL;
+  *rc = tx_system_add(s, name, "test.counter", rate, js, &f);
+  json_decref(js);
+  return f;
+}
+
+static void rates_out_of_range_are_rejected(void** state) {
+  (void)state;
+  const double bad[] = {0, -1, 100000.5, 1e9, NAN, INFINITY};
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    tx_system* s = tx_system_create();
+    int rc;
+    tx_fault f = add(s, "c", bad[i], NULL, &rc);
+    assert_int_equal(rc, -1);
+    assert_string_equal(f.key, "rate_hz");
+    tx_system_destroy(s);
+  }
+  tx_system* s = tx_system_create();
+  int rc;
+  add(s, "fastest", TX_RATE_MAX_HZ, NULL, &rc);
+  assert_int_equal(rc, 0);
+  tx_system_destroy(s);
+}
+
+static void two_writers_are_rejected(void** state) {
+  (void)state;
+  tx_system* s = tx_system_create();
+  int rc;
+  add(s, "a", 10, "{\"write\":\"x\"}", &rc);
+  add(s, "b", 20, "{\"write\":\"x\"}", &rc);
+  assert_int_equal(rc, 0); // each instance alone is fine
+  tx_fault f;
+  assert_int_equal(tx_system_finalize(s, &f), -1);
+  assert_non_null(strstr(f.message, "two writers"));
+  tx_system_destroy(s);
+}
+
+static void unknown_and_unwritten_reads_are_rejected(void** state) {
+  (void)state;
+  tx_system* s = tx_system_create();
+  int rc;
+  add(s, "a", 10, "{\"read\":\"nowhere\"}", &rc);
+  tx_fault f;
+  assert_int_equal(tx_system_finalize(s, &f), -1);
+  assert_string_equal(f.key, "a");
+  assert_non_null(strstr(f.message, "unknown component 'nowhere'"));
+  tx_system_destroy(s);
+
+  // declared in the model, but nobody writes it
+  s = tx_system_create();
+  assert_int_equal(tx_system_declare(s, &(tx_component_def){"declared", TX_F64, 1, 2, "1"}, &f), 0);
+  add(s, "a", 10, "{\"read\":\"declared\"}", &rc);
+  assert_int_equal(tx_system_finalize(s, &f), -1);
+  assert_non_null(strstr(f.message, "no controller writes"));
+  tx_system_destroy(s);
+}
+
+static void declared_schema_must_match(void** state) {
+  (void)state;
+  tx_system* s = tx_system_create();
+  tx_fault f;
+  assert_int_equal(tx_system_declare(s, &(tx_component_def){"x", TX_F32, 1, 2, "1"}, &f), 0);
+  assert_int_equal(tx_system_declare(s, &(tx_component_def){"x", TX_F32, 1, 2, "1"}, &f), -1);
+  int rc;
+  add(s, "a", 10, "{\"write\":\"x\"}", &rc); // writes f64, declared f32
+  assert_int_equal(tx_system_finalize(s, &f), -1);
+  assert_non_null(strstr(f.message, "declares"));
+  tx_system_destroy(s);
+}
+
+static void parameters_are_checked(void** state) {
+  (void)state;
+  const struct {
+    const char* params;
+    const char* key;
+  } bad[] = {
+      {"{\"gain\":\"high\"}", "params.gain"},  // wrong type
+      {"{\"gain\":1e7}", "params.gain"},       // out of range
+      {"{\"write\":5}", "params.write"},       // wrong type
+      {"{\"gian\":1}", "params.gian"},         // unknown
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    tx_system* s = tx_system_create();
+    int rc;
+    tx_fault f = add(s, "a", 10, bad[i].params, &rc);
+    assert_int_equal(rc, -1);
+    assert_string_equal(f.key, bad[i].key);
+    assert_true(strlen(f.message) > 0);
+    tx_system_destroy(s);
+  }
+}
+
+static void names_and_types_are_checked(void** state) {
+  (void)state;
+  tx_system* s = tx_system_create();
+  tx_fault f;
+  assert_int_equal(tx_system_add(s, "Bad Name", "test.counter", 10, NULL, &f), -1);
+  assert_string_equal(f.key, "name");
+  assert_int_equal(tx_system_add(s, "a", "no.such.type", 10, NULL, &f), -1);
+  assert_string_equal(f.key, "type");
+  assert_int_equal(tx_system_add(s, "a", "test.counter", 10, NULL, &f), 0);
+  assert_int_equal(tx_system_add(s, "a", "test.counter", 10, NULL, &f), -1); // same name twice
+  json_t* notobj = json_integer(3);
+  assert_int_equal(tx_system_add(s, "b", "test.counter", 10, notobj, &f), -1);
+  assert_string_equal(f.key, "params");
+  json_decref(notobj);
+  tx_system_destroy(s);
+  s = tx_system_create();
+  assert_int_equal(tx_system_finalize(s, &f), -1); // no controllers
+  tx_system_destroy(s);
+}
+
+static void registry_rejects_bad_classes(void** state) {
+  (void)state;
+  assert_int_equal(tx_register_controller(NULL), -1);
+  tx_controller_class no_step = {"test.nostep", "", counter_configure, NULL, NULL, NULL};
+  assert_int_equal(tx_register_controller(&no_step), -1);
+  assert_int_equal(tx_register_controller(&test_counter), -1); // taken
+  assert_null(tx_find_controller("test.nostep"));
+}
+
+static void groups_follow_rates_fastest_first(void** state) {
+  (void)state;
+  tx_system* s = tx_system_create();
+  int rc;
+  add(s, "slow", 20, NULL, &rc);
+  add(s, "fast", 4000, NULL, &rc);
+  add(s, "mid", 1000, NULL, &rc);
+  add(s, "slow2", 20, NULL, &rc);
+  tx_fault f;
+  assert_int_equal(tx_system_finalize(s, &f), 0);
+  assert_int_equal(tx_system_threads(s), 3);
+  assert_int_equal(tx_system_thread(s, 1), 0);
+  assert_int_equal(tx_system_thread(s, 2), 1);
+  assert_int_equal(tx_system_thread(s, 0), 2);
+  assert_int_equal(tx_system_thread(s, 3), 2);
+  tx_system_destroy(s);
+}
+
+int main(void) {
+  register_test_classes();
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(rates_out_of_range_are_rejected),
+      cmocka_unit_test(two_writers_are_rejected),
+      cmocka_unit_test(unknown_and_unwritten_reads_are_rejected),
+      cmocka_unit_test(declared_schema_must_match),
+      cmocka_unit_test(parameters_are_checked),
+      cmocka_unit_test(names_and_types_are_checked),
+      cmocka_unit_test(registry_rejects_bad_classes),
+      cmocka_unit_test(groups_follow_rates_fastest_first),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
