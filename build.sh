@@ -1,0 +1,83 @@
+#!/usr/bin/env bash
+# The two ways in, as the README gives them:
+#   ./build.sh run    install what is missing, build, run the default scenario headless
+#   ./build.sh test   install what is missing, build every variant CI checks, run every test
+# Other targets: build (Release only), quick (Release build + its tests).
+set -euo pipefail
+cd "$(dirname "$0")"
+
+jobs=$(nproc 2>/dev/null || echo 2)
+default_scenario=rates
+fuzz_seconds=${TX_FUZZ_SECONDS:-60}
+
+say() { printf '\n== %s\n' "$*" >&2; }
+
+# configure and build one variant: build_variant DIR [cmake args...]
+build_variant() {
+  local dir=$1; shift
+  cmake -S . -B "$dir" -DTX_WERROR=ON "$@" >/dev/null
+  cmake --build "$dir" -j"$jobs" >/dev/null
+}
+
+# run a variant's tests: test_variant DIR [ctest args...]
+test_variant() {
+  local dir=$1; shift
+  ctest --test-dir "$dir" --output-on-failure -j"$jobs" "$@"
+}
+
+tsan() {
+  # ThreadSanitizer needs a fixed address layout on kernels with many ASLR bits
+  if setarch "$(uname -m)" -R true 2>/dev/null; then setarch "$(uname -m)" -R "$@"; else "$@"; fi
+}
+
+target=${1:-}
+case "$target" in
+  run)
+    tools/install-deps.sh
+    say "build (Release)"
+    build_variant build -DCMAKE_BUILD_TYPE=Release
+    say "run $default_scenario (headless)"
+    ./build/tactus run "$default_scenario" "${@:2}"
+    ;;
+  build)
+    tools/install-deps.sh
+    build_variant build -DCMAKE_BUILD_TYPE=Release
+    ;;
+  quick)
+    tools/install-deps.sh
+    build_variant build -DCMAKE_BUILD_TYPE=Release
+    test_variant build
+    ;;
+  test)
+    tools/install-deps.sh
+    start=$(date +%s)
+    say "Release: build and test"
+    build_variant build -DCMAKE_BUILD_TYPE=Release
+    test_variant build
+
+    say "Debug + AddressSanitizer + UndefinedBehaviorSanitizer: build and test"
+    build_variant build-asan -DCMAKE_BUILD_TYPE=Debug -DTX_SANITIZE=address,undefined
+    ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 test_variant build-asan
+
+    say "ThreadSanitizer: the model and scheduler tests"
+    build_variant build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTX_SANITIZE=thread
+    TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" tsan ctest --test-dir build-tsan --output-on-failure -L tsan
+
+    say "core only: every optional part off"
+    build_variant build-core -DCMAKE_BUILD_TYPE=Release -DTX_WITH_BULLET=OFF -DTX_WITH_ODE=OFF \
+      -DTX_WITH_OSMESA=OFF -DTX_WITH_GLFW=OFF -DTX_WITH_DDS=OFF
+    test_variant build-core
+
+    say "libFuzzer: the scenario loader for ${fuzz_seconds} s"
+    CC=clang build_variant build-fuzz -DCMAKE_BUILD_TYPE=Debug -DTX_FUZZ=ON -DTX_SANITIZE=address,undefined \
+      -DTX_FUZZ_SECONDS="$fuzz_seconds"
+    test_variant build-fuzz -R fuzz
+
+    say "all variants passed in $(( $(date +%s) - start )) s"
+    ;;
+  *)
+    sed -n '2,6p' "$0" | sed 's/^# \{0,1\}//'
+    [ "$target" = "-h" ] || [ "$target" = "--help" ] && exit 0
+    exit 2
+    ;;
+esac
