@@ -1,0 +1,176 @@
+#!/usr/bin/env bash
+# Bad input to the tactus command: for each case, exit status 2 and one line on
+# stderr naming the file or the option, within 20 s, no crash. Then good input,
+# which must write a whole report.
+#
+#   test_command_bad_input.sh TACTUS [REPORT_CHECK]
+#
+# REPORT_CHECK (tests/scenarios/report_check.c) checks the report's keys and
+# types; without it a grep for each documented key stands in.
+set -u
+HERE=$(dirname "$(realpath "$0")")
+TACTUS=$(realpath "$1")
+CHECK=${2:-}
+[ -n "$CHECK" ] && CHECK=$(realpath "$CHECK")
+WORK=$(mktemp -d)
+trap 'rm -rf "$WORK"' EXIT
+# no core files from a crash end up beside the sources
+cd "$WORK" || exit 1
+# scenarios are looked up in the source tree only, whatever the caller's environment says
+unset TACTUS_SCENARIO_PATH
+. "$HERE/bad_input_lib.sh" || exit 1
+
+S=$WORK/scenarios
+mkdir -p "$S"
+worker() { # NAME RATE [PARAMS]
+  printf '{"name": "%s", "type": "rates.worker", "rate_hz": %s, "params": {%s}}' "$1" "$2" "${3:-}"
+}
+scenario() { # FILE CONTROLLER... : a scenario named t
+  local file=$1
+  shift
+  local list
+  list=$(IFS=,; echo "$*")
+  printf '{\n  "name": "t",\n  "controllers": [%s]\n}\n' "$list" >"$S/$file"
+}
+
+# --- files: syntax -----------------------------------------------------------
+printf '{\n  "name": "t",\n  "controllers": [\n}\n' >"$S/malformed.json"
+expect_bad_re "malformed JSON" "^tactus: $S/malformed.json:4:[0-9]+: " "$S/malformed.json:4:" -- run "$S/malformed.json"
+expect_bad_re "malformed JSON, describe" "malformed.json:4:[0-9]+: " "$S/malformed.json:4:" -- describe "$S/malformed.json"
+printf '{"name": "t",\n "name": "u", "controllers": []}\n' >"$S/duplicate.json"
+expect_bad_re "duplicate key" "duplicate.json:2:[0-9]+: " "$S/duplicate.json:2:" "duplicate" -- run "$S/duplicate.json"
+printf '' >"$S/empty.json"
+expect_bad "empty file" "$S/empty.json:" -- run "$S/empty.json"
+printf '[1, 2]' >"$S/array.json"
+expect_bad "top level not an object" "$S/array.json" "object" -- run "$S/array.json"
+printf '{"name": "t", "controllers": [], "x": "\xff\xfe"}' >"$S/binary.json"
+expect_bad "invalid UTF-8" "$S/binary.json:1:" -- run "$S/binary.json"
+
+printf '{"name": "t", "bo\\ngus": 1, "controllers": []}' >"$S/newline_key.json"
+expect_bad "a key with a newline in it" "$S/newline_key.json" "bo?gus" -- run "$S/newline_key.json"
+
+# --- files: unknown names ----------------------------------------------------
+expect_bad "unknown scenario name" "no_such_scenario" "unknown scenario" -- run no_such_scenario
+expect_bad "unknown scenario name, describe" "no_such_scenario" -- describe no_such_scenario
+expect_bad "missing file" "$S/missing.json" "No such file" -- run "$S/missing.json"
+expect_bad "missing file in a missing folder" "/nonexistent/dir/x.json" -- run /nonexistent/dir/x.json
+expect_bad "a folder, not a file" "$S" "not a regular file" -- run "$S/"
+scenario unknown_type.json '{"name": "a", "type": "no.such", "rate_hz": 10}'
+expect_bad "unknown controller type" "$S/unknown_type.json" "controllers[0].type" "no.such" -- run "$S/unknown_type.json"
+printf '{"name": "t", "bogus": 1, "controllers": [%s]}' "$(worker a 10)" >"$S/unknown_key.json"
+expect_bad "unknown top-level key" "$S/unknown_key.json" "bogus" -- run "$S/unknown_key.json"
+scenario unknown_ckey.json '{"name": "a", "type": "rates.worker", "rate": 10}'
+expect_bad "unknown controller key" "$S/unknown_ckey.json" "controllers[0].rate:" -- run "$S/unknown_ckey.json"
+scenario unknown_param.json "$(worker a 10 '"bogus": 1')"
+expect_bad "unknown parameter" "$S/unknown_param.json" "controllers[0].params.bogus" -- run "$S/unknown_param.json"
+scenario unknown_read.json "$(worker a 10 '"reads": ["t.nope"]')"
+expect_bad "read of an unknown component" "$S/unknown_read.json" "controllers[0]" "t.nope" -- run "$S/unknown_read.json"
+scenario two_writers.json "$(worker a 10 '"write": "t.x"')" "$(worker b 20 '"write": "t.x"')"
+expect_bad "two writers" "$S/two_writers.json" "controllers[1]" "two writers" -- run "$S/two_writers.json"
+
+# --- files: wrong types -------------------------------------------------------
+scenario rate_string.json "$(worker a '"fast"')"
+expect_bad "rate_hz a string" "$S/rate_string.json" "controllers[0].rate_hz" -- run "$S/rate_string.json"
+scenario param_string.json "$(worker a 10 '"work_us": "lots"')"
+expect_bad "work_us a string" "$S/param_string.json" "controllers[0].params.work_us" -- run "$S/param_string.json"
+scenario reads_string.json "$(worker a 10 '"reads": "t.x"')"
+expect_bad "reads not an array" "$S/reads_string.json" "controllers[0].params.reads" -- run "$S/reads_string.json"
+printf '{"name": 5, "controllers": [%s]}' "$(worker a 10)" >"$S/name_number.json"
+expect_bad "name a number" "$S/name_number.json" "name" -- run "$S/name_number.json"
+printf '{"name": "t", "controllers": {}}' >"$S/controllers_object.json"
+expect_bad "controllers an object" "$S/controllers_object.json" "controllers" -- run "$S/controllers_object.json"
+printf '{"name": "t", "duration_s": "long", "controllers": [%s]}' "$(worker a 10)" >"$S/duration_string.json"
+expect_bad "duration_s a string" "$S/duration_string.json" "duration_s" -- run "$S/duration_string.json"
+
+# --- files: out of range ------------------------------------------------------
+for rate in 0 -1 100001 1e300; do
+  scenario "rate_$rate.json" "$(worker a "$rate")"
+  expect_bad "rate_hz $rate" "$S/rate_$rate.json" "controllers[0].rate_hz" "out of range" -- run "$S/rate_$rate.json"
+done
+scenario work_big.json "$(worker a 10 '"work_us": 2e6')"
+expect_bad "work_us too big" "$S/work_big.json" "controllers[0].params.work_us" "out of range" -- run "$S/work_big.json"
+scenario rows_zero.json "$(worker a 10 '"write": "t.x", "rows": 0')"
+expect_bad "rows 0" "$S/rows_zero.json" "controllers[0].params.rows" -- run "$S/rows_zero.json"
+printf '{"name": "t", "duration_s": 0, "controllers": [%s]}' "$(worker a 10)" >"$S/duration_zero.json"
+expect_bad "duration_s 0" "$S/duration_zero.json" "duration_s" -- run "$S/duration_zero.json"
+
+# --- --out ----------------------------------------------------------------------
+GOOD=(rates --lockstep --duration 0.05 --set physics.work_us=0 --set graphics.work_us=0)
+expect_bad "--out under /dev/null" "--out /dev/null/x" -- run "${GOOD[@]}" --out /dev/null/x
+printf 'a regular file\n' >"$WORK/regular"
+expect_bad "--out under a regular file" "--out $WORK/regular/x" -- run "${GOOD[@]}" --out "$WORK/regular/x"
+expect_bad "--out a regular file" "--out $WORK/regular" -- run "${GOOD[@]}" --out "$WORK/regular"
+expect_bad "--out empty" "--out" -- run "${GOOD[@]}" --out ""
+# a failed run leaves nothing behind: no report anywhere it could have gone
+if [ -n "$(find "$WORK" -name report.json -o -name 'report.json.tmp' -o -name trace.csv)" ]; then
+  fail "a run with a bad --out left files: $(find "$WORK" -name 'report.json*' -o -name trace.csv)"
+fi
+[ -f "$WORK/regular" ] || fail "--out under a regular file replaced the file"
+[ -e "$WORK/out" ] && fail "a run with a bad --out made $WORK/out"
+
+# --- --set ----------------------------------------------------------------------
+expect_bad "--set of an unknown controller" "--set nobody.work_us=1" "nobody" -- run "${GOOD[@]}" --set nobody.work_us=1
+expect_bad "--set of an unknown parameter" "--set physics.bogus=1" "unknown parameter" -- run "${GOOD[@]}" --set physics.bogus=1
+expect_bad "--set of an unknown key" "--set bogus=1" -- run "${GOOD[@]}" --set bogus=1
+expect_bad "--set without '='" "--set physics" "KEY=VALUE" -- run "${GOOD[@]}" --set physics
+expect_bad "--set with an empty key" "--set =5" -- run "${GOOD[@]}" --set =5
+expect_bad "--set rate_hz out of range" "--set physics.rate_hz=0" "out of range" -- run "${GOOD[@]}" --set physics.rate_hz=0
+expect_bad "--set rate_hz too high" "--set haptics.rate_hz=100001" -- run "${GOOD[@]}" --set haptics.rate_hz=100001
+expect_bad "--set param out of range" "--set physics.work_us=-1" -- run "${GOOD[@]}" --set physics.work_us=-1
+expect_bad "--set param of the wrong type" "--set physics.rows=many" -- run "${GOOD[@]}" --set physics.rows=many
+expect_bad "--set duration_s bad" "--set duration_s=abc" -- run "${GOOD[@]}" --set duration_s=abc
+expect_bad "--set without a value" "--set" -- run rates --set
+
+# --- other options ----------------------------------------------------------------
+for d in 0 -1 abc nan inf 1e9 ""; do
+  expect_bad "--duration '$d'" "--duration $d" -- run rates --lockstep --duration "$d"
+done
+expect_bad "--duration without a value" "--duration" -- run rates --duration
+expect_bad "unknown subcommand" "bogus" -- bogus
+expect_bad "no command at all" "expected a command" --
+expect_bad "a newline in an argument" "no?such" -- run "$(printf 'no\nsuch')"
+expect_bad "a newline in a --set" "--set a?b=1" -- run rates --set "$(printf 'a\nb=1')"
+expect_bad "unknown option" "--bogus" -- run rates --bogus
+expect_bad "unknown short option" "'-x'" -- run -x rates
+expect_bad "unknown short options in a group" "'-x'" -- run -xy rates
+expect_bad "bench unknown short option" "'-x'" -- bench -xy rates
+expect_bad "unexpected argument" "extra" -- run rates extra
+expect_bad "run without a scenario" "SCENARIO" -- run --lockstep
+expect_bad "--view bogus" "--view bogus" -- run rates --view bogus
+expect_bad "--stereo bogus" "--stereo bogus" -- run rates --stereo bogus
+expect_bad "--device bogus" "--device bogus" -- run rates --device bogus
+expect_bad "bench unknown name" "bogus" -- bench bogus
+expect_bad "bench unknown option" "--bogus" -- bench rates --bogus
+expect_bad "bench --duration bad" "--duration" -- bench rates --duration abc
+expect_bad "study unknown name" "bogus" -- study bogus
+expect_bad "bench without a name" "bench" "NAME" -- bench
+expect_bad "study without a name" "study" "NAME" -- study
+expect_bad "describe with two names" "describe" -- describe rates rates
+expect_bad "list with an argument" "list" -- list extra
+
+# --- good input -------------------------------------------------------------------
+OUT=$WORK/good/run
+rc=0
+timeout 20 "$TACTUS" run rates --lockstep --duration 0.2 --set physics.work_us=0 --set graphics.work_us=0 --out "$OUT" \
+  >"$WORK/stdout" 2>"$WORK/stderr" || rc=$?
+cases=$((cases + 1))
+if [ "$rc" -ne 0 ]; then
+  fail "good run: exit status $rc: $(head -n 1 "$WORK/stderr")"
+elif [ ! -s "$OUT/report.json" ]; then
+  fail "good run: no $OUT/report.json"
+else
+  [ -s "$WORK/stderr" ] && fail "good run: wrote to stderr: $(head -n 1 "$WORK/stderr")"
+  [ -s "$OUT/trace.csv" ] || fail "good run: --lockstep wrote no trace.csv"
+  [ -e "$OUT/report.json.tmp" ] && fail "good run: left report.json.tmp"
+  if [ -n "$CHECK" ]; then
+    "$CHECK" "$OUT/report.json" steps physics 4 collision 800 haptics 200 graphics 6 || fail "good run: report_check failed"
+  else
+    for key in scenario mode duration_s controllers name thread target_hz achieved_hz steps missed jitter_us step_us \
+      p50 p99 max warnings; do
+      grep -q "\"$key\":" "$OUT/report.json" || fail "good run: report.json has no \"$key\""
+    done
+  fi
+  grep -q '"mode": "lockstep"' "$OUT/report.json" || fail "good run: report.json is not a lockstep report"
+fi
+
+finish
