@@ -53,7 +53,7 @@ typedef struct tx_run_options {
 
 typedef struct tx_run_result {
   double duration_s;      // simulated (lockstep) or measured (real time)
-  uint64_t trace_hash;    // lockstep: FNV-1a of every publish, in order
+  uint64_t trace_hash;    // lockstep: tx_hash of every publish, in order
   bool stopped_early;     // progress returned false
   char scheduler[256];    // how the threads were scheduled, and any fallback
   bool fifo;              // SCHED_FIFO was in effect on every thread

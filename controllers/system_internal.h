@@ -74,7 +74,7 @@ struct tx_system {
   int nwarnings;
   bool tracing;        // lockstep: hash every publish
   FILE* trace;         // and write it here, if not NULL
-  uint64_t trace_hash; // FNV-1a over every publish, in order
+  uint64_t trace_hash; // tx_hash over every publish, in order
 };
 
 // nominal start of tick k of a group, ns from the run's start

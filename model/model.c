@@ -37,7 +37,8 @@ typedef struct component {
   size_t stride;                 // bytes per buffer, header included
   uint32_t readers;              // hazard slots
   uint32_t buffers;              // readers + 2
-  unsigned char* memory;         // buffers x stride
+  unsigned char* memory;         // buffers x stride, cache-line aligned
+  void* allocation;              // what memory was carved from
   hazard* hazards;               // readers
   _Alignas(CACHE_LINE) _Atomic uint32_t latest;
   _Alignas(CACHE_LINE) uint32_t back; // writer-private from here on
@@ -93,7 +94,7 @@ tx_model* tx_model_create(void) { return calloc(1, sizeof(tx_model)); }
 void tx_model_destroy(tx_model* m) {
   if (!m) return;
   for (uint32_t i = 0; i < m->count; i++) {
-    free(m->comps[i]->memory);
+    free(m->comps[i]->allocation);
     free(m->comps[i]->hazards);
     free(m->comps[i]);
   }
@@ -123,7 +124,9 @@ tx_comp tx_model_add(tx_model* m, const tx_component_def* def) {
   if (!tx_type_size(def->type)) return tx_set_error("%s: unknown element type %d", def->name, (int)def->type), none;
   if (def->rows == 0 || def->cols == 0) return tx_set_error("%s: rows and cols must be at least 1", def->name), none;
   uint64_t bytes = (uint64_t)def->rows * def->cols * tx_type_size(def->type);
-  if (bytes > (1ull << 32)) return tx_set_error("%s: %llu bytes is larger than 4 GiB", def->name, (unsigned long long)bytes), none;
+  if (bytes > TX_COMPONENT_BYTES_MAX)
+    return tx_set_error("%s: %ux%u %s is %llu MiB, more than the %u MiB a component may hold", def->name, def->rows,
+                        def->cols, tx_type_name(def->type), (unsigned long long)(bytes >> 20), TX_COMPONENT_BYTES_MAX >> 20), none;
   const char* units = def->units ? def->units : "1";
   if (strlen(units) >= TX_UNITS_MAX) return tx_set_error("%s: units '%s' too long", def->name, units), none;
 
@@ -164,14 +167,23 @@ static void* buffer_data(const component* c, uint32_t b) { return c->memory + (s
 bool tx_model_commit(tx_model* m) {
   if (!m) return tx_set_error("no model"), false;
   if (m->committed) return true;
+  uint64_t total = 0;
   for (uint32_t i = 0; i < m->count; i++) {
     component* c = m->comps[i];
     c->buffers = c->readers + 2;
     c->stride = header_size() + (c->bytes + CACHE_LINE - 1) / CACHE_LINE * CACHE_LINE;
-    c->memory = aligned_alloc(CACHE_LINE, c->stride * c->buffers);
+    total += (uint64_t)c->stride * c->buffers;
+  }
+  if (total > TX_MODEL_BYTES_MAX)
+    return tx_set_error("the model's buffers would take %llu MiB, more than %llu MiB", (unsigned long long)(total >> 20),
+                        (unsigned long long)(TX_MODEL_BYTES_MAX >> 20)), false;
+  for (uint32_t i = 0; i < m->count; i++) {
+    component* c = m->comps[i];
+    // calloc leaves large zeroed blocks untouched until used; align by hand
+    c->allocation = calloc(1, c->stride * c->buffers + CACHE_LINE);
+    c->memory = (unsigned char*)(((uintptr_t)c->allocation + CACHE_LINE - 1) / CACHE_LINE * CACHE_LINE);
     c->hazards = c->readers ? aligned_alloc(CACHE_LINE, sizeof(hazard) * c->readers) : NULL;
-    if (!c->memory || (c->readers && !c->hazards)) return tx_set_error("%s: out of memory", c->name), false;
-    memset(c->memory, 0, c->stride * c->buffers);
+    if (!c->allocation || (c->readers && !c->hazards)) return tx_set_error("%s: out of memory", c->name), false;
     for (uint32_t r = 0; r < c->readers; r++) atomic_init(&c->hazards[r].buffer, NO_BUFFER);
     for (uint32_t b = 0; b < c->buffers; b++) buffer_header(c, b)->rows = c->def.rows;
     atomic_init(&c->latest, 0);

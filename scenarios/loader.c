@@ -22,6 +22,9 @@ static int fail(char* err, size_t n, const char* fmt, ...) {
   va_start(ap, fmt);
   vsnprintf(err, n, fmt, ap);
   va_end(ap);
+  // keys and values from the file are quoted in messages: keep the message one line
+  for (char* c = err; n && *c; c++)
+    if ((unsigned char)*c < 0x20 || *c == 0x7f) *c = '?';
   return -1;
 }
 
@@ -81,6 +84,11 @@ static int apply_sets(const char* file, json_t* root, const tx_load_options* o, 
         json_decref(value);
         return fail(err, n, "--set %s: unknown key '%s' (use duration_s or CONTROLLER.PARAM)", text, key);
       }
+      // checked here, so that a bad value names the --set rather than the file
+      if (!json_is_number(value) || !(json_number_value(value) > 0 && json_number_value(value) <= 86400)) {
+        json_decref(value);
+        return fail(err, n, "--set %s: expected a number in (0, 86400]", text);
+      }
       json_object_set_new(root, key, value);
       continue;
     }
@@ -96,6 +104,7 @@ static int apply_sets(const char* file, json_t* root, const tx_load_options* o, 
     }
     if (found < 0 || !*param) {
       json_decref(value);
+      if (!*param) return fail(err, n, "--set %s: expected CONTROLLER.PARAM=VALUE", text);
       return fail(err, n, "--set %s: no controller named '%s' in %s", text, key, file);
     }
     c = json_array_get(controllers, found);
@@ -119,8 +128,13 @@ static int apply_sets(const char* file, json_t* root, const tx_load_options* o, 
   return 0;
 }
 
-// plugin libraries stay loaded for the life of the process: their classes live there
-static char loaded_plugins[32][PATH_MAX];
+// plugin libraries stay loaded for the life of the process: their classes live
+// there, even those of a plugin that failed half-way, which is not run again
+typedef struct loaded_plugin {
+  char path[PATH_MAX];
+  char failure[256]; // "" when it registered
+} loaded_plugin;
+static loaded_plugin loaded_plugins[32];
 static int nloaded_plugins;
 
 static int load_plugins(const char* file, const char* dir, json_t* plugins, const tx_load_options* o, char* err, size_t n) {
@@ -135,8 +149,10 @@ static int load_plugins(const char* file, const char* dir, json_t* plugins, cons
     const char* name = json_string_value(p);
     snprintf(path, sizeof path, "%s%s%s", name[0] == '/' ? "" : dir, name[0] == '/' ? "" : "/", name);
     if (!realpath(path, real)) return fail(err, n, "%s: plugins[%zu]: %s: %s", file, i, path, strerror(errno));
-    bool seen = false;
-    for (int k = 0; k < nloaded_plugins && !seen; k++) seen = strcmp(loaded_plugins[k], real) == 0;
+    const loaded_plugin* seen = NULL;
+    for (int k = 0; k < nloaded_plugins && !seen; k++)
+      if (strcmp(loaded_plugins[k].path, real) == 0) seen = &loaded_plugins[k];
+    if (seen && *seen->failure) return fail(err, n, "%s: plugins[%zu]: %s refused to register: %s", file, i, real, seen->failure);
     if (seen) continue;
     if (nloaded_plugins == 32) return fail(err, n, "%s: plugins[%zu]: more than 32 plugins", file, i);
     void* lib = dlopen(real, RTLD_NOW | RTLD_LOCAL);
@@ -146,9 +162,12 @@ static int load_plugins(const char* file, const char* dir, json_t* plugins, cons
       dlclose(lib);
       return fail(err, n, "%s: plugins[%zu]: %s has no tx_plugin_register", file, i, real);
     }
-    if (entry(TX_API_VERSION) != 0)
-      return fail(err, n, "%s: plugins[%zu]: %s refused to register: %s", file, i, real, tx_error());
-    strcpy(loaded_plugins[nloaded_plugins++], real);
+    loaded_plugin* lp = &loaded_plugins[nloaded_plugins++];
+    strcpy(lp->path, real);
+    if (entry(TX_API_VERSION) != 0) {
+      snprintf(lp->failure, sizeof lp->failure, "%s", *tx_error() ? tx_error() : "it returned an error");
+      return fail(err, n, "%s: plugins[%zu]: %s refused to register: %s", file, i, real, lp->failure);
+    }
   }
   return 0;
 }
@@ -203,7 +222,7 @@ static int add_controllers(const char* file, tx_system* sys, json_t* list, const
     else rc = tx_system_add(sys, json_string_value(name), json_string_value(type), json_number_value(rate),
                             json_object_get(c, "params"), &f);
     if (rc == 0) continue;
-    for (int k = 0; k < norigins; k++)
+    for (int k = norigins - 1; k >= 0; k--) // the last --set of a key is the one in effect
       if (origins[k].controller == (int)i && strcmp(origins[k].key, f.key) == 0)
         return fail(err, n, "--set %s: %s", origins[k].text, f.message);
     return fail(err, n, "%s: %s%s%s: %s", file, where, *f.key ? "." : "", f.key, f.message);
@@ -224,8 +243,11 @@ static tx_scenario* load_root(const char* file, const char* dir, json_t* root, c
 
   json_t *name = json_object_get(root, "name"), *desc = json_object_get(root, "description"),
          *duration = json_object_get(root, "duration_s");
-  if (!json_is_string(name) || !*json_string_value(name) || strlen(json_string_value(name)) >= TX_NAME_MAX)
-    return fail(err, n, "%s: name: expected a non-empty string", file), NULL;
+  // the name becomes part of the default output folder: keep it a plain file name
+  const char* nm = json_is_string(name) ? json_string_value(name) : "";
+  bool plain = *nm && strlen(nm) < TX_NAME_MAX;
+  for (const char* c = nm; *c && plain; c++) plain = (*c >= 'a' && *c <= 'z') || (*c >= '0' && *c <= '9') || *c == '_' || *c == '-';
+  if (!plain) return fail(err, n, "%s: name: expected 1-%d characters of a-z 0-9 _ -", file, TX_NAME_MAX - 1), NULL;
   if (desc && !json_is_string(desc)) return fail(err, n, "%s: description: expected a string", file), NULL;
   double seconds = 10;
   if (duration) {

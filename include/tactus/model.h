@@ -32,6 +32,8 @@ extern "C" {
 #define TX_NAME_MAX 64  // longest component or controller name, with its NUL
 #define TX_UNITS_MAX 16 // longest units string, with its NUL
 #define TX_READERS_MAX 62 // readers of one component
+#define TX_COMPONENT_BYTES_MAX (256u << 20) // payload of one component
+#define TX_MODEL_BYTES_MAX (1ull << 30)     // every buffer of a model together
 
 typedef enum tx_type { TX_F32 = 1, TX_F64, TX_I32, TX_U32, TX_U8 } tx_type;
 

@@ -107,6 +107,7 @@ static int bench_model(const bench_args* a) {
   char measured[64];
   snprintf(measured, sizeof measured, "%.2f us (with the fill)", pf.p99 * 1e-3);
   print_target("publish + acquire 10404x3 f32, p99", measured, "<= 20 us", pf.p99 * 1e-3 <= 20);
+  if (sink == -1.0f) printf("(unreachable: keeps the reads)\n");
   tx_samples_free(&swap);
   tx_samples_free(&full);
   free(source);
@@ -195,12 +196,15 @@ int tx_cmd_bench(int argc, char** argv) {
     else if (c == 'd') {
       if (!tx_parse_num(optarg, 0.1, 3600, &a.duration_s)) return tx_bad_input("--duration %s: expected seconds in [0.1, 3600]", optarg);
     } else if (c == 'h') optind = argc + 1;
+    else if (optopt && strncmp(argv[optind - 1], "--", 2) != 0) // inside a group of short options
+      return tx_bad_input("bench: unknown option '-%c'", optopt);
     else return tx_bad_input("bench: unknown or incomplete option '%s'", argv[optind - 1]);
   }
   if (optind != argc - 1) {
     printf("usage: tactus bench NAME [--out DIR] [--duration S]\n\n");
     for (size_t i = 0; i < sizeof benches / sizeof benches[0]; i++) printf("  %-10s %s\n", benches[i].name, benches[i].what);
-    return optind == argc + 1 ? 0 : TX_EXIT_BAD_INPUT;
+    if (optind == argc + 1) return 0; // --help
+    return tx_bad_input("bench: expected one NAME from the list above");
   }
   for (size_t i = 0; i < sizeof benches / sizeof benches[0]; i++)
     if (strcmp(argv[optind], benches[i].name) == 0) return benches[i].run(&a);

@@ -15,10 +15,13 @@
 int tx_bad_input(const char* fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
-  fputs("tactus: ", stderr);
-  vfprintf(stderr, fmt, ap);
-  fputc('\n', stderr);
+  char line[2048];
+  vsnprintf(line, sizeof line, fmt, ap);
   va_end(ap);
+  // arguments are quoted in messages: keep the message one line
+  for (char* c = line; *c; c++)
+    if ((unsigned char)*c < 0x20 || *c == 0x7f) *c = '?';
+  fprintf(stderr, "tactus: %s\n", line);
   return TX_EXIT_BAD_INPUT;
 }
 
@@ -35,7 +38,7 @@ bool tx_parse_num(const char* s, double min, double max, double* out) {
 static int make_dirs(const char* path) {
   char p[4096];
   if (snprintf(p, sizeof p, "%s", path) >= (int)sizeof p) return errno = ENAMETOOLONG, -1;
-  for (char* c = p + 1; *c; c++) {
+  for (char* c = *p ? p + 1 : p; *c; c++) { // an empty path has nothing past its NUL
     if (*c != '/') continue;
     *c = 0;
     if (mkdir(p, 0755) != 0 && errno != EEXIST) return -1;

@@ -72,10 +72,11 @@ int tx_cmd_describe(int argc, char** argv) {
 
 int tx_cmd_study(int argc, char** argv) {
   // studies arrive with the scenarios that need them; the command is here first
-  if (argc < 2 || strcmp(argv[1], "--help") == 0) {
+  if (argc >= 2 && strcmp(argv[1], "--help") == 0) {
     printf("usage: tactus study NAME [--out DIR]\n\nno studies in this build yet\n");
-    return argc < 2 ? TX_EXIT_BAD_INPUT : 0;
+    return 0;
   }
+  if (argc < 2) return tx_bad_input("study: expected a NAME (this build has no studies yet)");
   return tx_bad_input("study %s: unknown study (this build has none yet)", argv[1]);
 }
 
@@ -93,7 +94,7 @@ static int version(void) {
 int main(int argc, char** argv) {
   setvbuf(stdout, NULL, _IOLBF, 0);
   tx_register_builtin();
-  if (argc < 2) return fputs(usage, stderr), TX_EXIT_BAD_INPUT;
+  if (argc < 2) return tx_bad_input("expected a command: list, describe, run, bench, study (tactus --help)");
   const char* cmd = argv[1];
   if (!strcmp(cmd, "-h") || !strcmp(cmd, "--help") || !strcmp(cmd, "help")) return fputs(usage, stdout), 0;
   if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) return version();

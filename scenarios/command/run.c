@@ -44,18 +44,22 @@ int tx_run_scenario(tx_scenario* sc, const tx_run_config* cfg, json_t** report_o
   if (tx_out_dir(cfg->out, sc->name, dir, sizeof dir, err, sizeof err)) return tx_bad_input("%s", err);
   double duration = cfg->duration_s > 0 ? cfg->duration_s : sc->duration_s;
   FILE* trace = NULL;
-  char trace_path[4200];
-  if (cfg->lockstep) {
+  char trace_path[4200], trace_tmp[4300];
+  if (cfg->lockstep) { // written aside and renamed once the run is whole
     snprintf(trace_path, sizeof trace_path, "%s/trace.csv", dir);
-    trace = fopen(trace_path, "w");
+    snprintf(trace_tmp, sizeof trace_tmp, "%s.tmp", trace_path);
+    trace = fopen(trace_tmp, "w");
     if (!trace) return tx_bad_input("--out %s: cannot write trace.csv", dir);
-    fprintf(trace, "sim_ns,controller,component,seq,rows,fnv1a\n");
+    fprintf(trace, "sim_ns,controller,component,seq,rows,hash\n");
   }
   tx_catch_stop_signals();
   tx_run_options o = {duration, cfg->lockstep, trace, true, true, tx_progress, &duration};
   tx_run_result r;
   int rc = tx_system_run(sc->system, &o, &r, err, sizeof err);
-  if (trace) fclose(trace);
+  if (trace && (fclose(trace) != 0 || rc != 0 || rename(trace_tmp, trace_path) != 0)) {
+    remove(trace_tmp);
+    if (rc == 0) rc = -1, snprintf(err, sizeof err, "trace.csv in %.900s could not be written", dir);
+  }
   if (isatty(2)) fprintf(stderr, "\r%40s\r", "");
   if (rc) {
     fprintf(stderr, "tactus: run %s: %s\n", sc->name, err);
@@ -118,6 +122,9 @@ int tx_cmd_run(int argc, char** argv) {
     case 'q': cfg.quiet = true; break;
     case 'h': return fputs(run_usage, stdout), 0;
     default:
+      // inside a group of short options argv[optind - 1] is not the option; optopt is
+      if (optopt && strncmp(argv[optind - 1], "--", 2) != 0)
+        return tx_bad_input("run: unknown option '-%c' (tactus run --help)", optopt);
       return tx_bad_input("run: unknown or incomplete option '%s' (tactus run --help)", argv[optind - 1]);
     }
   }

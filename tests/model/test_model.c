@@ -41,6 +41,19 @@ static void rejects_bad_definitions_and_keeps_state(void** state) {
   tx_model_destroy(m);
 }
 
+static void model_size_is_bounded(void** state) {
+  (void)state;
+  tx_model* m = tx_model_create();
+  // 200 MiB is allowed for one component, but not six buffers of it (four readers)
+  tx_comp c = tx_model_add(m, &(tx_component_def){"big", TX_U8, 200u << 20, 1, "1"});
+  assert_int_not_equal(c.id, 0);
+  for (int r = 0; r < 4; r++) assert_int_not_equal(tx_model_add_reader(m, c).id, 0);
+  assert_false(tx_model_commit(m));
+  assert_non_null(strstr(tx_error(), "MiB"));
+  assert_int_equal(tx_model_add(m, &(tx_component_def){"huge", TX_U8, (256u << 20) + 1, 1, "1"}).id, 0);
+  tx_model_destroy(m);
+}
+
 static void type_names_round_trip(void** state) {
   (void)state;
   for (tx_type t = TX_F32; t <= TX_U8; t++) assert_int_equal(tx_type_from_name(tx_type_name(t)), t);
@@ -159,6 +172,7 @@ static void hash_is_stable_and_sensitive(void** state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(rejects_bad_definitions_and_keeps_state),
+      cmocka_unit_test(model_size_is_bounded),
       cmocka_unit_test(type_names_round_trip),
       cmocka_unit_test(publish_then_acquire),
       cmocka_unit_test(held_snapshot_never_changes),
