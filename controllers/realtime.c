@@ -105,6 +105,45 @@ static void* worker_main(void* arg) {
   return NULL;
 }
 
+// Keeps one CPU from halting while the run lasts. A halted CPU wakes late for
+// the next timer, and under a hypervisor a halted virtual CPU may wait
+// milliseconds to be scheduled again; a spinner in SCHED_IDLE, the lowest
+// class, holds it running and yields to every other thread at once.
+typedef struct spinner {
+  pthread_t thread;
+  int cpu;
+  _Atomic bool* stop;
+} spinner;
+
+static void* spinner_main(void* arg) {
+  spinner* sp = arg;
+  struct sched_param none = {0};
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(sp->cpu, &set);
+  if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &none) != 0 ||
+      pthread_setaffinity_np(pthread_self(), sizeof set, &set) != 0)
+    return NULL;
+  pthread_setname_np(pthread_self(), "tx-awake");
+  while (!atomic_load_explicit(sp->stop, memory_order_relaxed)) {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+  }
+  return NULL;
+}
+
+// CPU time taken by the hypervisor so far, all CPUs, in seconds; -1 if unknown
+static double steal_seconds(void) {
+  FILE* f = fopen("/proc/stat", "r");
+  if (!f) return -1;
+  unsigned long long v[8] = {0};
+  int n = fscanf(f, "cpu %llu %llu %llu %llu %llu %llu %llu %llu", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6], &v[7]);
+  fclose(f);
+  long hz = sysconf(_SC_CLK_TCK);
+  return n == 8 && hz > 0 ? (double)v[7] / (double)hz : -1;
+}
+
 static int usable_cpus(int* cpus, int max) {
   cpu_set_t set;
   int n = 0;
@@ -131,7 +170,9 @@ static void describe_scheduling(const worker* w, int n, tx_run_result* r) {
   if (!pin_asked) snprintf(pin, sizeof pin, "not pinned");
   else if (pin_err) snprintf(pin, sizeof pin, "not pinned (refused: %s)", strerror(pin_err));
   else snprintf(pin, sizeof pin, "pinned round-robin");
-  snprintf(r->scheduler, sizeof r->scheduler, "%d threads; %s; %s", n, fifo, pin);
+  size_t len = (size_t)snprintf(r->scheduler, sizeof r->scheduler, "%d threads; %s; %s", n, fifo, pin);
+  if (r->awake_cpus && len < sizeof r->scheduler)
+    snprintf(r->scheduler + len, sizeof r->scheduler - len, "; %d CPUs kept awake", r->awake_cpus);
 }
 
 int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r, char* err, size_t n) {
@@ -147,6 +188,17 @@ int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r, cha
   int cpus[CPU_SETSIZE];
   int ncpu = o->pin_threads ? usable_cpus(cpus, CPU_SETSIZE) : 0;
   int prio_max = sched_get_priority_max(SCHED_FIFO), prio_min = sched_get_priority_min(SCHED_FIFO);
+
+  // spinners first, so the CPUs are awake before the first tick
+  int all[CPU_SETSIZE];
+  int nall = o->keep_cpus_awake ? usable_cpus(all, CPU_SETSIZE) : 0;
+  _Atomic bool spinners_stop = false;
+  spinner* spinners = nall ? calloc(nall, sizeof *spinners) : NULL;
+  int nspin = 0;
+  for (int i = 0; spinners && i < nall; i++) {
+    spinners[nspin] = (spinner){.cpu = all[i], .stop = &spinners_stop};
+    if (pthread_create(&spinners[nspin].thread, NULL, spinner_main, &spinners[nspin]) == 0) nspin++;
+  }
 
   int rc = 0, started = 0;
   for (int g = 0; g < ng; g++) {
@@ -168,7 +220,10 @@ int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r, cha
   for (int g = 0; g < started && rc == 0; g++)
     if (w[g].init_rc) rc = -1, snprintf(err, n, "%s", w[g].init_err);
   if (rc) atomic_store(&stop, true);
-  gt.t0 = tx_mono_ns() + 2000000; // every first release lies in the future
+  // every first release lies in the future; spun-up CPUs get time to be
+  // running on the host before the first tick
+  gt.t0 = tx_mono_ns() + (nspin ? 100000000 : 2000000);
+  double steal_start = steal_seconds();
   gt.end = gt.t0 + (int64_t)(o->duration_s * 1e9);
   gt.open = true;
   pthread_cond_broadcast(&gt.cond);
@@ -185,6 +240,12 @@ int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r, cha
   }
   for (int g = 0; g < started; g++) pthread_join(th[g], NULL);
   int64_t finish = tx_mono_ns();
+  atomic_store(&spinners_stop, true);
+  for (int i = 0; i < nspin; i++) pthread_join(spinners[i].thread, NULL);
+  free(spinners);
+  r->awake_cpus = nspin;
+  double steal_end = steal_seconds();
+  r->steal_s = steal_start >= 0 && steal_end >= 0 ? steal_end - steal_start : -1;
   r->duration_s = (double)((finish < gt.end ? finish : gt.end) - gt.t0) * 1e-9;
   describe_scheduling(w, started, r);
   free(w);

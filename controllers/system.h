@@ -46,6 +46,7 @@ typedef struct tx_run_options {
   FILE* trace;         // lockstep: one line per publish, or NULL
   bool realtime_priority; // try SCHED_FIFO
   bool pin_threads;       // try CPU pinning
+  bool keep_cpus_awake;   // a SCHED_IDLE spinner per CPU, so no CPU halts between ticks
   // called about every 100 ms from the main thread; returning false stops the run
   bool (*progress)(double elapsed_s, void* user);
   void* progress_user;
@@ -58,6 +59,8 @@ typedef struct tx_run_result {
   char scheduler[256];    // how the threads were scheduled, and any fallback
   bool fifo;              // SCHED_FIFO was in effect on every thread
   bool pinned;            // every thread was pinned
+  int awake_cpus;         // CPUs kept awake by spinners
+  double steal_s;         // CPU time the hypervisor took during the run (all CPUs), -1 if unknown
 } tx_run_result;
 
 tx_system* tx_system_create(void);

@@ -4,6 +4,7 @@
 #include <errno.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 static json_t* percentiles_us(tx_percentiles p) {
   return json_pack("{s:f,s:f,s:f}", "p50", p.p50 * 1e-3, "p99", p.p99 * 1e-3, "max", p.max * 1e-3);
@@ -32,6 +33,7 @@ json_t* tx_report_json(const tx_report* r) {
   json_t* report = json_pack("{s:s,s:s,s:f,s:o,s:o,s:s}", "scenario", r->scenario, "mode",
                              r->lockstep ? "lockstep" : "realtime", "duration_s", r->result->duration_s,
                              "controllers", controllers, "warnings", warnings, "scheduler", r->result->scheduler);
+  if (!r->lockstep) json_object_set_new(report, "host_steal_s", json_real(r->result->steal_s));
   if (r->lockstep) {
     char hash[17];
     snprintf(hash, sizeof hash, "%016llx", (unsigned long long)r->result->trace_hash);
@@ -85,4 +87,8 @@ void tx_report_print(FILE* f, const json_t* report) {
     fprintf(f, "%s %s=%lld", shown++ ? "," : "warnings:", key, (long long)json_integer_value(v));
   }
   fprintf(f, "%s\n", shown ? "" : "warnings: none");
+  double steal = json_number_value(json_object_get(report, "host_steal_s"));
+  if (steal > 0)
+    fprintf(f, "host steal: %.2f s of CPU time taken by the hypervisor during the run (%.1f%% of %ld CPUs)\n", steal,
+            100 * steal / (num(report, "duration_s", NULL) * sysconf(_SC_NPROCESSORS_ONLN)), sysconf(_SC_NPROCESSORS_ONLN));
 }

@@ -28,6 +28,35 @@ static json_t* find_controller(json_t* report, const char* name) {
   return NULL;
 }
 
+// a controller that does nothing: what remains is the framework's cost
+static int idle_configure(tx_setup* s, void** self) {
+  (void)s;
+  *self = NULL;
+  return 0;
+}
+static void idle_step(tx_ctx* c, void* self) {
+  (void)c;
+  (void)self;
+}
+static const tx_controller_class idle_class = {"bench.idle", "does nothing", idle_configure, NULL, idle_step, NULL};
+
+// run a one-controller scenario of bench.idle at rate_hz; returns its statistics
+static int run_idle(double rate_hz, const tx_run_options* o, tx_controller_stats* st, tx_run_result* r, double* wall_ns) {
+  char text[256], err[512];
+  snprintf(text, sizeof text,
+           "{\"name\":\"overhead\",\"controllers\":[{\"name\":\"idle\",\"type\":\"bench.idle\",\"rate_hz\":%g}]}",
+           rate_hz);
+  tx_scenario* sc = tx_scenario_load_text("overhead", text, strlen(text), NULL, err, sizeof err);
+  if (!sc) return fprintf(stderr, "tactus: %s\n", err), 1;
+  int64_t t0 = tx_mono_ns();
+  int rc = tx_system_run(sc->system, o, r, err, sizeof err);
+  *wall_ns = (double)(tx_mono_ns() - t0);
+  if (rc) fprintf(stderr, "tactus: %s\n", err);
+  else *st = tx_system_stats(sc->system, 0);
+  tx_scenario_free(sc);
+  return rc ? 1 : 0;
+}
+
 // the rates scenario in real time, with the spine's targets
 static int bench_rates(const bench_args* a) {
   tx_scenario* sc = tx_load_for_command("rates", NULL, 0);
@@ -67,7 +96,23 @@ static int bench_rates(const bench_args* a) {
     all &= p99 <= 100 && pct <= 0.1;
   }
   printf("%s\n", all ? "all targets met" : "some targets MISSED");
+  double steal = json_number_value(json_object_get(report, "host_steal_s"));
+  double duration = json_number_value(json_object_get(report, "duration_s"));
   json_decref(report);
+
+  // the floor this machine sets: an empty 1 kHz controller alone, same length
+  if (!tx_find_controller(idle_class.type)) tx_register_controller(&idle_class);
+  tx_run_options alone = {.duration_s = duration, .realtime_priority = true, .pin_threads = true, .keep_cpus_awake = true};
+  tx_controller_stats st;
+  tx_run_result r;
+  double wall;
+  if (run_idle(1000, &alone, &st, &r, &wall)) return 1;
+  printf("\nthe machine's floor, an empty 1 kHz controller alone for %.0f s:\n", duration);
+  printf("  missed %llu of %llu deadlines (%.3f%%), period jitter p50/p99/max %.1f/%.1f/%.1f us\n",
+         (unsigned long long)st.missed, (unsigned long long)(st.steps + st.missed),
+         100.0 * (double)st.missed / (double)(st.steps + st.missed ? st.steps + st.missed : 1), st.jitter_ns.p50 * 1e-3,
+         st.jitter_ns.p99 * 1e-3, st.jitter_ns.max * 1e-3);
+  printf("  host steal: %.2f s during the scenario, %.2f s during the empty run\n", steal, r.steal_s);
   return 0;
 }
 
@@ -115,35 +160,6 @@ static int bench_model(const bench_args* a) {
   return 0;
 }
 
-// a controller that does nothing: what remains is the framework's cost
-static int idle_configure(tx_setup* s, void** self) {
-  (void)s;
-  *self = NULL;
-  return 0;
-}
-static void idle_step(tx_ctx* c, void* self) {
-  (void)c;
-  (void)self;
-}
-static const tx_controller_class idle_class = {"bench.idle", "does nothing", idle_configure, NULL, idle_step, NULL};
-
-// run a one-controller scenario of bench.idle at rate_hz; returns its statistics
-static int run_idle(double rate_hz, const tx_run_options* o, tx_controller_stats* st, tx_run_result* r, double* wall_ns) {
-  char text[256], err[512];
-  snprintf(text, sizeof text,
-           "{\"name\":\"overhead\",\"controllers\":[{\"name\":\"idle\",\"type\":\"bench.idle\",\"rate_hz\":%g}]}",
-           rate_hz);
-  tx_scenario* sc = tx_scenario_load_text("overhead", text, strlen(text), NULL, err, sizeof err);
-  if (!sc) return fprintf(stderr, "tactus: %s\n", err), 1;
-  int64_t t0 = tx_mono_ns();
-  int rc = tx_system_run(sc->system, o, r, err, sizeof err);
-  *wall_ns = (double)(tx_mono_ns() - t0);
-  if (rc) fprintf(stderr, "tactus: %s\n", err);
-  else *st = tx_system_stats(sc->system, 0);
-  tx_scenario_free(sc);
-  return rc ? 1 : 0;
-}
-
 static int bench_overhead(const bench_args* a) {
   (void)a;
   if (!tx_find_controller(idle_class.type)) tx_register_controller(&idle_class);
@@ -153,7 +169,7 @@ static int bench_overhead(const bench_args* a) {
   tx_run_result r;
   double lock_wall, rt_wall;
   tx_run_options lock = {.duration_s = lock_s, .lockstep = true};
-  tx_run_options rt = {.duration_s = rt_s, .realtime_priority = true, .pin_threads = true};
+  tx_run_options rt = {.duration_s = rt_s, .realtime_priority = true, .pin_threads = true, .keep_cpus_awake = true};
   if (run_idle(lock_hz, &lock, &ls, &r, &lock_wall) || run_idle(rt_hz, &rt, &rs, &r, &rt_wall)) return 1;
   double per_step = lock_wall / (double)ls.steps;
 

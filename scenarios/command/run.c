@@ -53,7 +53,8 @@ int tx_run_scenario(tx_scenario* sc, const tx_run_config* cfg, json_t** report_o
     fprintf(trace, "sim_ns,controller,component,seq,rows,hash\n");
   }
   tx_catch_stop_signals();
-  tx_run_options o = {duration, cfg->lockstep, trace, true, true, tx_progress, &duration};
+  tx_run_options o = {.duration_s = duration, .lockstep = cfg->lockstep, .trace = trace, .realtime_priority = true,
+                      .pin_threads = true, .keep_cpus_awake = true, .progress = tx_progress, .progress_user = &duration};
   tx_run_result r;
   int rc = tx_system_run(sc->system, &o, &r, err, sizeof err);
   if (trace && (fclose(trace) != 0 || rc != 0 || rename(trace_tmp, trace_path) != 0)) {

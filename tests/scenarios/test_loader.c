@@ -314,7 +314,7 @@ static void set_overrides_are_applied(void** state) {
   assert_string_equal(r.def->units, "N"); // a bare word is a string
 
   // and the run sees the new rate: 50 Hz for 0.25 s of virtual time
-  tx_run_options o = {s->duration_s, true, NULL, false, false, NULL, NULL};
+  tx_run_options o = {.duration_s = s->duration_s, .lockstep = true};
   tx_run_result res;
   char run_err[256] = "";
   assert_int_equal(tx_system_run(s->system, &o, &res, run_err, sizeof run_err), 0);
