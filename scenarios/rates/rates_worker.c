@@ -1,4 +1,4 @@
-// rates.worker: a synthetic controller that burns a set CPU time per step and
+// rates.worker: a synthetic controller that computes for a set time per step and
 // passes checksummed data through the model, to measure the scheduler and to
 // catch torn snapshots under real load.
 //
@@ -10,12 +10,11 @@
 
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #define READS_MAX 8
 
 typedef struct worker {
-  double work_ns;            // CPU time to burn per step
+  double work_ns;            // time to compute per step
   tx_port reads[READS_MAX];
   uint64_t last_seq[READS_MAX];
   int nreads;
@@ -25,20 +24,15 @@ typedef struct worker {
   tx_warning torn;
 } worker;
 
-static int64_t cpu_ns(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
-
-// spend about ns of this thread's CPU time on arithmetic
+// compute for about ns. Timed on the monotonic clock (vDSO, no system call):
+// a thread-CPU clock would cost a system call per check and drown the work.
 static void burn(double ns) {
   if (ns <= 0) return;
-  const int64_t until = cpu_ns() + (int64_t)ns;
+  const int64_t until = tx_mono_ns() + (int64_t)ns;
   volatile double sink = 1.0;
   do {
     for (int i = 0; i < 256; i++) sink = sink * 1.0000001 + 1e-9;
-  } while (cpu_ns() < until);
+  } while (tx_mono_ns() < until);
 }
 
 static uint32_t checksum(const float* v, size_t n) {
