@@ -97,7 +97,7 @@ static void fini(void* self) { free(self); }
 
 const tx_controller_class tx_rates_worker = {
     .type = "rates.worker",
-    .summary = "burns work_us of CPU per step; passes checksummed f32 payloads from 'reads' to 'write'",
+    .summary = "computes for work_us per step; passes checksummed f32 payloads from 'reads' to 'write'",
     .configure = configure,
     .init = init,
     .step = step,
