@@ -34,7 +34,7 @@ static json_t* param(tx_setup* s, const char* key) {
   return s->in->params ? json_object_get(s->in->params, key) : NULL;
 }
 
-static const char* json_kind(const json_t* v) {
+const char* tx_json_kind(const json_t* v) {
   switch (json_typeof(v)) {
   case JSON_OBJECT: return "an object";
   case JSON_ARRAY: return "an array";
@@ -49,7 +49,7 @@ static const char* json_kind(const json_t* v) {
 double tx_param_num(tx_setup* s, const char* key, double def, double min, double max) {
   json_t* v = param(s, key);
   if (!v) return def;
-  if (!json_is_number(v)) return tx_setup_fail(s, key, "expected a number, got %s", json_kind(v)), def;
+  if (!json_is_number(v)) return tx_setup_fail(s, key, "expected a number, got %s", tx_json_kind(v)), def;
   double x = json_number_value(v);
   if (!isfinite(x) || x < min || x > max)
     return tx_setup_fail(s, key, "%g is out of range [%g, %g]", x, min, max), def;
@@ -59,7 +59,7 @@ double tx_param_num(tx_setup* s, const char* key, double def, double min, double
 int64_t tx_param_int(tx_setup* s, const char* key, int64_t def, int64_t min, int64_t max) {
   json_t* v = param(s, key);
   if (!v) return def;
-  if (!json_is_integer(v)) return tx_setup_fail(s, key, "expected an integer, got %s", json_kind(v)), def;
+  if (!json_is_integer(v)) return tx_setup_fail(s, key, "expected an integer, got %s", tx_json_kind(v)), def;
   int64_t x = json_integer_value(v);
   if (x < min || x > max)
     return tx_setup_fail(s, key, "%lld is out of range [%lld, %lld]", (long long)x, (long long)min, (long long)max), def;
@@ -69,7 +69,7 @@ int64_t tx_param_int(tx_setup* s, const char* key, int64_t def, int64_t min, int
 bool tx_param_bool(tx_setup* s, const char* key, bool def) {
   json_t* v = param(s, key);
   if (!v) return def;
-  if (!json_is_boolean(v)) return tx_setup_fail(s, key, "expected true or false, got %s", json_kind(v)), def;
+  if (!json_is_boolean(v)) return tx_setup_fail(s, key, "expected true or false, got %s", tx_json_kind(v)), def;
   return json_is_true(v);
 }
 
@@ -83,20 +83,20 @@ static const char* keep(tx_setup* s, const char* str) {
 const char* tx_param_str(tx_setup* s, const char* key, const char* def) {
   json_t* v = param(s, key);
   if (!v) return def;
-  if (!json_is_string(v)) return tx_setup_fail(s, key, "expected a string, got %s", json_kind(v)), def;
+  if (!json_is_string(v)) return tx_setup_fail(s, key, "expected a string, got %s", tx_json_kind(v)), def;
   return keep(s, json_string_value(v));
 }
 
 int tx_param_strs(tx_setup* s, const char* key, const char** out, int max) {
   json_t* v = param(s, key);
   if (!v) return 0;
-  if (!json_is_array(v)) return tx_setup_fail(s, key, "expected an array of strings, got %s", json_kind(v)), 0;
+  if (!json_is_array(v)) return tx_setup_fail(s, key, "expected an array of strings, got %s", tx_json_kind(v)), 0;
   if ((int)json_array_size(v) > max)
     return tx_setup_fail(s, key, "%zu entries, at most %d allowed", json_array_size(v), max), 0;
   size_t i;
   json_t* e;
   json_array_foreach(v, i, e) {
-    if (!json_is_string(e)) return tx_setup_fail(s, key, "entry %zu: expected a string, got %s", i, json_kind(e)), 0;
+    if (!json_is_string(e)) return tx_setup_fail(s, key, "entry %zu: expected a string, got %s", i, tx_json_kind(e)), 0;
     out[i] = keep(s, json_string_value(e));
   }
   return (int)json_array_size(v);

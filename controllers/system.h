@@ -63,6 +63,9 @@ typedef struct tx_run_result {
   double steal_s;         // CPU time the hypervisor took during the run (all CPUs), -1 if unknown
 } tx_run_result;
 
+// "an object", "a string", ... for messages about a JSON value of the wrong type
+const char* tx_json_kind(const json_t* v);
+
 tx_system* tx_system_create(void);
 void tx_system_destroy(tx_system* s); // runs fini for configured instances
 

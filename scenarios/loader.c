@@ -28,15 +28,6 @@ static int fail(char* err, size_t n, const char* fmt, ...) {
   return -1;
 }
 
-static const char* json_kind(const json_t* v) {
-  if (json_is_object(v)) return "an object";
-  if (json_is_array(v)) return "an array";
-  if (json_is_string(v)) return "a string";
-  if (json_is_number(v)) return "a number";
-  if (json_is_boolean(v)) return "a boolean";
-  return "null";
-}
-
 // every key of obj must be one of known (NULL-terminated)
 static int check_keys(const char* file, const char* where, json_t* obj, const char* const* known, char* err, size_t n) {
   const char* key;
@@ -53,6 +44,14 @@ static int check_keys(const char* file, const char* where, json_t* obj, const ch
     return fail(err, n, "%s: %s%s%s: unknown key (known: %s)", file, where, *where ? "." : "", key, list);
   }
   return 0;
+}
+
+// list[i] must be an object with known keys only; where receives "list[i]"
+static int check_entry(const char* file, const char* list, size_t i, json_t* entry, const char* const* known,
+                       char* where, size_t wn, char* err, size_t n) {
+  snprintf(where, wn, "%s[%zu]", list, i);
+  if (!json_is_object(entry)) return fail(err, n, "%s: %s: expected an object, got %s", file, where, tx_json_kind(entry));
+  return check_keys(file, where, entry, known, err, n);
 }
 
 // a --set that changed one controller value, to name it when that value is wrong
@@ -143,7 +142,7 @@ static int load_plugins(const char* file, const char* dir, json_t* plugins, cons
   size_t i;
   json_t* p;
   json_array_foreach(plugins, i, p) {
-    if (!json_is_string(p)) return fail(err, n, "%s: plugins[%zu]: expected a path, got %s", file, i, json_kind(p));
+    if (!json_is_string(p)) return fail(err, n, "%s: plugins[%zu]: expected a path, got %s", file, i, tx_json_kind(p));
     if (!o || !o->allow_plugins) return fail(err, n, "%s: plugins[%zu]: plugins are not allowed here", file, i);
     char path[PATH_MAX], real[PATH_MAX];
     const char* name = json_string_value(p);
@@ -180,9 +179,7 @@ static int declare_model(const char* file, tx_system* sys, json_t* model, char* 
   json_t* c;
   json_array_foreach(model, i, c) {
     char where[48];
-    snprintf(where, sizeof where, "model[%zu]", i);
-    if (!json_is_object(c)) return fail(err, n, "%s: %s: expected an object, got %s", file, where, json_kind(c));
-    if (check_keys(file, where, c, keys, err, n)) return -1;
+    if (check_entry(file, "model", i, c, keys, where, sizeof where, err, n)) return -1;
     json_t *name = json_object_get(c, "name"), *type = json_object_get(c, "type"), *rows = json_object_get(c, "rows"),
            *cols = json_object_get(c, "cols"), *units = json_object_get(c, "units");
     if (!json_is_string(name)) return fail(err, n, "%s: %s.name: expected a string", file, where);
@@ -210,18 +207,16 @@ static int add_controllers(const char* file, tx_system* sys, json_t* list, const
   json_t* c;
   json_array_foreach(list, i, c) {
     char where[48];
-    snprintf(where, sizeof where, "controllers[%zu]", i);
-    if (!json_is_object(c)) return fail(err, n, "%s: %s: expected an object, got %s", file, where, json_kind(c));
-    if (check_keys(file, where, c, keys, err, n)) return -1;
+    if (check_entry(file, "controllers", i, c, keys, where, sizeof where, err, n)) return -1;
     json_t *name = json_object_get(c, "name"), *type = json_object_get(c, "type"), *rate = json_object_get(c, "rate_hz");
     if (!json_is_string(name)) return fail(err, n, "%s: %s.name: expected a string", file, where);
     if (!json_is_string(type)) return fail(err, n, "%s: %s.type: expected a string", file, where);
-    tx_fault f = {0};
-    int rc;
-    if (!json_is_number(rate)) rc = -1, snprintf(f.key, sizeof f.key, "rate_hz"), snprintf(f.message, sizeof f.message, "expected a number in Hz, got %s", rate ? json_kind(rate) : "nothing");
-    else rc = tx_system_add(sys, json_string_value(name), json_string_value(type), json_number_value(rate),
-                            json_object_get(c, "params"), &f);
-    if (rc == 0) continue;
+    tx_fault f = {.key = "rate_hz"};
+    if (!json_is_number(rate))
+      snprintf(f.message, sizeof f.message, "expected a number in Hz, got %s", rate ? tx_json_kind(rate) : "nothing");
+    else if (tx_system_add(sys, json_string_value(name), json_string_value(type), json_number_value(rate),
+                           json_object_get(c, "params"), &f) == 0)
+      continue;
     for (int k = norigins - 1; k >= 0; k--) // the last --set of a key is the one in effect
       if (origins[k].controller == (int)i && strcmp(origins[k].key, f.key) == 0)
         return fail(err, n, "--set %s: %s", origins[k].text, f.message);
