@@ -2,8 +2,8 @@
 //
 // Tick k of a group starts at t0 + k/rate (clock_nanosleep, TIMER_ABSTIME), so
 // errors never accumulate. A step that ends after the next tick's start is a
-// missed deadline; a group that falls a whole period behind skips the ticks it
-// missed, and each skipped tick counts as missed too. Threads ask for
+// missed deadline; that next tick then runs at once, late, unless its whole
+// period is already over: such ticks are skipped, each counted as missed. Threads ask for
 // SCHED_FIFO by rate (faster = higher priority) and a CPU each, round-robin,
 // fastest on the last CPU; where either is refused they run without it and
 // the result says so.
@@ -94,11 +94,13 @@ static void* worker_main(void* arg) {
     }
     prev_start = start;
     prev_k = k;
-    // deadline: the next tick's release; skip ticks that are already gone
+    // a step's deadline is the next tick's release. A late tick still runs,
+    // at once, while part of its period is left; one whose whole period is
+    // over is skipped, and counts as missed too
     int64_t done = tx_mono_ns();
     uint64_t next = k + 1;
-    while (t0 + tx_tick_ns(g->rate_hz, next) < done) next++;
-    uint64_t missed = (done > t0 + tx_tick_ns(g->rate_hz, k + 1)) + (next - (k + 1));
+    uint64_t missed = done > t0 + tx_tick_ns(g->rate_hz, next);
+    while (t0 + tx_tick_ns(g->rate_hz, next + 1) <= done) next++, missed++;
     for (int m = 0; m < g->count && missed; m++) s->inst[g->members[m]]->missed += missed;
     k = next;
   }

@@ -10,6 +10,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <time.h>
 
 // physics 60 Hz -> collision 4 kHz -> haptics 1 kHz -> graphics 30 Hz, as counters
 static tx_system* chain(void) {
@@ -124,6 +125,60 @@ static void realtime_runs_every_group_and_moves_data(void** state) {
   tx_system_destroy(s);
 }
 
+// step 1 sleeps sleep_ms: a controlled overrun
+typedef struct sleeper {
+  double sleep_ms;
+} sleeper;
+
+static int sleeper_configure(tx_setup* s, void** self) {
+  sleeper* z = calloc(1, sizeof *z);
+  *self = z;
+  z->sleep_ms = tx_param_num(s, "sleep_ms", 0, 0, 1000);
+  return 0;
+}
+
+static void sleeper_step(tx_ctx* c, void* self) {
+  sleeper* z = self;
+  if (tx_step_index(c) != 1) return;
+  int64_t ns = (int64_t)(z->sleep_ms * 1e6);
+  struct timespec ts = {ns / 1000000000, ns % 1000000000};
+  nanosleep(&ts, NULL);
+}
+
+// 5 Hz for 1 s: ticks at 0, 200, 400, 600 and 800 ms; step 1 starts at 200 ms
+static void overrun(double sleep_ms, uint64_t want_steps, uint64_t want_missed) {
+  static tx_controller_class cls = {"test.sleeper", "sleeps once", sleeper_configure, NULL, sleeper_step, counter_fini};
+  if (!tx_find_controller(cls.type)) assert_int_equal(tx_register_controller(&cls), 0);
+  tx_system* s = tx_system_create();
+  tx_fault f;
+  json_t* p = json_pack("{s:f}", "sleep_ms", sleep_ms);
+  assert_int_equal(tx_system_add(s, "z", "test.sleeper", 5, p, &f), 0);
+  json_decref(p);
+  assert_int_equal(tx_system_finalize(s, &f), 0);
+  tx_run_options o = {.duration_s = 1.0};
+  tx_run_result r;
+  char err[256];
+  assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+  tx_controller_stats st = tx_system_stats(s, 0);
+  print_message("  sleep %g ms: %llu steps, %llu missed\n", sleep_ms, (unsigned long long)st.steps,
+                (unsigned long long)st.missed);
+  assert_int_equal(st.steps, want_steps);
+  assert_int_equal(st.missed, want_missed);
+  tx_system_destroy(s);
+}
+
+// ends at 500 ms, inside tick 2's period (400-600): tick 2 runs late, nothing is skipped
+static void a_late_tick_still_runs_in_its_period(void** state) {
+  (void)state;
+  overrun(300, 5, 1);
+}
+
+// ends at 700 ms: tick 2's period is over, so it is skipped; tick 3 runs late
+static void a_tick_whose_period_is_over_is_skipped(void** state) {
+  (void)state;
+  overrun(500, 4, 2);
+}
+
 static int failing_init(tx_ctx* c, void* self) { return -1; }
 
 static void a_failing_init_stops_the_run_cleanly(void** state) {
@@ -166,6 +221,8 @@ int main(void) {
       cmocka_unit_test(lockstep_runs_each_rate_exactly),
       cmocka_unit_test(lockstep_ties_go_to_the_slower_group),
       cmocka_unit_test(realtime_runs_every_group_and_moves_data),
+      cmocka_unit_test(a_late_tick_still_runs_in_its_period),
+      cmocka_unit_test(a_tick_whose_period_is_over_is_skipped),
       cmocka_unit_test(a_failing_init_stops_the_run_cleanly),
       cmocka_unit_test(bad_durations_are_refused),
   };
