@@ -1,0 +1,38 @@
+// Internal: haptic device backends, chosen by a spec such as "sim",
+// "scripted:pierce-down" or "scripted:path/to/waypoints.csv".
+//
+// A haptics tick reads the device's state, renders a force and writes it;
+// the device holds that force until the next write (zero-order hold).
+#ifndef TX_CONTROLLERS_HAPTICS_DEVICE_H
+#define TX_CONTROLLERS_HAPTICS_DEVICE_H
+
+#include <tactus/haptics.h>
+
+#include <stddef.h>
+
+typedef struct tx_device tx_device;
+
+typedef struct tx_device_backend {
+  const char* scheme; // the spec up to the first ':'
+  // open with the rest of the spec; period_s is the haptics tick. NULL and a
+  // one-line message on failure
+  tx_device* (*open)(const char* arg, double period_s, char* err, size_t n);
+  void (*info)(const tx_device* d, tx_device_info* out);
+  // the state at time t_s from the start; false if the device had nothing new
+  bool (*read)(tx_device* d, double t_s, tx_device_state* out);
+  void (*write)(tx_device* d, const double force[3]); // N, held until the next write
+  void (*close)(tx_device* d);
+} tx_device_backend;
+
+typedef struct tx_device_handle {
+  const tx_device_backend* backend;
+  tx_device* device;
+} tx_device_handle;
+
+// open a spec; returns -1 with a message naming the spec when it is bad
+int tx_device_open(const char* spec, double period_s, tx_device_handle* h, char* err, size_t n);
+void tx_device_close(tx_device_handle* h);
+
+extern const tx_device_backend tx_device_scripted;
+
+#endif

@@ -1,0 +1,190 @@
+// scripted: a device that follows waypoints, for headless and repeatable runs.
+//
+// "scripted:NAME" plays a built-in motion of the suturing skin tests;
+// "scripted:FILE.csv" plays a waypoint file, one row per waypoint:
+//   t_s, x_m, y_m, z_m [, qw, qx, qy, qz] [, grip_rad]
+// Rows are interpolated linearly (orientation by normalised lerp); after the
+// last row the device holds still. Lines starting with '#' and a first line
+// of column names are skipped. Forces written to it are ignored.
+#include "device.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define ROWS_MAX 1000000
+
+typedef struct waypoint {
+  double t;       // s
+  double pos[3];  // m
+  double quat[4]; // w, x, y, z
+  double grip;    // rad
+} waypoint;
+
+struct tx_device {
+  waypoint* w;
+  size_t count;
+};
+
+// The skin tests of the suturing journal paper, in metres: the skin's
+// mid-plane is y = 0; a 0.4 cm skin and a 0.05 cm HIP touch at |y| = 2.5 mm,
+// so the sliding motions run at |y| = 2 mm, 0.5 mm into the skin.
+// Piercing moves at 5 mm/s along y, sliding at 10 mm/s along x or z.
+typedef struct motion {
+  const char* name;
+  int count;
+  double t_pos[6][4]; // t, x, y, z
+} motion;
+
+static const motion motions[] = {
+    {"pierce-down", 4, {{0, 0, 0.010, 0}, {0.5, 0, 0.010, 0}, {4.5, 0, -0.010, 0}, {5.0, 0, -0.010, 0}}},
+    {"pierce-up", 4, {{0, 0, -0.010, 0}, {0.5, 0, -0.010, 0}, {4.5, 0, 0.010, 0}, {5.0, 0, 0.010, 0}}},
+    {"slide-x-over", 5, {{0, -0.03, 0.010, 0}, {1.0, -0.03, 0.002, 0}, {7.0, 0.03, 0.002, 0}, {8.0, 0.03, 0.010, 0}, {8.5, 0.03, 0.010, 0}}},
+    {"slide-x-under", 5, {{0, -0.03, -0.010, 0}, {1.0, -0.03, -0.002, 0}, {7.0, 0.03, -0.002, 0}, {8.0, 0.03, -0.010, 0}, {8.5, 0.03, -0.010, 0}}},
+    {"slide-z-over", 5, {{0, 0, 0.010, -0.03}, {1.0, 0, 0.002, -0.03}, {7.0, 0, 0.002, 0.03}, {8.0, 0, 0.010, 0.03}, {8.5, 0, 0.010, 0.03}}},
+    {"slide-z-under", 5, {{0, 0, -0.010, -0.03}, {1.0, 0, -0.002, -0.03}, {7.0, 0, -0.002, 0.03}, {8.0, 0, -0.010, 0.03}, {8.5, 0, -0.010, 0.03}}},
+};
+
+static tx_device* with_rows(size_t count) {
+  tx_device* d = calloc(1, sizeof *d);
+  if (d && !(d->w = calloc(count, sizeof *d->w))) {
+    free(d);
+    d = NULL;
+  }
+  if (d) d->count = count;
+  return d;
+}
+
+static tx_device* from_motion(const motion* m) {
+  tx_device* d = with_rows((size_t)m->count);
+  for (int i = 0; d && i < m->count; i++)
+    d->w[i] = (waypoint){m->t_pos[i][0], {m->t_pos[i][1], m->t_pos[i][2], m->t_pos[i][3]}, {1, 0, 0, 0}, 0};
+  return d;
+}
+
+// parse one row of 4, 5, 8 or 9 numbers; returns a message or NULL
+static const char* parse_row(char* line, waypoint* w) {
+  double v[10];
+  int n = 0;
+  for (char* p = line; n < 10;) {
+    char* end;
+    errno = 0;
+    v[n] = strtod(p, &end);
+    if (end == p || errno || !isfinite(v[n])) return "expected a finite number";
+    n++;
+    while (*end == ' ' || *end == '\t') end++;
+    if (*end == ',') p = end + 1;
+    else if (*end == 0 || *end == '\n' || *end == '\r') break;
+    else return "expected ',' between numbers";
+  }
+  if (n != 4 && n != 5 && n != 8 && n != 9) return "expected 4, 5, 8 or 9 columns: t, x, y, z [, qw, qx, qy, qz] [, grip]";
+  *w = (waypoint){v[0], {v[1], v[2], v[3]}, {1, 0, 0, 0}, 0};
+  if (n >= 8) {
+    double q = sqrt(v[4] * v[4] + v[5] * v[5] + v[6] * v[6] + v[7] * v[7]);
+    if (!(q > 1e-9)) return "the quaternion is zero";
+    for (int i = 0; i < 4; i++) w->quat[i] = v[4 + i] / q;
+  }
+  if (n == 5 || n == 9) w->grip = v[n - 1];
+  for (int i = 0; i < 3; i++)
+    if (fabs(w->pos[i]) > 10) return "a position beyond 10 m (the file must be in metres)";
+  return NULL;
+}
+
+static tx_device* from_file(const char* path, char* err, size_t n) {
+  FILE* f = fopen(path, "r");
+  if (!f) return snprintf(err, n, "%s: %s", path, strerror(errno)), NULL;
+  size_t cap = 256, count = 0;
+  tx_device* d = with_rows(cap);
+  char line[1024];
+  int lineno = 0;
+  const char* problem = NULL;
+  while (d && !problem && fgets(line, sizeof line, f)) {
+    lineno++;
+    if (!strchr(line, '\n') && !feof(f)) problem = "line longer than 1023 characters";
+    else if (line[0] == '#' || line[strspn(line, " \t\r\n")] == 0) continue;
+    else if (lineno == 1 && !strchr("+-.0123456789", line[strspn(line, " \t")])) continue; // column names
+    else if (count == ROWS_MAX) problem = "more than 1000000 waypoints";
+    else {
+      if (count == cap) {
+        waypoint* grown = realloc(d->w, 2 * cap * sizeof *grown);
+        if (!grown) {
+          problem = "out of memory";
+          break;
+        }
+        d->w = grown, cap *= 2;
+      }
+      problem = parse_row(line, &d->w[count]);
+      if (!problem && d->w[count].t < 0) problem = "time must not be negative";
+      if (!problem && count && d->w[count].t <= d->w[count - 1].t) problem = "time must increase from row to row";
+      count++;
+    }
+  }
+  fclose(f);
+  if (!problem && d && count == 0) problem = "no waypoints", lineno = 0;
+  if (problem || !d) {
+    if (lineno) snprintf(err, n, "%s:%d: %s", path, lineno, problem ? problem : "out of memory");
+    else snprintf(err, n, "%s: %s", path, problem ? problem : "out of memory");
+    if (d) free(d->w);
+    free(d);
+    return NULL;
+  }
+  d->count = count;
+  return d;
+}
+
+static tx_device* open_scripted(const char* arg, double period_s, char* err, size_t n) {
+  (void)period_s;
+  for (size_t i = 0; i < sizeof motions / sizeof motions[0]; i++)
+    if (strcmp(arg, motions[i].name) == 0) return from_motion(&motions[i]);
+  size_t len = strlen(arg);
+  if (len > 4 && strcmp(arg + len - 4, ".csv") == 0) return from_file(arg, err, n);
+  snprintf(err, n, "device 'scripted:%s': expected a .csv file or one of pierce-down, pierce-up, slide-x-over, "
+                   "slide-x-under, slide-z-over, slide-z-under", arg);
+  return NULL;
+}
+
+static void info_scripted(const tx_device* d, tx_device_info* out) {
+  // a scripted hand has no device limits of its own: those of a Touch-class device
+  (void)d;
+  *out = (tx_device_info){.max_force = 3.3, .max_stiffness = 500, .damping = 0,
+                          .workspace_min = {-0.5, -0.5, -0.5}, .workspace_max = {0.5, 0.5, 0.5}};
+}
+
+static bool read_scripted(tx_device* d, double t, tx_device_state* s) {
+  size_t i = 0; // the segment w[i]..w[i+1] holding t (few rows: a linear search is fine)
+  while (i + 1 < d->count && d->w[i + 1].t <= t) i++;
+  const waypoint* a = &d->w[i];
+  const waypoint* b = i + 1 < d->count ? &d->w[i + 1] : a;
+  double span = b->t - a->t;
+  double u = span > 0 ? fmin(fmax((t - a->t) / span, 0), 1) : 0;
+  double q = 0;
+  for (int k = 0; k < 3; k++) {
+    s->pos[k] = a->pos[k] + u * (b->pos[k] - a->pos[k]);
+    s->vel[k] = span > 0 && t >= a->t && t < b->t ? (b->pos[k] - a->pos[k]) / span : 0;
+  }
+  // q and -q are one orientation: interpolate along the short way
+  double dot = 0;
+  for (int k = 0; k < 4; k++) dot += a->quat[k] * b->quat[k];
+  double sign = dot < 0 ? -1 : 1;
+  for (int k = 0; k < 4; k++) {
+    s->quat[k] = a->quat[k] + u * (sign * b->quat[k] - a->quat[k]);
+    q += s->quat[k] * s->quat[k];
+  }
+  for (int k = 0; k < 4; k++) s->quat[k] /= sqrt(q);
+  s->grip = a->grip + u * (b->grip - a->grip);
+  s->buttons = 0;
+  s->t_ns = (int64_t)llround(t * 1e9);
+  return true;
+}
+
+static void write_scripted(tx_device* d, const double force[3]) { (void)d, (void)force; }
+
+static void close_scripted(tx_device* d) {
+  free(d->w);
+  free(d);
+}
+
+const tx_device_backend tx_device_scripted = {"scripted", open_scripted, info_scripted, read_scripted, write_scripted,
+                                              close_scripted};

@@ -1,0 +1,129 @@
+// The scripted device: built-in motions, waypoint files, and bad files
+// rejected with FILE:LINE.
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include "controllers/haptics/device.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static tx_device_state at(tx_device_handle* h, double t) {
+  tx_device_state s;
+  assert_true(h->backend->read(h->device, t, &s));
+  return s;
+}
+
+static void pierce_down_moves_down_through_the_skin(void** state) {
+  (void)state;
+  tx_device_handle h;
+  char err[256];
+  assert_int_equal(tx_device_open("scripted:pierce-down", 1e-3, &h, err, sizeof err), 0);
+  assert_true(at(&h, 0).pos[1] == 0.010);
+  tx_device_state mid = at(&h, 2.5);
+  assert_true(fabs(mid.pos[1]) < 1e-12); // through the mid-plane half-way
+  assert_true(fabs(mid.vel[1] + 0.005) < 1e-12);
+  assert_true(at(&h, 99).pos[1] == -0.010); // holds at the end
+  assert_true(at(&h, 99).vel[1] == 0);
+  tx_device_info info;
+  h.backend->info(h.device, &info);
+  assert_true(info.max_force > 0);
+  tx_device_close(&h);
+}
+
+static void every_named_motion_opens(void** state) {
+  (void)state;
+  const char* names[] = {"pierce-down", "pierce-up", "slide-x-over", "slide-x-under", "slide-z-over", "slide-z-under"};
+  for (size_t i = 0; i < 6; i++) {
+    char spec[64], err[256];
+    snprintf(spec, sizeof spec, "scripted:%s", names[i]);
+    tx_device_handle h;
+    assert_int_equal(tx_device_open(spec, 1e-3, &h, err, sizeof err), 0);
+    tx_device_state s = at(&h, 4.0);
+    double sign = strstr(names[i], "under") || strstr(names[i], "up") ? -1 : 1;
+    if (strstr(names[i], "slide")) assert_true(fabs(s.pos[1] - sign * 0.002) < 1e-12); // sliding in contact
+    tx_device_close(&h);
+  }
+}
+
+static char* write_file(const char* text) {
+  static char path[64];
+  snprintf(path, sizeof path, "/tmp/tx-scripted-XXXXXX.csv");
+  int fd = mkstemps(path, 4);
+  assert_true(fd >= 0);
+  assert_int_equal(write(fd, text, strlen(text)), (ssize_t)strlen(text));
+  close(fd);
+  return path;
+}
+
+static void waypoint_file_is_interpolated(void** state) {
+  (void)state;
+  char* path = write_file("t_s,x_m,y_m,z_m,qw,qx,qy,qz,grip_rad\n# a comment\n0,0,0,0,1,0,0,0,0\n"
+                          "2,0.02,0,0,0,0,0,1,0.4\n\n3,0.02,0,0.01,-1,0,0,0,0\n");
+  char spec[128], err[256];
+  snprintf(spec, sizeof spec, "scripted:%s", path);
+  tx_device_handle h;
+  assert_int_equal(tx_device_open(spec, 1e-3, &h, err, sizeof err), 0);
+  tx_device_state s = at(&h, 1.0);
+  assert_true(fabs(s.pos[0] - 0.01) < 1e-12);
+  assert_true(fabs(s.vel[0] - 0.01) < 1e-12);
+  assert_true(fabs(s.grip - 0.2) < 1e-12);
+  double q = 0;
+  for (int k = 0; k < 4; k++) q += s.quat[k] * s.quat[k];
+  assert_true(fabs(q - 1) < 1e-12);
+  s = at(&h, 2.5); // from (0,0,0,1) to (-1,0,0,0): the short way stays a unit rotation
+  assert_true(isfinite(s.quat[0]) && fabs(s.quat[0] * s.quat[0] + s.quat[3] * s.quat[3] - 1) < 1e-12);
+  assert_true(fabs(s.pos[2] - 0.005) < 1e-12);
+  tx_device_close(&h);
+  unlink(path);
+}
+
+static void bad_files_name_the_line(void** state) {
+  (void)state;
+  const struct {
+    const char* text;
+    const char* want;
+  } bad[] = {
+      {"0,0,0,0\n1,0,0\n", ":2: expected 4, 5, 8 or 9 columns"},
+      {"0,0,0,0\n0,1,0,0\n", ":2: time must increase"},
+      {"0,0,0,0\n1,nan,0,0\n", ":2: expected a finite number"},
+      {"0,0,0,0\n1;0;0;0\n", ":2: expected ','"},
+      {"0,0,0,0\n1,0,0,0,0,0,0,0\n", ":2: the quaternion is zero"},
+      {"0,0,0,0\n1,50,0,0\n", ":2: a position beyond 10 m"},
+      {"-1,0,0,0\n", ":1: time must not be negative"},
+      {"# nothing\n", ": no waypoints"},
+      {"t,x,y,z\nx,0,0,0\n", ":2: expected a finite number"},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    char* path = write_file(bad[i].text);
+    char spec[128], err[512] = "";
+    snprintf(spec, sizeof spec, "scripted:%s", path);
+    tx_device_handle h;
+    assert_int_equal(tx_device_open(spec, 1e-3, &h, err, sizeof err), -1);
+    if (!strstr(err, bad[i].want) || !strstr(err, path)) fail_msg("case %zu: '%s' lacks '%s'", i, err, bad[i].want);
+    unlink(path);
+  }
+  char err[256];
+  tx_device_handle h;
+  assert_int_equal(tx_device_open("scripted:/no/such/file.csv", 1e-3, &h, err, sizeof err), -1);
+  assert_non_null(strstr(err, "/no/such/file.csv"));
+  assert_int_equal(tx_device_open("scripted:wiggle", 1e-3, &h, err, sizeof err), -1);
+  assert_non_null(strstr(err, "pierce-down"));
+  assert_int_equal(tx_device_open("phantom", 1e-3, &h, err, sizeof err), -1);
+  assert_non_null(strstr(err, "unknown kind"));
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(pierce_down_moves_down_through_the_skin),
+      cmocka_unit_test(every_named_motion_opens),
+      cmocka_unit_test(waypoint_file_is_interpolated),
+      cmocka_unit_test(bad_files_name_the_line),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
