@@ -2,9 +2,16 @@
 #include "loader.h"
 #include "rates/rates_worker.h"
 
+#include "../controllers/collision/wall.h"
+#include "../controllers/haptics/haptics_controller.h"
+
 #include <pthread.h>
 
-static void register_all(void) { tx_register_controller(&tx_rates_worker); }
+static void register_all(void) {
+  tx_register_controller(&tx_rates_worker);
+  tx_register_controller(&tx_collision_wall);
+  tx_register_controller(&tx_haptics_controller);
+}
 
 void tx_register_builtin(void) {
   static pthread_once_t once = PTHREAD_ONCE_INIT;

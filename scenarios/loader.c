@@ -54,10 +54,11 @@ static int check_entry(const char* file, const char* list, size_t i, json_t* ent
   return check_keys(file, where, entry, known, err, n);
 }
 
-// a --set that changed one controller value, to name it when that value is wrong
+// a --set or --device that changed one controller value, to name it when that value is wrong
 typedef struct set_origin {
   int controller;
-  char key[128]; // "params.X" or "rate_hz"
+  char key[128];    // "params.X" or "rate_hz"
+  const char* flag; // "--set" or "--device"
   const char* text;
 } set_origin;
 
@@ -109,6 +110,7 @@ static int apply_sets(const char* file, json_t* root, const tx_load_options* o, 
     c = json_array_get(controllers, found);
     set_origin* so = &origins[(*norigins)++];
     so->controller = found;
+    so->flag = "--set";
     so->text = text;
     if (strcmp(param, "rate_hz") == 0) {
       json_object_set_new(c, "rate_hz", value);
@@ -198,6 +200,30 @@ static int declare_model(const char* file, tx_system* sys, json_t* model, char* 
   return 0;
 }
 
+// the i-th --device goes to the i-th controller of type "haptics"
+static int apply_devices(const char* file, json_t* root, const tx_load_options* o, set_origin* origins, int* norigins,
+                         char* err, size_t n) {
+  json_t* controllers = json_object_get(root, "controllers");
+  size_t index = 0, used = 0;
+  json_t* c;
+  json_array_foreach(controllers, index, c) {
+    if (used == (size_t)o->ndevices) break;
+    json_t* type = json_object_get(c, "type");
+    if (!json_is_string(type) || strcmp(json_string_value(type), "haptics") != 0) continue;
+    json_t* params = json_object_get(c, "params");
+    if (!params) json_object_set_new(c, "params", params = json_object());
+    if (!json_is_object(params)) return fail(err, n, "%s: controllers[%zu].params: expected an object", file, index);
+    json_object_set_new(params, "device", json_string(o->devices[used]));
+    origins[*norigins] = (set_origin){(int)index, "params.device", "--device", o->devices[used]};
+    (*norigins)++;
+    used++;
+  }
+  if (used < (size_t)o->ndevices)
+    return fail(err, n, "--device %s: %s has %zu haptics controller%s, so it takes at most %zu --device", o->devices[used],
+                file, used, used == 1 ? "" : "s", used);
+  return 0;
+}
+
 static int add_controllers(const char* file, tx_system* sys, json_t* list, const set_origin* origins, int norigins,
                            char* err, size_t n) {
   if (!json_is_array(list) || json_array_size(list) == 0)
@@ -219,7 +245,7 @@ static int add_controllers(const char* file, tx_system* sys, json_t* list, const
       continue;
     for (int k = norigins - 1; k >= 0; k--) // the last --set of a key is the one in effect
       if (origins[k].controller == (int)i && strcmp(origins[k].key, f.key) == 0)
-        return fail(err, n, "--set %s: %s", origins[k].text, f.message);
+        return fail(err, n, "%s %s: %s", origins[k].flag, origins[k].text, f.message);
     return fail(err, n, "%s: %s%s%s: %s", file, where, *f.key ? "." : "", f.key, f.message);
   }
   return 0;
@@ -231,10 +257,12 @@ static tx_scenario* load_root(const char* file, const char* dir, json_t* root, c
   if (!json_is_object(root)) return fail(err, n, "%s: expected a JSON object at the top", file), NULL;
   static const char* const keys[] = {"name", "description", "duration_s", "model", "plugins", "controllers", NULL};
   if (check_keys(file, "", root, keys, err, n)) return NULL;
-  set_origin origins[SETS_MAX];
+  set_origin origins[SETS_MAX + 2];
   int norigins = 0;
   if (o && o->nsets > SETS_MAX) return fail(err, n, "--set: more than %d", SETS_MAX), NULL;
+  if (o && (o->ndevices < 0 || o->ndevices > 2)) return fail(err, n, "--device: at most two (one per hand)"), NULL;
   if (apply_sets(file, root, o, origins, &norigins, err, n)) return NULL;
+  if (o && o->ndevices && apply_devices(file, root, o, origins, &norigins, err, n)) return NULL;
 
   json_t *name = json_object_get(root, "name"), *desc = json_object_get(root, "description"),
          *duration = json_object_get(root, "duration_s");

@@ -21,6 +21,8 @@ typedef struct tx_load_options {
   const char* const* sets;  // "KEY=VALUE" overrides, applied before checking
   int nsets;
   bool allow_plugins;       // false where the text is untrusted (the fuzzer)
+  const char* const* devices; // --device specs, given in turn to the controllers of type "haptics"
+  int ndevices;             // at most 2
 } tx_load_options;
 
 // register the built-in controller classes (idempotent)

@@ -59,7 +59,7 @@ static int run_idle(double rate_hz, const tx_run_options* o, tx_controller_stats
 
 // the rates scenario in real time, with the spine's targets
 static int bench_rates(const bench_args* a) {
-  tx_scenario* sc = tx_load_for_command("rates", NULL, 0);
+  tx_scenario* sc = tx_load_for_command("rates", NULL, 0, NULL, 0);
   if (!sc) return TX_EXIT_BAD_INPUT;
   printf("bench rates: %g s in real time, four controllers loading both cores\n",
          a->duration_s > 0 ? a->duration_s : sc->duration_s);

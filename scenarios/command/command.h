@@ -22,7 +22,8 @@ bool tx_parse_num(const char* s, double min, double max, double* out);
 // make the output folder (given, or out/STEM-TIMESTAMP) and check that it takes files
 int tx_out_dir(const char* given, const char* stem, char* dir, size_t n, char* err, size_t en);
 // load a scenario by name or path; prints the error and returns NULL on failure
-tx_scenario* tx_load_for_command(const char* name, const char* const* sets, int nsets);
+tx_scenario* tx_load_for_command(const char* name, const char* const* sets, int nsets, const char* const* devices,
+                                 int ndevices);
 // stop requests (SIGINT, SIGTERM) end a run cleanly; the progress callback of a run
 void tx_catch_stop_signals(void);
 bool tx_progress(double elapsed_s, void* total_s);

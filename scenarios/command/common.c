@@ -72,10 +72,11 @@ int tx_out_dir(const char* given, const char* stem, char* dir, size_t n, char* e
   return 0;
 }
 
-tx_scenario* tx_load_for_command(const char* name, const char* const* sets, int nsets) {
+tx_scenario* tx_load_for_command(const char* name, const char* const* sets, int nsets, const char* const* devices,
+                                 int ndevices) {
   char path[PATH_MAX], err[1024];
   if (tx_scenario_locate(name, path, sizeof path, err, sizeof err)) return tx_bad_input("%s", err), NULL;
-  tx_load_options o = {sets, nsets, true};
+  tx_load_options o = {sets, nsets, true, devices, ndevices};
   tx_scenario* s = tx_scenario_load(path, &o, err, sizeof err);
   if (!s) tx_bad_input("%s", err);
   return s;

@@ -36,7 +36,7 @@ int tx_cmd_list(int argc, char** argv) {
 
 int tx_cmd_describe(int argc, char** argv) {
   if (argc != 2) return tx_bad_input("describe: expected one SCENARIO (tactus describe rates)");
-  tx_scenario* sc = tx_load_for_command(argv[1], NULL, 0);
+  tx_scenario* sc = tx_load_for_command(argv[1], NULL, 0, NULL, 0);
   if (!sc) return TX_EXIT_BAD_INPUT;
   tx_system* s = sc->system;
   printf("%s: %s\nfile: %s\ndefault duration: %g s\n\nthreads:\n", sc->name, sc->description, sc->path,

@@ -91,6 +91,7 @@ int tx_cmd_run(int argc, char** argv) {
   static const char* const stereo[] = {"mono", "sbs", "tb", "anaglyph", "lr", NULL};
   tx_run_config cfg = {0};
   const char* sets[64];
+  const char* devices[2];
   int nsets = 0, ndevices = 0;
   const char* view = "none";
   optind = 1;
@@ -111,7 +112,8 @@ int tx_cmd_run(int argc, char** argv) {
       if (++ndevices > 2) return tx_bad_input("--device %s: at most two devices (one per hand)", optarg);
       if (!device_spec_valid(optarg))
         return tx_bad_input("--device %s: expected scripted:NAME, scripted:FILE.csv, replay:FILE, sim, udp:HOST:PORT or mouse", optarg);
-      return tx_bad_input("--device %s: no device backends in this build yet", optarg);
+      devices[ndevices - 1] = optarg;
+      break;
     case 'v':
       if (!one_of(optarg, views)) return tx_bad_input("--view %s: expected none, png or window", optarg);
       view = optarg;
@@ -134,7 +136,7 @@ int tx_cmd_run(int argc, char** argv) {
   if (!cfg.scenario) return tx_bad_input("run: expected a SCENARIO (tactus list shows them)");
   if (strcmp(view, "none") != 0) return tx_bad_input("--view %s: no graphics views in this build yet", view);
 
-  tx_scenario* sc = tx_load_for_command(cfg.scenario, sets, nsets);
+  tx_scenario* sc = tx_load_for_command(cfg.scenario, sets, nsets, devices, ndevices);
   if (!sc) return TX_EXIT_BAD_INPUT;
   int rc = tx_run_scenario(sc, &cfg, NULL);
   tx_scenario_free(sc);

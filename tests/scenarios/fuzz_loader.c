@@ -26,7 +26,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     default: break;
     }
   }
-  tx_load_options o = {sets + first, count, false};
+  tx_load_options o = {.sets = sets + first, .nsets = count, .allow_plugins = false};
   char err[1024];
   err[0] = 0;
   tx_scenario* s = tx_scenario_load_text("fuzz.json", (const char*)data, size, &o, err, sizeof err);

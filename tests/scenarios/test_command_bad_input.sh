@@ -139,6 +139,17 @@ expect_bad "run without a scenario" "SCENARIO" -- run --lockstep
 expect_bad "--view bogus" "--view bogus" -- run rates --view bogus
 expect_bad "--stereo bogus" "--stereo bogus" -- run rates --stereo bogus
 expect_bad "--device bogus" "--device bogus" -- run rates --device bogus
+# devices go to the scenario's haptics controllers; each bad spec names the --device
+expect_bad "--device unknown motion" "--device scripted:wiggle" "pierce-down" -- run haptics-wall --lockstep --device scripted:wiggle
+expect_bad "--device unknown kind" "--device sim" "unknown kind" -- run haptics-wall --lockstep --device sim
+expect_bad "--device missing file" "--device scripted:$WORK/none.csv" "No such file" -- run haptics-wall --lockstep --device "scripted:$WORK/none.csv"
+printf 't,x,y,z\n0,0,0,0\n0.5,0,zero,0\n' > "$WORK/bad_row.csv"
+expect_bad "--device bad waypoint row" "bad_row.csv:3:" "finite number" -- run haptics-wall --lockstep --device "scripted:$WORK/bad_row.csv"
+expect_bad "--device without a haptics controller" "--device scripted:pierce-up" "0 haptics controllers" -- run rates --device scripted:pierce-up
+expect_bad "--device more than the scenario has" "at most 1 --device" -- run haptics-wall --device scripted:pierce-up --device scripted:pierce-down
+expect_bad "--device three times" "at most two" -- run haptics-wall --device scripted:pierce-up --device scripted:pierce-up --device scripted:pierce-up
+expect_bad "haptics limit above the device's" "--set haptics.max_force=10" "out of range" -- run haptics-wall --lockstep --set haptics.max_force=10
+expect_bad "haptics mode unknown" "--set haptics.mode=fast" "sample_hold" -- run haptics-wall --lockstep --set haptics.mode=fast
 expect_bad "bench unknown name" "bogus" -- bench bogus
 expect_bad "bench unknown option" "--bogus" -- bench rates --bogus
 expect_bad "bench --duration bad" "--duration" -- bench rates --duration abc

@@ -26,7 +26,7 @@ static char err[1024];
 
 static tx_scenario* load_sets(const char* text, const char* const* sets, int nsets, bool plugins) {
   err[0] = 0;
-  tx_load_options o = {sets, nsets, plugins};
+  tx_load_options o = {.sets = sets, .nsets = nsets, .allow_plugins = plugins};
   return tx_scenario_load_text(LABEL, text, strlen(text), &o, err, sizeof err);
 }
 
@@ -419,7 +419,7 @@ static void files_load_and_errors_name_the_path(void** state) {
   write_file(good, one_worker);
   write_file(bad, "{\n\"name\": \"t\",\n\"controllers\": [ {\"name\": \"a\" \"type\": 1} ]\n}\n");
 
-  tx_load_options o = {NULL, 0, false};
+  tx_load_options o = {.allow_plugins = false};
   tx_scenario* s = tx_scenario_load(good, &o, err, sizeof err);
   if (!s) fail_msg("%s", err);
   assert_string_equal(s->path, good);
@@ -453,7 +453,7 @@ static void plugin_paths_resolve_beside_the_file(void** state) {
   char path[128], prefix[160], beside[160];
   snprintf(path, sizeof path, "%s/with_plugin.json", dir);
   write_file(path, "{\"name\":\"t\",\"plugins\":[\"libnone.so\"],\"controllers\":[{\"name\":\"a\"," WORKER ",\"rate_hz\":1}]}");
-  tx_load_options o = {NULL, 0, true};
+  tx_load_options o = {.allow_plugins = true};
   assert_null(tx_scenario_load(path, &o, err, sizeof err));
   snprintf(prefix, sizeof prefix, "%s: plugins[0]: ", path);
   snprintf(beside, sizeof beside, "%s/libnone.so", dir);

@@ -1,0 +1,157 @@
+// haptics: one device, rendered every tick from the published force model.
+//
+// Each tick: read the device; render F = F0 + K (x - x0) from the latest force
+// model (or hold F0, the papers' sample-and-hold); let the passivity
+// controller add damping if asked; pass the safety chain; write the force.
+// It publishes what the rest of the model needs from the device, and counts
+// every safety event as a warning of the run.
+#include "haptics_controller.h"
+
+#include "device.h"
+#include "passivity.h"
+#include "render.h"
+#include "safety.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { W_NON_FINITE, W_CLAMPED, W_RATE, W_WATCHDOG, W_WORKSPACE, W_SILENT, W_COUNT };
+
+typedef struct haptics {
+  tx_device_handle device;
+  tx_render_mode mode;
+  bool passivity_control;
+  tx_safety_limits limits;
+  tx_safety safety;
+  tx_passivity passivity;
+  tx_port model;                 // the force model read, 0 for none
+  tx_port pose, velocity, force, energy;
+  tx_warning warn[W_COUNT];
+  tx_device_state state;         // last sample
+  double silent_s;               // since the last sample
+} haptics;
+
+static double lowered(tx_setup* s, const char* key, double device_value) {
+  return tx_param_num(s, key, device_value, 1e-9, device_value); // can only lower
+}
+
+static int configure(tx_setup* s, void** self) {
+  haptics* h = calloc(1, sizeof *h);
+  if (!h) return -1;
+  *self = h;
+  const double period = 1.0 / tx_setup_rate(s);
+  const char* spec = tx_param_str(s, "device", "scripted:pierce-down");
+  int hand = (int)tx_param_int(s, "hand", 0, 0, 1);
+  const char* mode = tx_param_str(s, "mode", "local");
+  const char* model = tx_param_str(s, "force_model", "");
+  h->passivity_control = tx_param_bool(s, "passivity_control", false);
+  if (!spec || !mode || !model) return -1; // a parameter error is already recorded
+  if (strcmp(mode, "local") == 0) h->mode = TX_RENDER_LOCAL_MODEL;
+  else if (strcmp(mode, "sample_hold") == 0) h->mode = TX_RENDER_SAMPLE_HOLD;
+  else return tx_setup_fail(s, "mode", "expected \"local\" or \"sample_hold\", got \"%s\"", mode);
+
+  char err[512];
+  if (tx_device_open(spec, period, &h->device, err, sizeof err)) return tx_setup_fail(s, "device", "%s", err);
+  tx_device_info info;
+  h->device.backend->info(h->device.device, &info);
+  tx_safety_limits d = tx_safety_limits_from_device(&info);
+  h->limits = d;
+  h->limits.max_force = lowered(s, "max_force", d.max_force);
+  h->limits.max_force_rate = lowered(s, "max_force_rate", d.max_force_rate);
+  h->limits.model_timeout_s = lowered(s, "model_timeout_s", d.model_timeout_s);
+  h->limits.device_timeout_s = lowered(s, "device_timeout_s", d.device_timeout_s);
+  h->limits.ramp_s = lowered(s, "ramp_s", d.ramp_s);
+  const char* bad = tx_safety_limits_check(&h->limits);
+  if (bad) return tx_setup_fail(s, NULL, "safety limits: %s", bad);
+  tx_safety_init(&h->safety);
+
+  if (*model) h->model = tx_setup_read(s, model);
+  char name[TX_NAME_MAX];
+  snprintf(name, sizeof name, "device%d.pose", hand);
+  h->pose = tx_setup_write(s, &(tx_component_def){name, TX_F64, 1, 7, "m"}); // x y z, qw qx qy qz
+  snprintf(name, sizeof name, "device%d.velocity", hand);
+  h->velocity = tx_setup_write(s, &(tx_component_def){name, TX_F64, 1, 3, "m/s"});
+  snprintf(name, sizeof name, "device%d.force", hand);
+  h->force = tx_setup_write(s, &(tx_component_def){name, TX_F64, 1, 3, "N"}); // what was sent
+  snprintf(name, sizeof name, "device%d.energy", hand);
+  h->energy = tx_setup_write(s, &(tx_component_def){name, TX_F64, 1, 2, "J"}); // observed, dissipated
+  static const char* const keys[W_COUNT] = {"force_non_finite", "force_clamped", "force_rate_limited",
+                                            "watchdog", "outside_workspace", "device_silent"};
+  for (int w = 0; w < W_COUNT; w++) h->warn[w] = tx_setup_warning(s, keys[w]);
+  return 0;
+}
+
+// count the safety events of this tick as run warnings
+static void warn_new(tx_ctx* c, haptics* h, const tx_safety_counts* before) {
+  const tx_safety_counts* now = &h->safety.counts;
+  if (now->non_finite > before->non_finite) tx_warn(c, h->warn[W_NON_FINITE]);
+  if (now->clamped > before->clamped) tx_warn(c, h->warn[W_CLAMPED]);
+  if (now->rate_limited > before->rate_limited) tx_warn(c, h->warn[W_RATE]);
+  if (now->watchdog > before->watchdog) tx_warn(c, h->warn[W_WATCHDOG]);
+  if (now->workspace > before->workspace) tx_warn(c, h->warn[W_WORKSPACE]);
+}
+
+// what the rest of the model sees of the device
+static void publish(tx_ctx* c, haptics* h, const double force[3]) {
+  double* pose = tx_write(c, h->pose);
+  memcpy(pose, h->state.pos, 3 * sizeof *pose);
+  memcpy(pose + 3, h->state.quat, 4 * sizeof *pose);
+  memcpy(tx_write(c, h->velocity), h->state.vel, 3 * sizeof(double));
+  memcpy(tx_write(c, h->force), force, 3 * sizeof(double));
+  double* e = tx_write(c, h->energy);
+  e[0] = h->passivity.energy;
+  e[1] = h->passivity.dissipated;
+}
+
+// the device's first sample is published at time 0, so that the controllers
+// that run at time 0 (collision, physics) see where the tool really is
+static int init(tx_ctx* c, void* self) {
+  haptics* h = self;
+  if (!h->device.backend->read(h->device.device, 0, &h->state)) h->state.quat[0] = 1;
+  const double zero[3] = {0, 0, 0};
+  publish(c, h, zero);
+  return 0;
+}
+
+static void step(tx_ctx* c, void* self) {
+  haptics* h = self;
+  const double dt = 1.0 / tx_rate(c), t = (double)tx_sim_ns(c) * 1e-9;
+  if (h->device.backend->read(h->device.device, t, &h->state)) h->silent_s = 0;
+  else h->silent_s += dt, tx_warn(c, h->warn[W_SILENT]);
+
+  double f[3] = {0, 0, 0}, model_age = 0;
+  if (h->model.id) {
+    tx_snapshot snap = tx_read(c, h->model);
+    const double* m = snap.data; // f0 (3), x0 (3), K (9)
+    tx_force_model fm;
+    memcpy(fm.f0, m, sizeof fm.f0);
+    memcpy(fm.x0, m + 3, sizeof fm.x0);
+    memcpy(fm.k, m + 6, sizeof fm.k);
+    tx_render_force(&fm, h->mode, h->state.pos, f);
+    model_age = snap.seq ? (double)(tx_sim_ns(c) - snap.sim_ns) * 1e-9 : INFINITY; // no model yet: no force
+  }
+  tx_passivity_tick(&h->passivity, f, h->state.vel, dt, h->passivity_control);
+  tx_safety_counts before = h->safety.counts;
+  double out[3];
+  tx_safety_apply(&h->safety, &h->limits, dt, f, h->state.pos, model_age, h->silent_s, out);
+  warn_new(c, h, &before);
+  h->device.backend->write(h->device.device, out);
+  publish(c, h, out);
+}
+
+static void fini(void* self) {
+  haptics* h = self;
+  if (h) tx_device_close(&h->device);
+  free(h);
+}
+
+const tx_controller_class tx_haptics_controller = {
+    .type = "haptics",
+    .summary = "renders F = F0 + K(x - x0) (or holds F0) on a device, through passivity and safety limits",
+    .configure = configure,
+    .init = init,
+    .step = step,
+    .fini = fini,
+};

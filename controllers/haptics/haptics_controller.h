@@ -1,0 +1,18 @@
+// Internal: the haptics controller class, registered as "haptics".
+//
+// Parameters: device (a device spec, default "scripted:pierce-down"), hand
+// (0 or 1: components device0.* or device1.*), mode ("local" or
+// "sample_hold"), force_model (the component to render, f64 1 x 15:
+// F0, x0, K row-major; "" for none), passivity_control, and max_force,
+// max_force_rate, model_timeout_s, device_timeout_s, ramp_s, which can only
+// lower the device's own limits.
+// Writes deviceN.pose (x y z qw qx qy qz), deviceN.velocity, deviceN.force
+// (what was sent) and deviceN.energy (observed and dissipated, J).
+#ifndef TX_CONTROLLERS_HAPTICS_CONTROLLER_H
+#define TX_CONTROLLERS_HAPTICS_CONTROLLER_H
+
+#include <tactus/controller.h>
+
+extern const tx_controller_class tx_haptics_controller;
+
+#endif

@@ -1,0 +1,107 @@
+// The haptics controller through the loader, in lockstep: the local model
+// follows the hand between physics frames, sample-and-hold lags, and the
+// safety chain and watchdog act and are counted.
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include "scenarios/loader.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+// a wall updated at wall_hz and a scripted hand rendered at 1 kHz
+static tx_scenario* load(double wall_hz, double stiffness, const char* motion, const char* haptics_params) {
+  char text[1024], err[512];
+  snprintf(text, sizeof text,
+           "{\"name\":\"t\",\"controllers\":["
+           "{\"name\":\"wall\",\"type\":\"collision.wall\",\"rate_hz\":%g,\"params\":{\"stiffness\":%g}},"
+           "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:%s\","
+           "\"force_model\":\"tool0.force_model\"%s%s}}]}",
+           wall_hz, stiffness, motion, *haptics_params ? "," : "", haptics_params);
+  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL, err, sizeof err);
+  if (!s) fail_msg("%s", err);
+  return s;
+}
+
+static void run(tx_scenario* s, double seconds) {
+  tx_run_options o = {.duration_s = seconds, .lockstep = true};
+  tx_run_result r;
+  char err[256];
+  assert_int_equal(tx_system_run(s->system, &o, &r, err, sizeof err), 0);
+}
+
+static const double* latest(tx_scenario* s, const char* name) {
+  tx_model* m = tx_system_model(s->system);
+  return tx_model_latest(m, tx_model_find(m, name)).data;
+}
+
+static uint64_t warnings(tx_scenario* s, const char* key) {
+  for (int w = 0; w < tx_system_warnings(s->system); w++)
+    if (strcmp(tx_system_warning_key(s->system, w), key) == 0) return tx_system_warning_count(s->system, w);
+  fail_msg("no warning %s", key);
+  return 0;
+}
+
+// pierce-down at 5 mm/s into a 300 N/m wall; after 3 s the hand is 2.5 mm deep
+static void local_model_follows_the_hand_between_frames(void** state) {
+  (void)state;
+  tx_scenario* local = load(60, 300, "pierce-down", "");
+  tx_scenario* hold = load(60, 300, "pierce-down", "\"mode\":\"sample_hold\"");
+  run(local, 3.0);
+  run(hold, 3.0);
+  double y = latest(local, "device0.pose")[1];
+  double exact = -300 * y;
+  double f_local = latest(local, "device0.force")[1], f_hold = latest(hold, "device0.force")[1];
+  print_message("  depth %.4f mm: exact %.6f N, local %.6f N, sample-and-hold %.6f N\n", -y * 1e3, exact, f_local, f_hold);
+  assert_true(exact > 0.7);
+  assert_true(fabs(f_local - exact) < 1e-9);
+  // the hold is up to one 60 Hz frame behind: 300 N/m x 5 mm/s / 60 Hz = 25 mN
+  assert_true(fabs(f_hold - exact) > 1e-4 && fabs(f_hold - exact) <= 0.025 + 1e-9);
+  // pressing into the wall, the hand does work on it: the environment absorbs energy
+  assert_true(latest(local, "device0.energy")[0] > 0);
+  assert_int_equal(warnings(local, "haptics.force_clamped"), 0);
+  tx_scenario_free(local);
+  tx_scenario_free(hold);
+}
+
+static void forces_above_the_device_are_clamped(void** state) {
+  (void)state;
+  tx_scenario* s = load(60, 1000, "pierce-down", ""); // 10 mm deep: 10 N asked of a 3.3 N device
+  run(s, 5.0);
+  const double* f = latest(s, "device0.force");
+  assert_true(f[1] <= 3.3 && f[1] > 3.2999);
+  assert_true(warnings(s, "haptics.force_clamped") > 0);
+  tx_scenario_free(s);
+
+  s = load(60, 1000, "pierce-down", "\"max_force\":1.5"); // a scenario may lower the limit
+  run(s, 5.0);
+  assert_true(latest(s, "device0.force")[1] <= 1.5);
+  tx_scenario_free(s);
+}
+
+// a wall model published once a second goes stale after 50 ms: the force fades to zero
+static void a_stale_model_fades_out(void** state) {
+  (void)state;
+  tx_scenario* s = load(1, 300, "pierce-up", ""); // starts 10 mm inside: 3 N at t = 0
+  run(s, 0.02);
+  assert_true(latest(s, "device0.force")[1] > 2.9);
+  tx_scenario_free(s);
+  s = load(1, 300, "pierce-up", "");
+  run(s, 0.5);
+  assert_true(latest(s, "device0.force")[1] == 0);
+  assert_true(warnings(s, "haptics.watchdog") > 0);
+  tx_scenario_free(s);
+}
+
+int main(void) {
+  tx_register_builtin();
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(local_model_follows_the_hand_between_frames),
+      cmocka_unit_test(forces_above_the_device_are_clamped),
+      cmocka_unit_test(a_stale_model_fades_out),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
