@@ -191,6 +191,77 @@ static int bench_overhead(const bench_args* a) {
   return 0;
 }
 
+// a wall at 60 Hz rendered by haptics at haptics_hz, with or without the rates scenario's load beside it
+static tx_scenario* haptics_scenario(double haptics_hz, bool loaded) {
+  char text[2048], err[512];
+  snprintf(text, sizeof text,
+           "{\"name\":\"bench-haptics\",\"controllers\":["
+           "{\"name\":\"wall\",\"type\":\"collision.wall\",\"rate_hz\":60},"
+           "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":%g,"
+           "\"params\":{\"device\":\"scripted:pierce-down\",\"force_model\":\"tool0.force_model\"}}%s]}",
+           haptics_hz,
+           loaded ? ",{\"name\":\"physics\",\"type\":\"rates.worker\",\"rate_hz\":20,\"params\":{\"work_us\":10000}},"
+                    "{\"name\":\"collision\",\"type\":\"rates.worker\",\"rate_hz\":4000,\"params\":{\"work_us\":50}},"
+                    "{\"name\":\"graphics\",\"type\":\"rates.worker\",\"rate_hz\":30,\"params\":{\"work_us\":5000}}"
+                  : "");
+  tx_scenario* sc = tx_scenario_load_text("bench-haptics", text, strlen(text), NULL, err, sizeof err);
+  if (!sc) fprintf(stderr, "tactus: %s\n", err);
+  return sc;
+}
+
+// the haptics controller of a scenario run in real time for seconds
+static int run_haptics(double hz, bool loaded, double seconds, tx_controller_stats* st, tx_run_result* r) {
+  tx_scenario* sc = haptics_scenario(hz, loaded);
+  if (!sc) return 1;
+  tx_run_options o = {.duration_s = seconds, .realtime_priority = true, .pin_threads = true, .keep_cpus_awake = true};
+  char err[512];
+  int rc = tx_system_run(sc->system, &o, r, err, sizeof err);
+  if (rc) fprintf(stderr, "tactus: %s\n", err);
+  for (int i = 0; rc == 0 && i < tx_system_count(sc->system); i++)
+    if (strcmp(tx_system_name(sc->system, i), "haptics") == 0) *st = tx_system_stats(sc->system, i);
+  tx_scenario_free(sc);
+  return rc ? 1 : 0;
+}
+
+static int bench_haptics(const bench_args* a) {
+  const double seconds = a->duration_s > 0 ? a->duration_s : 10;
+  tx_controller_stats idle1k, loaded1k, idle10k;
+  tx_run_result r1, r2, r3;
+  printf("bench haptics: a wall at 60 Hz rendered by the haptics controller, %g s per case, in real time\n\n", seconds);
+  if (run_haptics(1000, false, seconds, &idle1k, &r1) || run_haptics(1000, true, seconds, &loaded1k, &r2) ||
+      run_haptics(10000, false, seconds, &idle10k, &r3))
+    return 1;
+  printf("  %-34s %9s %9s %9s %9s %9s %9s %10s %8s\n", "case", "Hz", "tick p50", "tick p99", "jit p50", "jit p99",
+         "jit max", "missed", "steal s");
+  const struct {
+    const char* name;
+    const tx_controller_stats* st;
+    const tx_run_result* r;
+  } rows[] = {{"1 kHz, nothing else running", &idle1k, &r1},
+              {"1 kHz, rates load on both cores", &loaded1k, &r2},
+              {"10 kHz, nothing else running", &idle10k, &r3}};
+  for (int i = 0; i < 3; i++) {
+    const tx_controller_stats* st = rows[i].st;
+    char missed[32];
+    snprintf(missed, sizeof missed, "%.3f%%", 100.0 * (double)st->missed / (double)(st->steps + st->missed));
+    printf("  %-34s %9.1f %9.2f %9.2f %9.1f %9.1f %9.1f %10s %8.2f\n", rows[i].name, st->achieved_hz,
+           st->step_ns.p50 * 1e-3, st->step_ns.p99 * 1e-3, st->jitter_ns.p50 * 1e-3, st->jitter_ns.p99 * 1e-3,
+           st->jitter_ns.max * 1e-3, missed, rows[i].r->steal_s);
+  }
+  printf("  (tick and jitter in us; a tick is the device read, rendering, passivity, safety, write and publishes)\n");
+  printf("\ntargets:\n");
+  char measured[64];
+  snprintf(measured, sizeof measured, "%.2f us", loaded1k.step_ns.p99 * 1e-3);
+  print_target("one haptics tick, p99 (loaded)", measured, "<= 20 us", loaded1k.step_ns.p99 * 1e-3 <= 20);
+  double pct = 100.0 * (double)loaded1k.missed / (double)(loaded1k.steps + loaded1k.missed);
+  snprintf(measured, sizeof measured, "%.3f%%", pct);
+  print_target("1 kHz with both cores loaded, missed", measured, "<= 0.1%", pct <= 0.1);
+  snprintf(measured, sizeof measured, "%.1f Hz, p99 %.1f us", idle10k.achieved_hz, idle10k.jitter_ns.p99 * 1e-3);
+  print_target("10 kHz reachable, jitter p99", measured, "<= 50 us",
+               idle10k.achieved_hz > 9900 && idle10k.jitter_ns.p99 * 1e-3 <= 50);
+  return 0;
+}
+
 static const struct {
   const char* name;
   int (*run)(const bench_args*);
@@ -199,6 +270,7 @@ static const struct {
     {"rates", bench_rates, "the rates scenario for 10 s in real time: rates, jitter, missed deadlines"},
     {"model", bench_model, "publish + acquire of a 10404x3 f32 component"},
     {"overhead", bench_overhead, "framework cost of an empty controller step"},
+    {"haptics", bench_haptics, "haptics tick cost, 1 kHz under load, 10 kHz idle"},
 };
 
 int tx_cmd_bench(int argc, char** argv) {
