@@ -35,6 +35,7 @@ void tx_write_rows(tx_ctx* c, tx_port p, uint32_t rows) {
 }
 
 int64_t tx_sim_ns(const tx_ctx* c) { return c->sim_ns; }
+const char* tx_record_dir(const tx_ctx* c) { return c->sys->record_dir; }
 uint64_t tx_step_index(const tx_ctx* c) { return c->step; }
 double tx_rate(const tx_ctx* c) { return c->in->rate_hz; }
 
@@ -73,6 +74,10 @@ int64_t tx_instance_step(tx_system* s, instance* in, int64_t sim_ns) {
   publish_written(s, in, sim_ns);
   in->steps++;
   return tx_mono_ns() - t0;
+}
+
+void tx_instance_finish(instance* in) {
+  if (in->cls->finish) in->cls->finish(&in->ctx, in->self);
 }
 
 int tx_instance_init(tx_system* s, instance* in, char* err, size_t n) {

@@ -44,6 +44,7 @@ int tx_run_lockstep(tx_system* s, const tx_run_options* o, tx_run_result* r, cha
     }
   }
   free(next);
+  for (int i = 0; i < s->count && rc == 0; i++) tx_instance_finish(s->inst[i]);
   r->duration_s = o->duration_s;
   r->trace_hash = s->trace_hash;
   snprintf(r->scheduler, sizeof r->scheduler, "lockstep: one thread, virtual clock");

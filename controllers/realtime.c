@@ -104,6 +104,7 @@ static void* worker_main(void* arg) {
     for (int m = 0; m < g->count && missed; m++) s->inst[g->members[m]]->missed += missed;
     k = next;
   }
+  for (int m = 0; m < g->count && w->init_rc == 0; m++) tx_instance_finish(s->inst[g->members[m]]);
   return NULL;
 }
 

@@ -248,7 +248,9 @@ int tx_system_run(tx_system* s, const tx_run_options* o, tx_run_result* r, char*
   if (!s->model) return snprintf(err, n, "the system is not finalized"), -1;
   if (!(o->duration_s > 0 && o->duration_s <= 86400)) return snprintf(err, n, "duration %g s is out of range (0, 86400]", o->duration_s), -1;
   if (!tx_system_prepare_stats(s, o->duration_s)) return snprintf(err, n, "out of memory for statistics"), -1;
-  return o->lockstep ? tx_run_lockstep(s, o, r, err, n) : tx_run_realtime(s, o, r, err, n);
+  s->record_dir = o->record_dir;
+  int rc = o->lockstep ? tx_run_lockstep(s, o, r, err, n) : tx_run_realtime(s, o, r, err, n);
+  return rc;
 }
 
 int tx_system_count(const tx_system* s) { return s->count; }

@@ -47,6 +47,7 @@ typedef struct tx_run_options {
   bool realtime_priority; // try SCHED_FIFO
   bool pin_threads;       // try CPU pinning
   bool keep_cpus_awake;   // a SCHED_IDLE spinner per CPU, so no CPU halts between ticks
+  const char* record_dir; // folder for recordings (tx_record_dir), or NULL for none
   // called about every 100 ms from the main thread; returning false stops the run
   bool (*progress)(double elapsed_s, void* user);
   void* progress_user;

@@ -72,6 +72,7 @@ struct tx_system {
   char warning_keys[TX_WARNINGS_MAX][TX_WARNING_KEY_MAX];
   _Atomic uint64_t warning_counts[TX_WARNINGS_MAX];
   int nwarnings;
+  const char* record_dir; // of the current run, or NULL
   bool tracing;        // lockstep: hash every publish
   FILE* trace;         // and write it here, if not NULL
   uint64_t trace_hash; // tx_hash over every publish, in order
@@ -85,6 +86,8 @@ bool tx_system_prepare_stats(tx_system* s, double duration_s);
 int64_t tx_instance_step(tx_system* s, instance* in, int64_t sim_ns);
 // run init of one instance; 0 or -1 with err filled
 int tx_instance_init(tx_system* s, instance* in, char* err, size_t n);
+// after the last step of a run
+void tx_instance_finish(instance* in);
 
 int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r, char* err, size_t n);
 int tx_run_lockstep(tx_system* s, const tx_run_options* o, tx_run_result* r, char* err, size_t n);

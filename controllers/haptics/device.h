@@ -34,5 +34,6 @@ int tx_device_open(const char* spec, double period_s, tx_device_handle* h, char*
 void tx_device_close(tx_device_handle* h);
 
 extern const tx_device_backend tx_device_scripted;
+extern const tx_device_backend tx_device_replay;
 
 #endif

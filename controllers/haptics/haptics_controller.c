@@ -9,6 +9,7 @@
 
 #include "device.h"
 #include "passivity.h"
+#include "recorder.h"
 #include "render.h"
 #include "safety.h"
 
@@ -17,7 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { W_NON_FINITE, W_CLAMPED, W_RATE, W_WATCHDOG, W_WORKSPACE, W_SILENT, W_COUNT };
+enum { W_NON_FINITE, W_CLAMPED, W_RATE, W_WATCHDOG, W_WORKSPACE, W_SILENT, W_DROPPED, W_COUNT };
 
 typedef struct haptics {
   tx_device_handle device;
@@ -31,6 +32,10 @@ typedef struct haptics {
   tx_warning warn[W_COUNT];
   tx_device_state state;         // last sample
   double silent_s;               // since the last sample
+  int hand;
+  bool record;                   // when the run keeps recordings
+  tx_recorder* recorder;
+  tx_record rec;                 // this tick's record, filled as the tick goes
 } haptics;
 
 static double lowered(tx_setup* s, const char* key, double device_value) {
@@ -43,7 +48,8 @@ static int configure(tx_setup* s, void** self) {
   *self = h;
   const double period = 1.0 / tx_setup_rate(s);
   const char* spec = tx_param_str(s, "device", "scripted:pierce-down");
-  int hand = (int)tx_param_int(s, "hand", 0, 0, 1);
+  int hand = h->hand = (int)tx_param_int(s, "hand", 0, 0, 1);
+  h->record = tx_param_bool(s, "record", true);
   const char* mode = tx_param_str(s, "mode", "local");
   const char* model = tx_param_str(s, "force_model", "");
   h->passivity_control = tx_param_bool(s, "passivity_control", false);
@@ -78,7 +84,8 @@ static int configure(tx_setup* s, void** self) {
   snprintf(name, sizeof name, "device%d.energy", hand);
   h->energy = tx_setup_write(s, &(tx_component_def){name, TX_F64, 1, 2, "J"}); // observed, dissipated
   static const char* const keys[W_COUNT] = {"force_non_finite", "force_clamped", "force_rate_limited",
-                                            "watchdog", "outside_workspace", "device_silent"};
+                                            "watchdog", "outside_workspace", "device_silent",
+                                            "record_dropped"};
   for (int w = 0; w < W_COUNT; w++) h->warn[w] = tx_setup_warning(s, keys[w]);
   return 0;
 }
@@ -112,6 +119,16 @@ static int init(tx_ctx* c, void* self) {
   if (!h->device.backend->read(h->device.device, 0, &h->state)) h->state.quat[0] = 1;
   const double zero[3] = {0, 0, 0};
   publish(c, h, zero);
+  char err[512];
+  if (h->record && tx_record_dir(c)) {
+    tx_device_info info;
+    h->device.backend->info(h->device.device, &info);
+    h->recorder = tx_recorder_start(tx_record_dir(c), h->hand, tx_rate(c), &info, err, sizeof err);
+    if (!h->recorder) {
+      fprintf(stderr, "tactus: recording: %s\n", err);
+      return -1;
+    }
+  }
   return 0;
 }
 
@@ -130,6 +147,7 @@ static void step(tx_ctx* c, void* self) {
     memcpy(fm.x0, m + 3, sizeof fm.x0);
     memcpy(fm.k, m + 6, sizeof fm.k);
     tx_render_force(&fm, h->mode, h->state.pos, f);
+    memcpy(h->rec.force_model, m, sizeof h->rec.force_model);
     model_age = snap.seq ? (double)(tx_sim_ns(c) - snap.sim_ns) * 1e-9 : INFINITY; // no model yet: no force
   }
   tx_passivity_tick(&h->passivity, f, h->state.vel, dt, h->passivity_control);
@@ -139,11 +157,33 @@ static void step(tx_ctx* c, void* self) {
   warn_new(c, h, &before);
   h->device.backend->write(h->device.device, out);
   publish(c, h, out);
+  if (h->recorder) {
+    tx_record* r = &h->rec;
+    r->t_s = t;
+    memcpy(r->pos, h->state.pos, sizeof r->pos);
+    memcpy(r->quat, h->state.quat, sizeof r->quat);
+    memcpy(r->vel, h->state.vel, sizeof r->vel);
+    r->grip = h->state.grip;
+    r->buttons = h->state.buttons;
+    memcpy(r->force, out, sizeof r->force);
+    if (!tx_recorder_push(h->recorder, r)) tx_warn(c, h->warn[W_DROPPED]);
+  }
+}
+
+// the run is over: the recording is made whole (binary and CSV) before the report
+static void finish(tx_ctx* c, void* self) {
+  haptics* h = self;
+  char err[512];
+  if (tx_recorder_stop(h->recorder, err, sizeof err)) fprintf(stderr, "tactus: recording: %s\n", err);
+  h->recorder = NULL;
 }
 
 static void fini(void* self) {
   haptics* h = self;
-  if (h) tx_device_close(&h->device);
+  if (!h) return;
+  char err[512];
+  if (tx_recorder_stop(h->recorder, err, sizeof err)) fprintf(stderr, "tactus: recording: %s\n", err); // a failed run's
+  tx_device_close(&h->device);
   free(h);
 }
 
@@ -154,4 +194,5 @@ const tx_controller_class tx_haptics_controller = {
     .init = init,
     .step = step,
     .fini = fini,
+    .finish = finish,
 };

@@ -8,6 +8,8 @@
 //   init       runs once, on the controller's own thread, before the first step
 //   step       runs at the controller's rate; what it wrote with tx_write() is
 //              published when step returns (the "swap buffer" step)
+//   finish     optional: runs once after a run's last step, on the same thread;
+//              it may block (flush a recording), the run is over
 //   fini       frees what configure and init made
 //
 // No step may allocate, lock or block: the haptic thread shares nothing that
@@ -50,6 +52,7 @@ typedef struct tx_controller_class {
   int (*init)(tx_ctx* c, void* self);         // optional; 0 on success
   void (*step)(tx_ctx* c, void* self);
   void (*fini)(void* self);                   // optional
+  void (*finish)(tx_ctx* c, void* self);      // optional
 } tx_controller_class;
 
 // registry; returns 0, or -1 for a bad class or a taken type name
@@ -87,6 +90,7 @@ int64_t tx_sim_ns(const tx_ctx* c);                  // simulation time of this 
 uint64_t tx_step_index(const tx_ctx* c);             // 0 for the first step
 double tx_rate(const tx_ctx* c);                     // Hz
 void tx_warn(tx_ctx* c, tx_warning w);               // count one occurrence, lock-free
+const char* tx_record_dir(const tx_ctx* c);          // where this run keeps recordings, or NULL
 
 #ifdef __cplusplus
 }

@@ -38,7 +38,8 @@ static void idle_step(tx_ctx* c, void* self) {
   (void)c;
   (void)self;
 }
-static const tx_controller_class idle_class = {"bench.idle", "does nothing", idle_configure, NULL, idle_step, NULL};
+static const tx_controller_class idle_class = {
+    .type = "bench.idle", .summary = "does nothing", .configure = idle_configure, .step = idle_step};
 
 // run a one-controller scenario of bench.idle at rate_hz; returns its statistics
 static int run_idle(double rate_hz, const tx_run_options* o, tx_controller_stats* st, tx_run_result* r, double* wall_ns) {
@@ -64,7 +65,7 @@ static int bench_rates(const bench_args* a) {
   printf("bench rates: %g s in real time, four controllers loading both cores\n",
          a->duration_s > 0 ? a->duration_s : sc->duration_s);
   json_t* report = NULL;
-  tx_run_config cfg = {"rates", a->duration_s, false, a->out, false};
+  tx_run_config cfg = {.scenario = "rates", .duration_s = a->duration_s, .out = a->out};
   int rc = tx_run_scenario(sc, &cfg, &report);
   tx_scenario_free(sc);
   if (rc) return rc;

@@ -20,6 +20,7 @@ static const char run_usage[] =
     "  --view SPEC         none|png|window (default none)\n"
     "  --stereo MODE       mono|sbs|tb|anaglyph|lr (default mono)\n"
     "  --out DIR           output folder (default out/SCENARIO-TIMESTAMP)\n"
+    "  --no-record         no device recordings (OUT/deviceN.bin and .csv are written by default)\n"
     "  --quiet             no summary table\n"
     "\n"
     "Writes OUT/report.json: per controller achieved rate, missed deadlines, period jitter and step time.\n"
@@ -54,7 +55,8 @@ int tx_run_scenario(tx_scenario* sc, const tx_run_config* cfg, json_t** report_o
   }
   tx_catch_stop_signals();
   tx_run_options o = {.duration_s = duration, .lockstep = cfg->lockstep, .trace = trace, .realtime_priority = true,
-                      .pin_threads = true, .keep_cpus_awake = true, .progress = tx_progress, .progress_user = &duration};
+                      .pin_threads = true, .keep_cpus_awake = true, .record_dir = cfg->no_record ? NULL : dir,
+                      .progress = tx_progress, .progress_user = &duration};
   tx_run_result r;
   int rc = tx_system_run(sc->system, &o, &r, err, sizeof err);
   if (trace && (fclose(trace) != 0 || rc != 0 || rename(trace_tmp, trace_path) != 0)) {
@@ -86,6 +88,7 @@ int tx_cmd_run(int argc, char** argv) {
       {"duration", required_argument, 0, 'd'}, {"lockstep", no_argument, 0, 'l'}, {"set", required_argument, 0, 's'},
       {"device", required_argument, 0, 'D'},   {"view", required_argument, 0, 'v'}, {"stereo", required_argument, 0, 'S'},
       {"out", required_argument, 0, 'o'},      {"quiet", no_argument, 0, 'q'},   {"help", no_argument, 0, 'h'},
+      {"no-record", no_argument, 0, 'R'},
       {0, 0, 0, 0}};
   static const char* const views[] = {"none", "png", "window", NULL};
   static const char* const stereo[] = {"mono", "sbs", "tb", "anaglyph", "lr", NULL};
@@ -123,6 +126,7 @@ int tx_cmd_run(int argc, char** argv) {
       break;
     case 'o': cfg.out = optarg; break;
     case 'q': cfg.quiet = true; break;
+    case 'R': cfg.no_record = true; break;
     case 'h': return fputs(run_usage, stdout), 0;
     default:
       // inside a group of short options argv[optind - 1] is not the option; optopt is

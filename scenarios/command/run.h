@@ -12,6 +12,7 @@ typedef struct tx_run_config {
   bool lockstep;
   const char* out;      // NULL: out/SCENARIO-TIMESTAMP
   bool quiet;
+  bool no_record;       // no device recordings in OUT
 } tx_run_config;
 
 // run and report; *report receives the report (caller frees) when not NULL.

@@ -147,7 +147,8 @@ static void sleeper_step(tx_ctx* c, void* self) {
 
 // 5 Hz for 1 s: ticks at 0, 200, 400, 600 and 800 ms; step 1 starts at 200 ms
 static void overrun(double sleep_ms, uint64_t want_steps, uint64_t want_missed) {
-  static tx_controller_class cls = {"test.sleeper", "sleeps once", sleeper_configure, NULL, sleeper_step, counter_fini};
+  static tx_controller_class cls = {.type = "test.sleeper", .summary = "sleeps once", .configure = sleeper_configure,
+                                    .step = sleeper_step, .fini = counter_fini};
   if (!tx_find_controller(cls.type)) assert_int_equal(tx_register_controller(&cls), 0);
   tx_system* s = tx_system_create();
   tx_fault f;
@@ -183,8 +184,8 @@ static int failing_init(tx_ctx* c, void* self) { return -1; }
 
 static void a_failing_init_stops_the_run_cleanly(void** state) {
   (void)state;
-  static tx_controller_class bad = {"test.badinit", "fails init", counter_configure, failing_init, counter_step,
-                                    counter_fini};
+  static tx_controller_class bad = {.type = "test.badinit", .summary = "fails init", .configure = counter_configure,
+                                    .init = failing_init, .step = counter_step, .fini = counter_fini};
   if (!tx_find_controller(bad.type)) assert_int_equal(tx_register_controller(&bad), 0);
   for (int lock = 0; lock < 2; lock++) {
     tx_system* s = tx_system_create();

@@ -41,8 +41,9 @@ static void counter_step(tx_ctx* x, void* self) {
 
 static void counter_fini(void* self) { free(self); }
 
-static const tx_controller_class test_counter = {"test.counter", "counts steps", counter_configure, NULL, counter_step,
-                                                 counter_fini};
+static const tx_controller_class test_counter = {.type = "test.counter", .summary = "counts steps",
+                                                 .configure = counter_configure, .step = counter_step,
+                                                 .fini = counter_fini};
 
 static inline void register_test_classes(void) {
   if (!tx_find_controller("test.counter")) tx_register_controller(&test_counter);

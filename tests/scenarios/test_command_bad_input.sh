@@ -145,6 +145,8 @@ expect_bad "--device unknown kind" "--device sim" "unknown kind" -- run haptics-
 expect_bad "--device missing file" "--device scripted:$WORK/none.csv" "No such file" -- run haptics-wall --lockstep --device "scripted:$WORK/none.csv"
 printf 't,x,y,z\n0,0,0,0\n0.5,0,zero,0\n' > "$WORK/bad_row.csv"
 expect_bad "--device bad waypoint row" "bad_row.csv:3:" "finite number" -- run haptics-wall --lockstep --device "scripted:$WORK/bad_row.csv"
+expect_bad "--device replay of a text file" "--device replay:$WORK/regular" "not a tactus recording" -- run haptics-wall --lockstep --device "replay:$WORK/regular"
+expect_bad "--device replay of a missing file" "none.bin" "No such file" -- run haptics-wall --lockstep --device "replay:$WORK/none.bin"
 expect_bad "--device without a haptics controller" "--device scripted:pierce-up" "0 haptics controllers" -- run rates --device scripted:pierce-up
 expect_bad "--device more than the scenario has" "at most 1 --device" -- run haptics-wall --device scripted:pierce-up --device scripted:pierce-down
 expect_bad "--device three times" "at most two" -- run haptics-wall --device scripted:pierce-up --device scripted:pierce-up --device scripted:pierce-up
