@@ -36,6 +36,11 @@ void tx_write_rows(tx_ctx* c, tx_port p, uint32_t rows) {
 
 int64_t tx_sim_ns(const tx_ctx* c) { return c->sim_ns; }
 const char* tx_record_dir(const tx_ctx* c) { return c->sys->record_dir; }
+
+// read after the run, once every thread has joined
+void tx_set_result(tx_ctx* c, tx_result r, double value) {
+  if (r.id >= 1 && r.id <= c->sys->nresults) c->sys->result_values[r.id - 1] = value;
+}
 uint64_t tx_step_index(const tx_ctx* c) { return c->step; }
 double tx_rate(const tx_ctx* c) { return c->in->rate_hz; }
 

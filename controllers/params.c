@@ -135,6 +135,19 @@ tx_port tx_setup_read(tx_setup* s, const char* component) {
   return p ? (tx_port){(uint16_t)s->in->nports} : (tx_port){0};
 }
 
+tx_result tx_setup_result(tx_setup* s, const char* key) {
+  tx_system* sys = s->sys;
+  char full[TX_WARNING_KEY_MAX];
+  if (!key || snprintf(full, sizeof full, "%s.%s", s->in->name, key) >= (int)sizeof full)
+    return tx_setup_fail(s, NULL, "result key is missing or too long"), (tx_result){0};
+  for (int i = 0; i < sys->nresults; i++)
+    if (strcmp(sys->result_keys[i], full) == 0) return (tx_result){(uint16_t)(i + 1)};
+  if (sys->nresults == TX_WARNINGS_MAX) return tx_setup_fail(s, NULL, "more than %d result keys", TX_WARNINGS_MAX), (tx_result){0};
+  strcpy(sys->result_keys[sys->nresults], full);
+  sys->result_values[sys->nresults] = NAN;
+  return (tx_result){(uint16_t)++sys->nresults};
+}
+
 tx_warning tx_setup_warning(tx_setup* s, const char* key) {
   tx_system* sys = s->sys;
   char full[TX_WARNING_KEY_MAX];

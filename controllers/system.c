@@ -240,6 +240,7 @@ bool tx_system_prepare_stats(tx_system* s, double duration_s) {
     in->first_start_ns = in->last_start_ns = 0;
   }
   for (int w = 0; w < s->nwarnings; w++) atomic_store(&s->warning_counts[w], 0);
+  for (int k = 0; k < s->nresults; k++) s->result_values[k] = NAN;
   return true;
 }
 
@@ -263,6 +264,9 @@ int tx_system_ports(const tx_system* s, int i) { return s->inst[i]->nports; }
 tx_model* tx_system_model(tx_system* s) { return s->model; }
 int tx_system_warnings(const tx_system* s) { return s->nwarnings; }
 const char* tx_system_warning_key(const tx_system* s, int w) { return s->warning_keys[w]; }
+int tx_system_results(const tx_system* s) { return s->nresults; }
+const char* tx_system_result_key(const tx_system* s, int k) { return s->result_keys[k]; }
+double tx_system_result(const tx_system* s, int k) { return s->result_values[k]; }
 uint64_t tx_system_warning_count(const tx_system* s, int w) {
   return atomic_load(&((tx_system*)s)->warning_counts[w]);
 }

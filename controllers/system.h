@@ -93,5 +93,8 @@ tx_model* tx_system_model(tx_system* s);
 int tx_system_warnings(const tx_system* s);
 const char* tx_system_warning_key(const tx_system* s, int w);
 uint64_t tx_system_warning_count(const tx_system* s, int w);
+int tx_system_results(const tx_system* s);
+const char* tx_system_result_key(const tx_system* s, int k);
+double tx_system_result(const tx_system* s, int k); // NaN if the run did not set it
 
 #endif

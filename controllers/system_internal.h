@@ -69,6 +69,9 @@ struct tx_system {
   tx_model* model;
   group* groups; // fastest first
   int ngroups;
+  char result_keys[TX_WARNINGS_MAX][TX_WARNING_KEY_MAX];
+  double result_values[TX_WARNINGS_MAX]; // NaN until set
+  int nresults;
   char warning_keys[TX_WARNINGS_MAX][TX_WARNING_KEY_MAX];
   _Atomic uint64_t warning_counts[TX_WARNINGS_MAX];
   int nwarnings;

@@ -2,6 +2,7 @@
 #include "report.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
@@ -30,9 +31,15 @@ json_t* tx_report_json(const tx_report* r) {
   if (!r->lockstep && !r->result->fifo) json_object_set_new(warnings, "scheduler.no_sched_fifo", json_integer(1));
   if (!r->lockstep && !r->result->pinned) json_object_set_new(warnings, "scheduler.not_pinned", json_integer(1));
 
-  json_t* report = json_pack("{s:s,s:s,s:f,s:o,s:o,s:s}", "scenario", r->scenario, "mode",
+  json_t* results = json_object();
+  for (int k = 0; k < tx_system_results(s); k++) {
+    double v = tx_system_result(s, k); // a result never set is null, not a number
+    json_object_set_new(results, tx_system_result_key(s, k), isfinite(v) ? json_real(v) : json_null());
+  }
+  json_t* report = json_pack("{s:s,s:s,s:f,s:o,s:o,s:o,s:s}", "scenario", r->scenario, "mode",
                              r->lockstep ? "lockstep" : "realtime", "duration_s", r->result->duration_s,
-                             "controllers", controllers, "warnings", warnings, "scheduler", r->result->scheduler);
+                             "controllers", controllers, "warnings", warnings, "results", results, "scheduler",
+                             r->result->scheduler);
   if (!r->lockstep) json_object_set_new(report, "host_steal_s", json_real(r->result->steal_s));
   if (r->lockstep) {
     char hash[17];
@@ -87,6 +94,12 @@ void tx_report_print(FILE* f, const json_t* report) {
     fprintf(f, "%s %s=%lld", shown++ ? "," : "warnings:", key, (long long)json_integer_value(v));
   }
   fprintf(f, "%s\n", shown ? "" : "warnings: none");
+  shown = 0;
+  json_object_foreach(json_object_get(report, "results"), key, v) {
+    if (!json_is_number(v)) continue;
+    fprintf(f, "%s %s=%.6g", shown++ ? "," : "results:", key, json_number_value(v));
+  }
+  if (shown) fprintf(f, "\n");
   double steal = json_number_value(json_object_get(report, "host_steal_s"));
   if (steal > 0)
     fprintf(f, "host steal: %.2f s of CPU time taken by the hypervisor during the run (%.1f%% of %ld CPUs)\n", steal,

@@ -30,6 +30,7 @@ typedef struct haptics {
   tx_port model;                 // the force model read, 0 for none
   tx_port pose, velocity, force, energy;
   tx_warning warn[W_COUNT];
+  tx_result energy_result, dissipated_result, min_energy_result;
   tx_device_state state;         // last sample
   double silent_s;               // since the last sample
   int hand;
@@ -87,6 +88,9 @@ static int configure(tx_setup* s, void** self) {
                                             "watchdog", "outside_workspace", "device_silent",
                                             "record_dropped"};
   for (int w = 0; w < W_COUNT; w++) h->warn[w] = tx_setup_warning(s, keys[w]);
+  h->energy_result = tx_setup_result(s, "passivity_energy_j");
+  h->min_energy_result = tx_setup_result(s, "passivity_min_energy_j");
+  h->dissipated_result = tx_setup_result(s, "passivity_dissipated_j");
   return 0;
 }
 
@@ -173,6 +177,9 @@ static void step(tx_ctx* c, void* self) {
 // the run is over: the recording is made whole (binary and CSV) before the report
 static void finish(tx_ctx* c, void* self) {
   haptics* h = self;
+  tx_set_result(c, h->energy_result, h->passivity.energy);
+  tx_set_result(c, h->min_energy_result, h->passivity.min_energy);
+  tx_set_result(c, h->dissipated_result, h->passivity.dissipated);
   char err[512];
   if (tx_recorder_stop(h->recorder, err, sizeof err)) fprintf(stderr, "tactus: recording: %s\n", err);
   h->recorder = NULL;

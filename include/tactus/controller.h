@@ -44,6 +44,7 @@ typedef struct tx_setup tx_setup; // configure-time view of one instance
 typedef struct tx_ctx tx_ctx;     // run-time view of one instance
 typedef struct tx_port { uint16_t id; } tx_port;       // a declared read or write; 0 is invalid
 typedef struct tx_warning { uint16_t id; } tx_warning; // a counted warning; 0 is invalid
+typedef struct tx_result { uint16_t id; } tx_result;   // a number the run reports; 0 is invalid
 
 typedef struct tx_controller_class {
   const char* type;    // registry name, e.g. "rates.synthetic"
@@ -69,6 +70,7 @@ double tx_setup_rate(const tx_setup* s);      // Hz
 tx_port tx_setup_write(tx_setup* s, const tx_component_def* def);
 tx_port tx_setup_read(tx_setup* s, const char* component);
 tx_warning tx_setup_warning(tx_setup* s, const char* key); // reported as "INSTANCE.key"
+tx_result tx_setup_result(tx_setup* s, const char* key);   // reported as "INSTANCE.key"; put the units in the key
 
 // configure: parameters. Range checks are inclusive.
 double tx_param_num(tx_setup* s, const char* key, double def, double min, double max);
@@ -91,6 +93,7 @@ uint64_t tx_step_index(const tx_ctx* c);             // 0 for the first step
 double tx_rate(const tx_ctx* c);                     // Hz
 void tx_warn(tx_ctx* c, tx_warning w);               // count one occurrence, lock-free
 const char* tx_record_dir(const tx_ctx* c);          // where this run keeps recordings, or NULL
+void tx_set_result(tx_ctx* c, tx_result r, double value); // the last value set is reported (set it in finish)
 
 #ifdef __cplusplus
 }

@@ -67,6 +67,27 @@ static void local_model_follows_the_hand_between_frames(void** state) {
   tx_scenario_free(hold);
 }
 
+static double result(tx_scenario* s, const char* key) {
+  for (int k = 0; k < tx_system_results(s->system); k++)
+    if (strcmp(tx_system_result_key(s->system, k), key) == 0) return tx_system_result(s->system, k);
+  fail_msg("no result %s", key);
+  return NAN;
+}
+
+// pressed 10 mm into a 300 N/m wall, the wall holds 1/2 k x^2 = 15 mJ: the
+// observer's energy is that, and a passive wall never goes below zero
+static void the_observer_measures_the_stored_energy(void** state) {
+  (void)state;
+  tx_scenario* s = load(60, 300, "pierce-down", "");
+  run(s, 5.0);
+  double e = result(s, "haptics.passivity_energy_j");
+  print_message("  observed %.6f J, 1/2 k x^2 = %.6f J\n", e, 0.5 * 300 * 0.01 * 0.01);
+  assert_true(fabs(e - 0.015) < 0.0005);
+  assert_true(result(s, "haptics.passivity_min_energy_j") >= 0);
+  assert_true(result(s, "haptics.passivity_dissipated_j") == 0);
+  tx_scenario_free(s);
+}
+
 static void forces_above_the_device_are_clamped(void** state) {
   (void)state;
   tx_scenario* s = load(60, 1000, "pierce-down", ""); // 10 mm deep: 10 N asked of a 3.3 N device
@@ -100,6 +121,7 @@ int main(void) {
   tx_register_builtin();
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(local_model_follows_the_hand_between_frames),
+      cmocka_unit_test(the_observer_measures_the_stored_energy),
       cmocka_unit_test(forces_above_the_device_are_clamped),
       cmocka_unit_test(a_stale_model_fades_out),
   };
