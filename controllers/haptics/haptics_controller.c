@@ -32,6 +32,7 @@ typedef struct haptics {
   tx_warning warn[W_COUNT];
   tx_result energy_result, dissipated_result, min_energy_result;
   tx_device_state state;         // last sample
+  double held[3];                // N, the environment force rendered last tick, held since
   double silent_s;               // since the last sample
   int hand;
   bool record;                   // when the run keeps recordings
@@ -154,7 +155,15 @@ static void step(tx_ctx* c, void* self) {
     memcpy(h->rec.force_model, m, sizeof h->rec.force_model);
     model_age = snap.seq ? (double)(tx_sim_ns(c) - snap.sim_ns) * 1e-9 : INFINITY; // no model yet: no force
   }
-  tx_passivity_tick(&h->passivity, f, h->state.vel, dt, h->passivity_control);
+  // the observer pairs the velocity of the period just measured with the
+  // force held over it (this tick's force would make a sampled spring look
+  // passive); the controller then damps the force about to be rendered
+  double held[3] = {h->held[0], h->held[1], h->held[2]};
+  double alpha = tx_passivity_tick(&h->passivity, held, h->state.vel, dt, h->passivity_control);
+  for (int i = 0; i < 3; i++) {
+    h->held[i] = f[i];
+    f[i] -= alpha * h->state.vel[i];
+  }
   tx_safety_counts before = h->safety.counts;
   double out[3];
   tx_safety_apply(&h->safety, &h->limits, dt, f, h->state.pos, model_age, h->silent_s, out);

@@ -19,9 +19,12 @@ typedef struct tx_passivity {
   uint64_t activations; // ticks on which the controller added damping
 } tx_passivity;
 
-// observe one tick: the force about to be rendered (N), the device velocity
-// (m/s) and the tick length (s). With control on, force is changed in place
-// so that the energy stays >= 0. Returns the damping added, N s/m.
+// observe one period: the force held over it (N), the device velocity
+// measured over it (m/s) and its length (s). Pair them so: the force about
+// to be rendered with the last velocity would make a sampled spring look
+// passive. With control on, returns the damping a (N s/m) to subtract, as
+// a v, from the next force so that the energy stays >= 0 (force is changed
+// in place too, for callers that render what they observed).
 double tx_passivity_tick(tx_passivity* p, double force[3], const double vel[3], double dt, bool control);
 
 #endif

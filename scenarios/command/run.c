@@ -32,14 +32,6 @@ static bool one_of(const char* s, const char* const* options) {
   return false;
 }
 
-static bool device_spec_valid(const char* s) {
-  static const char* const prefixes[] = {"scripted:", "replay:", "udp:", NULL};
-  if (!strcmp(s, "sim") || !strcmp(s, "mouse")) return true;
-  for (const char* const* p = prefixes; *p; p++)
-    if (!strncmp(s, *p, strlen(*p)) && s[strlen(*p)]) return true;
-  return false;
-}
-
 int tx_run_scenario(tx_scenario* sc, const tx_run_config* cfg, json_t** report_out) {
   char dir[4096], err[1024];
   if (tx_out_dir(cfg->out, sc->name, dir, sizeof dir, err, sizeof err)) return tx_bad_input("%s", err);
@@ -113,8 +105,6 @@ int tx_cmd_run(int argc, char** argv) {
       break;
     case 'D':
       if (++ndevices > 2) return tx_bad_input("--device %s: at most two devices (one per hand)", optarg);
-      if (!device_spec_valid(optarg))
-        return tx_bad_input("--device %s: expected scripted:NAME, scripted:FILE.csv, replay:FILE, sim, udp:HOST:PORT or mouse", optarg);
       devices[ndevices - 1] = optarg;
       break;
     case 'v':

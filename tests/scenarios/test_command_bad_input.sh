@@ -141,12 +141,15 @@ expect_bad "--stereo bogus" "--stereo bogus" -- run rates --stereo bogus
 expect_bad "--device bogus" "--device bogus" -- run rates --device bogus
 # devices go to the scenario's haptics controllers; each bad spec names the --device
 expect_bad "--device unknown motion" "--device scripted:wiggle" "pierce-down" -- run haptics-wall --lockstep --device scripted:wiggle
-expect_bad "--device unknown kind" "--device sim" "unknown kind" -- run haptics-wall --lockstep --device sim
+expect_bad "--device unknown kind" "--device phantom:1" "unknown kind" -- run haptics-wall --lockstep --device phantom:1
 expect_bad "--device missing file" "--device scripted:$WORK/none.csv" "No such file" -- run haptics-wall --lockstep --device "scripted:$WORK/none.csv"
 printf 't,x,y,z\n0,0,0,0\n0.5,0,zero,0\n' > "$WORK/bad_row.csv"
 expect_bad "--device bad waypoint row" "bad_row.csv:3:" "finite number" -- run haptics-wall --lockstep --device "scripted:$WORK/bad_row.csv"
 expect_bad "--device replay of a text file" "--device replay:$WORK/regular" "not a tactus recording" -- run haptics-wall --lockstep --device "replay:$WORK/regular"
 expect_bad "--device replay of a missing file" "none.bin" "No such file" -- run haptics-wall --lockstep --device "replay:$WORK/none.bin"
+expect_bad "--device sim with a bad value" "--device sim:damping=-1" "damping" -- run haptics-wall --lockstep --device sim:damping=-1
+expect_bad "--device sim with an unknown key" "--device sim:bogus=1" "unknown key" -- run haptics-wall --lockstep --device sim:bogus=1
+expect_bad "--device sim with a bad hand" "scripted:nope" -- run haptics-wall --lockstep --device sim:hand=nope
 expect_bad "--device without a haptics controller" "--device scripted:pierce-up" "0 haptics controllers" -- run rates --device scripted:pierce-up
 expect_bad "--device more than the scenario has" "at most 1 --device" -- run haptics-wall --device scripted:pierce-up --device scripted:pierce-down
 expect_bad "--device three times" "at most two" -- run haptics-wall --device scripted:pierce-up --device scripted:pierce-up --device scripted:pierce-up

@@ -13,14 +13,14 @@
 #include <string.h>
 
 // a wall updated at wall_hz and a scripted hand rendered at 1 kHz
-static tx_scenario* load(double wall_hz, double stiffness, const char* motion, const char* haptics_params) {
+static tx_scenario* load(double wall_hz, double stiffness, const char* device, const char* haptics_params) {
   char text[1024], err[512];
   snprintf(text, sizeof text,
            "{\"name\":\"t\",\"controllers\":["
            "{\"name\":\"wall\",\"type\":\"collision.wall\",\"rate_hz\":%g,\"params\":{\"stiffness\":%g}},"
-           "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:%s\","
+           "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"%s\","
            "\"force_model\":\"tool0.force_model\"%s%s}}]}",
-           wall_hz, stiffness, motion, *haptics_params ? "," : "", haptics_params);
+           wall_hz, stiffness, device, *haptics_params ? "," : "", haptics_params);
   tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL, err, sizeof err);
   if (!s) fail_msg("%s", err);
   return s;
@@ -48,8 +48,8 @@ static uint64_t warnings(tx_scenario* s, const char* key) {
 // pierce-down at 5 mm/s into a 300 N/m wall; after 3 s the hand is 2.5 mm deep
 static void local_model_follows_the_hand_between_frames(void** state) {
   (void)state;
-  tx_scenario* local = load(60, 300, "pierce-down", "");
-  tx_scenario* hold = load(60, 300, "pierce-down", "\"mode\":\"sample_hold\"");
+  tx_scenario* local = load(60, 300, "scripted:pierce-down", "");
+  tx_scenario* hold = load(60, 300, "scripted:pierce-down", "\"mode\":\"sample_hold\"");
   run(local, 3.0);
   run(hold, 3.0);
   double y = latest(local, "device0.pose")[1];
@@ -78,7 +78,7 @@ static double result(tx_scenario* s, const char* key) {
 // observer's energy is that, and a passive wall never goes below zero
 static void the_observer_measures_the_stored_energy(void** state) {
   (void)state;
-  tx_scenario* s = load(60, 300, "pierce-down", "");
+  tx_scenario* s = load(60, 300, "scripted:pierce-down", "");
   run(s, 5.0);
   double e = result(s, "haptics.passivity_energy_j");
   print_message("  observed %.6f J, 1/2 k x^2 = %.6f J\n", e, 0.5 * 300 * 0.01 * 0.01);
@@ -88,16 +88,30 @@ static void the_observer_measures_the_stored_energy(void** state) {
   tx_scenario_free(s);
 }
 
+// closed loop on the simulated device: a 200 N/m hand aiming 10 mm into a
+// 300 N/m wall comes to rest where the two springs balance, 4 mm deep, 1.2 N
+static void a_simulated_hand_settles_against_the_wall(void** state) {
+  (void)state;
+  tx_scenario* s = load(60, 300, "sim:hand_stiffness=200,hand=pierce-down", "");
+  run(s, 5.0);
+  double y = latest(s, "device0.pose")[1], f = latest(s, "device0.force")[1];
+  print_message("  sim device at rest: %.4f mm deep, %.4f N\n", -y * 1e3, f);
+  assert_true(fabs(-y - 0.004) < 0.0001); // within the encoder quantum and a little settling
+  assert_true(fabs(f - 1.2) < 0.03);
+  assert_true(fabs(latest(s, "device0.velocity")[1]) < 1e-3);
+  tx_scenario_free(s);
+}
+
 static void forces_above_the_device_are_clamped(void** state) {
   (void)state;
-  tx_scenario* s = load(60, 1000, "pierce-down", ""); // 10 mm deep: 10 N asked of a 3.3 N device
+  tx_scenario* s = load(60, 1000, "scripted:pierce-down", ""); // 10 mm deep: 10 N asked of a 3.3 N device
   run(s, 5.0);
   const double* f = latest(s, "device0.force");
   assert_true(f[1] <= 3.3 && f[1] > 3.2999);
   assert_true(warnings(s, "haptics.force_clamped") > 0);
   tx_scenario_free(s);
 
-  s = load(60, 1000, "pierce-down", "\"max_force\":1.5"); // a scenario may lower the limit
+  s = load(60, 1000, "scripted:pierce-down", "\"max_force\":1.5"); // a scenario may lower the limit
   run(s, 5.0);
   assert_true(latest(s, "device0.force")[1] <= 1.5);
   tx_scenario_free(s);
@@ -106,11 +120,11 @@ static void forces_above_the_device_are_clamped(void** state) {
 // a wall model published once a second goes stale after 50 ms: the force fades to zero
 static void a_stale_model_fades_out(void** state) {
   (void)state;
-  tx_scenario* s = load(1, 300, "pierce-up", ""); // starts 10 mm inside: 3 N at t = 0
+  tx_scenario* s = load(1, 300, "scripted:pierce-up", ""); // starts 10 mm inside: 3 N at t = 0
   run(s, 0.02);
   assert_true(latest(s, "device0.force")[1] > 2.9);
   tx_scenario_free(s);
-  s = load(1, 300, "pierce-up", "");
+  s = load(1, 300, "scripted:pierce-up", "");
   run(s, 0.5);
   assert_true(latest(s, "device0.force")[1] == 0);
   assert_true(warnings(s, "haptics.watchdog") > 0);
@@ -122,6 +136,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(local_model_follows_the_hand_between_frames),
       cmocka_unit_test(the_observer_measures_the_stored_energy),
+      cmocka_unit_test(a_simulated_hand_settles_against_the_wall),
       cmocka_unit_test(forces_above_the_device_are_clamped),
       cmocka_unit_test(a_stale_model_fades_out),
   };
