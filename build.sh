@@ -65,7 +65,7 @@ case "$target" in
 
     say "core only: every optional part off"
     build_variant build-core -DCMAKE_BUILD_TYPE=Release -DTX_WITH_BULLET=OFF -DTX_WITH_ODE=OFF \
-      -DTX_WITH_OSMESA=OFF -DTX_WITH_GLFW=OFF -DTX_WITH_DDS=OFF
+      -DTX_WITH_OSMESA=OFF -DTX_WITH_GLFW=OFF -DTX_WITH_DDS=OFF -DTX_WITH_PLPLOT=OFF
     test_variant build-core
 
     say "libFuzzer: the scenario loader for ${fuzz_seconds} s"

@@ -70,22 +70,12 @@ int tx_cmd_describe(int argc, char** argv) {
   return 0;
 }
 
-int tx_cmd_study(int argc, char** argv) {
-  // studies arrive with the scenarios that need them; the command is here first
-  if (argc >= 2 && strcmp(argv[1], "--help") == 0) {
-    printf("usage: tactus study NAME [--out DIR]\n\nno studies in this build yet\n");
-    return 0;
-  }
-  if (argc < 2) return tx_bad_input("study: expected a NAME (this build has no studies yet)");
-  return tx_bad_input("study %s: unknown study (this build has none yet)", argv[1]);
-}
-
 static int version(void) {
   printf("tactus %s (%s%s%s)\noptional parts:", TX_VERSION, TX_BUILD_TYPE, *TX_SANITIZE ? ", sanitize=" : "",
          TX_SANITIZE);
   const struct { const char* name; int on; } parts[] = {
       {"bullet", TX_WITH_BULLET}, {"ode", TX_WITH_ODE}, {"osmesa", TX_WITH_OSMESA}, {"glfw", TX_WITH_GLFW},
-      {"dds", TX_WITH_DDS}};
+      {"dds", TX_WITH_DDS}, {"plplot", TX_WITH_PLPLOT}};
   for (size_t i = 0; i < sizeof parts / sizeof parts[0]; i++) printf(" %s=%s", parts[i].name, parts[i].on ? "on" : "off");
   printf("\n");
   return 0;

@@ -2,6 +2,8 @@
 //
 //   report_check REPORT keys                 every documented key, with its JSON type
 //   report_check REPORT steps NAME N [...]   controller NAME ran exactly N steps, none missed
+//   report_check STUDY study                 haptic-stability.json: its keys, within 25% of the
+//                                            bound, passivity control at least twice as stiff
 //
 // Exit status 0 when the report passes, 1 with one line on stderr when it does not.
 #include <jansson.h>
@@ -88,6 +90,26 @@ static int check_steps(const json_t* r, int argc, char** argv) {
   return 0;
 }
 
+static int check_study(const json_t* r) {
+  const json_t* cases = json_object_get(r, "cases");
+  if (!json_is_array(cases) || json_array_size(cases) == 0) return bad("expected a non-empty array", "cases");
+  size_t i;
+  const json_t* c;
+  json_array_foreach(cases, i, c) {
+    char where[32];
+    snprintf(where, sizeof where, "cases[%zu].", i);
+    if (need_number(c, "period_s", where) || need_number(c, "k_max_theory", where) ||
+        need_number(c, "k_max_measured", where) || need_number(c, "k_max_with_passivity_control", where))
+      return 1;
+    double theory = json_number_value(json_object_get(c, "k_max_theory"));
+    double measured = json_number_value(json_object_get(c, "k_max_measured"));
+    double pc = json_number_value(json_object_get(c, "k_max_with_passivity_control"));
+    if (!(measured > 0.75 * theory && measured < 1.25 * theory)) return bad("measured not within 25% of theory", where);
+    if (!(pc >= 2 * measured)) return bad("passivity control less than 2x the measured", where);
+  }
+  return 0;
+}
+
 int main(int argc, char** argv) {
   if (argc < 3) return fprintf(stderr, "usage: report_check REPORT keys | REPORT steps NAME N [NAME N ...]\n"), 2;
   report_path = argv[1];
@@ -98,6 +120,7 @@ int main(int argc, char** argv) {
   if (!json_is_object(r)) rc = bad("expected an object", "(top)");
   else if (strcmp(argv[2], "keys") == 0) rc = check_keys(r);
   else if (strcmp(argv[2], "steps") == 0) rc = check_keys(r) || check_steps(r, argc - 3, argv + 3);
+  else if (strcmp(argv[2], "study") == 0) rc = check_study(r);
   else {
     fprintf(stderr, "report_check: unknown check '%s'\n", argv[2]);
     rc = 2;

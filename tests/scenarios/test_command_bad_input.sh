@@ -160,6 +160,10 @@ expect_bad "bench unknown option" "--bogus" -- bench rates --bogus
 expect_bad "bench --duration bad" "--duration" -- bench rates --duration abc
 expect_bad "study unknown name" "bogus" -- study bogus
 expect_bad "bench without a name" "bench" "NAME" -- bench
+expect_bad "study --set unknown key" "--set device.bogus=1" "unknown key" -- study haptic-stability --set device.bogus=1 --out "$WORK/st"
+expect_bad "study --set out of range" "damping" -- study haptic-stability --set device.damping=-5 --out "$WORK/st"
+expect_bad "study --set not a number" "--set device.period=abc" -- study haptic-stability --set device.period=abc --out "$WORK/st"
+expect_bad "study unwritable --out" "--out /dev/null/x" -- study haptic-stability --out /dev/null/x
 expect_bad "study without a name" "study" "NAME" -- study
 expect_bad "describe with two names" "describe" -- describe rates rates
 expect_bad "list with an argument" "list" -- list extra

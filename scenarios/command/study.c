@@ -1,0 +1,49 @@
+// tactus study: experiments that write JSON, CSV and PNG plots.
+#include "command.h"
+
+#include "../studies/studies.h"
+
+#include <getopt.h>
+#include <stdio.h>
+#include <string.h>
+
+static const struct {
+  const char* name;
+  int (*run)(const tx_study_args*);
+  const char* what;
+} studies[] = {
+    {"haptic-stability", tx_study_haptic_stability,
+     "largest stable wall stiffness vs Colgate's bound, with and without passivity control"},
+};
+
+int tx_cmd_study(int argc, char** argv) {
+  static const struct option longs[] = {
+      {"out", required_argument, 0, 'o'}, {"set", required_argument, 0, 's'}, {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
+  const char* out = NULL;
+  const char* sets[64];
+  int nsets = 0;
+  bool help = false;
+  optind = 1;
+  opterr = 0;
+  for (int c; (c = getopt_long(argc, argv, "", longs, NULL)) != -1;) {
+    if (c == 'o') out = optarg;
+    else if (c == 's') {
+      if (nsets == 64) return tx_bad_input("--set: at most 64");
+      sets[nsets++] = optarg;
+    } else if (c == 'h') help = true;
+    else return tx_bad_input("study: unknown or incomplete option '%s'", argv[optind - 1]);
+  }
+  if (help || optind != argc - 1) {
+    printf("usage: tactus study NAME [--out DIR] [--set KEY=VALUE]...\n\n");
+    for (size_t i = 0; i < sizeof studies / sizeof studies[0]; i++) printf("  %-18s %s\n", studies[i].name, studies[i].what);
+    return help ? 0 : tx_bad_input("study: expected one NAME from the list above");
+  }
+  for (size_t i = 0; i < sizeof studies / sizeof studies[0]; i++) {
+    if (strcmp(argv[optind], studies[i].name) != 0) continue;
+    char dir[4096], err[1024];
+    if (tx_out_dir(out, studies[i].name, dir, sizeof dir, err, sizeof err)) return tx_bad_input("%s", err);
+    tx_study_args a = {dir, sets, nsets};
+    return studies[i].run(&a);
+  }
+  return tx_bad_input("study %s: unknown study (tactus study lists them)", argv[optind]);
+}
