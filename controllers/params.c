@@ -130,9 +130,14 @@ tx_port tx_setup_write(tx_setup* s, const tx_component_def* def) {
   return (tx_port){(uint16_t)s->in->nports};
 }
 
-tx_port tx_setup_read(tx_setup* s, const char* component) {
+tx_port tx_setup_read(tx_setup* s, const char* component) { return tx_setup_read_as(s, component, (tx_type)0, 0); }
+
+tx_port tx_setup_read_as(tx_setup* s, const char* component, tx_type type, uint32_t cols) {
   port* p = new_port(s, component, false);
-  return p ? (tx_port){(uint16_t)s->in->nports} : (tx_port){0};
+  if (!p) return (tx_port){0};
+  p->want_type = type;
+  p->want_cols = cols;
+  return (tx_port){(uint16_t)s->in->nports};
 }
 
 tx_result tx_setup_result(tx_setup* s, const char* key) {

@@ -199,6 +199,19 @@ int tx_system_finalize(tx_system* s, tx_fault* f) {
       return fault(f, in->name, "reads unknown component '%s'", name);
     }
   }
+  // a read that needs a schema gets it
+  for (int i = 0; i < s->count; i++) {
+    instance* in = s->inst[i];
+    for (int p = 0; p < in->nports; p++) {
+      const port* pt = &in->ports[p];
+      if (pt->write) continue;
+      const tx_component_def* d = writer_def(s, pt->name, NULL);
+      if ((pt->want_type && d->type != pt->want_type) || (pt->want_cols && d->cols != pt->want_cols))
+        return fault(f, in->name, "reads '%s' as %s x %u, but it is written as %s %ux%u", pt->name,
+                     pt->want_type ? tx_type_name(pt->want_type) : "any", pt->want_cols, tx_type_name(d->type), d->rows,
+                     d->cols);
+    }
+  }
   // declared components need a writer too, or nothing could ever fill them
   for (int d = 0; d < s->ndeclared; d++)
     if (!writer_def(s, s->declared[d].name, NULL))

@@ -15,6 +15,8 @@ typedef struct port {
   tx_component_def def; // writes: the declared schema (name, units point above)
   tx_comp comp;         // after finalize
   tx_reader reader;     // reads: this instance's hazard slot
+  tx_type want_type;    // reads: the element type needed, 0 for any
+  uint32_t want_cols;   // reads: values per row needed, 0 for any
   bool dirty;           // written during the current step
 } port;
 

@@ -24,7 +24,7 @@ static int configure(tx_setup* s, void** self) {
   const char* pose = tx_param_str(s, "pose", "device0.pose");
   const char* model = tx_param_str(s, "force_model", "tool0.force_model");
   if (!pose || !model) return -1;
-  w->pose = tx_setup_read(s, pose);
+  w->pose = tx_setup_read_as(s, pose, TX_F64, 7); // x y z, qw qx qy qz
   w->model = tx_setup_write(s, &(tx_component_def){model, TX_F64, 1, 15, "N, m, N/m"});
   return 0;
 }

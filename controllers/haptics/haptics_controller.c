@@ -28,6 +28,8 @@ typedef struct haptics {
   tx_safety safety;
   tx_passivity passivity;
   tx_port model;                 // the force model read, 0 for none
+  tx_port tool;                  // virtual coupling: the simulated tool's pose, 0 for none
+  double coupling_k, coupling_b; // N/m, N s/m
   tx_port pose, velocity, force, energy;
   tx_warning warn[W_COUNT];
   tx_result energy_result, dissipated_result, min_energy_result;
@@ -49,12 +51,18 @@ static int configure(tx_setup* s, void** self) {
   if (!h) return -1;
   *self = h;
   const double period = 1.0 / tx_setup_rate(s);
+  if (tx_setup_rate(s) > 10000) return tx_setup_fail(s, NULL, "haptics runs at most at 10000 Hz, not %g", tx_setup_rate(s));
   const char* spec = tx_param_str(s, "device", "scripted:pierce-down");
   int hand = h->hand = (int)tx_param_int(s, "hand", 0, 0, 1);
   h->record = tx_param_bool(s, "record", true);
   const char* mode = tx_param_str(s, "mode", "local");
   const char* model = tx_param_str(s, "force_model", "");
   h->passivity_control = tx_param_bool(s, "passivity_control", false);
+  const char* tool = tx_param_str(s, "coupling_tool", "");
+  h->coupling_k = tx_param_num(s, "coupling_stiffness", 200, 0, 1e5);
+  h->coupling_b = tx_param_num(s, "coupling_damping", 1, 0, 1e3);
+  if (!tool) return -1;
+  if (*tool && *model) return tx_setup_fail(s, "coupling_tool", "renders either a force model or a coupling, not both");
   if (!spec || !mode || !model) return -1; // a parameter error is already recorded
   if (strcmp(mode, "local") == 0) h->mode = TX_RENDER_LOCAL_MODEL;
   else if (strcmp(mode, "sample_hold") == 0) h->mode = TX_RENDER_SAMPLE_HOLD;
@@ -75,7 +83,8 @@ static int configure(tx_setup* s, void** self) {
   if (bad) return tx_setup_fail(s, NULL, "safety limits: %s", bad);
   tx_safety_init(&h->safety);
 
-  if (*model) h->model = tx_setup_read(s, model);
+  if (*model) h->model = tx_setup_read_as(s, model, TX_F64, 15); // F0, x0, K
+  if (*tool) h->tool = tx_setup_read_as(s, tool, TX_F64, 7);     // a pose: x y z, qw qx qy qz
   char name[TX_NAME_MAX];
   snprintf(name, sizeof name, "device%d.pose", hand);
   h->pose = tx_setup_write(s, &(tx_component_def){name, TX_F64, 1, 7, "m"}); // x y z, qw qx qy qz
@@ -154,6 +163,13 @@ static void step(tx_ctx* c, void* self) {
     tx_render_force(&fm, h->mode, h->state.pos, f);
     memcpy(h->rec.force_model, m, sizeof h->rec.force_model);
     model_age = snap.seq ? (double)(tx_sim_ns(c) - snap.sim_ns) * 1e-9 : INFINITY; // no model yet: no force
+  } else if (h->tool.id) {
+    // virtual coupling: a spring-damper pulls the device toward the simulated
+    // tool, which the physics moves; the tool's pose is x y z (then orientation)
+    tx_snapshot snap = tx_read(c, h->tool);
+    const double still[3] = {0, 0, 0};
+    tx_render_coupling(h->coupling_k, h->coupling_b, snap.data, still, h->state.pos, h->state.vel, f);
+    model_age = snap.seq ? (double)(tx_sim_ns(c) - snap.sim_ns) * 1e-9 : INFINITY;
   }
   // the observer pairs the velocity of the period just measured with the
   // force held over it (this tick's force would make a sampled spring look

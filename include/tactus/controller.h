@@ -69,6 +69,9 @@ double tx_setup_rate(const tx_setup* s);      // Hz
 // instance is configured.
 tx_port tx_setup_write(tx_setup* s, const tx_component_def* def);
 tx_port tx_setup_read(tx_setup* s, const char* component);
+// a read that needs this element type and this many values per row (0: any);
+// the loader rejects a writer of another schema
+tx_port tx_setup_read_as(tx_setup* s, const char* component, tx_type type, uint32_t cols);
 tx_warning tx_setup_warning(tx_setup* s, const char* key); // reported as "INSTANCE.key"
 tx_result tx_setup_result(tx_setup* s, const char* key);   // reported as "INSTANCE.key"; put the units in the key
 

@@ -59,7 +59,7 @@ static int configure(tx_setup* s, void** self) {
   w->work_ns = 1e3 * tx_param_num(s, "work_us", 0, 0, 1e6);
   const char* reads[READS_MAX];
   w->nreads = tx_param_strs(s, "reads", reads, READS_MAX);
-  for (int i = 0; i < w->nreads; i++) w->reads[i] = tx_setup_read(s, reads[i]);
+  for (int i = 0; i < w->nreads; i++) w->reads[i] = tx_setup_read_as(s, reads[i], TX_F32, 0);
   const char* out = tx_param_str(s, "write", NULL);
   int64_t rows = tx_param_int(s, "rows", 1, 1, 1 << 24);
   int64_t cols = tx_param_int(s, "cols", 3, 1, 64);

@@ -75,6 +75,30 @@ static void unknown_and_unwritten_reads_are_rejected(void** state) {
   tx_system_destroy(s);
 }
 
+// the counter reads f64 x 2; a reader that needs f64 x 15 is refused that component
+static int picky_configure(tx_setup* s, void** self) {
+  *self = NULL;
+  tx_setup_read_as(s, tx_param_str(s, "read", "x"), TX_F64, 15);
+  return 0;
+}
+
+static void picky_step(tx_ctx* c, void* self) {}
+
+static void reads_get_the_schema_they_need(void** state) {
+  (void)state;
+  static const tx_controller_class picky = {.type = "test.picky", .configure = picky_configure, .step = picky_step};
+  if (!tx_find_controller("test.picky")) assert_int_equal(tx_register_controller(&picky), 0);
+  tx_system* s = tx_system_create();
+  int rc;
+  add(s, "a", 10, "{\"write\":\"x\"}", &rc);
+  tx_fault f;
+  assert_int_equal(tx_system_add(s, "b", "test.picky", 10, NULL, &f), 0);
+  assert_int_equal(tx_system_finalize(s, &f), -1);
+  assert_string_equal(f.key, "b");
+  assert_non_null(strstr(f.message, "reads 'x' as f64 x 15, but it is written as f64 1x2"));
+  tx_system_destroy(s);
+}
+
 static void declared_schema_must_match(void** state) {
   (void)state;
   tx_system* s = tx_system_create();
@@ -164,6 +188,7 @@ int main(void) {
       cmocka_unit_test(two_writers_are_rejected),
       cmocka_unit_test(unknown_and_unwritten_reads_are_rejected),
       cmocka_unit_test(declared_schema_must_match),
+      cmocka_unit_test(reads_get_the_schema_they_need),
       cmocka_unit_test(parameters_are_checked),
       cmocka_unit_test(names_and_types_are_checked),
       cmocka_unit_test(registry_rejects_bad_classes),

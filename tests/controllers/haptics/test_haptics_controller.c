@@ -102,6 +102,58 @@ static void a_simulated_hand_settles_against_the_wall(void** state) {
   tx_scenario_free(s);
 }
 
+// a simulated tool held still at y = 5 mm, as physics would publish it
+static int tool_configure(tx_setup* s, void** self) {
+  *self = NULL;
+  tx_setup_write(s, &(tx_component_def){"tool0.pose", TX_F64, 1, 7, "m"});
+  return 0;
+}
+static void tool_step(tx_ctx* c, void* self) {
+  double* pose = tx_write(c, (tx_port){1});
+  double still[7] = {0, 0.005, 0, 1, 0, 0, 0};
+  memcpy(pose, still, sizeof still);
+}
+
+// virtual coupling: 200 N/m between the device (ending at y = -10 mm) and the tool
+static void virtual_coupling_pulls_toward_the_tool(void** state) {
+  (void)state;
+  static const tx_controller_class tool = {.type = "test.tool", .configure = tool_configure, .step = tool_step};
+  if (!tx_find_controller(tool.type)) assert_int_equal(tx_register_controller(&tool), 0);
+  const char* text = "{\"name\":\"t\",\"controllers\":["
+                     "{\"name\":\"tool\",\"type\":\"test.tool\",\"rate_hz\":60},"
+                     "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{"
+                     "\"device\":\"scripted:pierce-down\",\"coupling_tool\":\"tool0.pose\","
+                     "\"coupling_stiffness\":200,\"coupling_damping\":1}}]}";
+  char err[512];
+  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL, err, sizeof err);
+  if (!s) fail_msg("%s", err);
+  run(s, 5.0);
+  assert_true(fabs(latest(s, "device0.force")[1] - 200 * 0.015) < 1e-9);
+  tx_scenario_free(s);
+}
+
+static void configuration_mistakes_are_refused(void** state) {
+  (void)state;
+  const struct {
+    const char* controllers;
+    const char* want;
+  } bad[] = {
+      {"{\"name\":\"h\",\"type\":\"haptics\",\"rate_hz\":20000}", "at most at 10000 Hz"},
+      {"{\"name\":\"w\",\"type\":\"collision.wall\",\"rate_hz\":60,\"params\":{\"pose\":\"device0.velocity\"}},"
+       "{\"name\":\"h\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"force_model\":\"tool0.force_model\"}}",
+       "reads 'device0.velocity' as f64 x 7"},
+      {"{\"name\":\"h\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"force_model\":\"a\",\"coupling_tool\":\"b\"}}",
+       "not both"},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    char text[1024], err[512] = "";
+    snprintf(text, sizeof text, "{\"name\":\"t\",\"controllers\":[%s]}", bad[i].controllers);
+    tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL, err, sizeof err);
+    assert_null(s);
+    if (!strstr(err, bad[i].want)) fail_msg("case %zu: '%s' lacks '%s'", i, err, bad[i].want);
+  }
+}
+
 static void forces_above_the_device_are_clamped(void** state) {
   (void)state;
   tx_scenario* s = load(60, 1000, "scripted:pierce-down", ""); // 10 mm deep: 10 N asked of a 3.3 N device
@@ -137,6 +189,8 @@ int main(void) {
       cmocka_unit_test(local_model_follows_the_hand_between_frames),
       cmocka_unit_test(the_observer_measures_the_stored_energy),
       cmocka_unit_test(a_simulated_hand_settles_against_the_wall),
+      cmocka_unit_test(virtual_coupling_pulls_toward_the_tool),
+      cmocka_unit_test(configuration_mistakes_are_refused),
       cmocka_unit_test(forces_above_the_device_are_clamped),
       cmocka_unit_test(a_stale_model_fades_out),
   };
