@@ -36,5 +36,6 @@ void tx_device_close(tx_device_handle* h);
 extern const tx_device_backend tx_device_scripted;
 extern const tx_device_backend tx_device_replay;
 extern const tx_device_backend tx_device_sim;
+extern const tx_device_backend tx_device_udp;
 
 #endif

@@ -8,9 +8,9 @@
 tx_safety_limits tx_safety_limits_from_device(const tx_device_info* info) {
   tx_safety_limits l = {
       .max_force = info->max_force,
-      .ramp_s = 0.010,
+      .ramp_s = 0.005,
       .model_timeout_s = 0.050, // three physics frames at 60 Hz
-      .device_timeout_s = 0.020,
+      .device_timeout_s = 0.004, // 4 lost samples at 1 kHz: with the ramp, zero within 10 ms of silence
   };
   l.max_force_rate = l.max_force / l.ramp_s * 2; // twice what a full ramp needs
   for (int i = 0; i < 3; i++) {

@@ -39,7 +39,8 @@ typedef struct tx_safety {
   tx_safety_counts counts;
 } tx_safety;
 
-// limits from a device: its max force, a 10 ms ramp, 50 ms model and 20 ms device timeouts
+// limits from a device: its max force, a 5 ms ramp, 50 ms model and 4 ms device timeouts,
+// so that a device gone silent feels no force 9 ms after its last sample
 tx_safety_limits tx_safety_limits_from_device(const tx_device_info* info);
 // NULL when every field is finite and consistent, else what is wrong ("max_force: ...")
 const char* tx_safety_limits_check(const tx_safety_limits* l);

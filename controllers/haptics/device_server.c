@@ -1,0 +1,261 @@
+// A device served over UDP; see device_server.h and docs/device-protocol.md.
+#include "device_server.h"
+
+#include "device.h"
+#include "device_protocol.h"
+
+#include <arpa/inet.h>
+#include <errno.h>
+#include <math.h>
+#include <poll.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/random.h>
+#include <sys/socket.h>
+#include <time.h>
+#include <unistd.h>
+
+#define DRAIN_MAX 256          // packets taken per wake: a flood cannot starve the state ticks
+#define IDLE_WAIT_NS 100000000 // between checks of the stop flag before the first hello
+#define SAMPLES (1u << 18)     // round trips kept for percentiles: 4 min at 1 kHz
+
+struct tx_device_server {
+  tx_device_server_def def;
+  tx_device_handle dev;
+  tx_device_info info;
+  int fd;
+  uint32_t session;           // ours
+  uint64_t seq;               // our last sent
+  bool locked;                // the peer is known
+  struct sockaddr_in peer;    // then, the only source accepted
+  tx_dp_peer from;            // the peer's session and newest sequence
+  int64_t echo_ns;            // send_ns of the newest packet accepted
+  int64_t arrival_ns;         // when it arrived, monotonic
+  bool streaming;             // a hello has come: states flow
+  int64_t t0_ns;              // when the stream started: device time 0
+  int64_t next_ns;            // the next state tick
+  int64_t last_force_ns;      // arrival of the newest force
+  bool forcing;               // a force from the peer is on the device
+  int64_t last_echo_measured; // the newest state a round trip was measured for
+  tx_samples loop, link;
+  tx_device_server_stats stats;
+};
+
+static bool same_addr(const struct sockaddr_in* a, const struct sockaddr_in* b) {
+  return a->sin_addr.s_addr == b->sin_addr.s_addr && a->sin_port == b->sin_port;
+}
+
+tx_device_server_def tx_device_server_def_default(void) {
+  tx_device_server_def d = {.rate_hz = 1000, .force_timeout_s = 0.02};
+  d.listen.sin_family = AF_INET;
+  d.listen.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  d.listen.sin_port = htons(TX_DEVICE_SERVER_PORT);
+  d.peer.sin_family = AF_INET;
+  return d;
+}
+
+static const char* addr_text(const struct sockaddr_in* a, char* buf, size_t n) {
+  char ip[INET_ADDRSTRLEN] = "?";
+  inet_ntop(AF_INET, &a->sin_addr, ip, sizeof ip);
+  snprintf(buf, n, "%s:%u", ip, ntohs(a->sin_port));
+  return buf;
+}
+
+tx_device_server* tx_device_server_open(const tx_device_server_def* def, char* err, size_t n) {
+  if (!def->spec || !*def->spec) return snprintf(err, n, "no device to serve"), NULL;
+  if (!(def->rate_hz > 0 && def->rate_hz <= TX_DP_MAX_RATE_HZ))
+    return snprintf(err, n, "rate %g Hz: expected (0, %g]", def->rate_hz, TX_DP_MAX_RATE_HZ), NULL;
+  if (!(def->duration_s >= 0 && def->duration_s <= 1e7)) return snprintf(err, n, "duration: out of range"), NULL;
+  if (!(def->force_timeout_s > 0 && def->force_timeout_s <= 10))
+    return snprintf(err, n, "force timeout: expected (0, 10] s"), NULL;
+  tx_device_server* s = calloc(1, sizeof *s);
+  if (!s) return snprintf(err, n, "out of memory"), NULL;
+  s->def = *def;
+  s->fd = -1;
+  if (!tx_samples_init(&s->loop, SAMPLES) || !tx_samples_init(&s->link, SAMPLES)) {
+    snprintf(err, n, "out of memory");
+    tx_device_server_close(s);
+    return NULL;
+  }
+  if (tx_device_open(def->spec, 1 / def->rate_hz, &s->dev, err, n)) {
+    tx_device_server_close(s);
+    return NULL;
+  }
+  s->dev.backend->info(s->dev.device, &s->info);
+  char where[64];
+  s->fd = socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+  int on = 1;
+  if (s->fd >= 0) setsockopt(s->fd, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on);
+  if (s->fd < 0 || bind(s->fd, (const struct sockaddr*)&def->listen, sizeof def->listen) != 0) {
+    snprintf(err, n, "--listen %s: %s", addr_text(&def->listen, where, sizeof where), strerror(errno));
+    tx_device_server_close(s);
+    return NULL;
+  }
+  if (getrandom(&s->session, sizeof s->session, GRND_NONBLOCK) != (ssize_t)sizeof s->session)
+    s->session = (uint32_t)(tx_dp_now_ns() ^ ((int64_t)getpid() << 16));
+  if (!s->session) s->session = 1;
+  if (def->peer.sin_port) s->locked = true, s->peer = def->peer;
+  return s;
+}
+
+uint16_t tx_device_server_port(const tx_device_server* s) {
+  struct sockaddr_in a = {0};
+  socklen_t len = sizeof a;
+  getsockname(s->fd, (struct sockaddr*)&a, &len);
+  return ntohs(a.sin_port);
+}
+
+static void send_packet(tx_device_server* s, tx_dp_packet* p) {
+  int64_t now = tx_dp_now_ns();
+  p->session = s->session;
+  p->seq = ++s->seq;
+  p->send_ns = now;
+  p->echo_ns = s->echo_ns;
+  int64_t hold = s->echo_ns ? now - s->arrival_ns : 0;
+  p->echo_hold_ns = hold <= 0 ? 0 : hold >= UINT32_MAX ? UINT32_MAX : (uint32_t)hold;
+  uint8_t buf[TX_DP_MAX_SIZE];
+  size_t size = tx_dp_encode(p, buf, sizeof buf);
+  if (size == 0 || sendto(s->fd, buf, size, MSG_DONTWAIT | MSG_NOSIGNAL, (const struct sockaddr*)&s->peer,
+                          sizeof s->peer) != (ssize_t)size)
+    s->stats.send_errors++;
+}
+
+static void zero_device(tx_device_server* s) {
+  const double zero[3] = {0, 0, 0};
+  s->dev.backend->write(s->dev.device, zero);
+  s->forcing = false;
+}
+
+// one datagram
+static void consider(tx_device_server* s, const uint8_t* buf, size_t n, const struct sockaddr_in* from,
+                     int64_t arrival) {
+  if (s->locked && !same_addr(from, &s->peer)) {
+    s->stats.foreign++;
+    return;
+  }
+  tx_dp_packet p;
+  if (tx_dp_decode(buf, n, &p) != TX_DP_OK) {
+    s->stats.malformed++;
+    return;
+  }
+  if (!s->locked) { // the first valid hello picks the peer for good
+    if (p.type != TX_DP_HELLO) {
+      s->stats.other_session++;
+      return;
+    }
+    s->locked = true;
+    s->peer = *from;
+  }
+  // a new session of the same peer (a new run) may start while serving
+  tx_dp_verdict v = tx_dp_peer_accept(&s->from, &p, true);
+  if (v == TX_DP_STALE) s->stats.stale++;
+  if (v == TX_DP_OTHER_SESSION) s->stats.other_session++;
+  if (v != TX_DP_ACCEPT && v != TX_DP_NEW_SESSION) return;
+  s->echo_ns = p.send_ns;
+  s->arrival_ns = arrival;
+  if (p.type == TX_DP_HELLO) {
+    if (v == TX_DP_NEW_SESSION) { // forces and round trips of an older session no longer count
+      if (s->forcing) zero_device(s);
+      s->last_echo_measured = 0;
+    }
+    tx_dp_packet hello = {.type = TX_DP_HELLO, .hello = {s->def.rate_hz, s->info}};
+    send_packet(s, &hello);
+    s->stats.hellos++;
+    if (!s->streaming) {
+      s->streaming = true;
+      s->t0_ns = s->next_ns = tx_dp_now_ns();
+    }
+  } else if (p.type == TX_DP_FORCE) {
+    s->dev.backend->write(s->dev.device, p.force);
+    s->stats.forces++;
+    s->last_force_ns = arrival;
+    s->forcing = true;
+    // the first force computed from a state measures its round trip, on our clock only
+    if (p.echo_ns > s->last_echo_measured && p.echo_ns >= s->t0_ns && p.echo_ns <= arrival) {
+      s->last_echo_measured = p.echo_ns;
+      int64_t loop = arrival - p.echo_ns;
+      tx_samples_add(&s->loop, loop);
+      tx_samples_add(&s->link, loop - (int64_t)p.echo_hold_ns);
+      s->stats.round_trips++;
+    }
+  } else {
+    s->stats.unexpected++;
+  }
+}
+
+static int drain(tx_device_server* s, char* err, size_t n) {
+  for (int i = 0; i < DRAIN_MAX; i++) {
+    uint8_t buf[TX_DP_MAX_SIZE + 1];
+    struct sockaddr_in from;
+    int64_t arrival;
+    long got = tx_dp_recv(s->fd, buf, sizeof buf, &from, &arrival);
+    if (got >= 0) consider(s, buf, (size_t)got, &from, arrival);
+    else if (errno == EAGAIN || errno == EWOULDBLOCK) return 0;
+    else if (errno != EINTR && errno != ECONNREFUSED) return snprintf(err, n, "receive: %s", strerror(errno)), -1;
+  }
+  return 0;
+}
+
+// the state tick: sample the device at its scheduled time and send it
+static void tick(tx_device_server* s, int64_t now, int64_t period) {
+  double t = (double)(s->next_ns - s->t0_ns) * 1e-9;
+  tx_device_state st;
+  if (s->dev.backend->read(s->dev.device, t, &st)) { // a device with nothing new (a replay's end) falls silent
+    tx_dp_packet p = {.type = TX_DP_STATE, .state = st};
+    send_packet(s, &p);
+    s->stats.states++;
+  }
+  s->next_ns += period;
+  if (now - s->next_ns > period) { // far behind: skip the missed ticks rather than burst them
+    s->stats.late_ticks++;
+    s->next_ns = now + period;
+  }
+}
+
+int tx_device_server_run(tx_device_server* s, const atomic_int* stop, char* err, size_t n) {
+  const int64_t period = (int64_t)llround(1e9 / s->def.rate_hz);
+  const int64_t duration = (int64_t)llround(s->def.duration_s * 1e9), force_timeout = (int64_t)llround(s->def.force_timeout_s * 1e9);
+  int rc = 0;
+  while (!atomic_load(stop)) {
+    int64_t now = tx_dp_now_ns();
+    if (s->streaming && duration && now - s->t0_ns >= duration) break;
+    if (s->streaming && now >= s->next_ns) tick(s, now, period);
+    if (s->forcing && now - s->last_force_ns > force_timeout) { // the simulator went quiet
+      zero_device(s);
+      s->stats.force_timeouts++;
+    }
+    // sleep until input, the next tick or a signal
+    int64_t wait = s->streaming ? s->next_ns - tx_dp_now_ns() : IDLE_WAIT_NS;
+    if (wait < 0) wait = 0;
+    struct timespec to = {wait / 1000000000, wait % 1000000000};
+    struct pollfd pfd = {s->fd, POLLIN, 0};
+    if (ppoll(&pfd, 1, &to, NULL) < 0 && errno != EINTR) {
+      rc = -1, snprintf(err, n, "poll: %s", strerror(errno));
+      break;
+    }
+    if (drain(s, err, n)) {
+      rc = -1;
+      break;
+    }
+  }
+  zero_device(s);
+  return rc;
+}
+
+void tx_device_server_get_stats(const tx_device_server* s, tx_device_server_stats* out) {
+  *out = s->stats;
+  out->loop = tx_samples_percentiles(&s->loop);
+  out->link = tx_samples_percentiles(&s->link);
+}
+
+void tx_device_server_close(tx_device_server* s) {
+  if (!s) return;
+  if (s->dev.device) zero_device(s);
+  tx_device_close(&s->dev);
+  if (s->fd >= 0) close(s->fd);
+  tx_samples_free(&s->loop);
+  tx_samples_free(&s->link);
+  free(s);
+}

@@ -1,0 +1,216 @@
+#!/usr/bin/env bash
+# tactus-device and the udp device, end to end on loopback:
+#   - bad input: exit status 2 and one line naming the option or file
+#   - a scripted device served to `tactus run haptics-wall --device udp:...`:
+#     the run completes, and once the stream stops the rendered force is zero
+#     within 10 ms (device timeout 4 ms + ramp 5 ms)
+#   - the same through a lossy relay (10% loss, reordering, duplicates,
+#     garbage, replays, forged packets): no crash, stale and foreign packets
+#     dropped, the force still within the clamp and zero after the stream stops
+#   - Ctrl-C stops the server cleanly
+#
+#   test_tactus_device.sh TACTUS_DEVICE TACTUS UDP_SHIM
+set -u
+HERE=$(dirname "$(realpath "$0")")
+DEVICE=$(realpath "$1")
+RUNNER=$(realpath "$2")
+SHIM=$(realpath "$3")
+WORK=$(mktemp -d)
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
+  rm -rf "$WORK"
+}
+trap cleanup EXIT
+cd "$WORK" || exit 1
+unset TACTUS_SCENARIO_PATH
+. "$HERE/bad_input_lib.sh" || exit 1
+
+# the port a server printed on its first line ("... on 127.0.0.1:PORT ..."), waiting up to 5 s
+port_of() {
+  local file=$1 port=""
+  for _ in $(seq 50); do
+    port=$(sed -n 's/.* on 127\.0\.0\.1:\([0-9][0-9]*\).*/\1/p; s/.*listening on 127\.0\.0\.1:\([0-9][0-9]*\).*/\1/p' "$file" | head -n 1)
+    [ -n "$port" ] && break
+    sleep 0.1
+  done
+  echo "$port"
+}
+
+# device0.csv: |F| was at least 0.5 N in the 50 ms before the last new state, and is
+# exactly zero within 10 ms after it (the stream stopped there)
+zero_within_10ms() {
+  awk -F, 'NR > 1 {
+      t[NR] = $1; f[NR] = sqrt($5 * $5 + $6 * $6 + $7 * $7)
+      if (f[NR] > 3.3) { print "force " f[NR] " N above the 3.3 N clamp at " $1 " s"; bad = 1 }
+      if ($2 != px || $3 != py || $4 != pz) last = NR
+      px = $2; py = $3; pz = $4
+    }
+    END {
+      if (bad) exit 1
+      before = 0
+      for (i = last; i > 1 && t[i] > t[last] - 0.050; i--) if (f[i] > before) before = f[i]
+      for (i = last; i <= NR; i++) if (f[i] == 0) break
+      if (i > NR) { printf "the force never reached zero after the last new state at %.3f s\n", t[last]; exit 1 }
+      printf "last new state at %.3f s (|F| up to %.3f N before it); zero %.1f ms later\n", t[last], before, (t[i] - t[last]) * 1e3
+      exit !(before >= 0.5 && t[i] - t[last] <= 0.0105)
+    }' "$1"
+}
+
+# --- bad input --------------------------------------------------------------------
+TACTUS=$DEVICE
+expect_bad "no SPEC" "SPEC" --
+expect_bad "unknown option" "--bogus" -- scripted:pierce-down --bogus
+expect_bad "unknown short option" "'-x'" -- -x scripted:pierce-down
+expect_bad "extra argument" "extra" -- scripted:pierce-down extra
+for r in 0 -5 abc nan inf 1e6 ""; do
+  expect_bad "--rate '$r'" "--rate $r" -- scripted:pierce-down --rate "$r"
+done
+expect_bad "--rate without a value" "--rate" -- scripted:pierce-down --rate
+for d in 0 -1 abc 1e9; do
+  expect_bad "--duration '$d'" "--duration $d" -- scripted:pierce-down --duration "$d"
+done
+for a in bogus 127.0.0.1 127.0.0.1: :80 127.0.0.1:65536 127.0.0.1:x 300.1.1.1:80 example.com:80; do
+  expect_bad "--listen '$a'" "--listen $a" -- scripted:pierce-down --listen "$a"
+  expect_bad "--peer '$a'" "--peer $a" -- scripted:pierce-down --peer "$a"
+done
+expect_bad "--peer port 0" "--peer 127.0.0.1:0" -- scripted:pierce-down --peer 127.0.0.1:0
+# parsed and refused before any socket: no traffic leaves loopback
+expect_bad "--peer off loopback, listening on loopback" "--peer" "--listen" -- scripted:pierce-down --peer 10.1.2.3:5000
+expect_bad "a newline in an option" "--listen a?b" -- scripted:pierce-down --listen "$(printf 'a\nb')"
+expect_bad "unknown device kind" "bogus:1" "unknown kind" -- bogus:1
+expect_bad "unknown motion" "scripted:wiggle" "pierce-down" -- scripted:wiggle
+expect_bad "missing waypoint file" "$WORK/none.csv" "No such file" -- "scripted:$WORK/none.csv"
+printf 't,x,y,z\n0,0,0,0\n0.5,0,zero,0\n' >"$WORK/bad_row.csv"
+expect_bad "bad waypoint row" "bad_row.csv:3:" -- "scripted:$WORK/bad_row.csv"
+printf 'not a recording\n' >"$WORK/text.bin"
+expect_bad "replay of a text file" "$WORK/text.bin" -- "replay:$WORK/text.bin"
+expect_bad "replay of a missing file" "$WORK/none.bin" "No such file" -- "replay:$WORK/none.bin"
+expect_bad "a udp device served again" "udp:127.0.0.1:9" -- udp:127.0.0.1:9
+# a port already taken: the second server says so
+timeout 20 "$DEVICE" scripted:pierce-down --listen 127.0.0.1:0 >"$WORK/taken.out" 2>&1 &
+pids+=($!)
+taken=$(port_of "$WORK/taken.out")
+if [ -z "$taken" ]; then
+  fail "a server on port 0 printed no port: $(head -n 1 "$WORK/taken.out")"
+else
+  expect_bad "--listen on a port in use" "--listen 127.0.0.1:$taken" "in use" -- scripted:pierce-down --listen "127.0.0.1:$taken"
+fi
+kill -INT "${pids[-1]}" 2>/dev/null
+
+TACTUS=$RUNNER
+expect_bad "run: --device udp: without an address" "--device udp:bogus" "HOST:PORT" -- run haptics-wall --device udp:bogus
+expect_bad "run: --device udp: port 0" "--device udp:127.0.0.1:0" -- run haptics-wall --device udp:127.0.0.1:0
+expect_bad "run: --device udp: off loopback" "--device udp:10.1.2.3:5000" "bind=" -- run haptics-wall --device udp:10.1.2.3:5000
+# nobody serving: refused quickly, named, within the 2 s wait
+expect_bad "run: --device udp: nobody there" "--device udp:127.0.0.1:9" "no hello" -- run haptics-wall --device udp:127.0.0.1:9
+
+cases=$((cases + 1))
+help=$("$DEVICE" --help) || fail "--help: exit status $?"
+case "$help" in *"usage: tactus-device SPEC"*"--listen"*"--peer"*"--rate"*"--duration"*) ;; *) fail "--help: no usage" ;; esac
+
+# --- closed loop over loopback ------------------------------------------------------
+# serve a scripted hand; the run renders the wall; the device stops streaming at 3.5 s,
+# when the hand is 5 mm into the wall (1.5 N)
+run_against() { # NAME PORT: run haptics-wall against udp:127.0.0.1:PORT into $WORK/NAME
+  timeout 60 "$RUNNER" run haptics-wall --device "udp:127.0.0.1:$2" --duration 4.5 --out "$WORK/$1" --quiet \
+    >"$WORK/$1.stdout" 2>"$WORK/$1.stderr"
+}
+
+cases=$((cases + 1))
+timeout 60 "$DEVICE" scripted:pierce-down --listen 127.0.0.1:0 --duration 3.5 >"$WORK/dev1.out" 2>"$WORK/dev1.err" &
+dev=$!
+pids+=($dev)
+port=$(port_of "$WORK/dev1.out")
+if [ -z "$port" ]; then
+  fail "closed loop: the server printed no port: $(cat "$WORK/dev1.err")"
+else
+  run_against loop "$port"
+  rc=$?
+  wait "$dev"
+  drc=$?
+  [ "$rc" -eq 0 ] || fail "closed loop: tactus run exit status $rc: $(head -n 1 "$WORK/loop.stderr")"
+  [ "$drc" -eq 0 ] || fail "closed loop: tactus-device exit status $drc: $(head -n 1 "$WORK/dev1.err")"
+  [ -s "$WORK/loop/report.json" ] || fail "closed loop: no report.json"
+  if [ -s "$WORK/loop/device0.csv" ]; then
+    msg=$(zero_within_10ms "$WORK/loop/device0.csv") || fail "closed loop: $msg"
+    echo "closed loop: $msg"
+  else
+    fail "closed loop: no device0.csv"
+  fi
+  grep -q "round trip (" "$WORK/dev1.out" || fail "closed loop: the server measured no round trip: $(tail -n 2 "$WORK/dev1.out")"
+  sed -n 's/^/closed loop: tactus-device: /p' "$WORK/dev1.out" | tail -n 2
+fi
+
+# --- the same through the lossy relay ---------------------------------------------------
+cases=$((cases + 1))
+timeout 60 "$DEVICE" scripted:pierce-down --listen 127.0.0.1:0 --duration 3.5 >"$WORK/dev2.out" 2>"$WORK/dev2.err" &
+dev=$!
+pids+=($dev)
+port=$(port_of "$WORK/dev2.out")
+if [ -z "$port" ]; then
+  fail "lossy: the server printed no port"
+else
+  timeout 60 "$SHIM" "$port" 4242 >"$WORK/shim.out" 2>&1 &
+  shim=$!
+  pids+=($shim)
+  sport=$(port_of "$WORK/shim.out")
+  if [ -z "$sport" ]; then
+    fail "lossy: the relay printed no port"
+  else
+    run_against lossy "$sport"
+    rc=$?
+    wait "$dev"
+    drc=$?
+    kill -TERM "$shim"
+    wait "$shim"
+    [ "$rc" -eq 0 ] || fail "lossy: tactus run exit status $rc: $(head -n 1 "$WORK/lossy.stderr")"
+    [ "$drc" -eq 0 ] || fail "lossy: tactus-device exit status $drc"
+    [ -s "$WORK/lossy/report.json" ] || fail "lossy: no report.json"
+    if [ -s "$WORK/lossy/device0.csv" ]; then
+      msg=$(zero_within_10ms "$WORK/lossy/device0.csv") || fail "lossy: $msg"
+      echo "lossy: $msg"
+    else
+      fail "lossy: no device0.csv"
+    fi
+    sed -n 's/^/lossy: /p' "$WORK/shim.out" | tail -n 1
+    sed -n 's/^/lossy: tactus-device: /p' "$WORK/dev2.out" | tail -n 2
+    # the device dropped what the relay spoilt: stale, malformed and forged (foreign) packets
+    stats=$(grep '^packets:' "$WORK/dev2.out")
+    for what in stale malformed foreign; do
+      n=$(echo "$stats" | sed -n "s/.* \([0-9][0-9]*\) $what.*/\1/p")
+      [ -n "$n" ] && [ "$n" -gt 0 ] || fail "lossy: the device counted no $what packets: $stats"
+    done
+  fi
+fi
+
+# --- Ctrl-C ---------------------------------------------------------------------------------
+cases=$((cases + 1))
+timeout 20 "$DEVICE" scripted:pierce-down --listen 127.0.0.1:0 >"$WORK/dev3.out" 2>"$WORK/dev3.err" &
+dev=$!
+pids+=($dev)
+port=$(port_of "$WORK/dev3.out")
+if [ -z "$port" ]; then
+  fail "Ctrl-C: the server printed no port"
+else
+  timeout 60 "$RUNNER" run haptics-wall --device "udp:127.0.0.1:$port" --duration 1.5 --out "$WORK/intr" --quiet \
+    >"$WORK/intr.stdout" 2>"$WORK/intr.stderr" &
+  run=$!
+  pids+=($run)
+  sleep 1
+  kill -INT "$dev"
+  start=$(date +%s%N)
+  wait "$dev"
+  drc=$?
+  ms=$((($(date +%s%N) - start) / 1000000))
+  wait "$run"
+  rc=$?
+  [ "$drc" -eq 0 ] || fail "Ctrl-C: tactus-device exit status $drc: $(head -n 1 "$WORK/dev3.err")"
+  [ "$ms" -lt 2000 ] || fail "Ctrl-C: tactus-device took $ms ms to stop"
+  [ -s "$WORK/dev3.err" ] && fail "Ctrl-C: tactus-device wrote to stderr: $(head -n 1 "$WORK/dev3.err")"
+  grep -q '^packets:' "$WORK/dev3.out" || fail "Ctrl-C: no summary"
+  [ "$rc" -eq 0 ] || fail "Ctrl-C: the run it served failed with status $rc: $(head -n 1 "$WORK/intr.stderr")"
+  grep -q '"haptics.device_silent"' "$WORK/intr/report.json" || fail "Ctrl-C: the run counted no silent device"
+fi
+
+finish
