@@ -57,7 +57,8 @@ case "$target" in
 
     say "Debug + AddressSanitizer + UndefinedBehaviorSanitizer: build and test"
     build_variant build-asan -DCMAKE_BUILD_TYPE=Debug -DTX_SANITIZE=address,undefined
-    ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 test_variant build-asan
+    ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp UBSAN_OPTIONS=print_stacktrace=1 \
+      test_variant build-asan
 
     say "ThreadSanitizer: the model and scheduler tests"
     build_variant build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTX_SANITIZE=thread

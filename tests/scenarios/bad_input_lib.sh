@@ -25,7 +25,7 @@ expect_bad() {
   shift
   cases=$((cases + 1))
   local rc=0
-  timeout 20 "$TACTUS" "$@" >"$WORK/stdout" 2>"$WORK/stderr" </dev/null || rc=$?
+  timeout -k 5 20 "$TACTUS" "$@" >"$WORK/stdout" 2>"$WORK/stderr" </dev/null || rc=$?
   local lines
   lines=$(grep -c '' "$WORK/stderr")
   local line
