@@ -48,7 +48,7 @@ static bool same_addr(const struct sockaddr_in* a, const struct sockaddr_in* b) 
 }
 
 tx_device_server_def tx_device_server_def_default(void) {
-  tx_device_server_def d = {.rate_hz = 1000, .force_timeout_s = 0.02};
+  tx_device_server_def d = {.rate_hz = 1000, .force_timeout_s = 0.02, .align_s = 120e-6};
   d.listen.sin_family = AF_INET;
   d.listen.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   d.listen.sin_port = htons(TX_DEVICE_SERVER_PORT);
@@ -129,6 +129,21 @@ static void zero_device(tx_device_server* s) {
 }
 
 // one datagram
+// Both ends tick at the same rate but in no set phase, so a state can wait up
+// to a whole period at the client before its tick reads it. The client tells
+// how long it waited (echo_hold_ns); shift the next sends a quarter of the way
+// toward the aim each time, the error taken within half a period either way
+// (a wait of almost a period means the state came just after a tick).
+static void align(tx_device_server* s, uint32_t hold_ns) {
+  if (s->def.align_s <= 0) return;
+  const int64_t period = (int64_t)llround(1e9 / s->def.rate_hz);
+  int64_t error = (int64_t)hold_ns - (int64_t)llround(s->def.align_s * 1e9);
+  error %= period;
+  if (error > period / 2) error -= period;
+  if (error < -period / 2) error += period;
+  s->next_ns += error / 4;
+}
+
 static void consider(tx_device_server* s, const uint8_t* buf, size_t n, const struct sockaddr_in* from,
                      int64_t arrival) {
   if (s->locked && !same_addr(from, &s->peer)) {
@@ -179,6 +194,7 @@ static void consider(tx_device_server* s, const uint8_t* buf, size_t n, const st
       tx_samples_add(&s->loop, loop);
       tx_samples_add(&s->link, loop - (int64_t)p.echo_hold_ns);
       s->stats.round_trips++;
+      align(s, p.echo_hold_ns);
     }
   } else {
     s->stats.unexpected++;

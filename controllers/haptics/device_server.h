@@ -32,6 +32,9 @@ typedef struct tx_device_server_def {
   double rate_hz;            // state packets per second, (0, 100000]; 1000
   double duration_s;         // stop this long after the first hello; 0: until stopped
   double force_timeout_s;    // no new force for this long zeroes the device; 0.02
+  double align_s;            // aim for each state to wait this long at the client before its
+                             // tick reads it, by shifting when states are sent; 0: free-running;
+                             // 120e-6: enough for the link and the client's wake-up jitter
 } tx_device_server_def;
 
 typedef struct tx_device_server_stats {
