@@ -251,3 +251,15 @@ long tx_dp_recv(int fd, uint8_t* buf, size_t cap, struct sockaddr_in* from, int6
   if (msg.msg_flags & MSG_TRUNC) got = (ssize_t)cap;
   return (long)got;
 }
+
+size_t tx_dp_stamp_encode(tx_dp_packet* p, uint32_t session, uint64_t* seq, int64_t echo_ns, int64_t arrival_ns,
+                          uint8_t* buf, size_t cap) {
+  int64_t now = tx_dp_now_ns();
+  p->session = session;
+  p->seq = ++*seq;
+  p->send_ns = now;
+  p->echo_ns = echo_ns;
+  int64_t hold = echo_ns ? now - arrival_ns : 0;
+  p->echo_hold_ns = hold <= 0 ? 0 : hold >= UINT32_MAX ? UINT32_MAX : (uint32_t)hold;
+  return tx_dp_encode(p, buf, cap);
+}

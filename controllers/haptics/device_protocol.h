@@ -87,6 +87,11 @@ uint32_t tx_dp_crc32(const uint8_t* data, size_t n);
 size_t tx_dp_size(uint8_t type);
 // write p into buf; returns its size, or 0 if cap is too small or p would not decode
 size_t tx_dp_encode(const tx_dp_packet* p, uint8_t* buf, size_t cap);
+// stamp p as a sender's next packet (its session, ++*seq, now, and the echo of
+// the peer's newest accepted packet with how long it has waited since its
+// arrival at arrival_ns), then encode it; the size, or 0
+size_t tx_dp_stamp_encode(tx_dp_packet* p, uint32_t session, uint64_t* seq, int64_t echo_ns, int64_t arrival_ns,
+                          uint8_t* buf, size_t cap);
 // read n bytes into *out; on an error *out is unspecified
 tx_dp_error tx_dp_decode(const uint8_t* buf, size_t n, tx_dp_packet* out);
 // "bad CRC", ... for messages and counters

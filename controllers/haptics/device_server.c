@@ -108,15 +108,8 @@ uint16_t tx_device_server_port(const tx_device_server* s) {
 }
 
 static void send_packet(tx_device_server* s, tx_dp_packet* p) {
-  int64_t now = tx_dp_now_ns();
-  p->session = s->session;
-  p->seq = ++s->seq;
-  p->send_ns = now;
-  p->echo_ns = s->echo_ns;
-  int64_t hold = s->echo_ns ? now - s->arrival_ns : 0;
-  p->echo_hold_ns = hold <= 0 ? 0 : hold >= UINT32_MAX ? UINT32_MAX : (uint32_t)hold;
   uint8_t buf[TX_DP_MAX_SIZE];
-  size_t size = tx_dp_encode(p, buf, sizeof buf);
+  size_t size = tx_dp_stamp_encode(p, s->session, &s->seq, s->echo_ns, s->arrival_ns, buf, sizeof buf);
   if (size == 0 || sendto(s->fd, buf, size, MSG_DONTWAIT | MSG_NOSIGNAL, (const struct sockaddr*)&s->peer,
                           sizeof s->peer) != (ssize_t)size)
     s->stats.send_errors++;

@@ -86,15 +86,8 @@ static bool drain(tx_device* d) {
 }
 
 static void send_packet(tx_device* d, tx_dp_packet* p) {
-  int64_t now = tx_dp_now_ns();
-  p->session = d->session;
-  p->seq = ++d->seq;
-  p->send_ns = now;
-  p->echo_ns = d->echo_ns;
-  int64_t hold = d->echo_ns ? now - d->arrival_ns : 0;
-  p->echo_hold_ns = hold <= 0 ? 0 : hold >= UINT32_MAX ? UINT32_MAX : (uint32_t)hold;
   uint8_t buf[TX_DP_MAX_SIZE];
-  size_t n = tx_dp_encode(p, buf, sizeof buf);
+  size_t n = tx_dp_stamp_encode(p, d->session, &d->seq, d->echo_ns, d->arrival_ns, buf, sizeof buf);
   if (n == 0 || send(d->fd, buf, n, MSG_DONTWAIT | MSG_NOSIGNAL) != (ssize_t)n) d->counts.send_errors++;
 }
 

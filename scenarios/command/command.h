@@ -15,7 +15,9 @@ int tx_cmd_run(int argc, char** argv);
 int tx_cmd_bench(int argc, char** argv);
 int tx_cmd_study(int argc, char** argv);
 
-// print "tactus: MESSAGE" on one line to stderr; returns TX_EXIT_BAD_INPUT
+// the program name that starts every error line: "tactus" or "tactus-device"
+extern const char* tx_program;
+// print "PROGRAM: MESSAGE" on one line to stderr; returns TX_EXIT_BAD_INPUT
 int tx_bad_input(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 // parse a whole number string in [min, max]
 bool tx_parse_num(const char* s, double min, double max, double* out);

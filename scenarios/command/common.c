@@ -12,6 +12,8 @@
 #include <time.h>
 #include <unistd.h>
 
+const char* tx_program = "tactus";
+
 int tx_bad_input(const char* fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
@@ -21,7 +23,7 @@ int tx_bad_input(const char* fmt, ...) {
   // arguments are quoted in messages: keep the message one line
   for (char* c = line; *c; c++)
     if ((unsigned char)*c < 0x20 || *c == 0x7f) *c = '?';
-  fprintf(stderr, "tactus: %s\n", line);
+  fprintf(stderr, "%s: %s\n", tx_program, line);
   return TX_EXIT_BAD_INPUT;
 }
 

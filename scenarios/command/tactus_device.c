@@ -3,6 +3,7 @@
 // `tactus run ... --device udp:HOST:PORT`.
 #include "../../controllers/haptics/device_protocol.h"
 #include "../../controllers/haptics/device_server.h"
+#include "command.h"
 
 #include <arpa/inet.h>
 #include <errno.h>
@@ -15,7 +16,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define EXIT_BAD_INPUT 2
 
 static const char usage[] =
     "usage: tactus-device SPEC [OPTIONS]\n"
@@ -44,28 +44,6 @@ static void on_stop(int sig) {
   atomic_store(&stop_requested, 1);
 }
 
-// one line on stderr, control characters masked; status 2
-static int bad_input(const char* fmt, ...) {
-  va_list ap;
-  va_start(ap, fmt);
-  char line[1024];
-  vsnprintf(line, sizeof line, fmt, ap);
-  va_end(ap);
-  for (char* c = line; *c; c++)
-    if ((unsigned char)*c < 0x20 || *c == 0x7f) *c = '?';
-  fprintf(stderr, "tactus-device: %s\n", line);
-  return EXIT_BAD_INPUT;
-}
-
-static bool parse_num(const char* s, double min, double max, double* out) {
-  char* end = NULL;
-  errno = 0;
-  double v = strtod(s, &end);
-  if (!*s || *end || errno || !isfinite(v) || v < min || v > max) return false;
-  *out = v;
-  return true;
-}
-
 static void print_stats(const tx_device_server_stats* s) {
   printf("packets: %llu hellos, %llu states sent, %llu forces applied; dropped: %llu stale, %llu malformed, "
          "%llu foreign, %llu of no session, %llu unexpected; %llu send errors, %llu force timeouts, %llu late ticks\n",
@@ -84,6 +62,7 @@ static void print_stats(const tx_device_server_stats* s) {
 
 int main(int argc, char** argv) {
   setvbuf(stdout, NULL, _IOLBF, 0);
+  tx_program = "tactus-device";
   static const struct option longs[] = {{"listen", required_argument, 0, 'l'}, {"peer", required_argument, 0, 'p'},
                                         {"rate", required_argument, 0, 'r'},   {"duration", required_argument, 0, 'd'},
                                         {"quiet", no_argument, 0, 'q'},        {"help", no_argument, 0, 'h'},
@@ -96,38 +75,38 @@ int main(int argc, char** argv) {
   for (int c; (c = getopt_long(argc, argv, "h", longs, NULL)) != -1;) {
     switch (c) {
     case 'l':
-      if (!tx_dp_parse_addr(optarg, true, &def.listen, &why)) return bad_input("--listen %s: %s", optarg, why);
+      if (!tx_dp_parse_addr(optarg, true, &def.listen, &why)) return tx_bad_input("--listen %s: %s", optarg, why);
       break;
     case 'p':
-      if (!tx_dp_parse_addr(optarg, false, &def.peer, &why)) return bad_input("--peer %s: %s", optarg, why);
+      if (!tx_dp_parse_addr(optarg, false, &def.peer, &why)) return tx_bad_input("--peer %s: %s", optarg, why);
       break;
     case 'r':
-      if (!parse_num(optarg, 1, TX_DP_MAX_RATE_HZ, &def.rate_hz))
-        return bad_input("--rate %s: expected a rate in [1, 100000] Hz", optarg);
+      if (!tx_parse_num(optarg, 1, TX_DP_MAX_RATE_HZ, &def.rate_hz))
+        return tx_bad_input("--rate %s: expected a rate in [1, 100000] Hz", optarg);
       break;
     case 'd':
-      if (!parse_num(optarg, 1e-3, 1e6, &def.duration_s))
-        return bad_input("--duration %s: expected seconds in [0.001, 1000000]", optarg);
+      if (!tx_parse_num(optarg, 1e-3, 1e6, &def.duration_s))
+        return tx_bad_input("--duration %s: expected seconds in [0.001, 1000000]", optarg);
       break;
     case 'q': quiet = true; break;
     case 'h': return fputs(usage, stdout), 0;
     default:
       if (optopt && strncmp(argv[optind - 1], "--", 2) != 0)
-        return bad_input("unknown option '-%c' (tactus-device --help)", optopt);
-      return bad_input("unknown or incomplete option '%s' (tactus-device --help)", argv[optind - 1]);
+        return tx_bad_input("unknown option '-%c' (tactus-device --help)", optopt);
+      return tx_bad_input("unknown or incomplete option '%s' (tactus-device --help)", argv[optind - 1]);
     }
   }
-  if (optind >= argc) return bad_input("expected a device SPEC such as scripted:pierce-down (tactus-device --help)");
+  if (optind >= argc) return tx_bad_input("expected a device SPEC such as scripted:pierce-down (tactus-device --help)");
   def.spec = argv[optind++];
-  if (optind < argc) return bad_input("unexpected argument '%s'", argv[optind]);
+  if (optind < argc) return tx_bad_input("unexpected argument '%s'", argv[optind]);
   bool listen_loopback = (ntohl(def.listen.sin_addr.s_addr) >> 24) == 127;
   if (def.peer.sin_port && listen_loopback && (ntohl(def.peer.sin_addr.s_addr) >> 24) != 127)
-    return bad_input("--peer: a peer on another machine needs --listen on an address it can reach");
-  if (strncmp(def.spec, "udp:", 4) == 0) return bad_input("%s: a udp device cannot be served again over UDP", def.spec);
+    return tx_bad_input("--peer: a peer on another machine needs --listen on an address it can reach");
+  if (strncmp(def.spec, "udp:", 4) == 0) return tx_bad_input("%s: a udp device cannot be served again over UDP", def.spec);
 
   char err[1024];
   tx_device_server* s = tx_device_server_open(&def, err, sizeof err);
-  if (!s) return bad_input("%s", err);
+  if (!s) return tx_bad_input("%s", err);
 
   struct sigaction sa = {0};
   sa.sa_handler = on_stop; // no SA_RESTART: a signal wakes the wait at once
