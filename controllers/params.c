@@ -140,28 +140,31 @@ tx_port tx_setup_read_as(tx_setup* s, const char* component, tx_type type, uint3
   return (tx_port){(uint16_t)s->in->nports};
 }
 
-tx_result tx_setup_result(tx_setup* s, const char* key) {
-  tx_system* sys = s->sys;
+// "INSTANCE.key" in a run-wide table of keys (warnings or results): its id,
+// the same for the same key, or 0 after a configure error
+static uint16_t intern_key(tx_setup* s, char (*keys)[TX_WARNING_KEY_MAX], int* count, const char* key,
+                           const char* what) {
   char full[TX_WARNING_KEY_MAX];
   if (!key || snprintf(full, sizeof full, "%s.%s", s->in->name, key) >= (int)sizeof full)
-    return tx_setup_fail(s, NULL, "result key is missing or too long"), (tx_result){0};
-  for (int i = 0; i < sys->nresults; i++)
-    if (strcmp(sys->result_keys[i], full) == 0) return (tx_result){(uint16_t)(i + 1)};
-  if (sys->nresults == TX_WARNINGS_MAX) return tx_setup_fail(s, NULL, "more than %d result keys", TX_WARNINGS_MAX), (tx_result){0};
-  strcpy(sys->result_keys[sys->nresults], full);
-  sys->result_values[sys->nresults] = NAN;
-  return (tx_result){(uint16_t)++sys->nresults};
+    return tx_setup_fail(s, NULL, "%s key is missing or too long", what), 0;
+  for (int i = 0; i < *count; i++)
+    if (strcmp(keys[i], full) == 0) return (uint16_t)(i + 1);
+  if (*count == TX_WARNINGS_MAX) return tx_setup_fail(s, NULL, "more than %d %s keys", TX_WARNINGS_MAX, what), 0;
+  strcpy(keys[*count], full);
+  return (uint16_t)++*count;
+}
+
+tx_result tx_setup_result(tx_setup* s, const char* key) {
+  tx_system* sys = s->sys;
+  uint16_t id = intern_key(s, sys->result_keys, &sys->nresults, key, "result");
+  if (id) sys->result_values[id - 1] = NAN;
+  return (tx_result){id};
 }
 
 tx_warning tx_setup_warning(tx_setup* s, const char* key) {
   tx_system* sys = s->sys;
-  char full[TX_WARNING_KEY_MAX];
-  if (!key || snprintf(full, sizeof full, "%s.%s", s->in->name, key) >= (int)sizeof full)
-    return tx_setup_fail(s, NULL, "warning key is missing or too long"), (tx_warning){0};
-  for (int i = 0; i < sys->nwarnings; i++)
-    if (strcmp(sys->warning_keys[i], full) == 0) return (tx_warning){(uint16_t)(i + 1)};
-  if (sys->nwarnings == TX_WARNINGS_MAX) return tx_setup_fail(s, NULL, "more than %d warning keys", TX_WARNINGS_MAX), (tx_warning){0};
-  strcpy(sys->warning_keys[sys->nwarnings], full);
-  atomic_init(&sys->warning_counts[sys->nwarnings], 0);
-  return (tx_warning){(uint16_t)++sys->nwarnings};
+  int before = sys->nwarnings;
+  uint16_t id = intern_key(s, sys->warning_keys, &sys->nwarnings, key, "warning");
+  if (sys->nwarnings > before) atomic_init(&sys->warning_counts[id - 1], 0);
+  return (tx_warning){id};
 }
