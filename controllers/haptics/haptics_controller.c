@@ -175,7 +175,9 @@ static void step(tx_ctx* c, void* self) {
   // force held over it (this tick's force would make a sampled spring look
   // passive); the controller then damps the force about to be rendered
   double held[3] = {h->held[0], h->held[1], h->held[2]};
-  double alpha = tx_passivity_tick(&h->passivity, held, h->state.vel, dt, h->passivity_control);
+  bool finite = true; // a broken sample must not poison the energy for the rest of the run
+  for (int i = 0; i < 3; i++) finite = finite && isfinite(held[i]) && isfinite(h->state.vel[i]) && isfinite(f[i]);
+  double alpha = finite ? tx_passivity_tick(&h->passivity, held, h->state.vel, dt, h->passivity_control) : 0;
   for (int i = 0; i < 3; i++) {
     h->held[i] = f[i];
     f[i] -= alpha * h->state.vel[i];

@@ -132,6 +132,37 @@ static void virtual_coupling_pulls_toward_the_tool(void** state) {
   tx_scenario_free(s);
 }
 
+// a collision controller gone wrong: every other model it publishes is NaN
+static int broken_configure(tx_setup* s, void** self) {
+  *self = NULL;
+  tx_setup_write(s, &(tx_component_def){"tool0.force_model", TX_F64, 1, 15, "N, m, N/m"});
+  return 0;
+}
+static void broken_step(tx_ctx* c, void* self) {
+  double* m = tx_write(c, (tx_port){1});
+  memset(m, 0, 15 * sizeof *m);
+  m[1] = tx_step_index(c) % 2 ? NAN : 2.0;
+}
+
+static void a_nan_force_model_never_reaches_the_device(void** state) {
+  (void)state;
+  static const tx_controller_class broken = {.type = "test.broken", .configure = broken_configure, .step = broken_step};
+  if (!tx_find_controller(broken.type)) assert_int_equal(tx_register_controller(&broken), 0);
+  const char* text = "{\"name\":\"t\",\"controllers\":["
+                     "{\"name\":\"broken\",\"type\":\"test.broken\",\"rate_hz\":100},"
+                     "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{"
+                     "\"device\":\"scripted:slide-x-over\",\"force_model\":\"tool0.force_model\"}}]}";
+  char err[512];
+  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL, err, sizeof err);
+  if (!s) fail_msg("%s", err);
+  run(s, 1.0);
+  const double* f = latest(s, "device0.force");
+  assert_true(isfinite(f[0]) && isfinite(f[1]) && isfinite(f[2]) && fabs(f[1]) <= 3.3);
+  assert_true(warnings(s, "haptics.force_non_finite") > 0);
+  assert_true(isfinite(result(s, "haptics.passivity_energy_j"))); // the observer skipped the broken ticks
+  tx_scenario_free(s);
+}
+
 static void configuration_mistakes_are_refused(void** state) {
   (void)state;
   const struct {
@@ -191,6 +222,7 @@ int main(void) {
       cmocka_unit_test(a_simulated_hand_settles_against_the_wall),
       cmocka_unit_test(virtual_coupling_pulls_toward_the_tool),
       cmocka_unit_test(configuration_mistakes_are_refused),
+      cmocka_unit_test(a_nan_force_model_never_reaches_the_device),
       cmocka_unit_test(forces_above_the_device_are_clamped),
       cmocka_unit_test(a_stale_model_fades_out),
   };
