@@ -2,6 +2,8 @@
 // integration of the linear dynamics over each zero-order-hold period.
 #include "sim_device.h"
 
+#include "../range_check.h"
+
 #include "../../model/error.h"
 
 #include <math.h>
@@ -23,14 +25,9 @@ tx_sim_device_def tx_sim_device_def_default(void) {
   };
 }
 
-static _Thread_local char check_msg[160];
-
 // NULL if lo <= v <= hi (strictly above lo when open_lo) and finite
 static const char* range(const char* name, double v, double lo, bool open_lo, double hi, const char* units) {
-  if (isfinite(v) && (open_lo ? v > lo : v >= lo) && v <= hi) return NULL;
-  snprintf(check_msg, sizeof check_msg, "sim device: %s = %g %s, must be finite and in %s%g, %g]", name, v, units,
-           open_lo ? "(" : "[", lo, hi);
-  return check_msg;
+  return tx_check_range("sim device", name, v, lo, open_lo, hi, false, units);
 }
 
 const char* tx_sim_device_def_check(const tx_sim_device_def* d) {
@@ -47,11 +44,9 @@ const char* tx_sim_device_def_check(const tx_sim_device_def* d) {
   for (int i = 0; i < 3; i++) {
     if ((e = range("workspace_min", d->workspace_min[i], -10, false, 10, "m"))) return e;
     if ((e = range("workspace_max", d->workspace_max[i], -10, false, 10, "m"))) return e;
-    if (!(d->workspace_min[i] < d->workspace_max[i])) {
-      snprintf(check_msg, sizeof check_msg, "sim device: workspace_min[%d] = %g m must be below workspace_max[%d] = %g m", i,
-               d->workspace_min[i], i, d->workspace_max[i]);
-      return check_msg;
-    }
+    if (!(d->workspace_min[i] < d->workspace_max[i]))
+      return tx_check_fail("sim device: workspace_min[%d] = %g m must be below workspace_max[%d] = %g m", i,
+                           d->workspace_min[i], i, d->workspace_max[i]);
   }
   return NULL;
 }

@@ -3,6 +3,8 @@
 // to the rest position (eqs. 6, 7), damage and its recovery.
 #include "tissue.h"
 
+#include "../range_check.h"
+
 #include "../../model/error.h"
 
 #include <math.h>
@@ -27,21 +29,14 @@ tx_voxel_tissue_def tx_voxel_tissue_def_default(void) {
   };
 }
 
-static _Thread_local char check_msg[192];
-
 // NULL if lo <= v <= hi (strictly above lo when open_lo, strictly below hi when open_hi) and finite
 static const char* range(const char* name, double v, double lo, bool open_lo, double hi, bool open_hi,
                          const char* units) {
-  if (isfinite(v) && (open_lo ? v > lo : v >= lo) && (open_hi ? v < hi : v <= hi)) return NULL;
-  snprintf(check_msg, sizeof check_msg, "voxel tissue: %s = %g %s, must be finite and in %s%g, %g%s", name, v, units,
-           open_lo ? "(" : "[", lo, hi, open_hi ? ")" : "]");
-  return check_msg;
+  return tx_check_range("voxel tissue", name, v, lo, open_lo, hi, open_hi, units);
 }
 
 static const char* irange(const char* name, long long v, long long lo, long long hi) {
-  if (v >= lo && v <= hi) return NULL;
-  snprintf(check_msg, sizeof check_msg, "voxel tissue: %s = %lld, must be in [%lld, %lld]", name, v, lo, hi);
-  return check_msg;
+  return tx_check_count("voxel tissue", name, v, lo, hi);
 }
 
 const char* tx_voxel_tissue_def_check(const tx_voxel_tissue_def* d) {

@@ -12,18 +12,23 @@
 #include <stdio.h>
 #include <string.h>
 
-// a wall updated at wall_hz and a scripted hand rendered at 1 kHz
+static tx_scenario* load_text(const char* text) {
+  char err[512];
+  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL, err, sizeof err);
+  if (!s) fail_msg("%s", err);
+  return s;
+}
+
+// a wall updated at wall_hz and a device rendered at 1 kHz
 static tx_scenario* load(double wall_hz, double stiffness, const char* device, const char* haptics_params) {
-  char text[1024], err[512];
+  char text[1024];
   snprintf(text, sizeof text,
            "{\"name\":\"t\",\"controllers\":["
            "{\"name\":\"wall\",\"type\":\"collision.wall\",\"rate_hz\":%g,\"params\":{\"stiffness\":%g}},"
            "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"%s\","
            "\"force_model\":\"tool0.force_model\"%s%s}}]}",
            wall_hz, stiffness, device, *haptics_params ? "," : "", haptics_params);
-  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL, err, sizeof err);
-  if (!s) fail_msg("%s", err);
-  return s;
+  return load_text(text);
 }
 
 static void run(tx_scenario* s, double seconds) {
@@ -124,9 +129,7 @@ static void virtual_coupling_pulls_toward_the_tool(void** state) {
                      "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{"
                      "\"device\":\"scripted:pierce-down\",\"coupling_tool\":\"tool0.pose\","
                      "\"coupling_stiffness\":200,\"coupling_damping\":1}}]}";
-  char err[512];
-  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL, err, sizeof err);
-  if (!s) fail_msg("%s", err);
+  tx_scenario* s = load_text(text);
   run(s, 5.0);
   assert_true(fabs(latest(s, "device0.force")[1] - 200 * 0.015) < 1e-9);
   tx_scenario_free(s);
@@ -152,9 +155,7 @@ static void a_nan_force_model_never_reaches_the_device(void** state) {
                      "{\"name\":\"broken\",\"type\":\"test.broken\",\"rate_hz\":100},"
                      "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{"
                      "\"device\":\"scripted:slide-x-over\",\"force_model\":\"tool0.force_model\"}}]}";
-  char err[512];
-  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL, err, sizeof err);
-  if (!s) fail_msg("%s", err);
+  tx_scenario* s = load_text(text);
   run(s, 1.0);
   const double* f = latest(s, "device0.force");
   assert_true(isfinite(f[0]) && isfinite(f[1]) && isfinite(f[2]) && fabs(f[1]) <= 3.3);
