@@ -78,56 +78,94 @@ static int cell_coord(const tx_voxel_tissue* t, double x, int a) {
   return (int)f;
 }
 
-void tx_voxel_tissue_refresh_neighbours(tx_voxel_tissue* t) {
-  const int n = t->n, cap = t->def.max_neighbours;
+int tx_voxel_tissue_cell_of_point(const tx_voxel_tissue* t, const double p[3]) {
+  return (cell_coord(t, p[2], 2) * t->grid_dims[1] + cell_coord(t, p[1], 1)) * t->grid_dims[0] + cell_coord(t, p[0], 0);
+}
+
+// the grid is a linked list per cell, so that one voxel can change cells alone
+static void cell_unlink(tx_voxel_tissue* t, int i) {
+  int c = t->cell_of[i], nx = t->cell_next[i], pv = t->cell_prev[i];
+  if (pv >= 0) t->cell_next[pv] = nx;
+  else t->cell_head[c] = nx;
+  if (nx >= 0) t->cell_prev[nx] = pv;
+}
+
+static void cell_link(tx_voxel_tissue* t, int i, int c) {
+  t->cell_of[i] = c;
+  t->cell_prev[i] = -1;
+  t->cell_next[i] = t->cell_head[c];
+  if (t->cell_head[c] >= 0) t->cell_prev[t->cell_head[c]] = i;
+  t->cell_head[c] = i;
+}
+
+static void list_add(tx_voxel_tissue* t, int i, int j) {
+  const int cap = t->def.max_neighbours;
+  if (t->nbr_count[i] < cap) t->nbr[(size_t)i * (size_t)cap + (size_t)t->nbr_count[i]++] = j;
+  else t->overflow++;
+}
+
+static void list_remove(tx_voxel_tissue* t, int i, int j) {
+  int32_t* list = t->nbr + (size_t)i * (size_t)t->def.max_neighbours;
+  for (int k = 0; k < t->nbr_count[i]; k++)
+    if (list[k] == j) {
+      list[k] = list[--t->nbr_count[i]];
+      return;
+    }
+}
+
+// the voxels within reach of voxel i in the 27 cells around its own; with
+// add_both each found pair goes on both lists (i's lists are empty then),
+// otherwise only pairs j > i, the other half coming from j's own search
+static void search(tx_voxel_tissue* t, int i, bool add_both) {
   const int gx = t->grid_dims[0], gy = t->grid_dims[1], gz = t->grid_dims[2];
-  const int cells = gx * gy * gz;
-  int32_t* start = t->cell_start;
-  // bin by cell: counts, prefix sums, fill, then shift the starts back
-  memset(start, 0, sizeof *start * (size_t)(cells + 1));
-  for (int i = 0; i < n; i++) {
-    const double* p = t->pos + 3 * i;
-    int c = (cell_coord(t, p[2], 2) * gy + cell_coord(t, p[1], 1)) * gx + cell_coord(t, p[0], 0);
-    t->cell_of[i] = c;
-    start[c + 1]++;
-  }
-  for (int c = 0; c < cells; c++) start[c + 1] += start[c];
-  for (int i = 0; i < n; i++) t->cell_item[start[t->cell_of[i]]++] = i;
-  for (int c = cells; c > 0; c--) start[c] = start[c - 1];
-  start[0] = 0;
-  // each voxel remembers every voxel within reach in the 27 cells around it
   const double reach2 = t->reach * t->reach;
-  for (int i = 0; i < n; i++) {
-    const double* pi = t->pos + 3 * i;
-    int c = t->cell_of[i];
-    int cx = c % gx, cy = (c / gx) % gy, cz = c / (gx * gy);
-    int32_t* list = t->nbr + (size_t)i * (size_t)cap;
-    int m = 0;
-    for (int z = cz - 1; z <= cz + 1; z++) {
-      if (z < 0 || z >= gz) continue;
-      for (int y = cy - 1; y <= cy + 1; y++) {
-        if (y < 0 || y >= gy) continue;
-        for (int x = cx - 1; x <= cx + 1; x++) {
-          if (x < 0 || x >= gx) continue;
-          int cc = (z * gy + y) * gx + x;
-          for (int k = start[cc]; k < start[cc + 1]; k++) {
-            int j = t->cell_item[k];
-            if (j == i) continue;
-            const double* pj = t->pos + 3 * j;
-            double dx = pj[0] - pi[0], dy = pj[1] - pi[1], dz = pj[2] - pi[2];
-            if (dx * dx + dy * dy + dz * dz >= reach2) continue;
-            if (m < cap)
-              list[m++] = j;
-            else
-              t->overflow++;
-          }
+  const double* pi = t->pos + 3 * i;
+  int c = t->cell_of[i];
+  int cx = c % gx, cy = (c / gx) % gy, cz = c / (gx * gy);
+  for (int z = cz - 1; z <= cz + 1; z++) {
+    if (z < 0 || z >= gz) continue;
+    for (int y = cy - 1; y <= cy + 1; y++) {
+      if (y < 0 || y >= gy) continue;
+      for (int x = cx - 1; x <= cx + 1; x++) {
+        if (x < 0 || x >= gx) continue;
+        for (int j = t->cell_head[(z * gy + y) * gx + x]; j >= 0; j = t->cell_next[j]) {
+          if (j == i || (!add_both && j < i)) continue;
+          const double* pj = t->pos + 3 * j;
+          double dx = pj[0] - pi[0], dy = pj[1] - pi[1], dz = pj[2] - pi[2];
+          if (dx * dx + dy * dy + dz * dz >= reach2) continue;
+          list_add(t, i, j);
+          list_add(t, j, i);
         }
       }
     }
-    t->nbr_count[i] = m;
   }
+}
+
+void tx_voxel_tissue_refresh_neighbours(tx_voxel_tissue* t) {
+  const int n = t->n;
+  const int cells = t->grid_dims[0] * t->grid_dims[1] * t->grid_dims[2];
+  // bin every voxel afresh, then each pair once
+  for (int c = 0; c < cells; c++) t->cell_head[c] = -1;
+  for (int i = n - 1; i >= 0; i--) cell_link(t, i, tx_voxel_tissue_cell_of_point(t, t->pos + 3 * i));
+  memset(t->nbr_count, 0, sizeof *t->nbr_count * (size_t)n);
+  for (int i = 0; i < n; i++) search(t, i, false);
   memcpy(t->pos_built, t->pos, sizeof *t->pos * 3 * (size_t)n);
   t->rebuilds++;
+}
+
+void tx_voxel_tissue_refresh_voxel(tx_voxel_tissue* t, int i) {
+  // forget i on its neighbours' lists, move it to its cell, search again
+  const int32_t* list = t->nbr + (size_t)i * (size_t)t->def.max_neighbours;
+  for (int k = 0; k < t->nbr_count[i]; k++) list_remove(t, list[k], i);
+  t->nbr_count[i] = 0;
+  int c = tx_voxel_tissue_cell_of_point(t, t->pos + 3 * i);
+  if (c != t->cell_of[i]) {
+    cell_unlink(t, i);
+    cell_link(t, i, c);
+  }
+  search(t, i, true);
+  memcpy(t->pos_built + 3 * i, t->pos + 3 * i, 3 * sizeof *t->pos);
+  t->refreshes++;
 }
 
 // ---------------------------------------------------------------------------
@@ -137,8 +175,8 @@ static void free_all(tx_voxel_tissue* t) {
   free(t->id), free(t->mass), free(t->elasticity), free(t->radius0), free(t->radius), free(t->damage);
   free(t->pos0), free(t->pos), free(t->vel0), free(t->vel);
   free(t->nbr), free(t->nbr_count), free(t->pos_built);
-  free(t->cell_start), free(t->cell_item), free(t->cell_of);
-  free(t->damaged), free(t->is_damaged);
+  free(t->cell_head), free(t->cell_next), free(t->cell_prev), free(t->cell_of);
+  free(t->damaged), free(t->is_damaged), free(t->awake_list), free(t->is_awake);
 }
 
 bool tx_voxel_tissue_init(tx_voxel_tissue* out, const tx_voxel_tissue_def* def) {
@@ -158,11 +196,14 @@ bool tx_voxel_tissue_init(tx_voxel_tissue* out, const tx_voxel_tissue_def* def) 
   // the reach wide and their number is bounded, so a tiny radius costs
   // bigger cells, not memory
   t.reach = 2 * def->radius + def->skin;
+  // a voxel is filed under the cell of where its list was built, up to a
+  // quarter of the skin away, so cells are that much wider than the reach
+  const double edge = t.reach + 0.25 * def->skin;
   long long cells = 1;
   for (int a = 0; a < 3; a++) {
-    t.grid_lo[a] = def->origin[a] - 0.5 * def->block_size[a] - t.reach;
-    double extent = 2 * def->block_size[a] + 2 * t.reach;
-    double dims = floor(extent / t.reach);
+    t.grid_lo[a] = def->origin[a] - 0.5 * def->block_size[a] - edge;
+    double extent = 2 * def->block_size[a] + 2 * edge;
+    double dims = floor(extent / edge);
     t.grid_dims[a] = dims < 1 ? 1 : dims > 4096 ? 4096 : (int)dims;
   }
   const long long max_cells = 8LL * n + 4096;
@@ -173,7 +214,7 @@ bool tx_voxel_tissue_init(tx_voxel_tissue* out, const tx_voxel_tissue_def* def) 
     if (t.grid_dims[2] > t.grid_dims[a]) a = 2;
     t.grid_dims[a] = (t.grid_dims[a] + 1) / 2;
   }
-  for (int a = 0; a < 3; a++) t.cell_size[a] = (2 * def->block_size[a] + 2 * t.reach) / t.grid_dims[a];
+  for (int a = 0; a < 3; a++) t.cell_size[a] = (2 * def->block_size[a] + 2 * edge) / t.grid_dims[a];
 
   const size_t cap = (size_t)def->max_neighbours;
   t.id = calloc(un, sizeof *t.id);
@@ -189,14 +230,17 @@ bool tx_voxel_tissue_init(tx_voxel_tissue* out, const tx_voxel_tissue_def* def) 
   t.nbr = calloc(un * cap, sizeof *t.nbr);
   t.nbr_count = calloc(un, sizeof *t.nbr_count);
   t.pos_built = calloc(3 * un, sizeof *t.pos_built);
-  t.cell_start = calloc((size_t)cells + 1, sizeof *t.cell_start);
-  t.cell_item = calloc(un, sizeof *t.cell_item);
+  t.cell_head = calloc((size_t)cells, sizeof *t.cell_head);
+  t.cell_next = calloc(un, sizeof *t.cell_next);
+  t.cell_prev = calloc(un, sizeof *t.cell_prev);
   t.cell_of = calloc(un, sizeof *t.cell_of);
   t.damaged = calloc(un, sizeof *t.damaged);
   t.is_damaged = calloc(un, sizeof *t.is_damaged);
+  t.awake_list = calloc(un, sizeof *t.awake_list);
+  t.is_awake = calloc(un, sizeof *t.is_awake);
   if (!t.id || !t.mass || !t.elasticity || !t.radius0 || !t.radius || !t.damage || !t.pos0 || !t.pos || !t.vel0 ||
-      !t.vel || !t.nbr || !t.nbr_count || !t.pos_built || !t.cell_start || !t.cell_item || !t.cell_of ||
-      !t.damaged || !t.is_damaged) {
+      !t.vel || !t.nbr || !t.nbr_count || !t.pos_built || !t.cell_head || !t.cell_next || !t.cell_prev || !t.cell_of ||
+      !t.damaged || !t.is_damaged || !t.awake_list || !t.is_awake) {
     free_all(&t);
     tx_set_error("voxel tissue: out of memory for %d voxels", n);
     return false;
@@ -232,8 +276,10 @@ void tx_voxel_tissue_reset(tx_voxel_tissue* t) {
   memset(t->damage, 0, sizeof *t->damage * un);
   memset(t->is_damaged, 0, sizeof *t->is_damaged * un);
   t->n_damaged = 0;
+  memset(t->is_awake, 0, sizeof *t->is_awake * un);
+  t->n_awake = 0;
   t->phi_dt = 0;
-  t->steps = t->rebuilds = t->pairs = t->culled = t->contacts = t->overflow = t->faults = 0;
+  t->steps = t->rebuilds = t->refreshes = t->pairs = t->culled = t->contacts = t->overflow = t->faults = 0;
   tx_voxel_tissue_refresh_neighbours(t);
 }
 
@@ -280,6 +326,12 @@ static void recover(tx_voxel_tissue* t, double dt) {
       t->damaged[k] = t->damaged[--t->n_damaged];
     }
   }
+}
+
+void tx_voxel_tissue_wake(tx_voxel_tissue* t, int i) {
+  if (t->is_awake[i]) return;
+  t->is_awake[i] = 1;
+  t->awake_list[t->n_awake++] = i;
 }
 
 // ---------------------------------------------------------------------------
@@ -347,10 +399,12 @@ static bool respond(tx_voxel_tissue* t, int i, int j, const double p[3], const d
 static inline bool still(const double v[3]) { return v[0] == 0 && v[1] == 0 && v[2] == 0; }
 
 static void collide(tx_voxel_tissue* t, double dt) {
-  const int n = t->n, cap = t->def.max_neighbours;
+  const int cap = t->def.max_neighbours;
   uint64_t pairs = 0, culled = 0, contacts = 0;
   const double* vel = t->vel;
-  for (int i = 0; i < n; i++) {
+  // voxels woken by a contact join the end of the list and are seen in this pass
+  for (int w = 0; w < t->n_awake; w++) {
+    const int i = t->awake_list[w];
     // a pair of voxels at rest cannot meet: a resting voxel's pairs are
     // taken from its moving neighbours' side, so a block mostly at rest
     // costs one test per voxel
@@ -386,7 +440,10 @@ static void collide(tx_voxel_tissue* t, double dt) {
         // do not pass through
         th = 0;
       }
-      if (respond(t, i, j, p, v, th)) contacts++;
+      if (respond(t, i, j, p, v, th)) {
+        contacts++;
+        tx_voxel_tissue_wake(t, j);
+      }
     }
   }
   t->pairs += pairs, t->culled += culled, t->contacts += contacts;
@@ -433,13 +490,25 @@ static void spring_damper(tx_voxel_tissue* t, double dt) {
     transition(d->mass, d->spring, d->damper, dt, t->phi);
     t->phi_dt = dt;
   }
-  for (int i = 0; i < t->n; i++) {
+  for (int w = 0; w < t->n_awake;) {
+    const int i = t->awake_list[w];
     double* p = t->pos + 3 * i;
     double* v = t->vel + 3 * i;
     const double* p0 = t->pos0 + 3 * i;
     double x[3] = {p[0] - p0[0], p[1] - p0[1], p[2] - p0[2]};
-    // voxels at rest stay at rest: most of the block, most of the time
-    if (x[0] == 0 && x[1] == 0 && x[2] == 0 && v[0] == 0 && v[1] == 0 && v[2] == 0) continue;
+    // a voxel back within a millionth of its radius of rest, and too slow to
+    // leave that in a substep, is put to rest and sleeps (the paper's section
+    // 3: only voxels displaced lately need the spring-damper)
+    double eps = 1e-6 * t->radius0[i];
+    if (x[0] * x[0] + x[1] * x[1] + x[2] * x[2] < eps * eps &&
+        (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) * dt * dt < eps * eps) {
+      memcpy(p, p0, 3 * sizeof *p);
+      memset(v, 0, 3 * sizeof *v);
+      t->is_awake[i] = 0;
+      t->awake_list[w] = t->awake_list[--t->n_awake];
+      continue;
+    }
+    w++;
     double own[4];
     const double* ph = t->phi;
     if (t->mass[i] != d->mass) { // a voxel given its own mass
@@ -461,22 +530,25 @@ static void spring_damper(tx_voxel_tissue* t, double dt) {
 // ---------------------------------------------------------------------------
 // step
 
-// true when some voxel may leave half the skin during a frame of h: its
-// drift since the build plus its travel along its velocity, bounded without
-// a square root by (a + b)^2 <= 2 (a^2 + b^2). Then no pair beyond the reach
-// at the build can come within 2 radius, and no contact is missed.
-static bool lists_stale(const tx_voxel_tissue* t, double h) {
-  const double half = 0.5 * t->def.skin, lim = half * half;
-  for (int i = 0; i < t->n; i++) {
+// Know-Your-Neighbour by each voxel: one whose drift since its own list was
+// built, plus its travel along its velocity over a frame of h, may exceed a
+// quarter of the skin searches again (bounded without a square root by
+// (a + b)^2 <= 2 (a^2 + b^2)). A pair off the lists was at least the reach
+// apart when the later of its two voxels searched; since then one has moved
+// at most a quarter of the skin and the other at most half, so they are
+// still more than 2 radius apart, and no contact is missed.
+static void refresh_moved(tx_voxel_tissue* t, double h) {
+  const double quarter = 0.25 * t->def.skin, lim = quarter * quarter;
+  for (int w = 0; w < t->n_awake; w++) {
+    const int i = t->awake_list[w];
     const double* p = t->pos + 3 * i;
     const double* b = t->pos_built + 3 * i;
     const double* v = t->vel + 3 * i;
     double dx = p[0] - b[0], dy = p[1] - b[1], dz = p[2] - b[2];
     double drift = dx * dx + dy * dy + dz * dz;
     double travel = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) * h * h;
-    if (2 * (drift + travel) > lim) return true;
+    if (2 * (drift + travel) > lim) tx_voxel_tissue_refresh_voxel(t, i);
   }
-  return false;
 }
 
 // puts right what a caller may have written between steps (non-finite
@@ -488,33 +560,42 @@ static double scan(tx_voxel_tissue* t) {
     const double* v = t->vel + 3 * i;
     if (!isfinite(p[0] + p[1] + p[2] + v[0] + v[1] + v[2])) restore(t, i);
     if (!(isfinite(t->mass[i]) && t->mass[i] > 0)) t->mass[i] = t->def.mass, t->faults++;
+    // a caller may have moved a sleeping voxel
+    if (!t->is_awake[i]) {
+      const double* p0 = t->pos0 + 3 * i;
+      if (p[0] != p0[0] || p[1] != p0[1] || p[2] != p0[2] || v[0] != 0 || v[1] != 0 || v[2] != 0)
+        tx_voxel_tissue_wake(t, i);
+    }
     double v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
     if (v2 > vmax2) vmax2 = v2;
   }
   return vmax2;
 }
 
-enum { max_substeps = 256 };
+bool tx_voxel_tissue_step(tx_voxel_tissue* t, double dt) { return tx_voxel_tissue_step_with(t, dt, 1, NULL, NULL); }
 
-bool tx_voxel_tissue_step(tx_voxel_tissue* t, double dt) {
+bool tx_voxel_tissue_step_with(tx_voxel_tissue* t, double dt, int min_substeps, tx_voxel_substep_fn fn, void* user) {
   if (!(isfinite(dt) && dt > 0 && dt <= 1)) {
     tx_set_error("voxel tissue: step dt = %g s, must be finite and in (0, 1]", dt);
     return false;
   }
-  // a voxel that would cross more than a quarter of the skin in one frame
+  // a voxel that would cross more than an eighth of the skin in one frame
   // splits it, so that the lists stay valid without growing their reach
-  double travel = sqrt(scan(t)) * dt, quarter = 0.25 * t->def.skin;
+  double travel = sqrt(scan(t)) * dt, quarter = 0.125 * t->def.skin;
   int sub = 1;
   if (travel > quarter) {
     double s = ceil(travel / quarter);
-    sub = s > max_substeps ? max_substeps : (int)s;
+    sub = s > TX_VOXEL_MAX_SUBSTEPS ? TX_VOXEL_MAX_SUBSTEPS : (int)s;
   }
+  if (min_substeps > sub) sub = min_substeps > TX_VOXEL_MAX_SUBSTEPS ? TX_VOXEL_MAX_SUBSTEPS : min_substeps;
   t->substeps = sub;
   t->pairs = t->culled = t->contacts = 0;
   const double h = dt / sub;
   for (int s = 0; s < sub; s++) {
-    // know your neighbour: rebuild only when a contact could be missed
-    if (lists_stale(t, h)) tx_voxel_tissue_refresh_neighbours(t);
+    // a tool acts first, so that its pushes take part in this substep's contacts
+    if (fn) fn(t, s, sub, h, user);
+    // know your neighbour: a voxel searches again only when it could miss a contact
+    refresh_moved(t, h);
     // contacts on the velocities at the start of the frame, then the springs
     collide(t, h);
     spring_damper(t, h);
@@ -522,4 +603,18 @@ bool tx_voxel_tissue_step(tx_voxel_tissue* t, double dt) {
   if (t->n_damaged) recover(t, dt);
   t->steps++;
   return true;
+}
+
+double tx_voxel_tissue_energy(const tx_voxel_tissue* t) {
+  const double ks = t->def.spring;
+  double e = 0; // a sleeping voxel is at rest: no energy
+  for (int w = 0; w < t->n_awake; w++) {
+    const int i = t->awake_list[w];
+    const double* p = t->pos + 3 * i;
+    const double* p0 = t->pos0 + 3 * i;
+    const double* v = t->vel + 3 * i;
+    double x0 = p[0] - p0[0], x1 = p[1] - p0[1], x2 = p[2] - p0[2];
+    e += 0.5 * (t->mass[i] * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) + ks * (x0 * x0 + x1 * x1 + x2 * x2));
+  }
+  return e;
 }

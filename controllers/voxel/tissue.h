@@ -6,11 +6,12 @@
 // current position, id and damage. One step of length dt:
 //
 //   1. Know-Your-Neighbour: each voxel keeps a list of the voxels within
-//      reach (contact distance plus a skin). The lists are rebuilt from a
-//      uniform grid (cell edge = reach, counting sort, 27-cell search) only
-//      when some voxel may have moved more than half the skin since the last
-//      build, counting the motion predicted over this frame; between builds
-//      no pair can come into contact without being on the lists.
+//      reach (contact distance plus a skin), on both voxels' lists. A voxel
+//      searches again, alone, through a uniform grid of linked cells (27
+//      cells around its own), when it may have moved more than a quarter of
+//      the skin since its own last search, counting the motion predicted over
+//      this frame; so a block mostly at rest costs nothing to keep listed,
+//      and no pair can come into contact without being on the lists.
 //   2. Sphere-sphere collision over the frame along straight paths (eq. 2):
 //      the time of impact is the smaller root of the quadratic (eq. 3), and
 //      pairs whose roots cannot both be positive are culled by the signs of
@@ -20,8 +21,11 @@
 //   3. The parallel spring-damper to the rest position, f = -k_s x - k_d v
 //      (eqs. 6, 7), integrated exactly over dt, so any k_s, k_d, mass and dt
 //      are stable and a critically damped voxel never overshoots.
-//   A step in which some voxel would cross more than a quarter of the skin
+//   A step in which some voxel would cross more than an eighth of the skin
 //   is split into equal substeps (at most 256), so the lists stay valid.
+//   Only awake voxels (displaced or moving) cost anything in 1 to 3: a voxel
+//   back within a millionth of its radius of rest, and slow, is put exactly
+//   at rest and sleeps until a contact, a tool or a caller moves it.
 //   4. Damage recovery: a damaged voxel's radius grows back linearly to its
 //      rest radius within recovery_time.
 //
@@ -76,19 +80,25 @@ typedef struct tx_voxel_tissue {
   // Know-Your-Neighbour (section 3)
   int32_t* nbr;       // (n x max_neighbours) each voxel's neighbours, by id
   int32_t* nbr_count; // (n) entries used in each list
-  double* pos_built;  // (n x 3) positions when the lists were last built, m
+  double* pos_built;  // (n x 3) each voxel's position at its last search, m
   double reach;       // m, list distance: 2 max radius + skin
   int grid_dims[3];   // cells along x, y, z
   double grid_lo[3];  // m, minimum corner of the grid
-  double cell_size[3]; // m, cell edges, each at least reach
-  int32_t* cell_start; // (cells + 1) first item of each cell in cell_item
-  int32_t* cell_item;  // (n) voxel ids sorted by cell
-  int32_t* cell_of;    // (n) each voxel's cell
+  double cell_size[3]; // m, cell edges, each at least reach + skin / 4
+  int32_t* cell_head;  // (cells) first voxel filed in each cell, -1 for none
+  int32_t* cell_next;  // (n) next voxel in the same cell, -1 at the end
+  int32_t* cell_prev;  // (n) previous voxel in the same cell, -1 at the head
+  int32_t* cell_of;    // (n) the cell each voxel is filed in (where it last searched)
 
   // damaged voxels, so that recovery costs only what is damaged
   int32_t* damaged;  // (n) ids of the voxels with damage > 0
   uint8_t* is_damaged; // (n) 1 when listed in damaged
   int n_damaged;     // entries used in damaged
+
+  // awake voxels: those displaced or moving; the rest sit exactly at rest
+  int32_t* awake_list; // (n) ids of the awake voxels
+  uint8_t* is_awake;   // (n) 1 when listed in awake_list
+  int n_awake;         // entries used in awake_list
 
   // exact spring-damper transition over the last dt for def.mass
   double phi_dt;  // s, dt the transition was computed for (0: none yet)
@@ -97,7 +107,8 @@ typedef struct tx_voxel_tissue {
   // counters
   uint64_t steps;        // steps taken since init or reset
   int substeps;          // frames the last step was split into (fast voxels, at most 256)
-  uint64_t rebuilds;     // neighbour list builds
+  uint64_t rebuilds;     // builds of every list at once (init, reset, tx_voxel_tissue_refresh_neighbours)
+  uint64_t refreshes;    // searches of one voxel that had moved
   uint64_t pairs;        // pairs tested in the last step (all substeps)
   uint64_t culled;       // pairs the Vieta test rejected in the last step
   uint64_t contacts;     // collision responses in the last step
@@ -127,13 +138,39 @@ void tx_voxel_tissue_reset(tx_voxel_tissue* t);
 // set) otherwise
 bool tx_voxel_tissue_step(tx_voxel_tissue* t, double dt);
 
+// the most substeps a step is split into
+#define TX_VOXEL_MAX_SUBSTEPS 256
+
+// a tool's part of each substep (substep s of n, length h s), called before
+// the lists are checked and the contacts found; it may move voxels, change
+// their velocities and damage them
+typedef void (*tx_voxel_substep_fn)(tx_voxel_tissue* t, int s, int n, double h, void* user);
+
+// tx_voxel_tissue_step with a tool: at least min_substeps substeps (a fast
+// tool asks for more), fn (may be NULL) called at the start of each
+bool tx_voxel_tissue_step_with(tx_voxel_tissue* t, double dt, int min_substeps, tx_voxel_substep_fn fn, void* user);
+
+// kinetic plus spring energy of the block, J: sum of m v^2 / 2 + k_s x^2 / 2.
+// Collisions (e <= 1) and the damped springs never raise it; only a tool does
+double tx_voxel_tissue_energy(const tx_voxel_tissue* t);
+
 // adds amount (1, in (0, 1]) of damage to voxel id, clamped at full damage,
 // and shrinks its radius to radius0 (1 - damage_shrink damage); false on a bad
 // id or amount (state unchanged, tx_error() set)
 bool tx_voxel_tissue_damage(tx_voxel_tissue* t, int id, double amount);
 
-// rebuilds the neighbour lists now
+// rebuilds every neighbour list now
 void tx_voxel_tissue_refresh_neighbours(tx_voxel_tissue* t);
+
+// marks voxel i as moving, so that the step integrates it (a tool that
+// moves a voxel calls it; the step also finds voxels moved between steps)
+void tx_voxel_tissue_wake(tx_voxel_tissue* t, int i);
+
+// voxel i searches for its neighbours again from where it is now
+void tx_voxel_tissue_refresh_voxel(tx_voxel_tissue* t, int i);
+
+// the grid cell a point is filed under (points outside go to the border cells)
+int tx_voxel_tissue_cell_of_point(const tx_voxel_tissue* t, const double p[3]);
 
 // Vieta's cull (eq. 4) for relative position p = p2 - p1 (m), relative
 // velocity v = v2 - v1 (m/s) and contact distance r = r1 + r2 (m): true
