@@ -4,6 +4,7 @@
 
 #include "../controllers/collision/wall.h"
 #include "../controllers/haptics/haptics_controller.h"
+#include "../controllers/voxel/needle_controller.h"
 
 #include <pthread.h>
 
@@ -11,6 +12,7 @@ static void register_all(void) {
   tx_register_controller(&tx_rates_worker);
   tx_register_controller(&tx_collision_wall);
   tx_register_controller(&tx_haptics_controller);
+  tx_register_controller(&tx_voxel_needle_controller);
 }
 
 void tx_register_builtin(void) {

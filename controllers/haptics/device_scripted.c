@@ -1,6 +1,7 @@
 // scripted: a device that follows waypoints, for headless and repeatable runs.
 //
-// "scripted:NAME" plays a built-in motion of the suturing skin tests;
+// "scripted:NAME" plays a built-in motion of the suturing skin tests, or
+// "insert" of the needle-insertion scenario;
 // "scripted:FILE.csv" plays a waypoint file, one row per waypoint:
 //   t_s, x_m, y_m, z_m [, qw, qx, qy, qz] [, grip_rad]
 // Rows are interpolated linearly (orientation by normalised lerp); after the
@@ -45,6 +46,9 @@ static const motion motions[] = {
     {"slide-x-under", 5, {{0, -0.03, -0.010, 0}, {1.0, -0.03, -0.002, 0}, {7.0, 0.03, -0.002, 0}, {8.0, 0.03, -0.010, 0}, {8.5, 0.03, -0.010, 0}}},
     {"slide-z-over", 5, {{0, 0, 0.010, -0.03}, {1.0, 0, 0.002, -0.03}, {7.0, 0, 0.002, 0.03}, {8.0, 0, 0.010, 0.03}, {8.5, 0, 0.010, 0.03}}},
     {"slide-z-under", 5, {{0, 0, -0.010, -0.03}, {1.0, 0, -0.002, -0.03}, {7.0, 0, -0.002, 0.03}, {8.0, 0, -0.010, 0.03}, {8.5, 0, -0.010, 0.03}}},
+    // the voxel needle-insertion scenario: from 1 mm above the surface y = 0
+    // straight down at 3 mm/s to 4 mm deep, then straight back out at 3 mm/s
+    {"insert", 5, {{0, 0, 0.001, 0}, {0.2, 0, 0.001, 0}, {0.2 + 5.0 / 3, 0, -0.004, 0}, {0.2 + 10.0 / 3, 0, 0.001, 0}, {3.8, 0, 0.001, 0}}},
 };
 
 static tx_device* with_rows(size_t count) {
@@ -141,7 +145,7 @@ static tx_device* open_scripted(const char* arg, double period_s, char* err, siz
   size_t len = strlen(arg);
   if (len > 4 && strcmp(arg + len - 4, ".csv") == 0) return from_file(arg, err, n);
   snprintf(err, n, "device 'scripted:%s': expected a .csv file or one of pierce-down, pierce-up, slide-x-over, "
-                   "slide-x-under, slide-z-over, slide-z-under", arg);
+                   "slide-x-under, slide-z-over, slide-z-under, insert", arg);
   return NULL;
 }
 

@@ -36,6 +36,22 @@ static void pierce_down_moves_down_through_the_skin(void** state) {
   tx_device_close(&h);
 }
 
+// insert: 1 mm above the surface, down at 3 mm/s to 4 mm deep, back out at 3 mm/s
+static void insert_goes_in_and_out_at_3_mm_per_s(void** state) {
+  (void)state;
+  tx_device_handle h;
+  char err[256];
+  assert_int_equal(tx_device_open("scripted:insert", 1e-3, &h, err, sizeof err), 0);
+  assert_true(at(&h, 0).pos[1] == 0.001 && at(&h, 0).vel[1] == 0);
+  tx_device_state down = at(&h, 1.0), up = at(&h, 2.5);
+  assert_true(fabs(down.vel[1] + 0.003) < 1e-12 && fabs(up.vel[1] - 0.003) < 1e-12);
+  assert_true(fabs(down.pos[1] - (0.001 - 0.003 * 0.8)) < 1e-12);
+  assert_true(fabs(at(&h, 0.2 + 5.0 / 3).pos[1] + 0.004) < 1e-12); // deepest point
+  assert_true(down.pos[0] == 0 && down.pos[2] == 0 && down.quat[0] == 1);  // straight, along the axis
+  assert_true(at(&h, 10).pos[1] == 0.001 && at(&h, 10).vel[1] == 0);      // out and still
+  tx_device_close(&h);
+}
+
 static void every_named_motion_opens(void** state) {
   (void)state;
   const char* names[] = {"pierce-down", "pierce-up", "slide-x-over", "slide-x-under", "slide-z-over", "slide-z-under"};
@@ -121,6 +137,7 @@ static void bad_files_name_the_line(void** state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(pierce_down_moves_down_through_the_skin),
+      cmocka_unit_test(insert_goes_in_and_out_at_3_mm_per_s),
       cmocka_unit_test(every_named_motion_opens),
       cmocka_unit_test(waypoint_file_is_interpolated),
       cmocka_unit_test(bad_files_name_the_line),

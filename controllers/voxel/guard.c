@@ -1,0 +1,75 @@
+// The needle's numerical guard: checkpoint, energy bound, roll back.
+#include "guard.h"
+
+#include "../../model/error.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void save(tx_voxel_guard* g, const tx_voxel_tissue* t, double energy_in) {
+  size_t un = (size_t)g->n;
+  memcpy(g->pos, t->pos, 3 * un * sizeof *g->pos);
+  memcpy(g->vel, t->vel, 3 * un * sizeof *g->vel);
+  memcpy(g->damage, t->damage, un * sizeof *g->damage);
+  g->energy_in = energy_in;
+}
+
+bool tx_voxel_guard_init(tx_voxel_guard* g, const tx_voxel_tissue* t, int every) {
+  memset(g, 0, sizeof *g);
+  size_t un = (size_t)t->n;
+  g->n = t->n;
+  g->every = every < 1 ? 1 : every;
+  g->pos = malloc(3 * un * sizeof *g->pos);
+  g->vel = malloc(3 * un * sizeof *g->vel);
+  g->damage = malloc(un * sizeof *g->damage);
+  if (!g->pos || !g->vel || !g->damage) {
+    tx_voxel_guard_fini(g);
+    return tx_set_error("voxel guard: out of memory for %d voxels", t->n), false;
+  }
+  save(g, t, 0);
+  return true;
+}
+
+void tx_voxel_guard_fini(tx_voxel_guard* g) {
+  free(g->pos), free(g->vel), free(g->damage);
+  memset(g, 0, sizeof *g);
+}
+
+bool tx_voxel_guard_check(tx_voxel_guard* g, tx_voxel_tissue* t, tx_voxel_needle* nd) {
+  g->steps++;
+  double e = tx_voxel_tissue_energy(t);
+  bool finite = isfinite(e) && isfinite(nd->force[0] + nd->force[1] + nd->force[2]) && isfinite(nd->energy_in);
+  // passivity: no more than the needle's net work, with a margin and a floor
+  // far below any motion that matters (a voxel a nanometre off rest)
+  double floor = 0.5 * t->def.spring * 1e-18 * t->n + 1e-30;
+  bool bounded = finite && e <= 2 * fmax(nd->energy_in, 0) + floor;
+  if (finite && bounded) {
+    if (e > g->energy_max) g->energy_max = e;
+    if (g->steps % (uint64_t)g->every == 0) save(g, t, nd->energy_in);
+    return false;
+  }
+  // undo: the checkpoint's positions, velocities and damage; every voxel
+  // wakes so that the step sorts out which are at rest
+  size_t un = (size_t)g->n;
+  memcpy(t->pos, g->pos, 3 * un * sizeof *t->pos);
+  memcpy(t->vel, g->vel, 3 * un * sizeof *t->vel);
+  for (int i = 0; i < g->n; i++) {
+    if (g->damage[i] != t->damage[i]) {
+      t->damage[i] = 0;
+      t->radius[i] = t->radius0[i];
+      if (g->damage[i] > 0) tx_voxel_tissue_damage(t, i, g->damage[i]);
+    }
+    tx_voxel_tissue_wake(t, i);
+  }
+  tx_voxel_tissue_refresh_neighbours(t);
+  nd->energy_in = g->energy_in;
+  memset(nd->force, 0, sizeof nd->force);
+  memset(nd->stiffness, 0, sizeof nd->stiffness);
+  memset(nd->friction, 0, sizeof nd->friction);
+  memset(nd->cutting, 0, sizeof nd->cutting);
+  nd->k_axial = 0;
+  g->recoveries++;
+  if (!finite) g->non_finite++;
+  return true;
+}

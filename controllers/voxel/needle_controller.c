@@ -1,0 +1,218 @@
+// voxel.needle: the voxel block and the needle, one frame per step.
+//
+// Each step reads the device pose, moves the needle there, steps the block
+// with the needle's contacts inside its substeps, guards the result, and
+// publishes the force model for the haptics controller: F0 = eq. 9's force
+// at the tip, K = -k a a^T with k the springs the tip holds (capped). The
+// drawable components (spheres, damage, the needle's segment) go out every
+// draw_every steps. With a record folder, the run's haptic recording is
+// written in finish as needle-recording.csv (docs/needle.md).
+#include "needle_controller.h"
+
+#include "guard.h"
+#include "needle.h"
+#include "recording.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { W_RECOVERED, W_FAULTS, W_OVERFLOW, W_RECORD_FULL, W_COUNT };
+
+typedef struct needle_ctl {
+  tx_voxel_tissue tissue;
+  tx_voxel_needle needle;
+  tx_voxel_guard guard;
+  bool ready;               // tissue, needle and guard initialised
+  double max_stiffness;     // N/m, cap on K
+  int draw_every;           // steps between publishes of the drawables
+  uint64_t steps;
+  tx_port pose, model, spheres, damage, segment, force;
+  tx_warning warn[W_COUNT];
+  tx_result peak_result, cuts_result, energy_result;
+  uint64_t faults_seen, overflow_seen;
+  double peak;              // N, largest force magnitude
+  tx_recording rec;         // rows kept for finish, when recording
+  bool record;
+  double record_max_s;
+} needle_ctl;
+
+static int configure(tx_setup* s, void** self) {
+  needle_ctl* c = calloc(1, sizeof *c);
+  if (!c) return -1;
+  *self = c;
+  tx_voxel_tissue_def d = tx_voxel_tissue_def_default();
+  static const char* const size_keys[3] = {"block_x_m", "block_y_m", "block_z_m"};
+  static const char* const count_keys[3] = {"count_x", "count_y", "count_z"};
+  for (int a = 0; a < 3; a++) {
+    d.block_size[a] = tx_param_num(s, size_keys[a], 5e-3, 1e-5, 1);
+    d.count[a] = (int)tx_param_int(s, count_keys[a], 10, 1, 1000);
+  }
+  // the block's top face at y = top_y_m, centred on x = z = 0
+  double top = tx_param_num(s, "top_y_m", 0, -10, 10);
+  d.origin[0] = -0.5 * d.block_size[0];
+  d.origin[1] = top - d.block_size[1];
+  d.origin[2] = -0.5 * d.block_size[2];
+  d.mass = tx_param_num(s, "mass_kg", d.mass, 1e-15, 1);
+  d.elasticity = tx_param_num(s, "elasticity", d.elasticity, 0, 1);
+  d.spring = tx_param_num(s, "spring_n_m", d.spring, 0, 1e9);
+  d.damper = tx_param_num(s, "damper_n_s_m", d.damper, 0, 1e9);
+  d.radius = tx_param_num(s, "radius_m", d.radius, 1e-7, 1);
+  d.damage_shrink = tx_param_num(s, "damage_shrink", d.damage_shrink, 0, 0.99);
+  d.recovery_time = tx_param_num(s, "recovery_s", d.recovery_time, 1e-3, 1e6);
+  d.skin = tx_param_num(s, "skin_m", d.skin, 1e-7, 1);
+  tx_voxel_needle_def nd = tx_voxel_needle_def_default();
+  nd.gauge = (int)tx_param_int(s, "gauge", nd.gauge, 10, 34);
+  const char* tip = tx_param_str(s, "tip", "conical");
+  nd.tip_angle_deg = tx_param_num(s, "tip_angle_deg", nd.tip_angle_deg, 1, 89);
+  nd.length = tx_param_num(s, "length_m", nd.length, 1e-3, 1);
+  nd.friction = tx_param_num(s, "friction", nd.friction, 0, 10);
+  nd.rupture_force = tx_param_num(s, "rupture_force_n", nd.rupture_force, 1e-9, 1e4);
+  nd.load_time = tx_param_num(s, "load_time_s", nd.load_time, 1e-5, 1);
+  c->max_stiffness = tx_param_num(s, "max_stiffness_n_m", 500, 0, 1e5);
+  c->draw_every = (int)tx_param_int(s, "draw_every", 16, 1, 100000);
+  int every = (int)tx_param_int(s, "checkpoint_steps", 100, 1, 100000);
+  c->record = tx_param_bool(s, "record", true);
+  c->record_max_s = tx_param_num(s, "record_max_s", 120, 1, 3600);
+  const char* pose = tx_param_str(s, "pose", "device0.pose");
+  const char* model = tx_param_str(s, "force_model", "tool0.force_model");
+  if (!tip || !pose || !model) return -1;
+  if (!tx_needle_tip_parse(tip, &nd.tip))
+    return tx_setup_fail(s, "tip", "expected \"conical\", \"bevel\" or \"blunt\", got \"%s\"", tip);
+  const char* bad = tx_voxel_tissue_def_check(&d);
+  if (!bad) bad = tx_voxel_needle_def_check(&nd);
+  if (bad) return tx_setup_fail(s, NULL, "%s", bad);
+  if (!tx_voxel_tissue_init(&c->tissue, &d)) return tx_setup_fail(s, NULL, "%s", tx_error());
+  if (!tx_voxel_needle_init(&c->needle, &nd, &c->tissue) || !tx_voxel_guard_init(&c->guard, &c->tissue, every)) {
+    c->ready = true; // fini frees whatever was made
+    return tx_setup_fail(s, NULL, "%s", tx_error());
+  }
+  c->ready = true;
+  const uint32_t n = (uint32_t)c->tissue.n;
+  c->pose = tx_setup_read_as(s, pose, TX_F64, 7); // x y z, qw qx qy qz
+  c->model = tx_setup_write(s, &(tx_component_def){model, TX_F64, 1, 15, "N, m, N/m"});
+  c->spheres = tx_setup_write(s, &(tx_component_def){"tissue.spheres", TX_F32, n, 4, "m"});
+  c->damage = tx_setup_write(s, &(tx_component_def){"tissue.damage", TX_F32, n, 1, "1"});
+  c->segment = tx_setup_write(s, &(tx_component_def){"needle.segments", TX_F32, 1, 7, "m"});
+  // eq. 9 apart: the force, then stiffness, friction and cutting (N), then the depth (m)
+  c->force = tx_setup_write(s, &(tx_component_def){"needle.force", TX_F64, 1, 13, "N, m"});
+  static const char* const keys[W_COUNT] = {"recovered", "voxel_faults", "neighbour_overflow", "record_full"};
+  for (int w = 0; w < W_COUNT; w++) c->warn[w] = tx_setup_warning(s, keys[w]);
+  c->peak_result = tx_setup_result(s, "peak_force_n");
+  c->cuts_result = tx_setup_result(s, "voxels_cut");
+  c->energy_result = tx_setup_result(s, "max_energy_j");
+  return 0;
+}
+
+static void publish_drawables(tx_ctx* ctx, needle_ctl* c) {
+  const tx_voxel_tissue* t = &c->tissue;
+  float* sp = tx_write(ctx, c->spheres);
+  float* dm = tx_write(ctx, c->damage);
+  for (int i = 0; i < t->n; i++) {
+    for (int a = 0; a < 3; a++) sp[4 * i + a] = (float)t->pos[3 * i + a];
+    sp[4 * i + 3] = (float)t->radius[i];
+    dm[i] = (float)t->damage[i];
+  }
+  const tx_voxel_needle* nd = &c->needle;
+  float* seg = tx_write(ctx, c->segment);
+  for (int a = 0; a < 3; a++) {
+    seg[a] = (float)(nd->tip1[a] - nd->def.length * nd->dir[a]);
+    seg[3 + a] = (float)nd->tip1[a];
+  }
+  seg[6] = (float)nd->radius;
+}
+
+static void publish_forces(tx_ctx* ctx, needle_ctl* c) {
+  const tx_voxel_needle* nd = &c->needle;
+  double* m = tx_write(ctx, c->model); // f0 (3), x0 (3), K (9)
+  memcpy(m, nd->force, 3 * sizeof *m);
+  memcpy(m + 3, nd->tip1, 3 * sizeof *m);
+  double k = fmin(nd->k_axial, c->max_stiffness);
+  for (int r = 0; r < 3; r++)
+    for (int col = 0; col < 3; col++) m[6 + 3 * r + col] = -k * nd->dir[r] * nd->dir[col];
+  double* f = tx_write(ctx, c->force);
+  memcpy(f, nd->force, 3 * sizeof *f);
+  memcpy(f + 3, nd->stiffness, 3 * sizeof *f);
+  memcpy(f + 6, nd->friction, 3 * sizeof *f);
+  memcpy(f + 9, nd->cutting, 3 * sizeof *f);
+  f[12] = tx_voxel_needle_depth(nd, &c->tissue);
+}
+
+static int init(tx_ctx* ctx, void* self) {
+  needle_ctl* c = self;
+  // the needle is placed by the first step's pose (haptics publishes it at time 0)
+  tx_snapshot pose = tx_read(ctx, c->pose);
+  if (pose.seq) memcpy(c->needle.tip1, pose.data, sizeof c->needle.tip1);
+  publish_forces(ctx, c);
+  publish_drawables(ctx, c);
+  if (c->record && tx_record_dir(ctx)) {
+    size_t rows = (size_t)ceil(c->record_max_s * tx_rate(ctx)) + 1;
+    if (!tx_recording_alloc(&c->rec, rows)) {
+      fprintf(stderr, "tactus: voxel.needle: %s\n", tx_error());
+      return -1;
+    }
+  }
+  return 0;
+}
+
+static void step(tx_ctx* ctx, void* self) {
+  needle_ctl* c = self;
+  const double dt = 1.0 / tx_rate(ctx);
+  const double* pose = tx_read(ctx, c->pose).data;
+  bool was_punctured = c->needle.punctured;
+  int was_contacts = c->needle.contacts;
+  if (!tx_voxel_needle_step(&c->needle, &c->tissue, pose, pose + 3, dt)) {
+    tx_warn(ctx, c->warn[W_RECOVERED]); // a non-finite pose: hold the last force model
+    return;
+  }
+  if (tx_voxel_guard_check(&c->guard, &c->tissue, &c->needle)) tx_warn(ctx, c->warn[W_RECOVERED]);
+  if (c->tissue.faults > c->faults_seen) c->faults_seen = c->tissue.faults, tx_warn(ctx, c->warn[W_FAULTS]);
+  if (c->tissue.overflow > c->overflow_seen) c->overflow_seen = c->tissue.overflow, tx_warn(ctx, c->warn[W_OVERFLOW]);
+  const double* f = c->needle.force;
+  c->peak = fmax(c->peak, sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]));
+  publish_forces(ctx, c);
+  if (++c->steps % (uint64_t)c->draw_every == 0) publish_drawables(ctx, c);
+  if (c->rec.cap) {
+    tx_needle_event ev = TX_EVENT_NONE;
+    if (!was_contacts && c->needle.contacts) ev = TX_EVENT_CONTACT;
+    else if (!was_punctured && c->needle.punctured) ev = TX_EVENT_PUNCTURE;
+    else if (was_contacts && !c->needle.contacts) ev = TX_EVENT_EXIT;
+    tx_recording_row row = {(double)tx_sim_ns(ctx) * 1e-9, tx_voxel_needle_depth(&c->needle, &c->tissue),
+                            {f[0], f[1], f[2]}, ev};
+    if (!tx_recording_push(&c->rec, &row)) tx_warn(ctx, c->warn[W_RECORD_FULL]);
+  }
+}
+
+static void finish(tx_ctx* ctx, void* self) {
+  needle_ctl* c = self;
+  tx_set_result(ctx, c->peak_result, c->peak);
+  tx_set_result(ctx, c->cuts_result, (double)c->needle.cuts);
+  tx_set_result(ctx, c->energy_result, c->guard.energy_max);
+  if (c->rec.cap && tx_record_dir(ctx)) {
+    char path[4200];
+    snprintf(path, sizeof path, "%s/needle-recording.csv", tx_record_dir(ctx));
+    if (!tx_recording_write(&c->rec, path)) fprintf(stderr, "tactus: voxel.needle: %s\n", tx_error());
+  }
+}
+
+static void fini(void* self) {
+  needle_ctl* c = self;
+  if (c->ready) {
+    tx_voxel_guard_fini(&c->guard);
+    tx_voxel_needle_fini(&c->needle);
+    tx_voxel_tissue_fini(&c->tissue);
+  }
+  tx_recording_free(&c->rec);
+  free(c);
+}
+
+const tx_controller_class tx_voxel_needle_controller = {
+    .type = "voxel.needle",
+    .summary = "spherical voxel tissue and a straight needle at the haptic rate: force model, spheres, damage",
+    .configure = configure,
+    .init = init,
+    .step = step,
+    .finish = finish,
+    .fini = fini,
+};
