@@ -19,9 +19,15 @@ typedef struct tx_voxel_guard {
   int n;             // voxels
   int every;         // steps between checkpoints
   uint64_t steps;    // steps checked
-  double* pos;       // (n x 3) checkpoint positions, m
-  double* vel;       // (n x 3) checkpoint velocities, m/s
-  double* damage;    // (n) checkpoint damage, 1
+  // the checkpoint holds only what is not at rest: the awake voxels' state
+  // and the damaged voxels' damage, so that taking it costs what is moving
+  int32_t* awake;    // (n) ids of the voxels awake at the checkpoint
+  int n_awake;       // entries used in awake
+  double* pos;       // (n x 3) their positions, m
+  double* vel;       // (n x 3) their velocities, m/s
+  int32_t* damaged;  // (n) ids of the voxels damaged at the checkpoint
+  int n_damaged;     // entries used in damaged
+  double* damage;    // (n) their damage, 1
   double energy_in;  // J, the needle's work at the checkpoint
   double energy_max; // J, the most the block has held
   uint64_t recoveries; // steps undone

@@ -36,6 +36,7 @@ tx_voxel_needle_def tx_voxel_needle_def_default(void) {
       .length = 0.04,
       .friction = 0.3,
       .rupture_force = 0.2,
+      .cutting_force = 0.1,
       .load_time = 0.005,
       .axis = {0, -1, 0},
       .side = {1, 0, 0},
@@ -52,6 +53,7 @@ const char* tx_voxel_needle_def_check(const tx_voxel_needle_def* d) {
   if ((e = tx_check_range("needle", "length", d->length, 0, true, 1, false, "m"))) return e;
   if ((e = tx_check_range("needle", "friction", d->friction, 0, false, 10, false, "(Coulomb coefficient)"))) return e;
   if ((e = tx_check_range("needle", "rupture_force", d->rupture_force, 0, true, 1e4, false, "N"))) return e;
+  if ((e = tx_check_range("needle", "cutting_force", d->cutting_force, 0, true, 1e4, false, "N"))) return e;
   if ((e = tx_check_range("needle", "load_time", d->load_time, 0, true, 1, false, "s"))) return e;
   for (int a = 0; a < 3; a++)
     if (!isfinite(d->axis[a]) || !isfinite(d->side[a])) return tx_check_fail("needle: axis and side must be finite");
@@ -72,11 +74,10 @@ bool tx_voxel_needle_init(tx_voxel_needle* out, const tx_voxel_needle_def* def, 
   size_t un = (size_t)t->n;
   n.cut = calloc(un, sizeof *n.cut);
   n.cut_list = calloc(un, sizeof *n.cut_list);
-  n.stamp = calloc(un, sizeof *n.stamp);
   n.load = calloc(un, sizeof *n.load);
   n.load_t = calloc(un, sizeof *n.load_t);
-  if (!n.cut || !n.cut_list || !n.stamp || !n.load || !n.load_t) {
-    free(n.cut), free(n.cut_list), free(n.stamp), free(n.load), free(n.load_t);
+  if (!n.cut || !n.cut_list || !n.load || !n.load_t) {
+    free(n.cut), free(n.cut_list), free(n.load), free(n.load_t);
     return tx_set_error("needle: out of memory for %d voxels", t->n), false;
   }
   *out = n;
@@ -85,7 +86,7 @@ bool tx_voxel_needle_init(tx_voxel_needle* out, const tx_voxel_needle_def* def, 
 }
 
 void tx_voxel_needle_fini(tx_voxel_needle* n) {
-  free(n->cut), free(n->cut_list), free(n->stamp), free(n->load), free(n->load_t);
+  free(n->cut), free(n->cut_list), free(n->load), free(n->load_t);
   memset(n, 0, sizeof *n);
 }
 
@@ -228,13 +229,16 @@ static void touch(frame* f, tx_voxel_tissue* t, int i, const double T[3]) {
   double age = n->time - n->load_t[i];
   n->load[i] = n->load[i] * exp(-age / n->def.load_time) + jn;
   n->load_t[i] = n->time;
-  if (n->load[i] / n->def.load_time >= n->def.rupture_force * n->cut_scale) {
+  // the first cut of an insertion (puncture) takes the rupture force, those
+  // after it (the crack running on) the smaller cutting force
+  double limit = n->punctured ? n->def.cutting_force : n->def.rupture_force;
+  if (n->load[i] / n->def.load_time >= limit * n->cut_scale) {
     cut_voxel(n, t, i);
     n->load[i] = 0;
   }
 }
 
-// the grid cells within reach of the needle, visited along its axis
+// the voxels in the grid cells within reach of the needle
 static void substep(tx_voxel_tissue* t, int s, int ns, double h, void* user) {
   frame* f = user;
   tx_voxel_needle* n = f->n;
@@ -242,10 +246,6 @@ static void substep(tx_voxel_tissue* t, int s, int ns, double h, void* user) {
   double u = (double)(s + 1) / ns, T[3];
   for (int k = 0; k < 3; k++) T[k] = n->tip0[k] + u * (n->tip1[k] - n->tip0[k]);
   f->k_axial = 0;
-  if (++n->query == 0) { // the stamps wrapped: start them again
-    memset(n->stamp, 0, sizeof *n->stamp * (size_t)t->n);
-    n->query = 1;
-  }
   // voxels drift up to half the skin from the cells they were sorted into
   const double rmax = t->def.radius, reach = n->radius + rmax + 0.25 * t->def.skin;
   const double* a = n->dir;
@@ -266,30 +266,37 @@ static void substep(tx_voxel_tissue* t, int s, int ns, double h, void* user) {
     if (tb < t1) t1 = tb;
   }
   if (t0 > t1) return;
-  double cmin = fmin(t->cell_size[0], fmin(t->cell_size[1], t->cell_size[2]));
-  double len = (t1 - t0) * n->def.length;
-  int samples = 1 + (int)ceil(len / (0.5 * cmin));
-  for (int j = 0; j <= samples; j++) {
-    double w = t0 + (t1 - t0) * j / samples, c[3];
-    int lo[3], hi[3];
-    for (int k = 0; k < 3; k++) {
-      c[k] = from[k] + w * (to[k] - from[k]);
-      double fl = floor((c[k] - reach - t->grid_lo[k]) / t->cell_size[k]);
-      double fh = floor((c[k] + reach - t->grid_lo[k]) / t->cell_size[k]);
-      lo[k] = fl < 0 ? 0 : fl >= t->grid_dims[k] ? t->grid_dims[k] - 1 : (int)fl;
-      hi[k] = fh < 0 ? 0 : fh >= t->grid_dims[k] ? t->grid_dims[k] - 1 : (int)fh;
-    }
-    for (int z = lo[2]; z <= hi[2]; z++)
-      for (int y = lo[1]; y <= hi[1]; y++)
-        for (int x = lo[0]; x <= hi[0]; x++) {
-          int cell = (z * t->grid_dims[1] + y) * t->grid_dims[0] + x;
-          for (int i = t->cell_head[cell]; i >= 0; i = t->cell_next[i]) {
-            if (n->stamp[i] == n->query) continue;
-            n->stamp[i] = n->query;
-            touch(f, t, i, T);
-          }
-        }
+  // the cells of the clipped segment's box whose centre lies within the
+  // reach plus half a cell diagonal of the segment: each visited once
+  double p0[3], p1[3], seg[3], seg2 = 0;
+  int lo[3], hi[3];
+  for (int k = 0; k < 3; k++) {
+    p0[k] = from[k] + t0 * (to[k] - from[k]);
+    p1[k] = from[k] + t1 * (to[k] - from[k]);
+    seg[k] = p1[k] - p0[k];
+    seg2 += seg[k] * seg[k];
+    double fl = floor((fmin(p0[k], p1[k]) - reach - t->grid_lo[k]) / t->cell_size[k]);
+    double fh = floor((fmax(p0[k], p1[k]) + reach - t->grid_lo[k]) / t->cell_size[k]);
+    lo[k] = fl < 0 ? 0 : fl >= t->grid_dims[k] ? t->grid_dims[k] - 1 : (int)fl;
+    hi[k] = fh < 0 ? 0 : fh >= t->grid_dims[k] ? t->grid_dims[k] - 1 : (int)fh;
   }
+  const double* cs = t->cell_size;
+  double half_diag = 0.5 * sqrt(cs[0] * cs[0] + cs[1] * cs[1] + cs[2] * cs[2]), lim = reach + half_diag;
+  for (int z = lo[2]; z <= hi[2]; z++)
+    for (int y = lo[1]; y <= hi[1]; y++)
+      for (int x = lo[0]; x <= hi[0]; x++) {
+        double c[3] = {t->grid_lo[0] + (x + 0.5) * cs[0], t->grid_lo[1] + (y + 0.5) * cs[1], t->grid_lo[2] + (z + 0.5) * cs[2]};
+        double w[3] = {c[0] - p0[0], c[1] - p0[1], c[2] - p0[2]};
+        double along = seg2 > 0 ? dot(w, seg) / seg2 : 0;
+        along = along < 0 ? 0 : along > 1 ? 1 : along;
+        double dx = w[0] - along * seg[0], dy = w[1] - along * seg[1], dz = w[2] - along * seg[2];
+        // border cells also hold every voxel beyond the grid: always visited
+        bool border = x == 0 || y == 0 || z == 0 || x == t->grid_dims[0] - 1 || y == t->grid_dims[1] - 1 ||
+                      z == t->grid_dims[2] - 1;
+        if (!border && dx * dx + dy * dy + dz * dz > lim * lim) continue;
+        int cell = (z * t->grid_dims[1] + y) * t->grid_dims[0] + x;
+        for (int i = t->cell_head[cell]; i >= 0; i = t->cell_next[i]) touch(f, t, i, T);
+      }
 }
 
 // rotate v by the unit quaternion q (w, x, y, z)

@@ -12,8 +12,9 @@
 //     the sliding, at most friction times the normal impulse;
 //   - an uncut voxel in front of the tip is pushed along the axis (a bevel
 //     tip pushes it along the bevel face's normal). When its load, averaged
-//     over load_time, reaches the cutting load (rupture_force times the tip's
-//     sharpness: 1 blunt, sin(tip_angle) conical or bevel), the voxel is cut:
+//     over load_time, reaches the cutting load (rupture_force for the first
+//     cut of an insertion, the puncture, and cutting_force after it, times
+//     the tip's sharpness: 1 blunt, sin(tip_angle) conical or bevel), it is cut:
 //     fully damaged (its radius shrinks), and from then on parted sideways.
 //     A cut voxel is uncut again once its damage has healed.
 //
@@ -52,7 +53,8 @@ typedef struct tx_voxel_needle_def {
   double tip_angle_deg; // degrees: conical half-angle, or the bevel face's angle to the axis, in (0, 90); 15
   double length;        // m, hub to tip; 0.04
   double friction;      // 1, Coulomb coefficient between the shaft and the voxels, in [0, 10]; 0.3
-  double rupture_force; // N, load on one voxel that a blunt tip cuts it with, in (0, 1e4]; 0.2
+  double rupture_force; // N, load on one voxel that a blunt tip punctures it with, in (0, 1e4]; 0.2
+  double cutting_force; // N, the same once punctured (the crack runs on), in (0, 1e4]; 0.1
   double load_time;     // s, how long a voxel's tip load is averaged before it is compared, in (0, 1]; 0.005
   double axis[3];       // unit direction hub to tip in the device frame; (0, -1, 0): down, Y up
   double side[3];       // unit direction the bevel face looks toward, device frame, normal to axis; (1, 0, 0)
@@ -67,8 +69,6 @@ typedef struct tx_voxel_needle {
   uint8_t* cut;        // (n) 1 where the needle has cut the voxel and it has not healed
   int32_t* cut_list;   // (n) ids of the cut voxels
   int n_cut;           // entries used in cut_list
-  uint32_t* stamp;     // (n) the last query that visited each voxel
-  uint32_t query;      // stamp of the current query
   double* load;        // (n) N s, each voxel's tip impulse, decaying with load_time
   double* load_t;      // (n) s, when load was last updated
 

@@ -69,6 +69,7 @@ static int configure(tx_setup* s, void** self) {
   nd.length = tx_param_num(s, "length_m", nd.length, 1e-3, 1);
   nd.friction = tx_param_num(s, "friction", nd.friction, 0, 10);
   nd.rupture_force = tx_param_num(s, "rupture_force_n", nd.rupture_force, 1e-9, 1e4);
+  nd.cutting_force = tx_param_num(s, "cutting_force_n", nd.cutting_force, 1e-9, 1e4);
   nd.load_time = tx_param_num(s, "load_time_s", nd.load_time, 1e-5, 1);
   c->max_stiffness = tx_param_num(s, "max_stiffness_n_m", 500, 0, 1e5);
   c->draw_every = (int)tx_param_int(s, "draw_every", 16, 1, 100000);

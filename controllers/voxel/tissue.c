@@ -551,21 +551,17 @@ static void refresh_moved(tx_voxel_tissue* t, double h) {
   }
 }
 
-// puts right what a caller may have written between steps (non-finite
-// positions or velocities, bad masses) and returns the largest speed squared
+// puts right what a caller may have written into awake voxels between steps
+// (non-finite positions or velocities, bad masses) and returns the largest
+// speed squared; sleeping voxels are at rest and cost nothing
 static double scan(tx_voxel_tissue* t) {
   double vmax2 = 0;
-  for (int i = 0; i < t->n; i++) {
+  for (int w = 0; w < t->n_awake; w++) {
+    const int i = t->awake_list[w];
     const double* p = t->pos + 3 * i;
     const double* v = t->vel + 3 * i;
     if (!isfinite(p[0] + p[1] + p[2] + v[0] + v[1] + v[2])) restore(t, i);
     if (!(isfinite(t->mass[i]) && t->mass[i] > 0)) t->mass[i] = t->def.mass, t->faults++;
-    // a caller may have moved a sleeping voxel
-    if (!t->is_awake[i]) {
-      const double* p0 = t->pos0 + 3 * i;
-      if (p[0] != p0[0] || p[1] != p0[1] || p[2] != p0[2] || v[0] != 0 || v[1] != 0 || v[2] != 0)
-        tx_voxel_tissue_wake(t, i);
-    }
     double v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
     if (v2 > vmax2) vmax2 = v2;
   }

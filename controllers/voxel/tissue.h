@@ -38,8 +38,9 @@
 //     tx_voxel_tissue_fini(&t);
 //
 // Init allocates everything; step, damage and reset never allocate. Callers
-// may write pos, vel and mass between steps (the lists follow on the next
-// step).
+// may write pos, vel and mass between steps, and then wake the voxels they
+// wrote (tx_voxel_tissue_wake); the lists follow on the next step. A step
+// costs in proportion to the awake voxels, not to the block.
 #ifndef TX_CONTROLLERS_VOXEL_TISSUE_H
 #define TX_CONTROLLERS_VOXEL_TISSUE_H
 

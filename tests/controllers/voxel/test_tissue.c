@@ -112,6 +112,7 @@ static void collision_conserves(void** state) {
       assert_true(tx_voxel_tissue_init(&t, &d));
       t.mass[1] = 3e-7;
       t.vel[0] = 0.5, t.vel[1] = vy[iy], t.vel[3] = -0.2;
+      tx_voxel_tissue_wake(&t, 0), tx_voxel_tissue_wake(&t, 1);
       double m0[3], k0, m1[3], k1;
       momentum_energy(&t, m0, &k0);
       uint64_t contacts = 0;
@@ -176,6 +177,7 @@ static void time_of_impact_matches(void** state) {
   tx_voxel_tissue t;
   assert_true(tx_voxel_tissue_init(&t, &def));
   t.vel[0] = 1;
+  tx_voxel_tissue_wake(&t, 0);
   double x0 = t.pos[0], x1 = t.pos[3];
   assert_true(tx_voxel_tissue_step(&t, 1e-3)); // hit at 0.6 ms, inside this frame
   assert_int_equal(t.contacts, 1);
@@ -283,6 +285,7 @@ static void spring_damper_returns(void** state) {
   assert_true(tx_voxel_tissue_init(&t, &d));
   const double x0 = 0.1e-3, w = sqrt(d.spring / d.mass), dt = 1e-3;
   t.pos[0] += x0;
+  tx_voxel_tissue_wake(&t, 0);
   double prev = x0, worst = 0;
   for (int s = 1; s <= 100; s++) {
     assert_true(tx_voxel_tissue_step(&t, dt));
@@ -301,6 +304,7 @@ static void spring_damper_returns(void** state) {
   d.damper *= 0.2;
   assert_true(tx_voxel_tissue_init(&t, &d));
   t.pos[0] += x0;
+  tx_voxel_tissue_wake(&t, 0);
   double lowest = x0;
   for (int s = 1; s <= 100; s++) {
     assert_true(tx_voxel_tissue_step(&t, dt));
@@ -314,6 +318,7 @@ static void spring_damper_returns(void** state) {
   d.spring *= 1e3;
   assert_true(tx_voxel_tissue_init(&t, &d));
   t.pos[1] -= x0;
+  tx_voxel_tissue_wake(&t, 0);
   for (int s = 1; s <= 1000; s++) assert_true(tx_voxel_tissue_step(&t, dt));
   assert_true(isfinite(t.pos[1]) && fabs(t.pos[1] - t.pos0[1]) <= x0);
   tx_voxel_tissue_fini(&t);
@@ -409,6 +414,7 @@ static void bad_input_refused(void** state) {
   // steps of no length, negative, NaN or Inf: refused, nothing moves
   assert_true(tx_voxel_tissue_init(&t, &good));
   t.vel[5] = 0.01;
+  tx_voxel_tissue_wake(&t, 1);
   const double bad_dt[] = {0, -1e-3, NAN, INFINITY, 2};
   for (size_t k = 0; k < sizeof bad_dt / sizeof *bad_dt; k++) {
     assert_false(tx_voxel_tissue_step(&t, bad_dt[k]));
@@ -420,6 +426,7 @@ static void bad_input_refused(void** state) {
   t.pos[3 * 500] = NAN;
   t.vel[3 * 600 + 1] = INFINITY;
   t.mass[700] = -1;
+  tx_voxel_tissue_wake(&t, 500), tx_voxel_tissue_wake(&t, 600), tx_voxel_tissue_wake(&t, 700);
   for (int s = 0; s < 10; s++) assert_true(tx_voxel_tissue_step(&t, 1e-3));
   assert_true(t.faults >= 3);
   for (int i = 0; i < 3 * t.n; i++) assert_true(isfinite(t.pos[i]) && isfinite(t.vel[i]));
@@ -460,6 +467,7 @@ static void block_20k_steps_without_allocation(void** state) {
         for (int x = 8; x < 13; x++) {
           int i = (z * 40 + 39) * 20 + x;
           t.vel[3 * i + 1] = -0.05;
+          tx_voxel_tissue_wake(&t, i);
         }
     if (s == 50) tx_voxel_tissue_damage(&t, (12 * 40 + 39) * 20 + 10, 1);
     double t0 = now_s();
