@@ -14,7 +14,18 @@ static const struct {
 } studies[] = {
     {"haptic-stability", tx_study_haptic_stability,
      "largest stable wall stiffness vs Colgate's bound, with and without passivity control"},
+    {"needle-fit", tx_study_needle_fit, "FILE: fit the voxel tissue to a needle recording, RMS vs run time, Figure 5"},
+    {"needle-stability", tx_study_needle_stability, "needle in voxels at stiff, elastic, light, fast and overlapping extremes"},
 };
+
+// the studies that take a FILE after their name
+static const char* const with_file[] = {"needle-fit"};
+
+static bool takes_file(const char* name) {
+  for (size_t i = 0; i < sizeof with_file / sizeof with_file[0]; i++)
+    if (strcmp(name, with_file[i]) == 0) return true;
+  return false;
+}
 
 int tx_cmd_study(int argc, char** argv) {
   static const struct option longs[] = {
@@ -33,16 +44,19 @@ int tx_cmd_study(int argc, char** argv) {
     } else if (c == 'h') help = true;
     else return tx_bad_input("study: unknown or incomplete option '%s'", argv[optind - 1]);
   }
-  if (help || optind != argc - 1) {
-    printf("usage: tactus study NAME [--out DIR] [--set KEY=VALUE]...\n\n");
+  if (help || optind < argc - 2 || optind > argc - 1) {
+    printf("usage: tactus study NAME [FILE] [--out DIR] [--set KEY=VALUE]...\n\n");
     for (size_t i = 0; i < sizeof studies / sizeof studies[0]; i++) printf("  %-18s %s\n", studies[i].name, studies[i].what);
     return help ? 0 : tx_bad_input("study: expected one NAME from the list above");
   }
   for (size_t i = 0; i < sizeof studies / sizeof studies[0]; i++) {
     if (strcmp(argv[optind], studies[i].name) != 0) continue;
+    const char* file = optind == argc - 2 ? argv[optind + 1] : NULL;
+    if (takes_file(studies[i].name) && !file) return tx_bad_input("study %s: expected a FILE after the name", studies[i].name);
+    if (!takes_file(studies[i].name) && file) return tx_bad_input("study %s: unexpected argument '%s'", studies[i].name, file);
     char dir[4096], err[1024];
     if (tx_out_dir(out, studies[i].name, dir, sizeof dir, err, sizeof err)) return tx_bad_input("%s", err);
-    tx_study_args a = {dir, sets, nsets};
+    tx_study_args a = {dir, sets, nsets, file};
     return studies[i].run(&a);
   }
   return tx_bad_input("study %s: unknown study (tactus study lists them)", argv[optind]);

@@ -9,8 +9,11 @@ typedef struct tx_study_args {
   const char* out_dir;      // made and checked already
   const char* const* sets;  // KEY=VALUE
   int nsets;
+  const char* file;         // the FILE operand of a study that takes one, else NULL
 } tx_study_args;
 
 int tx_study_haptic_stability(const tx_study_args* a);
+int tx_study_needle_fit(const tx_study_args* a);
+int tx_study_needle_stability(const tx_study_args* a);
 
 #endif
