@@ -165,6 +165,34 @@ expect_bad "study --set out of range" "damping" -- study haptic-stability --set 
 expect_bad "study --set not a number" "--set device.period=abc" -- study haptic-stability --set device.period=abc --out "$WORK/st"
 expect_bad "study unwritable --out" "--out /dev/null/x" -- study haptic-stability --out /dev/null/x
 expect_bad "study without a name" "study" "NAME" -- study
+
+# --- the voxel needle: scenario keys, recordings, studies, bench ---------------------
+expect_bad "needle tip unknown" "needle.tip" "sharp" -- run needle-voxel --lockstep --set needle.tip=sharp
+expect_bad "needle gauge out of range" "needle.gauge" -- run needle-voxel --lockstep --set needle.gauge=40
+expect_bad "needle radius negative" "needle.radius_m" -- run needle-voxel --lockstep --set needle.radius_m=-1
+expect_bad "needle friction not a number" "needle.friction" -- run needle-voxel --lockstep --set needle.friction=lots
+expect_bad "needle unknown key" "needle.bogus" -- run needle-voxel --lockstep --set needle.bogus=1
+expect_bad "needle-fit without a file" "needle-fit" "FILE" -- study needle-fit --out "$WORK/nf"
+expect_bad "needle-fit missing file" "$WORK/none.csv" "No such file" -- study needle-fit "$WORK/none.csv" --out "$WORK/nf"
+printf 't_s,depth_m,fx_n,fy_n,fz_n,event\n0,0,0,0.1,0,\n0.001,0,0,x,0,\n' >"$WORK/bad_value.csv"
+expect_bad "needle-fit bad value" "$WORK/bad_value.csv:3:" "finite" -- study needle-fit "$WORK/bad_value.csv" --out "$WORK/nf"
+printf 't,depth,fx,fy,fz\n0,0,0,0.1,0,\n' >"$WORK/bad_header.csv"
+expect_bad "needle-fit bad header" "$WORK/bad_header.csv:1:" "header" -- study needle-fit "$WORK/bad_header.csv" --out "$WORK/nf"
+printf 't_s,depth_m,fx_n,fy_n,fz_n,event\n0,0,0,0.1,0,\n0.005,0,0,0.1,0,\n' >"$WORK/slow.csv"
+expect_bad "needle-fit below 1 kHz" "$WORK/slow.csv:3:" "1 ms" -- study needle-fit "$WORK/slow.csv" --out "$WORK/nf"
+printf 't_s,depth_m,fx_n,fy_n,fz_n,event\n0,0,0,0.1,0,\n0.001,0,0,0.1,0,jab\n' >"$WORK/bad_event.csv"
+expect_bad "needle-fit unknown event" "$WORK/bad_event.csv:3:" "event" -- study needle-fit "$WORK/bad_event.csv" --out "$WORK/nf"
+printf 't_s,depth_m,fx_n,fy_n,fz_n,event\n0,0,0,0,0,\n0.001,0,0,0,0,\n' >"$WORK/flat.csv"
+expect_bad "needle-fit nothing to fit" "$WORK/flat.csv" "zero" -- study needle-fit "$WORK/flat.csv" --out "$WORK/nf"
+printf 't_s,depth_m,fx_n,fy_n,fz_n,event\n0,0,0,0.1,0,\n0.001,0,0,0.1,0,\n' >"$WORK/ok.csv"
+expect_bad "needle-fit --set unknown key" "--set bogus=1" "unknown key" -- study needle-fit "$WORK/ok.csv" --set bogus=1 --out "$WORK/nf"
+expect_bad "needle-fit --set evals too few" "--set evals=3" -- study needle-fit "$WORK/ok.csv" --set evals=3 --out "$WORK/nf"
+expect_bad "needle-fit --set evals fraction" "--set evals=20.5" -- study needle-fit "$WORK/ok.csv" --set evals=20.5 --out "$WORK/nf"
+expect_bad "needle-stability with a file" "needle-stability" "unexpected argument" -- study needle-stability extra --out "$WORK/ns"
+expect_bad "needle-stability --set unknown" "--set k=1" "unknown key" -- study needle-stability --set k=1 --out "$WORK/ns"
+expect_bad "needle-stability --set bad duration" "--set duration_s=-1" -- study needle-stability --set duration_s=-1 --out "$WORK/ns"
+expect_bad "haptic-stability with a file" "haptic-stability" "unexpected argument" -- study haptic-stability extra --out "$WORK/st"
+expect_bad "bench voxels --duration bad" "--duration" -- bench voxels --duration 0
 expect_bad "describe with two names" "describe" -- describe rates rates
 expect_bad "list with an argument" "list" -- list extra
 
