@@ -1,6 +1,7 @@
-// tactus bench voxels: one voxel.needle controller stepping the scripted
-// insertion (in at 3 mm/s, 4 mm deep, back out) through blocks of 250 to
-// 100000 voxels, 0.5 mm apart, 5 mm deep, growing sideways. The step time of
+// tactus bench voxels: the needle-voxel scenario (voxel.needle with its
+// fitted tissue, haptics with scripted:insert: in at 3 mm/s, 4 mm deep, back
+// out) with blocks of 250 to 100000 voxels, 0.5 mm apart, 5 mm deep, growing
+// sideways. The step time of
 // each case is measured in lockstep; the haptic frequency a servo loop
 // running nothing else would reach is 1 / step time. Then the 20000-voxel
 // block runs in real time at 1 kHz beside the haptics controller.
@@ -23,23 +24,31 @@ enum { NCASES = sizeof cases / sizeof cases[0] };
 static const double paper_a[4] = {833.3, 714.3, 666.7, 66.7};
 static const double paper_b[4] = {3050.4, 1993.4, 1439.8, 1062.4};
 
-static tx_scenario* scene(const int c[3], double seconds) {
-  char text[2048], err[512];
-  snprintf(text, sizeof text,
-           "{\"name\":\"bench-voxels\",\"duration_s\":%g,\"controllers\":["
-           "{\"name\":\"needle\",\"type\":\"voxel.needle\",\"rate_hz\":1000,\"params\":{"
-           "\"count_x\":%d,\"count_y\":%d,\"count_z\":%d,\"block_x_m\":%g,\"block_y_m\":%g,\"block_z_m\":%g,"
-           "\"radius_m\":0.0002,\"skin_m\":0.0002,\"record\":false}},"
-           "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,"
-           "\"params\":{\"device\":\"scripted:insert\",\"force_model\":\"tool0.force_model\",\"record\":false}}]}",
-           seconds, c[0], c[1], c[2], c[0] * 0.5e-3, c[1] * 0.5e-3, c[2] * 0.5e-3);
-  tx_scenario* sc = tx_scenario_load_text("bench-voxels", text, strlen(text), NULL, err, sizeof err);
+// the shipped needle-voxel scenario (its fitted tissue, 18-gauge needle and
+// scripted:insert) with the block resized and the recordings off
+static tx_scenario* scene(const int c[3]) {
+  char path[4096], err[512], sets[8][64];
+  if (tx_scenario_locate("needle-voxel", path, sizeof path, err, sizeof err)) {
+    fprintf(stderr, "tactus: %s\n", err);
+    return NULL;
+  }
+  static const char* const axis = "xyz";
+  for (int a = 0; a < 3; a++) {
+    snprintf(sets[a], sizeof sets[a], "needle.count_%c=%d", axis[a], c[a]);
+    snprintf(sets[3 + a], sizeof sets[3 + a], "needle.block_%c_m=%g", axis[a], c[a] * 0.5e-3);
+  }
+  snprintf(sets[6], sizeof sets[6], "needle.record=false");
+  snprintf(sets[7], sizeof sets[7], "haptics.record=false");
+  const char* list[8];
+  for (int k = 0; k < 8; k++) list[k] = sets[k];
+  tx_load_options o = {.sets = list, .nsets = 8};
+  tx_scenario* sc = tx_scenario_load(path, &o, err, sizeof err);
   if (!sc) fprintf(stderr, "tactus: %s\n", err);
   return sc;
 }
 
 static int run(const int c[3], double seconds, bool lockstep, tx_controller_stats* st, tx_run_result* r) {
-  tx_scenario* sc = scene(c, seconds);
+  tx_scenario* sc = scene(c);
   if (!sc) return 1;
   tx_run_options o = {.duration_s = seconds, .lockstep = lockstep, .realtime_priority = !lockstep,
                       .pin_threads = !lockstep, .keep_cpus_awake = !lockstep};
@@ -57,8 +66,9 @@ static void target(const char* what, const char* measured, const char* limit, bo
 
 int tx_bench_voxels(double duration_s) {
   const double seconds = duration_s > 0 ? duration_s : 3.8;
-  printf("bench voxels: voxel.needle stepping the scripted insertion (3 mm/s, 4 mm deep, out again), %g s per case,\n"
-         "lockstep; one frame = needle contacts, collisions, springs, guard and the force model publish\n\n", seconds);
+  printf("bench voxels: the needle-voxel scenario (3 mm/s, 4 mm deep, out again) with the block resized, %g s per\n"
+         "case, lockstep; a step of voxel.needle = needle contacts, collisions, springs, guard, force model publish\n\n",
+         seconds);
   printf("  %8s %10s %10s %10s %12s %12s   %s\n", "voxels", "p50 us", "p99 us", "max us", "Hz at p50", "Hz at p99",
          "paper Table 1 Hz: (A) P3 1.4 GHz, (B) Core Duo 1.66 GHz");
   double logn[NCASES], logt[NCASES], hz99[NCASES];
@@ -102,8 +112,8 @@ int tx_bench_voxels(double duration_s) {
   char m[64];
   snprintf(m, sizeof m, "%.0f Hz at p99 (lockstep)", hz99[5]);
   target("20000 voxels: haptic frequency at p99", m, ">= 1000 Hz", hz99[5] >= 1000);
-  snprintf(m, sizeof m, "%.1f Hz, %.2f%% missed", rt.achieved_hz, missed);
-  target("20000 voxels at 1 kHz in real time", m, ">= 999 Hz", rt.achieved_hz >= 999 && missed <= 1);
+  snprintf(m, sizeof m, "%.2f%% missed (%.1f Hz)", missed, rt.achieved_hz);
+  target("20000 voxels at 1 kHz in real time, missed", m, "<= 1%", missed <= 1);
   snprintf(m, sizeof m, "b = %.3f (large: %.3f)", slope, slope_large);
   target("step cost about linear in voxels (b <= 1.15)", m, "b <= 1.15", slope <= 1.15 && slope_large <= 1.15);
   snprintf(m, sizeof m, "%.0f Hz at p50", exp(-logt[3]) * 1e6);
