@@ -14,11 +14,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-// a short insertion (to 2.8 mm and back) sampled at 1 kHz
+// a short insertion (to 2.6 mm and back) sampled at 1 kHz
 static void short_curve(tx_recording* r) {
   tx_insertion_model m = tx_insertion_model_default();
   tx_insertion_motion mo = tx_insertion_motion_default();
-  mo.max_depth = 2.8e-3, mo.wait = 0.05;
+  mo.max_depth = 2.6e-3, mo.wait = 0.02;
   assert_true(tx_insertion_generate(&m, &mo, r));
 }
 
@@ -66,11 +66,11 @@ static void fit_recovers_its_own_curve(void** state) {
   tx_needle_fit_params p = tx_needle_fit_params_default();
   double start = tx_needle_fit_simulate(&p, &r, NULL);
   tx_needle_fit_result res;
-  assert_true(tx_needle_fit(&r, &p, 40, NULL, NULL, &res));
+  assert_true(tx_needle_fit(&r, &p, 24, NULL, NULL, &res));
   print_message("  own curve: RMS %.4f N from %.4f N (peak %.3f N) in %d simulations\n", res.rms, start, res.peak,
                 res.evaluations);
-  assert_true(res.evaluations <= 40);
-  assert_true(res.rms < 0.6 * start);
+  assert_true(res.evaluations <= 24);
+  assert_true(res.rms < 0.7 * start);
   assert_true(fabs(tx_needle_fit_simulate(&p, &r, NULL) - res.rms) <= 1e-12); // p holds the best
   tx_recording_free(&r);
 }
