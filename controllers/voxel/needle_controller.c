@@ -6,7 +6,8 @@
 // at the tip, K = -k a a^T with k the springs the tip holds (capped). The
 // drawable components (spheres, damage, the needle's segment) go out every
 // draw_every steps. With a record folder, the run's haptic recording is
-// written in finish as needle-recording.csv (docs/needle.md).
+// written in finish as needle-recording.csv (docs/needle.md), with the
+// events contact, puncture, retract and exit.
 #include "needle_controller.h"
 
 #include "guard.h"
@@ -33,6 +34,7 @@ typedef struct needle_ctl {
   tx_result peak_result, cuts_result, energy_result;
   uint64_t faults_seen, overflow_seen;
   double peak;              // N, largest force magnitude
+  double inward;            // m/s, the needle's speed along its axis in the last frame (> 0: going in)
   tx_recording rec;         // rows kept for finish, when recording
   bool record;
   double record_max_s;
@@ -163,6 +165,7 @@ static void step(tx_ctx* ctx, void* self) {
   const double* pose = tx_read(ctx, c->pose).data;
   bool was_punctured = c->needle.punctured;
   int was_contacts = c->needle.contacts;
+  double was_in = c->inward; // m/s, the needle's speed along its axis over the last frame
   if (!tx_voxel_needle_step(&c->needle, &c->tissue, pose, pose + 3, dt)) {
     tx_warn(ctx, c->warn[W_RECOVERED]); // a non-finite pose: hold the last force model
     return;
@@ -174,11 +177,14 @@ static void step(tx_ctx* ctx, void* self) {
   c->peak = fmax(c->peak, sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]));
   publish_forces(ctx, c);
   if (++c->steps % (uint64_t)c->draw_every == 0) publish_drawables(ctx, c);
+  const tx_voxel_needle* nd = &c->needle;
+  c->inward = nd->vel[0] * nd->dir[0] + nd->vel[1] * nd->dir[1] + nd->vel[2] * nd->dir[2];
   if (c->rec.cap) {
     tx_needle_event ev = TX_EVENT_NONE;
-    if (!was_contacts && c->needle.contacts) ev = TX_EVENT_CONTACT;
-    else if (!was_punctured && c->needle.punctured) ev = TX_EVENT_PUNCTURE;
-    else if (was_contacts && !c->needle.contacts) ev = TX_EVENT_EXIT;
+    if (!was_contacts && nd->contacts) ev = TX_EVENT_CONTACT;
+    else if (!was_punctured && nd->punctured) ev = TX_EVENT_PUNCTURE;
+    else if (was_contacts && !nd->contacts) ev = TX_EVENT_EXIT;
+    else if (nd->contacts && was_in > 0 && c->inward < 0) ev = TX_EVENT_RETRACT;
     tx_recording_row row = {(double)tx_sim_ns(ctx) * 1e-9, tx_voxel_needle_depth(&c->needle, &c->tissue),
                             {f[0], f[1], f[2]}, ev};
     if (!tx_recording_push(&c->rec, &row)) tx_warn(ctx, c->warn[W_RECORD_FULL]);
