@@ -7,11 +7,14 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
+#include "controllers/voxel/recording.h"
 #include "scenarios/loader.h"
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #ifndef TX_SOURCE_DIR
 #error "TX_SOURCE_DIR must name the source tree"
@@ -90,6 +93,49 @@ static void shipped_scenario_inserts(void** state) {
   tx_scenario_free(s);
 }
 
+// the whole scripted insertion, recorded: OUT/needle-recording.csv reads back
+// strictly, and the shipped (fitted) tissue follows the reference curve it
+// was fitted to within 10% of its peak, row by row
+static void recording_follows_the_reference(void** state) {
+  (void)state;
+  char dir[] = "/tmp/tx-needle-XXXXXX", err[512], path[128];
+  assert_non_null(mkdtemp(dir));
+  tx_scenario* s = tx_scenario_load(TX_SOURCE_DIR "/scenarios/needle-voxel/needle-voxel.json", NULL, err, sizeof err);
+  if (!s) fail_msg("%s", err);
+  tx_run_options o = {.duration_s = 3.8, .lockstep = true, .record_dir = dir};
+  tx_run_result r;
+  assert_int_equal(tx_system_run(s->system, &o, &r, err, sizeof err), 0);
+  tx_scenario_free(s);
+  snprintf(path, sizeof path, "%s/needle-recording.csv", dir);
+  tx_recording got, ref;
+  if (!tx_recording_read(&got, path)) fail_msg("%s", tx_error());
+  assert_true(tx_recording_read(&ref, TX_SOURCE_DIR "/assets/needle/reference-insertion.csv"));
+  assert_int_equal(got.count, 3800);
+  int events[5] = {0};
+  for (size_t k = 0; k < got.count; k++) events[got.rows[k].event]++;
+  assert_true(events[TX_EVENT_CONTACT] >= 1 && events[TX_EVENT_PUNCTURE] >= 1 && events[TX_EVENT_RETRACT] == 1 &&
+              events[TX_EVENT_EXIT] >= 1);
+  double sum = 0, peak = 0;
+  size_t n = 0;
+  for (size_t k = 0; k < ref.count && k < got.count; k++) {
+    assert_true(fabs(got.rows[k].t - ref.rows[k].t) < 1e-9);
+    for (int a = 0; a < 3; a++) sum += pow(got.rows[k].f[a] - ref.rows[k].f[a], 2);
+    peak = fmax(peak, fabs(ref.rows[k].f[1]));
+    n++;
+  }
+  double rms = sqrt(sum / (double)n);
+  print_message("  needle-voxel against the reference: RMS %.4f N, %.1f%% of the %.3f N peak\n", rms, 100 * rms / peak, peak);
+  assert_true(rms <= 0.1 * peak);
+  tx_recording_free(&got);
+  tx_recording_free(&ref);
+  unlink(path);
+  snprintf(path, sizeof path, "%s/device0.bin", dir);
+  unlink(path);
+  snprintf(path, sizeof path, "%s/device0.csv", dir);
+  unlink(path);
+  assert_int_equal(rmdir(dir), 0);
+}
+
 static void bad_params_named(void** state) {
   (void)state;
   const struct { const char* params; const char* key; } cases[] = {
@@ -114,6 +160,8 @@ static void bad_params_named(void** state) {
 
 int main(void) {
   tx_register_builtin();
-  const struct CMUnitTest tests[] = {cmocka_unit_test(shipped_scenario_inserts), cmocka_unit_test(bad_params_named)};
+  const struct CMUnitTest tests[] = {cmocka_unit_test(shipped_scenario_inserts),
+                                     cmocka_unit_test(recording_follows_the_reference),
+                                     cmocka_unit_test(bad_params_named)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
