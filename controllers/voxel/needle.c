@@ -71,6 +71,8 @@ bool tx_voxel_needle_init(tx_voxel_needle* out, const tx_voxel_needle_def* def, 
   n.def = *def;
   n.radius = 0.5 * tx_needle_gauge_diameter(def->gauge);
   n.cut_scale = def->tip == TX_NEEDLE_BLUNT ? 1 : sin(def->tip_angle_deg * M_PI / 180);
+  memcpy(n.dir, def->axis, sizeof n.dir); // until a pose turns it
+  memcpy(n.side, def->side, sizeof n.side);
   size_t un = (size_t)t->n;
   n.cut = calloc(un, sizeof *n.cut);
   n.cut_list = calloc(un, sizeof *n.cut_list);
@@ -354,6 +356,17 @@ bool tx_voxel_needle_step(tx_voxel_needle* n, tx_voxel_tissue* t, const double t
   return true;
 }
 
+// distance from a point to the block's rest box, m (0 inside)
+static double box_distance(const tx_voxel_tissue* t, const double p[3]) {
+  double d2 = 0;
+  for (int k = 0; k < 3; k++) {
+    double lo = t->def.origin[k], hi = lo + t->def.block_size[k];
+    double e = p[k] < lo ? lo - p[k] : p[k] > hi ? p[k] - hi : 0;
+    d2 += e * e;
+  }
+  return sqrt(d2);
+}
+
 double tx_voxel_needle_depth(const tx_voxel_needle* n, const tx_voxel_tissue* t) {
   // where the axis line through the tip enters the rest box (slab method)
   const double* a = n->dir;
@@ -361,13 +374,13 @@ double tx_voxel_needle_depth(const tx_voxel_needle* n, const tx_voxel_tissue* t)
   for (int k = 0; k < 3; k++) {
     double b0 = t->def.origin[k], b1 = b0 + t->def.block_size[k];
     if (fabs(a[k]) < 1e-12) {
-      if (n->tip1[k] < b0 || n->tip1[k] > b1) return -INFINITY;
+      if (n->tip1[k] < b0 || n->tip1[k] > b1) return -box_distance(t, n->tip1);
       continue;
     }
     double ta = (b0 - n->tip1[k]) / a[k], tb = (b1 - n->tip1[k]) / a[k];
     if (ta > tb) { double x = ta; ta = tb; tb = x; }
     lo = fmax(lo, ta), hi = fmin(hi, tb);
   }
-  if (lo > hi) return -INFINITY;
+  if (lo > hi || !isfinite(lo)) return -box_distance(t, n->tip1);
   return -lo; // the entry lies lo along the axis from the tip
 }

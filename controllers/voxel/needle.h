@@ -119,7 +119,8 @@ void tx_voxel_needle_reset(tx_voxel_needle* n);
 bool tx_voxel_needle_step(tx_voxel_needle* n, tx_voxel_tissue* t, const double tip[3], const double quat[4], double dt);
 
 // depth of the tip below the surface where the needle's axis enters the
-// block's rest box, m (negative above it); -INFINITY when the axis misses the box
+// block's rest box, m (negative above it); when the axis misses the box,
+// minus the tip's distance to it
 double tx_voxel_needle_depth(const tx_voxel_needle* n, const tx_voxel_tissue* t);
 
 #endif

@@ -273,6 +273,42 @@ static void neighbours_against_all_pairs(void** state) {
   tx_voxel_tissue_fini(&t);
 }
 
+// each voxel searching again on its own as it moves: after every step of a
+// shaken block, every pair that could touch (closer than 2 radius plus a
+// quarter of the skin) is on both lists, and the lists stay symmetric
+static void moving_voxels_keep_their_neighbours(void** state) {
+  (void)state;
+  tx_voxel_tissue_def d = tx_voxel_tissue_def_default();
+  d.count[0] = d.count[1] = d.count[2] = 6;
+  d.radius = 0.2e-3;
+  tx_voxel_tissue t;
+  assert_true(tx_voxel_tissue_init(&t, &d));
+  uint64_t seed = 7;
+  for (int i = 0; i < t.n; i++) {
+    for (int a = 0; a < 3; a++) t.vel[3 * i + a] = uniform(&seed, -0.3, 0.3);
+    tx_voxel_tissue_wake(&t, i);
+  }
+  const int cap = d.max_neighbours;
+  const double close = 2 * d.radius + 0.25 * d.skin;
+  for (int s = 0; s < 40; s++) {
+    assert_true(tx_voxel_tissue_step(&t, 1e-3));
+    for (int i = 0; i < t.n; i++)
+      for (int j = i + 1; j < t.n; j++) {
+        double dd = 0;
+        for (int a = 0; a < 3; a++) dd += pow(t.pos[3 * j + a] - t.pos[3 * i + a], 2);
+        bool ij = false, ji = false;
+        for (int k = 0; k < t.nbr_count[i]; k++) ij |= t.nbr[i * cap + k] == j;
+        for (int k = 0; k < t.nbr_count[j]; k++) ji |= t.nbr[j * cap + k] == i;
+        assert_true(ij == ji);
+        if (dd < close * close) assert_true(ij);
+      }
+  }
+  assert_true(t.refreshes > (uint64_t)t.n); // the voxels did search again, each on its own
+  assert_int_equal(t.rebuilds, 1);          // and the whole block never had to
+  assert_int_equal(t.overflow, 0);
+  tx_voxel_tissue_fini(&t);
+}
+
 // one voxel displaced 0.1 mm: critically damped it creeps back without
 // crossing rest, on x0 (1 + w t) exp(-w t); underdamped it crosses; a
 // thousand times stiffer springs stay finite
@@ -503,6 +539,7 @@ int main(void) {
       cmocka_unit_test(time_of_impact_matches),
       cmocka_unit_test(vieta_against_brute_force),
       cmocka_unit_test(neighbours_against_all_pairs),
+      cmocka_unit_test(moving_voxels_keep_their_neighbours),
       cmocka_unit_test(spring_damper_returns),
       cmocka_unit_test(damage_recovers),
       cmocka_unit_test(bad_input_refused),
