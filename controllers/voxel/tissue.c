@@ -62,6 +62,14 @@ const char* tx_voxel_tissue_def_check(const tx_voxel_tissue_def* d) {
   if ((e = range("recovery_time", d->recovery_time, 0, true, 1e6, false, "s"))) return e;
   if ((e = range("skin", d->skin, 0, true, 1, false, "m"))) return e;
   if ((e = irange("max_neighbours", d->max_neighbours, 1, 200))) return e;
+  // voxels packed tighter than this have more neighbours within reach than a
+  // lattice point has within two spacings (26): the lists overflow and every
+  // search crawls through crowded cells
+  double spacing = INFINITY;
+  for (int a = 0; a < 3; a++) spacing = fmin(spacing, d->block_size[a] / d->count[a]);
+  if (2 * d->radius + d->skin > 2 * spacing)
+    return tx_check_fail("voxel tissue: 2 radius + skin = %g m, must be at most twice the lattice spacing, %g m",
+                         2 * d->radius + d->skin, spacing);
   return NULL;
 }
 

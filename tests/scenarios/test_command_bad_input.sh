@@ -172,6 +172,7 @@ expect_bad "needle gauge out of range" "needle.gauge" -- run needle-voxel --lock
 expect_bad "needle radius negative" "needle.radius_m" -- run needle-voxel --lockstep --set needle.radius_m=-1
 expect_bad "needle friction not a number" "needle.friction" -- run needle-voxel --lockstep --set needle.friction=lots
 expect_bad "needle unknown key" "needle.bogus" -- run needle-voxel --lockstep --set needle.bogus=1
+expect_bad "needle voxels packed too tight" "needle-voxel.json" "lattice spacing" -- run needle-voxel --lockstep --set needle.count_x=100
 expect_bad "needle-fit without a file" "needle-fit" "FILE" -- study needle-fit --out "$WORK/nf"
 expect_bad "needle-fit missing file" "$WORK/none.csv" "No such file" -- study needle-fit "$WORK/none.csv" --out "$WORK/nf"
 printf 't_s,depth_m,fx_n,fy_n,fz_n,event\n0,0,0,0.1,0,\n0.001,0,0,x,0,\n' >"$WORK/bad_value.csv"

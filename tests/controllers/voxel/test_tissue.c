@@ -446,6 +446,10 @@ static void bad_input_refused(void** state) {
   d = good;
   d.elasticity = 1.01;
   assert_non_null(strstr(tx_voxel_tissue_def_check(&d), "elasticity"));
+  // packed so tight that the lists would overflow: refused
+  d = good;
+  d.count[0] = 100;
+  assert_non_null(strstr(tx_voxel_tissue_def_check(&d), "twice the lattice spacing"));
 
   // steps of no length, negative, NaN or Inf: refused, nothing moves
   assert_true(tx_voxel_tissue_init(&t, &good));
