@@ -4,6 +4,9 @@
 
 #include "../controllers/collision/wall.h"
 #include "../controllers/haptics/haptics_controller.h"
+#include "../views/graphics/graphics_view.h"
+
+#include <tactus/config.h>
 
 #include <pthread.h>
 
@@ -11,6 +14,9 @@ static void register_all(void) {
   tx_register_controller(&tx_rates_worker);
   tx_register_controller(&tx_collision_wall);
   tx_register_controller(&tx_haptics_controller);
+#if TX_WITH_OSMESA || TX_WITH_GLFW
+  tx_register_controller(&tx_graphics_view);
+#endif
 }
 
 void tx_register_builtin(void) {
