@@ -259,24 +259,27 @@ static void draw_overlay(view* v, render_state* rs, int w, int h) {
   char line[128];
   int y = 8, lines = 0;
   for (int i = 0; i < v->def.nitems; i++) lines += v->def.items[i].kind != TX_DRAW_PLANE;
-  tx_overlay_rect(rs->overlay, 4, 4, 330, 14 * (lines + 2) + 8, shade);
+  tx_overlay_rect(rs->overlay, 4, 4, 330, 25 * lines + 24, shade);
   snprintf(line, sizeof line, "VIEW %s  T %.2f S", tx_stereo_mode_name(v->stereo), (double)v->frame_sim_ns * 1e-9);
   tx_overlay_text(rs->overlay, 10, y, 2, line, white);
-  y += 14;
+  y += 16;
   for (int i = 0; i < v->def.nitems; i++) {
     const tx_draw_item* it = &v->def.items[i];
     if (it->kind == TX_DRAW_PLANE) continue;
     snprintf(line, sizeof line, "%s %.0f HZ", it->name, rs->rates[i][0]);
+    double mag = -1;
     if (it->kind == TX_DRAW_TOOL && it->show_force && v->scene.items[i].rows[1]) {
       const double* f = v->scene.items[i].data[1];
-      double mag = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+      mag = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
       size_t len = strlen(line);
       snprintf(line + len, sizeof line - len, "  F %.2f N", mag);
-      tx_overlay_rect(rs->overlay, 10, y + 14, (int)fmin(300, 60 * mag), 6, bar);
-      y += 8;
     }
     tx_overlay_text(rs->overlay, 10, y, 2, line, white);
-    y += 14;
+    y += 16;
+    if (mag >= 0) { // the force as a bar, 60 px per newton
+      tx_overlay_rect(rs->overlay, 10, y, (int)fmin(310, 60 * mag), 5, bar);
+      y += 9;
+    }
   }
   tx_overlay_flush(rs->overlay, w, h);
 }
@@ -364,21 +367,23 @@ static void finish_frames(view* v, render_state* rs) {
   char path[4400], err[600];
   if (v->rendered == 0) return;
 #if TX_WITH_GLFW
-  if (rs->win) { // a screenshot of what the window showed last
+  if (rs->win) { // a screenshot of the last frame: drawn once more and read from the back buffer
     const tx_gl* gl = tx_renderer_gl(rs->r);
     int fw, fh;
     tx_window_framebuffer(rs->win, &fw, &fh);
+    int w = v->stereo == TX_STEREO_SBS ? fw / 2 : fw, h = v->stereo == TX_STEREO_TB ? fh / 2 : fh;
     uint8_t* px = malloc((size_t)fw * fh * 4);
-    if (px) {
-      if (v->stereo == TX_STEREO_QUAD) gl->ReadBuffer(GL_FRONT_LEFT);
-      else gl->ReadBuffer(GL_FRONT);
+    if (px && w > 0 && h > 0) {
+      tx_stereo_draw(rs->r, &v->def, &v->def.camera, v->stereo, 0, w, h);
+      draw_overlay(v, rs, fw, fh);
+      gl->ReadBuffer(v->stereo == TX_STEREO_QUAD ? GL_BACK_LEFT : GL_BACK);
       gl->PixelStorei(GL_PACK_ALIGNMENT, 1);
       gl->ReadPixels(0, 0, fw, fh, GL_RGBA, GL_UNSIGNED_BYTE, px);
       snprintf(path, sizeof path, "%s/window.png", v->frames_dir);
       if (tx_png_write(path, px, fw, fh, true, err, sizeof err)) fprintf(stderr, "tactus: view: %s\n", err);
       else v->written++;
-      free(px);
     }
+    free(px);
     return;
   }
 #endif

@@ -106,7 +106,7 @@ static int read_camera(const where* w, const json_t* cam, tx_view_def* d) {
   const json_t* v;
   if ((v = json_object_get(cam, "eye")) && numbers(w, "camera.eye", v, 3, -1e4, 1e4, c->eye)) return -1;
   if ((v = json_object_get(cam, "target")) && numbers(w, "camera.target", v, 3, -1e4, 1e4, c->target)) return -1;
-  if ((v = json_object_get(cam, "up")) && numbers(w, "camera.up", v, 3, -1, 1, c->up)) return -1;
+  if ((v = json_object_get(cam, "up")) && numbers(w, "camera.up", v, 3, -1e4, 1e4, c->up)) return -1;
   double deg = c->fov_y * 180 / M_PI;
   if ((v = json_object_get(cam, "fov_deg")) && number(w, "camera.fov_deg", v, 1, 170, false, &deg)) return -1;
   c->fov_y = deg * M_PI / 180;
@@ -147,7 +147,7 @@ static int read_item(const where* w, size_t i, const json_t* e, tx_draw_item* it
       snprintf(sub, sizeof sub, "%s.point", key);
       if ((q = json_object_get(v, "point")) && numbers(w, sub, q, 3, -1e4, 1e4, p)) return -1;
       snprintf(sub, sizeof sub, "%s.normal", key);
-      if ((q = json_object_get(v, "normal")) && numbers(w, sub, q, 3, -1, 1, nrm)) return -1;
+      if ((q = json_object_get(v, "normal")) && numbers(w, sub, q, 3, -1e4, 1e4, nrm)) return -1;
       double l = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
       if (!(l > 1e-6)) return bad(w, sub, "expected a non-zero direction");
       snprintf(sub, sizeof sub, "%s.size_m", key);
@@ -250,7 +250,7 @@ int tx_view_def_from_json(const json_t* view, tx_view_def* d, char* key, size_t 
     for (int i = 0; i < 3; i++) d->background[i] = (float)c[i];
   }
   if ((v = json_object_get(view, "light"))) {
-    if (numbers(&w, "light", v, 3, -1, 1, c)) return -1;
+    if (numbers(&w, "light", v, 3, -1e4, 1e4, c)) return -1;
     double l = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
     if (!(l > 1e-6)) return bad(&w, "light", "expected a non-zero direction");
     for (int i = 0; i < 3; i++) d->light_dir[i] = (float)(c[i] / l);
