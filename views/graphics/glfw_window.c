@@ -99,13 +99,12 @@ tx_window* tx_window_open(int width, int height, bool want_quad, char* err, size
   glfwSetErrorCallback(on_error);
   if (!glfwInit()) return snprintf(err, n, "no window: GLFW: %s", glfw_error), NULL;
   tx_window* t = calloc(1, sizeof *t);
-  if (!t) return glfwTerminate(), snprintf(err, n, "out of memory"), NULL;
+  if (!t) return snprintf(err, n, "out of memory"), NULL;
   // quad buffers where the driver has them; otherwise the chosen mode in a plain window
   if (want_quad && (t->w = make(width, height, true))) t->quad = true;
   else t->w = make(width, height, false);
   if (!t->w) {
     free(t);
-    glfwTerminate();
     return snprintf(err, n, "no window: GLFW: %s", glfw_error), NULL;
   }
   glfwMakeContextCurrent(t->w);
@@ -120,10 +119,11 @@ tx_window* tx_window_open(int width, int height, bool want_quad, char* err, size
   return t;
 }
 
+// GLFW stays initialised for the rest of the process: terminating it unloads
+// the GL driver, whose process-wide state then can no longer be told apart
 void tx_window_close(tx_window* t) {
   if (!t) return;
   glfwDestroyWindow(t->w);
-  glfwTerminate();
   free(t);
 }
 

@@ -307,10 +307,13 @@ static int setup_target(view* v, render_state* rs, char* err, size_t n) {
   return 0;
 }
 
+// the overlay uses the renderer's GL entry points, and both need their context
 static void teardown(render_state* rs) {
-  tx_renderer_destroy(rs->r);
 #if TX_WITH_GLFW
   tx_overlay_destroy(rs->overlay);
+#endif
+  tx_renderer_destroy(rs->r);
+#if TX_WITH_GLFW
   if (rs->win) tx_window_close(rs->win);
 #endif
 #if TX_WITH_OSMESA
