@@ -169,12 +169,40 @@ static void draw_errors_name_the_view(void** state) {
   assert_non_null(strstr(err, "stereo_mode"));
 }
 
+// in real time the step never waits: each tick gives a frame or counts a dropped one
+static void real_time_hand_over(void** state) {
+  (void)state;
+  char dir[] = "/tmp/tx_view_XXXXXX", err[1024], text[2048], path[4200];
+  assert_non_null(mkdtemp(dir));
+  snprintf(text, sizeof text, wall_scene, view_json);
+  tx_load_options o = {.view = "png", .stereo = "sbs"};
+  tx_scenario* sc = tx_scenario_load_text("wall-view", text, strlen(text), &o, err, sizeof err);
+  if (!sc) fail_msg("%s", err);
+  tx_run_options ro = {.duration_s = 1.0, .out_dir = dir};
+  tx_run_result r;
+  if (tx_system_run(sc->system, &ro, &r, err, sizeof err)) fail_msg("%s", err);
+  for (int i = 0; i < tx_system_count(sc->system); i++)
+    if (strcmp(tx_system_name(sc->system, i), "view") == 0) {
+      tx_controller_stats st = tx_system_stats(sc->system, i);
+      double frames = result(sc->system, "view.frames"), dropped = result(sc->system, "view.frames_dropped");
+      assert_true(frames >= 1);
+      assert_true(frames + dropped == (double)st.steps);
+    }
+  snprintf(path, sizeof path, "%s/frames/contact_sheet.png", dir);
+  assert_int_equal(access(path, R_OK), 0);
+  tx_scenario_free(sc);
+  char cmd[4300];
+  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+  assert_int_equal(system(cmd), 0);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(png_frames_every_nth_and_last),
       cmocka_unit_test(stereo_files_and_sizes),
       cmocka_unit_test(automatic_draw_list),
       cmocka_unit_test(draw_errors_name_the_view),
+      cmocka_unit_test(real_time_hand_over),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
