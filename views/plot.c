@@ -6,6 +6,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 // a palette that reads on white: blue, orange, green, red, purple, brown, pink, grey, olive, cyan, ...
 static const int palette[16][3] = {{255, 255, 255}, {31, 119, 180}, {255, 127, 14}, {44, 160, 44},  {214, 39, 40},
@@ -36,13 +37,18 @@ static void range(const tx_plot* p, bool x, bool log_axis, double* lo, double* h
 }
 
 // one panel in the current subpage: frame, grid, labels, lines, legend at the right
-static void panel(const tx_plot* p) {
+static void panel(const tx_plot* p, double label_gap) {
   double x0, x1, y0, y1;
   range(p, true, p->log_x, &x0, &x1);
   range(p, false, p->log_y, &y0, &y1);
   pladv(0);
   plschr(0, 0.8);
-  plvpor(0.16, 0.74, 0.15, 0.88);
+  // the legend goes under the x label: all series in one row when their labels are short, else two columns
+  int nlabels = p->nseries < TX_PLOT_SERIES_MAX ? p->nseries : TX_PLOT_SERIES_MAX, chars = 0;
+  for (int s = 0; s < nlabels; s++) chars += (int)strlen(p->series[s].label) + 6;
+  int ncol = chars <= 60 ? nlabels : 2, nrow = nlabels ? (nlabels + ncol - 1) / ncol : 0;
+  double bottom = 0.12 + label_gap * 0.5 + 0.05 * nrow, top = label_gap > 0.12 ? 0.86 : 0.90;
+  plvpor(0.17, 0.95, bottom, top);
   plwind(x0, x1, y0, y1);
   // a light grid under everything, then the frame and the numbers in black
   plcol0(14);
@@ -93,8 +99,10 @@ static void panel(const tx_plot* p) {
   plwidth(1);
   PLFLT lw, lh;
   plcol0(15);
-  pllegend(&lw, &lh, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, PL_POSITION_RIGHT | PL_POSITION_OUTSIDE,
-           0.02, 0.0, 0.06, 0, 15, 1, 0, 0, nleg, opts, 0.6, 0.8, 1.4, 0, colors, texts, NULL, NULL, NULL, NULL,
+  if (!nleg) return;
+  pllegend(&lw, &lh, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, PL_POSITION_BOTTOM | PL_POSITION_OUTSIDE,
+           0.0, label_gap / (top - bottom), 0.06, 0, 15, 1, nrow, ncol, nleg, opts, 0.6, 0.8, 1.4, 0, colors, texts, NULL, NULL,
+           NULL, NULL,
            colors, styles, widths, colors, scales, symbol_numbers, symbols);
 }
 
@@ -114,7 +122,8 @@ static int render(const char* path, const tx_plot* panels, int count, int column
   plscol0(14, 215, 215, 215); // the grid
   plssub(cols, rows);
   plinit();
-  for (int i = 0; i < count; i++) panel(&panels[i]);
+  // the x label sits a fixed number of character heights under the axis: more of a small panel
+  for (int i = 0; i < count; i++) panel(&panels[i], count > 1 ? 0.17 : 0.11);
   plend();
   return 0;
 }
