@@ -31,6 +31,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #define FRAME_TIMES 65536 // frame times kept for the percentiles (a ring)
@@ -65,7 +66,8 @@ typedef struct view {
   uint64_t timed;                       // frames in frame_ms (all but the first)
   double first_frame_ms;                // ms, the first frame (shader compilation included)
   float* frame_ms;                      // (FRAME_TIMES) render + read-back time of a frame, ms
-  tx_result r_frames, r_dropped, r_p50, r_p99, r_threads, r_written, r_first;
+  float* frame_cpu_ms;                  // (FRAME_TIMES) CPU time of the rendering thread for it, ms
+  tx_result r_frames, r_dropped, r_p50, r_p99, r_threads, r_written, r_first, r_cpu50;
   tx_warning w_write, w_skipped;
   uint64_t skipped_reported;
   tx_ctx* ctx;                          // the step's context, for warnings from the renderer
@@ -141,6 +143,7 @@ static int configure(tx_setup* s, void** self) {
   v->r_p99 = tx_setup_result(s, "frame_ms_p99");
   v->r_threads = tx_setup_result(s, "render_threads");
   v->r_first = tx_setup_result(s, "first_frame_ms");
+  v->r_cpu50 = tx_setup_result(s, "frame_cpu_ms_p50");
   v->w_write = tx_setup_warning(s, "frame_not_written");
   v->w_skipped = tx_setup_warning(s, "rows_not_drawn");
   return 0;
@@ -167,9 +170,19 @@ static void auto_camera(view* v, const tx_renderer* r) {
 }
 
 // the first frame compiles shaders and fills llvmpipe's caches: it is reported apart
-static void record_time(view* v, double ms) {
-  if (v->rendered++ == 0) v->first_frame_ms = ms;
-  else v->frame_ms[v->timed++ % FRAME_TIMES] = (float)ms;
+static void record_time(view* v, double ms, double cpu_ms) {
+  if (v->rendered++ == 0) {
+    v->first_frame_ms = ms;
+    return;
+  }
+  v->frame_cpu_ms[v->timed % FRAME_TIMES] = (float)cpu_ms;
+  v->frame_ms[v->timed++ % FRAME_TIMES] = (float)ms;
+}
+
+static int64_t thread_cpu_ns(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return (int64_t)t.tv_sec * 1000000000 + t.tv_nsec;
 }
 
 static int cmp_float(const void* a, const void* b) {
@@ -177,12 +190,12 @@ static int cmp_float(const void* a, const void* b) {
   return (x > y) - (x < y);
 }
 
-static double percentile(const view* v, double p) {
+static double percentile(const view* v, const float* samples, double p) {
   uint64_t n = v->timed < FRAME_TIMES ? v->timed : FRAME_TIMES;
   if (!n) return NAN;
   float* copy = malloc(n * sizeof *copy);
   if (!copy) return NAN;
-  memcpy(copy, v->frame_ms, n * sizeof *copy);
+  memcpy(copy, samples, n * sizeof *copy);
   qsort(copy, n, sizeof *copy, cmp_float);
   double x = copy[(size_t)fmin((double)n - 1, floor(p * (double)n))];
   free(copy);
@@ -325,7 +338,7 @@ static void teardown(render_state* rs) {
 
 // one frame: draw every pass, read back, and write it when its turn comes
 static void render_frame(view* v, render_state* rs) {
-  int64_t t0 = tx_mono_ns();
+  int64_t t0 = tx_mono_ns(), c0 = thread_cpu_ns();
   tx_renderer_upload(rs->r, &v->scene);
   if (v->def.auto_camera) auto_camera(v, rs->r);
   const tx_gl* gl = tx_renderer_gl(rs->r);
@@ -353,12 +366,12 @@ static void render_frame(view* v, render_state* rs) {
   if (rs->win) {
     draw_overlay(v, rs, w * (v->stereo == TX_STEREO_SBS ? 2 : 1), h * (v->stereo == TX_STEREO_TB ? 2 : 1));
     if (!tx_window_present(rs->win)) kill(getpid(), SIGINT); // closing the window ends the run, report and all
-    record_time(v, (double)(tx_mono_ns() - t0) * 1e-6);
+    record_time(v, (double)(tx_mono_ns() - t0) * 1e-6, (double)(thread_cpu_ns() - c0) * 1e-6);
     return;
   }
 #endif
   gl->Finish();
-  record_time(v, (double)(tx_mono_ns() - t0) * 1e-6);
+  record_time(v, (double)(tx_mono_ns() - t0) * 1e-6, (double)(thread_cpu_ns() - c0) * 1e-6);
   if (index % (uint64_t)v->def.frame_every == 0) {
     write_frame(v, rs, index);
     tx_contact_sheet_add(&rs->sheet, v->stereo == TX_STEREO_LR ? rs->left : target_pixels(rs), rs->img_w, rs->img_h, false);
@@ -460,7 +473,9 @@ static int init(tx_ctx* c, void* self) {
     fprintf(stderr, "tactus: view: %s: %s\n", v->frames_dir, strerror(errno));
     return -1;
   }
-  if (!(v->frame_ms = calloc(FRAME_TIMES, sizeof *v->frame_ms))) return -1;
+  if (!(v->frame_ms = calloc(FRAME_TIMES, sizeof *v->frame_ms)) ||
+      !(v->frame_cpu_ms = calloc(FRAME_TIMES, sizeof *v->frame_cpu_ms)))
+    return -1;
   sem_init(&v->go, 0, 0);
   sem_init(&v->idle, 0, 1);
   sem_init(&v->started, 0, 0);
@@ -520,8 +535,9 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, v->r_frames, (double)v->rendered);
   tx_set_result(c, v->r_written, (double)v->written);
   tx_set_result(c, v->r_dropped, (double)v->dropped);
-  tx_set_result(c, v->r_p50, percentile(v, 0.5));
-  tx_set_result(c, v->r_p99, percentile(v, 0.99));
+  tx_set_result(c, v->r_p50, percentile(v, v->frame_ms, 0.5));
+  tx_set_result(c, v->r_p99, percentile(v, v->frame_ms, 0.99));
+  tx_set_result(c, v->r_cpu50, percentile(v, v->frame_cpu_ms, 0.5));
   tx_set_result(c, v->r_threads, v->target == TARGET_PNG ? v->render_threads : NAN);
   tx_set_result(c, v->r_first, v->rendered ? v->first_frame_ms : NAN);
 }
@@ -536,6 +552,7 @@ static void fini(void* self) {
     sem_destroy(&v->started);
   }
   free(v->frame_ms);
+  free(v->frame_cpu_ms);
   free(v);
 }
 

@@ -6,8 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define SPHERE_SLICES 48
-#define SPHERE_STACKS 32
+#define SPHERE_SLICES 32
+#define SPHERE_STACKS 20
 #define CYL_SIDES 16
 #define SKIN_TEX 512
 
