@@ -131,6 +131,7 @@ bool tx_window_is_quad(const tx_window* t) { return t->quad; }
 tx_gl_proc tx_window_proc(const char* name) { return (tx_gl_proc)glfwGetProcAddress(name); }
 void tx_window_framebuffer(const tx_window* t, int* width, int* height) { glfwGetFramebufferSize(t->w, width, height); }
 void tx_window_set_title(tx_window* t, const char* title) { glfwSetWindowTitle(t->w, title); }
+void tx_window_resize(tx_window* t, int width, int height) { glfwSetWindowSize(t->w, width, height); }
 
 bool tx_window_present(tx_window* t) {
   glfwSwapBuffers(t->w);

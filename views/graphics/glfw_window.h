@@ -24,6 +24,7 @@ bool tx_window_is_quad(const tx_window* w);
 tx_gl_proc tx_window_proc(const char* name);
 void tx_window_framebuffer(const tx_window* w, int* width, int* height);
 void tx_window_set_title(tx_window* w, const char* title);
+void tx_window_resize(tx_window* w, int width, int height);
 // show the frame and handle input; false once the window asked to close
 bool tx_window_present(tx_window* w);
 

@@ -57,6 +57,7 @@ typedef struct view {
   sem_t started;                        // the renderer finished its setup
   pthread_t thread;
   bool thread_running;
+  bool sems_ready;                      // the semaphores were made (init got that far)
   atomic_bool quit;
   bool setup_failed;
   char setup_error[512];
@@ -308,7 +309,11 @@ static int setup_target(view* v, render_state* rs, char* err, size_t n) {
   } else {
 #if TX_WITH_GLFW
     if (!(rs->win = tx_window_open(rs->img_w, rs->img_h, v->stereo != TX_STEREO_MONO, err, n))) return -1;
-    if (tx_window_is_quad(rs->win)) v->stereo = TX_STEREO_QUAD, tx_stereo_image_size(v->stereo, v->def.width, v->def.height, &rs->img_w, &rs->img_h);
+    if (tx_window_is_quad(rs->win)) { // each eye has the whole window
+      v->stereo = TX_STEREO_QUAD;
+      tx_stereo_image_size(v->stereo, v->def.width, v->def.height, &rs->img_w, &rs->img_h);
+      tx_window_resize(rs->win, rs->img_w, rs->img_h);
+    }
     if (!(rs->r = tx_renderer_create(tx_window_proc, err, n))) return -1;
     rs->overlay = tx_overlay_create(tx_renderer_gl(rs->r));
 #endif
@@ -479,6 +484,7 @@ static int init(tx_ctx* c, void* self) {
   sem_init(&v->go, 0, 0);
   sem_init(&v->idle, 0, 1);
   sem_init(&v->started, 0, 0);
+  v->sems_ready = true;
   if (start_thread(v) != 0) {
     fprintf(stderr, "tactus: view: cannot start the rendering thread\n");
     return -1;
@@ -546,7 +552,7 @@ static void fini(void* self) {
   view* v = self;
   if (!v) return;
   stop_thread(v);
-  if (v->frame_ms) {
+  if (v->sems_ready) {
     sem_destroy(&v->go);
     sem_destroy(&v->idle);
     sem_destroy(&v->started);
