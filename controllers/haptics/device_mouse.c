@@ -25,26 +25,26 @@ static double value(uint64_t b) {
 }
 
 void tx_mouse_input_set(const double pos[3], uint32_t buttons) {
-  uint64_t s = atomic_load_explicit(&seq, memory_order_relaxed);
-  atomic_store_explicit(&seq, s + 1, memory_order_relaxed);
-  atomic_thread_fence(memory_order_release);
+  // sequentially consistent throughout: a reader that sees any of these
+  // stores sees the odd count before it, so it retries
+  uint64_t s = atomic_load(&seq);
+  atomic_store(&seq, s + 1);
   for (int i = 0; i < 3; i++) {
     double p = pos[i] < -TX_MOUSE_WORKSPACE_M ? -TX_MOUSE_WORKSPACE_M : pos[i] > TX_MOUSE_WORKSPACE_M ? TX_MOUSE_WORKSPACE_M : pos[i];
-    atomic_store_explicit(&pos_bits[i], bits(p == p ? p : 0), memory_order_relaxed);
+    atomic_store(&pos_bits[i], bits(p == p ? p : 0));
   }
-  atomic_store_explicit(&buttons_bits, buttons, memory_order_relaxed);
-  atomic_store_explicit(&seq, s + 2, memory_order_release);
+  atomic_store(&buttons_bits, buttons);
+  atomic_store(&seq, s + 2);
   atomic_store(&have_input, true);
 }
 
 bool tx_mouse_input_get(double pos[3], uint32_t* buttons) {
   if (!atomic_load(&have_input)) return false;
   for (;;) {
-    uint64_t s0 = atomic_load_explicit(&seq, memory_order_acquire);
-    for (int i = 0; i < 3; i++) pos[i] = value(atomic_load_explicit(&pos_bits[i], memory_order_relaxed));
-    *buttons = (uint32_t)atomic_load_explicit(&buttons_bits, memory_order_relaxed);
-    atomic_thread_fence(memory_order_acquire);
-    if (!(s0 & 1) && atomic_load_explicit(&seq, memory_order_relaxed) == s0) return true;
+    uint64_t s0 = atomic_load(&seq);
+    for (int i = 0; i < 3; i++) pos[i] = value(atomic_load(&pos_bits[i]));
+    *buttons = (uint32_t)atomic_load(&buttons_bits);
+    if (!(s0 & 1) && atomic_load(&seq) == s0) return true;
   }
 }
 

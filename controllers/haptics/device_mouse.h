@@ -1,8 +1,8 @@
 // Internal: the input channel of the `mouse` device. A window's input thread
 // sets where the mouse and keyboard put the tool; the haptics thread reads it
 // through the `mouse` device backend (device.h) at its own rate. A sequence
-// lock over atomics: the writer never waits, a reader retries only while a
-// write is under way. One channel per process (one window).
+// lock over sequentially consistent atomics: the writer never waits, a reader
+// retries only while a write is under way. One channel per process (one window).
 #ifndef TX_CONTROLLERS_HAPTICS_DEVICE_MOUSE_H
 #define TX_CONTROLLERS_HAPTICS_DEVICE_MOUSE_H
 
