@@ -164,7 +164,8 @@ static void auto_camera(view* v, const tx_renderer* r) {
   double dist = 1.15 * radius / sin(0.5 * c->fov_y), dir[3] = {0, 0.6, 1}, len = sqrt(1.36);
   for (int i = 0; i < 3; i++) c->eye[i] = c->target[i] + dist * dir[i] / len;
   c->up[0] = 0, c->up[1] = 1, c->up[2] = 0;
-  c->convergence = dist;
+  if (!v->def.convergence_given) c->convergence = dist;
+  if (!v->def.interaxial_given) c->interaxial = c->convergence / 30;
   c->near_m = fmax(dist - 4 * radius, dist * 0.02);
   c->far_m = dist + 6 * radius;
   v->def.auto_camera = false;

@@ -6,7 +6,7 @@
 
 tx_camera tx_camera_default(void) {
   return (tx_camera){.eye = {0, 0.2, 0.35}, .target = {0, 0, 0}, .up = {0, 1, 0}, .fov_y = 40 * M_PI / 180,
-                     .near_m = 0.01, .far_m = 10, .interaxial = 0.065, .convergence = 0.403};
+                     .near_m = 0.01, .far_m = 10, .interaxial = 0.403 / 30, .convergence = 0.403};
 }
 
 static void sub(const double a[3], const double b[3], double o[3]) {

@@ -30,7 +30,7 @@ typedef struct tx_camera {
   double convergence; // m, distance from the eye to the zero-parallax plane, > 0
 } tx_camera;
 
-// eye at (0, 0.2, 0.35) m looking at the origin, 40 degrees, 65 mm apart, converging at the target
+// eye at (0, 0.2, 0.35) m looking at the origin, 40 degrees, converging at the target, eyes 1/30 of that apart
 tx_camera tx_camera_default(void);
 // NULL, or what is wrong with the camera
 const char* tx_camera_check(const tx_camera* c);

@@ -240,9 +240,11 @@ int tx_view_def_from_json(const json_t* view, tx_view_def* d, char* key, size_t 
     const json_t* q;
     if ((q = json_object_get(v, "interaxial_m")) && number(&w, "stereo.interaxial_m", q, 0, 1, false, &d->camera.interaxial))
       return -1;
+    d->interaxial_given = q != NULL;
     if ((q = json_object_get(v, "convergence_m")) &&
         number(&w, "stereo.convergence_m", q, 0, 1e4, true, &d->camera.convergence))
       return -1;
+    d->convergence_given = q != NULL;
   }
   double c[3];
   if ((v = json_object_get(view, "background"))) {
@@ -255,6 +257,8 @@ int tx_view_def_from_json(const json_t* view, tx_view_def* d, char* key, size_t 
     if (!(l > 1e-6)) return bad(&w, "light", "expected a non-zero direction");
     for (int i = 0; i < 3; i++) d->light_dir[i] = (float)(c[i] / l);
   }
+  // the 1/30 rule of stereography: comfortable depth for a scene at the convergence distance
+  if (!d->interaxial_given) d->camera.interaxial = d->camera.convergence / 30;
   if ((v = json_object_get(view, "draw"))) {
     if (!json_is_array(v) || json_array_size(v) == 0 || json_array_size(v) > TX_DRAW_MAX)
       return bad(&w, "draw", "expected an array of 1 to %d entries", TX_DRAW_MAX);

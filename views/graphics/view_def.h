@@ -44,6 +44,8 @@ typedef struct tx_draw_item {
 typedef struct tx_view_def {
   tx_camera camera;       // cyclopean camera and the stereo geometry
   bool auto_camera;       // no "camera" given: frame the first snapshot's bounding box
+  bool interaxial_given;  // stereo.interaxial_m was given; else it is the convergence distance / 30
+  bool convergence_given; // stereo.convergence_m was given; else the eye-target distance
   int width, height;      // px, one eye's image
   int frame_every;        // png: write every Nth rendered frame (and the last)
   float background[3];    // 1, linear RGB

@@ -63,6 +63,8 @@ static void full_view(void** state) {
   // the camera's own target distance is the convergence when stereo does not say
   assert_int_equal(parse("{\"camera\": {\"eye\": [0, 0.3, 0.4], \"target\": [0, 0, 0]}}", &d, key, msg), 0);
   assert_true(fabs(d.camera.convergence - 0.5) < 1e-12);
+  assert_true(fabs(d.camera.interaxial - 0.5 / 30) < 1e-12); // the 1/30 rule unless stereo.interaxial_m says
+  assert_false(d.interaxial_given);
 }
 
 static void expect_error(const char* text, const char* want_key, const char* want_msg) {
