@@ -46,7 +46,7 @@ struct tx_renderer {
 // squarings, which llvmpipe runs far faster than pow()
 static const char* const fs_src =
     "#version 330 core\n"
-    "in vec3 v_pos; in vec3 v_normal; in vec3 v_colour; in vec2 v_uv;\n"
+    "in vec3 v_normal; flat in vec3 v_colour; in vec2 v_uv;\n"
     "uniform vec3 u_light; uniform vec3 u_view_dir; uniform vec3 u_half; uniform int u_textured;\n"
     "uniform sampler2D u_tex; uniform vec4 u_lighting;\n"
     "out vec4 frag;\n"
@@ -65,9 +65,9 @@ static const char* const mesh_vs =
     "#version 330 core\n"
     "layout(location = 0) in vec3 a_pos; layout(location = 1) in vec3 a_normal; layout(location = 2) in vec2 a_uv;\n"
     "uniform mat4 u_proj; uniform mat4 u_view; uniform vec3 u_colour;\n"
-    "out vec3 v_pos; out vec3 v_normal; out vec3 v_colour; out vec2 v_uv;\n"
+    "out vec3 v_normal; flat out vec3 v_colour; out vec2 v_uv;\n"
     "void main() {\n"
-    "  v_pos = a_pos; v_normal = a_normal; v_colour = u_colour; v_uv = a_uv;\n"
+    "  v_normal = a_normal; v_colour = u_colour; v_uv = a_uv;\n"
     "  gl_Position = u_proj * u_view * vec4(a_pos, 1.0);\n"
     "}\n";
 
@@ -75,10 +75,10 @@ static const char* const sphere_vs =
     "#version 330 core\n"
     "layout(location = 0) in vec3 a_pos; layout(location = 1) in vec4 a_sphere; layout(location = 2) in vec3 a_colour;\n"
     "uniform mat4 u_proj; uniform mat4 u_view;\n"
-    "out vec3 v_pos; out vec3 v_normal; out vec3 v_colour; out vec2 v_uv;\n"
+    "out vec3 v_normal; flat out vec3 v_colour; out vec2 v_uv;\n"
     "void main() {\n"
     "  vec3 p = a_sphere.xyz + a_sphere.w * a_pos;\n"
-    "  v_pos = p; v_normal = a_pos; v_colour = a_colour; v_uv = vec2(0.0);\n"
+    "  v_normal = a_pos; v_colour = a_colour; v_uv = vec2(0.0);\n"
     "  gl_Position = u_proj * u_view * vec4(p, 1.0);\n"
     "}\n";
 
@@ -87,7 +87,7 @@ static const char* const cyl_vs =
     "layout(location = 0) in vec3 a_pos; layout(location = 1) in vec3 a_p0; layout(location = 2) in vec4 a_p1r;\n"
     "layout(location = 3) in vec3 a_colour;\n"
     "uniform mat4 u_proj; uniform mat4 u_view;\n"
-    "out vec3 v_pos; out vec3 v_normal; out vec3 v_colour; out vec2 v_uv;\n"
+    "out vec3 v_normal; flat out vec3 v_colour; out vec2 v_uv;\n"
     "void main() {\n"
     "  vec3 axis = a_p1r.xyz - a_p0; float len = length(axis);\n"
     "  vec3 y = len > 1e-9 ? axis / len : vec3(0.0, 1.0, 0.0);\n"
@@ -95,7 +95,7 @@ static const char* const cyl_vs =
     "  vec3 x = normalize(cross(t, y)); vec3 z = cross(x, y);\n"
     "  vec3 radial = x * a_pos.x + z * a_pos.z;\n"
     "  vec3 p = a_p0 + y * (a_pos.y * len) + radial * a_p1r.w;\n"
-    "  v_pos = p; v_normal = radial; v_colour = a_colour; v_uv = vec2(0.0);\n"
+    "  v_normal = radial; v_colour = a_colour; v_uv = vec2(0.0);\n"
     "  gl_Position = u_proj * u_view * vec4(p, 1.0);\n"
     "}\n";
 
