@@ -36,6 +36,7 @@ void tx_write_rows(tx_ctx* c, tx_port p, uint32_t rows) {
 
 int64_t tx_sim_ns(const tx_ctx* c) { return c->sim_ns; }
 const char* tx_record_dir(const tx_ctx* c) { return c->sys->record_dir; }
+const char* tx_output_dir(const tx_ctx* c) { return c->sys->out_dir; }
 
 // read after the run, once every thread has joined
 void tx_set_result(tx_ctx* c, tx_result r, double value) {

@@ -34,6 +34,8 @@ static json_t* param(tx_setup* s, const char* key) {
   return s->in->params ? json_object_get(s->in->params, key) : NULL;
 }
 
+json_t* tx_param_json(tx_setup* s, const char* key) { return param(s, key); }
+
 const char* tx_json_kind(const json_t* v) {
   switch (json_typeof(v)) {
   case JSON_OBJECT: return "an object";

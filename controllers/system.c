@@ -263,6 +263,7 @@ int tx_system_run(tx_system* s, const tx_run_options* o, tx_run_result* r, char*
   if (!(o->duration_s > 0 && o->duration_s <= 86400)) return snprintf(err, n, "duration %g s is out of range (0, 86400]", o->duration_s), -1;
   if (!tx_system_prepare_stats(s, o->duration_s)) return snprintf(err, n, "out of memory for statistics"), -1;
   s->record_dir = o->record_dir;
+  s->out_dir = o->out_dir;
   int rc = o->lockstep ? tx_run_lockstep(s, o, r, err, n) : tx_run_realtime(s, o, r, err, n);
   return rc;
 }

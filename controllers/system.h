@@ -48,6 +48,7 @@ typedef struct tx_run_options {
   bool pin_threads;       // try CPU pinning
   bool keep_cpus_awake;   // a SCHED_IDLE spinner per CPU, so no CPU halts between ticks
   const char* record_dir; // folder for recordings (tx_record_dir), or NULL for none
+  const char* out_dir;    // the run's output folder (views write frames there), or NULL
   // called about every 100 ms from the main thread; returning false stops the run
   bool (*progress)(double elapsed_s, void* user);
   void* progress_user;
@@ -78,6 +79,11 @@ int tx_system_add(tx_system* s, const char* name, const char* type, double rate_
 int tx_system_finalize(tx_system* s, tx_fault* f);
 // run; on failure (an init failed) returns -1 with a message in err
 int tx_system_run(tx_system* s, const tx_run_options* o, tx_run_result* r, char* err, size_t n);
+
+// for built-in classes only: params.KEY as JSON (borrowed, marked as used), or NULL
+json_t* tx_param_json(tx_setup* s, const char* key);
+// the run's output folder (tx_run_options.out_dir), or NULL
+const char* tx_output_dir(const tx_ctx* c);
 
 // introspection, valid after finalize
 int tx_system_count(const tx_system* s);

@@ -78,6 +78,7 @@ struct tx_system {
   _Atomic uint64_t warning_counts[TX_WARNINGS_MAX];
   int nwarnings;
   const char* record_dir; // of the current run, or NULL
+  const char* out_dir;    // of the current run, or NULL
   bool tracing;        // lockstep: hash every publish
   FILE* trace;         // and write it here, if not NULL
   uint64_t trace_hash; // tx_hash over every publish, in order

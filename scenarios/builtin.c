@@ -5,6 +5,9 @@
 #include "../controllers/collision/wall.h"
 #include "../controllers/haptics/haptics_controller.h"
 #include "../controllers/voxel/needle_controller.h"
+#include "../views/graphics/graphics_view.h"
+
+#include <tactus/config.h>
 
 #include <pthread.h>
 
@@ -13,6 +16,9 @@ static void register_all(void) {
   tx_register_controller(&tx_collision_wall);
   tx_register_controller(&tx_haptics_controller);
   tx_register_controller(&tx_voxel_needle_controller);
+#if TX_WITH_OSMESA || TX_WITH_GLFW
+  tx_register_controller(&tx_graphics_view);
+#endif
 }
 
 void tx_register_builtin(void) {

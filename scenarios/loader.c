@@ -1,6 +1,8 @@
 // Scenario files: JSON (jansson) to a checked, finalized controller system.
 #include "loader.h"
 
+#include "../views/graphics/view_def.h"
+
 #include <tactus/config.h>
 
 #include <dirent.h>
@@ -251,11 +253,42 @@ static int add_controllers(const char* file, tx_system* sys, json_t* list, const
   return 0;
 }
 
+#define VIEW_INSTANCE "view" // the graphics view's name in the report
+
+// the scenario's "view" is always checked; a graphics view is added only when the run draws
+static int add_view(const char* file, tx_system* sys, json_t* view, const tx_load_options* o, char* err, size_t n) {
+  tx_view_def d = tx_view_def_default();
+  char key[128] = "", msg[300];
+  if (view && tx_view_def_from_json(view, &d, key, sizeof key, msg, sizeof msg))
+    return fail(err, n, "%s: view%s%s: %s", file, *key ? "." : "", key, msg);
+  if (!o || !o->view || strcmp(o->view, "none") == 0) return 0;
+  json_t* rate = view ? json_object_get(view, "rate_hz") : NULL;
+  json_t* params = json_object();
+  json_t* available = json_array();
+  if (!params || !available) return json_decref(params), json_decref(available), fail(err, n, "%s: out of memory", file);
+  // what the model holds, for the draw list made from the naming conventions
+  for (int i = 0; i < tx_system_count(sys); i++)
+    for (int p = 0; p < tx_system_ports(sys, i) && json_array_size(available) < 256; p++)
+      if (tx_system_port(sys, i, p).write) json_array_append_new(available, json_string(tx_system_port(sys, i, p).component));
+  if (view) json_object_set(params, "view", view);
+  json_object_set_new(params, "available", available);
+  json_object_set_new(params, "target", json_string(o->view));
+  json_object_set_new(params, "stereo_mode", json_string(o->stereo ? o->stereo : "mono"));
+  json_object_set_new(params, "wait", json_boolean(o->view_wait));
+  tx_fault f;
+  int rc = tx_system_add(sys, VIEW_INSTANCE, "views.graphics", rate ? json_number_value(rate) : 30, params, &f);
+  json_decref(params);
+  if (rc == 0) return 0;
+  const char* k = strncmp(f.key, "params.", 7) == 0 ? f.key + 7 : f.key;
+  if (strcmp(k, "view") == 0 || strcmp(k, "name") == 0) k = "";
+  return fail(err, n, "%s: view%s%s: %s", file, *k ? "." : "", k, f.message);
+}
+
 static tx_scenario* load_root(const char* file, const char* dir, json_t* root, const tx_load_options* o, char* err,
                               size_t n) {
   tx_register_builtin();
   if (!json_is_object(root)) return fail(err, n, "%s: expected a JSON object at the top", file), NULL;
-  static const char* const keys[] = {"name", "description", "duration_s", "model", "plugins", "controllers", NULL};
+  static const char* const keys[] = {"name", "description", "duration_s", "model", "plugins", "controllers", "view", NULL};
   if (check_keys(file, "", root, keys, err, n)) return NULL;
   set_origin origins[SETS_MAX + 2];
   int norigins = 0;
@@ -290,7 +323,8 @@ static tx_scenario* load_root(const char* file, const char* dir, json_t* root, c
   snprintf(s->description, sizeof s->description, "%s", desc ? json_string_value(desc) : "");
   s->duration_s = seconds;
   if (declare_model(file, s->system, json_object_get(root, "model"), err, n) ||
-      add_controllers(file, s->system, json_object_get(root, "controllers"), origins, norigins, err, n)) {
+      add_controllers(file, s->system, json_object_get(root, "controllers"), origins, norigins, err, n) ||
+      add_view(file, s->system, json_object_get(root, "view"), o, err, n)) {
     tx_scenario_free(s);
     return NULL;
   }
@@ -299,7 +333,10 @@ static tx_scenario* load_root(const char* file, const char* dir, json_t* root, c
     int index = -1;
     for (int i = 0; i < tx_system_count(s->system); i++)
       if (strcmp(tx_system_name(s->system, i), f.key) == 0) index = i;
-    if (index >= 0) fail(err, n, "%s: controllers[%d]: %s", file, index, f.message);
+    bool is_view = index >= 0 && o && o->view && strcmp(o->view, "none") != 0 && index == tx_system_count(s->system) - 1 &&
+                   strcmp(f.key, VIEW_INSTANCE) == 0;
+    if (is_view) fail(err, n, "%s: view.draw: %s", file, f.message);
+    else if (index >= 0) fail(err, n, "%s: controllers[%d]: %s", file, index, f.message);
     else fail(err, n, "%s: %s", file, f.message);
     tx_scenario_free(s);
     return NULL;

@@ -23,6 +23,9 @@ typedef struct tx_load_options {
   bool allow_plugins;       // false where the text is untrusted (the fuzzer)
   const char* const* devices; // --device specs, given in turn to the controllers of type "haptics"
   int ndevices;             // at most 2
+  const char* view;         // "png" or "window" adds the graphics view; NULL or "none" only checks "view"
+  const char* stereo;       // the view's stereo mode (mono, sbs, tb, anaglyph, lr), NULL for mono
+  bool view_wait;           // lockstep: the view renders every tick instead of dropping frames
 } tx_load_options;
 
 // register the built-in controller classes (idempotent)

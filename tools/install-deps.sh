@@ -9,6 +9,7 @@ core=(build-essential cmake pkg-config git
 optional=(libbullet-dev libode-dev libassimp-dev liburdfdom-dev
           libosmesa6-dev libglfw3-dev libpng-dev
           libplplot-dev plplot-driver-cairo
+          xvfb xauth                   # xvfb-run: the window-mode screenshot test
           cyclonedds-dev tetgen)
 
 want=("${core[@]}")

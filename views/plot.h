@@ -1,11 +1,20 @@
-// Internal: PNG line plots with axes, units and a legend (PLplot, cairo).
-// Built without PLplot (TX_WITH_PLPLOT=OFF), tx_plot_png says so and fails,
+// Internal: PNG line plots with axes, units, a grid and a legend (PLplot,
+// cairo), one panel or several side by side like the force and displacement
+// figures of the suturing journal paper (Figures 15-19: force in N against
+// the HIP's displacement, one line per case, a panel per experiment).
+// Built without PLplot (TX_WITH_PLPLOT=OFF), the functions say so and fail,
 // and callers keep their CSV and JSON.
+//
+//     tx_plot_series s[] = {{"r = 0.05 cm", x, f, n, false, 1}, {"r = 0.1 cm", x2, f2, n2, false, 2}};
+//     tx_plot p = {"(a) piercing", "HIP displacement y (mm)", "force F_y (N)", false, false, s, 2};
+//     tx_plot_png("force.png", &p, err, sizeof err);
 #ifndef TX_VIEWS_PLOT_H
 #define TX_VIEWS_PLOT_H
 
 #include <stdbool.h>
 #include <stddef.h>
+
+#define TX_PLOT_SERIES_MAX 12 // series with a legend entry in one panel
 
 typedef struct tx_plot_series {
   const char* label;  // legend entry
@@ -13,7 +22,7 @@ typedef struct tx_plot_series {
   const double* y;
   int n;
   bool points;        // markers instead of a line
-  int color;          // PLplot colour-map-0 index, 1-15
+  int color;          // palette index 1-14 (tx_plot_color), 15 is black
 } tx_plot_series;
 
 typedef struct tx_plot {
@@ -25,7 +34,11 @@ typedef struct tx_plot {
   int nseries;
 } tx_plot;
 
-// write the plot to path (PNG, 800 x 600); 0, or -1 with a message
+// one panel, 800 x 600 px; 0, or -1 with a message
 int tx_plot_png(const char* path, const tx_plot* p, char* err, size_t n);
+// n panels in rows of `columns`, each 640 x 480 px, one legend per panel; 0, or -1 with a message
+int tx_plot_png_panels(const char* path, const tx_plot* panels, int count, int columns, char* err, size_t n);
+// the palette as RGB 0-255 (index 1-15), for anything drawn to match
+void tx_plot_color(int index, int rgb[3]);
 
 #endif

@@ -4,7 +4,7 @@
 #include <stdio.h>
 #include <string.h>
 
-static const tx_device_backend* const backends[] = {&tx_device_scripted, &tx_device_replay, &tx_device_sim, &tx_device_udp};
+static const tx_device_backend* const backends[] = {&tx_device_scripted, &tx_device_replay, &tx_device_sim, &tx_device_udp, &tx_device_mouse};
 
 int tx_device_open(const char* spec, double period_s, tx_device_handle* h, char* err, size_t n) {
   *h = (tx_device_handle){0};
@@ -16,7 +16,7 @@ int tx_device_open(const char* spec, double period_s, tx_device_handle* h, char*
     h->device = backends[i]->open(colon ? colon + 1 : "", period_s, err, n);
     return h->device ? 0 : -1;
   }
-  snprintf(err, n, "device '%s': unknown kind (known: scripted:NAME, scripted:FILE.csv, replay:FILE, sim[:KEY=VALUE,...], udp:HOST:PORT)", spec);
+  snprintf(err, n, "device '%s': unknown kind (known: scripted:NAME, scripted:FILE.csv, replay:FILE, sim[:KEY=VALUE,...], udp:HOST:PORT, mouse)", spec);
   return -1;
 }
 

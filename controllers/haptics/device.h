@@ -37,5 +37,6 @@ extern const tx_device_backend tx_device_scripted;
 extern const tx_device_backend tx_device_replay;
 extern const tx_device_backend tx_device_sim;
 extern const tx_device_backend tx_device_udp;
+extern const tx_device_backend tx_device_mouse; // driven by a window (device_mouse.h)
 
 #endif

@@ -1,6 +1,7 @@
 // tactus bench: benchmark tables for the spine. Timings are medians and
 // percentiles of one run on this machine; they are printed, never asserted.
 #include "bench_voxels.h"
+#include "bench_render.h"
 #include "command.h"
 #include "run.h"
 
@@ -20,6 +21,10 @@ typedef struct bench_args {
 static void print_target(const char* what, const char* measured, const char* limit, bool ok) {
   printf("  %-44s %-24s %-12s %s\n", what, measured, limit, ok ? "met" : "MISSED");
 }
+void print_bench_target(const char* what, const char* measured, const char* limit, bool ok) {
+  print_target(what, measured, limit, ok);
+}
+static int bench_render(const bench_args* a) { return tx_bench_render(a->out, a->duration_s); }
 
 static json_t* find_controller(json_t* report, const char* name) {
   size_t i;
@@ -276,6 +281,7 @@ static const struct {
     {"overhead", bench_overhead, "framework cost of an empty controller step"},
     {"haptics", bench_haptics, "haptics tick cost, 1 kHz under load, 10 kHz idle"},
     {"voxels", bench_voxels, "needle in 250 to 100000 voxels: haptic Hz beside the voxel paper's Table 1"},
+    {"render", bench_render, "graphics view frame times, mono and 2x640x480 stereo, beside 1 kHz haptics"},
 };
 
 int tx_cmd_bench(int argc, char** argv) {

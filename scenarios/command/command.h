@@ -26,6 +26,9 @@ int tx_out_dir(const char* given, const char* stem, char* dir, size_t n, char* e
 // load a scenario by name or path; prints the error and returns NULL on failure
 tx_scenario* tx_load_for_command(const char* name, const char* const* sets, int nsets, const char* const* devices,
                                  int ndevices);
+// the same, with a graphics view ("png" or "window"; NULL or "none" for none) drawn in a stereo mode
+tx_scenario* tx_load_for_command_view(const char* name, const char* const* sets, int nsets, const char* const* devices,
+                                      int ndevices, const char* view, const char* stereo, bool lockstep);
 // stop requests (SIGINT, SIGTERM) end a run cleanly; the progress callback of a run
 void tx_catch_stop_signals(void);
 bool tx_progress(double elapsed_s, void* total_s);

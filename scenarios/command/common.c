@@ -76,9 +76,14 @@ int tx_out_dir(const char* given, const char* stem, char* dir, size_t n, char* e
 
 tx_scenario* tx_load_for_command(const char* name, const char* const* sets, int nsets, const char* const* devices,
                                  int ndevices) {
+  return tx_load_for_command_view(name, sets, nsets, devices, ndevices, NULL, NULL, false);
+}
+
+tx_scenario* tx_load_for_command_view(const char* name, const char* const* sets, int nsets, const char* const* devices,
+                                      int ndevices, const char* view, const char* stereo, bool lockstep) {
   char path[PATH_MAX], err[1024];
   if (tx_scenario_locate(name, path, sizeof path, err, sizeof err)) return tx_bad_input("%s", err), NULL;
-  tx_load_options o = {sets, nsets, true, devices, ndevices};
+  tx_load_options o = {sets, nsets, true, devices, ndevices, view, stereo, lockstep};
   tx_scenario* s = tx_scenario_load(path, &o, err, sizeof err);
   if (!s) tx_bad_input("%s", err);
   return s;

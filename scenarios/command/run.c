@@ -3,6 +3,9 @@
 #include "run.h"
 
 #include "../../views/report.h"
+#include "../../views/trace_plot.h"
+
+#include <tactus/config.h>
 
 #include <getopt.h>
 #include <stdio.h>
@@ -17,13 +20,14 @@ static const char run_usage[] =
     "  --lockstep          one thread on a virtual clock: deterministic, writes OUT/trace.csv\n"
     "  --set KEY=VALUE     override CONTROLLER.PARAM, CONTROLLER.rate_hz or duration_s (repeatable)\n"
     "  --device SPEC       a haptic device per hand: scripted:NAME|FILE.csv, replay:FILE, sim, udp:HOST:PORT, mouse\n"
-    "  --view SPEC         none|png|window (default none)\n"
-    "  --stereo MODE       mono|sbs|tb|anaglyph|lr (default mono)\n"
+    "  --view SPEC         none|png|window (default none): png writes OUT/frames/ (OSMesa), window needs DISPLAY\n"
+    "  --stereo MODE       mono|sbs|tb|anaglyph|lr (default mono): side by side, top-bottom, red-cyan, or left and right files\n"
     "  --out DIR           output folder (default out/SCENARIO-TIMESTAMP)\n"
     "  --no-record         no device recordings (OUT/deviceN.bin and .csv are written by default)\n"
     "  --quiet             no summary table\n"
     "\n"
-    "Writes OUT/report.json: per controller achieved rate, missed deadlines, period jitter and step time.\n"
+    "Writes OUT/report.json: per controller achieved rate, missed deadlines, period jitter and step time,\n"
+    "and OUT/device0.png (force and position traces) when a haptics device was recorded.\n"
     "Ctrl-C stops the run early and still writes the report.\n";
 
 static bool one_of(const char* s, const char* const* options) {
@@ -47,7 +51,7 @@ int tx_run_scenario(tx_scenario* sc, const tx_run_config* cfg, json_t** report_o
   }
   tx_catch_stop_signals();
   tx_run_options o = {.duration_s = duration, .lockstep = cfg->lockstep, .trace = trace, .realtime_priority = true,
-                      .pin_threads = true, .keep_cpus_awake = true, .record_dir = cfg->no_record ? NULL : dir,
+                      .pin_threads = true, .keep_cpus_awake = true, .record_dir = cfg->no_record ? NULL : dir, .out_dir = dir,
                       .progress = tx_progress, .progress_user = &duration};
   tx_run_result r;
   int rc = tx_system_run(sc->system, &o, &r, err, sizeof err);
@@ -65,6 +69,14 @@ int tx_run_scenario(tx_scenario* sc, const tx_run_config* cfg, json_t** report_o
     json_decref(report);
     fprintf(stderr, "tactus: %s\n", report ? err : "out of memory for the report");
     return 1;
+  }
+  // force and position traces of every device recorded in this run
+  for (int hand = 0; hand < 2 && !cfg->no_record; hand++) {
+    char csv[4200], png[4200], perr[1024];
+    snprintf(csv, sizeof csv, "%s/device%d.csv", dir, hand);
+    snprintf(png, sizeof png, "%s/device%d.png", dir, hand);
+    if (access(csv, R_OK) == 0 && tx_trace_plot_png(csv, png, perr, sizeof perr) != 0 && TX_WITH_PLPLOT)
+      fprintf(stderr, "tactus: %s\n", perr);
   }
   if (!cfg->quiet) {
     tx_report_print(stdout, report);
@@ -89,6 +101,7 @@ int tx_cmd_run(int argc, char** argv) {
   const char* devices[2];
   int nsets = 0, ndevices = 0;
   const char* view = "none";
+  const char* stereo_mode = "mono";
   optind = 1;
   opterr = 0;
   // GNU getopt moves operands behind the options, so SCENARIO may stand anywhere
@@ -113,6 +126,7 @@ int tx_cmd_run(int argc, char** argv) {
       break;
     case 'S':
       if (!one_of(optarg, stereo)) return tx_bad_input("--stereo %s: expected mono, sbs, tb, anaglyph or lr", optarg);
+      stereo_mode = optarg;
       break;
     case 'o': cfg.out = optarg; break;
     case 'q': cfg.quiet = true; break;
@@ -128,9 +142,19 @@ int tx_cmd_run(int argc, char** argv) {
   if (optind < argc) cfg.scenario = argv[optind++];
   if (optind < argc) return tx_bad_input("run: unexpected argument '%s'", argv[optind]);
   if (!cfg.scenario) return tx_bad_input("run: expected a SCENARIO (tactus list shows them)");
-  if (strcmp(view, "none") != 0) return tx_bad_input("--view %s: no graphics views in this build yet", view);
+  if (strcmp(view, "png") == 0 && !TX_WITH_OSMESA)
+    return tx_bad_input("--view png: this build has no OSMesa (configure with -DTX_WITH_OSMESA=ON)");
+  if (strcmp(view, "window") == 0 && !TX_WITH_GLFW)
+    return tx_bad_input("--view window: this build has no GLFW (configure with -DTX_WITH_GLFW=ON)");
+  if (strcmp(view, "window") == 0 && !(getenv("DISPLAY") && *getenv("DISPLAY")))
+    return tx_bad_input("--view window: no display (DISPLAY is not set); use --view png for frames without one");
+  if (strcmp(stereo_mode, "mono") != 0 && strcmp(view, "none") == 0)
+    return tx_bad_input("--stereo %s: needs --view png or --view window", stereo_mode);
+  for (int i = 0; i < ndevices; i++)
+    if ((strcmp(devices[i], "mouse") == 0 || strncmp(devices[i], "mouse:", 6) == 0) && strcmp(view, "window") != 0)
+      return tx_bad_input("--device %s: the mouse drives the tool through a window: add --view window", devices[i]);
 
-  tx_scenario* sc = tx_load_for_command(cfg.scenario, sets, nsets, devices, ndevices);
+  tx_scenario* sc = tx_load_for_command_view(cfg.scenario, sets, nsets, devices, ndevices, view, stereo_mode, cfg.lockstep);
   if (!sc) return TX_EXIT_BAD_INPUT;
   int rc = tx_run_scenario(sc, &cfg, NULL);
   tx_scenario_free(sc);

@@ -155,6 +155,37 @@ expect_bad "--device more than the scenario has" "at most 1 --device" -- run hap
 expect_bad "--device three times" "at most two" -- run haptics-wall --device scripted:pierce-up --device scripted:pierce-up --device scripted:pierce-up
 expect_bad "haptics limit above the device's" "--set haptics.max_force=10" "out of range" -- run haptics-wall --lockstep --set haptics.max_force=10
 expect_bad "haptics mode unknown" "--set haptics.mode=fast" "sample_hold" -- run haptics-wall --lockstep --set haptics.mode=fast
+# --- views: --view, --stereo and a scenario's "view" (docs/views.md) ---------------
+expect_bad "--stereo without a view" "--stereo sbs" "--view png" -- run haptics-wall --lockstep --stereo sbs
+expect_bad "--device mouse without a window" "--device mouse" "--view window" -- run haptics-wall --lockstep --device mouse
+expect_bad "--device mouse with options" "--device mouse:fast" -- run haptics-wall --lockstep --device mouse:fast
+DISPLAY= expect_bad "--view window without a display (or GLFW)" "--view window" -- run haptics-wall --view window
+view_scenario() { # FILE VIEW_JSON: the wall scenario with this "view"
+  printf '{"name": "t", "controllers": [{"name": "wall", "type": "collision.wall", "rate_hz": 60},
+  {"name": "haptics", "type": "haptics", "rate_hz": 1000, "params": {"force_model": "tool0.force_model"}}],
+  "view": %s}\n' "$2" >"$S/$1"
+}
+view_scenario view_key.json '{"draw": [{"tool": "device0", "colur": [1, 0, 0]}]}'
+expect_bad "view: unknown draw key, even without --view" "$S/view_key.json: view.draw[0].colur: unknown key" -- run "$S/view_key.json" --lockstep
+# a build without OSMesa refuses --view png at once, in one line
+if "$TACTUS" run rates --lockstep --view png --duration 0.01 --out "$WORK/probe" 2>&1 | grep -q "no OSMesa"; then
+  expect_bad "--view png without OSMesa" "--view png" "no OSMesa" -- run haptics-wall --lockstep --view png
+else
+view_scenario view_colour.json '{"draw": [{"tool": "device0", "colour": [1, 0, 2]}]}'
+expect_bad "view: colour out of range" "view.draw[0].colour" "[0, 1]" -- run "$S/view_colour.json" --lockstep --view png
+view_scenario view_camera.json '{"camera": {"eye": [0, 0, 0], "target": [0, 0, 0]}}'
+expect_bad "view: eye on the target" "view.camera" "differ" -- run "$S/view_camera.json" --lockstep --view png
+view_scenario view_size.json '{"width": 100000}'
+expect_bad "view: too wide" "view.width" -- run "$S/view_size.json" --lockstep --view png
+view_scenario view_rate.json '{"rate_hz": "fast"}'
+expect_bad "view: rate not a number" "view.rate_hz" -- run "$S/view_rate.json" --lockstep --view png
+view_scenario view_missing.json '{"draw": [{"mesh": "skin"}]}'
+expect_bad "view: draws what nobody writes" "$S/view_missing.json: view.draw" "skin.x" -- run "$S/view_missing.json" --lockstep --view png
+view_scenario view_shape.json '{"draw": [{"tool": "tool0.force_model"}]}'
+expect_bad "view: a tool that is no pose" "view.draw" -- run "$S/view_shape.json" --lockstep --view png
+expect_bad "view: nothing drawable" "view" "nothing to draw" -- run rates --lockstep --view png
+fi
+expect_bad "bench render with a bad duration" "--duration 0" -- bench render --duration 0
 expect_bad "bench unknown name" "bogus" -- bench bogus
 expect_bad "bench unknown option" "--bogus" -- bench rates --bogus
 expect_bad "bench --duration bad" "--duration" -- bench rates --duration abc

@@ -1,0 +1,12 @@
+// Internal: `tactus bench render`, in its own file (bench_render.c).
+#ifndef TX_SCENARIOS_COMMAND_BENCH_RENDER_H
+#define TX_SCENARIOS_COMMAND_BENCH_RENDER_H
+
+#include <stdbool.h>
+
+// frame times of the graphics view, mono and stereo, beside 1 kHz haptics; the exit status
+int tx_bench_render(const char* out, double duration_s);
+// one line of a bench's target table
+void print_bench_target(const char* what, const char* measured, const char* limit, bool ok);
+
+#endif

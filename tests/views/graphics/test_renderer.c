@@ -1,0 +1,293 @@
+// Headless renders of known scenes on OSMesa, checked against what geometry
+// and the lighting model say: the silhouette of a sphere, the colour of a lit
+// sphere at its centre, the eyes' disparity in each stereo layout, meshes
+// with bad rows, and PNG files read back.
+#include "views/graphics/osmesa_target.h"
+#include "views/graphics/png_writer.h"
+#include "views/graphics/renderer.h"
+#include "views/graphics/stereo_frame.h"
+
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include <cmocka.h>
+
+#define W 320
+#define H 240
+
+typedef struct frame {
+  tx_osmesa* osm;
+  tx_renderer* r;
+  int w, h;     // image, px
+  uint8_t* rgba; // copy of the image, top row first
+} frame;
+
+static tx_view_def scene_def(void) {
+  tx_view_def d = tx_view_def_default();
+  d.width = W, d.height = H;
+  d.camera.eye[0] = 0, d.camera.eye[1] = 0, d.camera.eye[2] = 1;
+  d.camera.target[0] = d.camera.target[1] = d.camera.target[2] = 0;
+  d.camera.fov_y = 40 * M_PI / 180;
+  d.camera.near_m = 0.1, d.camera.far_m = 10, d.camera.convergence = 1, d.camera.interaxial = 0.06;
+  d.background[0] = d.background[1] = d.background[2] = 0;
+  d.light_dir[0] = 0, d.light_dir[1] = 0, d.light_dir[2] = -1; // from the camera into the scene
+  return d;
+}
+
+// render a scene of spheres (x y z r each) in a stereo mode into f
+static void render(frame* f, tx_view_def* d, tx_stereo_mode mode, tx_scene* s) {
+  char err[256];
+  tx_stereo_image_size(mode, d->width, d->height, &f->w, &f->h);
+  f->osm = tx_osmesa_create(f->w, f->h, err, sizeof err);
+  if (!f->osm) fail_msg("%s", err);
+  f->r = tx_renderer_create(tx_osmesa_proc, err, sizeof err);
+  if (!f->r) fail_msg("%s", err);
+  tx_renderer_upload(f->r, s);
+  tx_stereo_draw(f->r, d, &d->camera, mode, 0, d->width, d->height);
+  tx_renderer_gl(f->r)->Finish();
+  f->rgba = malloc((size_t)f->w * f->h * 4);
+  const uint8_t* px = tx_osmesa_pixels(f->osm);
+  for (int y = 0; y < f->h; y++) memcpy(f->rgba + (size_t)y * f->w * 4, px + (size_t)(f->h - 1 - y) * f->w * 4, (size_t)f->w * 4);
+}
+
+static void release(frame* f) {
+  tx_renderer_destroy(f->r);
+  tx_osmesa_destroy(f->osm);
+  free(f->rgba);
+}
+
+static const uint8_t* at(const frame* f, int x, int y) { return f->rgba + 4 * ((size_t)y * f->w + x); }
+static bool lit(const uint8_t* p, int channel) { return channel < 0 ? p[0] + p[1] + p[2] > 24 : p[channel] > 8; }
+
+// centroid x of the lit pixels inside [x0, x1) (channel -1: any)
+static double centroid_x(const frame* f, int x0, int x1, int y0, int y1, int channel, int* count) {
+  double sum = 0;
+  *count = 0;
+  for (int y = y0; y < y1; y++)
+    for (int x = x0; x < x1; x++)
+      if (lit(at(f, x, y), channel)) sum += x + 0.5, (*count)++;
+  return *count ? sum / *count : NAN;
+}
+
+static tx_scene spheres_scene(tx_view_def* d, const float* spheres, uint32_t n, const float colour[3]) {
+  d->items[0] = (tx_draw_item){.kind = TX_DRAW_SPHERES, .range = {0, 1}};
+  memcpy(d->items[0].colour, colour, 3 * sizeof(float));
+  d->nitems = 1;
+  tx_scene s = {.count = 1};
+  s.items[0] = (tx_scene_item){&d->items[0], {spheres}, {n}};
+  return s;
+}
+
+// the silhouette's ends along the row through the sphere's centre are where
+// the cone of rays tangent to the sphere meets the image plane: tan(theta +- alpha)
+static void sphere_silhouette(void** state) {
+  (void)state;
+  const float white[3] = {1, 1, 1};
+  const float xs[2] = {0, 0.2f};
+  for (int k = 0; k < 2; k++) {
+    tx_view_def d = scene_def();
+    float sp[4] = {xs[k], 0, 0, 0.1f};
+    tx_scene s = spheres_scene(&d, sp, 1, white);
+    frame f = {0};
+    render(&f, &d, TX_STEREO_MONO, &s);
+    double focal = 0.5 * H / tan(0.5 * d.camera.fov_y); // px
+    double theta = atan(xs[k] / 1.0), alpha = asin(0.1 / sqrt(1.0 + xs[k] * xs[k]));
+    double left = 0.5 * W + focal * tan(theta - alpha), right = 0.5 * W + focal * tan(theta + alpha);
+    int row = H / 2, first = -1, last = -1;
+    for (int x = 0; x < W; x++)
+      if (lit(at(&f, x, row), -1)) {
+        if (first < 0) first = x;
+        last = x + 1;
+      }
+    if (fabs(first - left) > 1.5 || fabs(last - right) > 1.5)
+      fail_msg("sphere at x=%g: silhouette [%d, %d] px, expected [%.2f, %.2f]", xs[k], first, last, left, right);
+    // and vertically, for the sphere on the axis: the same radius
+    if (k == 0) {
+      int top = -1, bottom = -1;
+      for (int y = 0; y < H; y++)
+        if (lit(at(&f, W / 2, y), -1)) {
+          if (top < 0) top = y;
+          bottom = y + 1;
+        }
+      assert_true(fabs((bottom - top) - (right - left)) < 2.0);
+    }
+    release(&f);
+  }
+}
+
+static float expected_channel(float base, float ndotl, float ndoth) {
+  float s = ndoth > 0 ? powf(ndoth, TX_LIGHT_SHININESS) : 0;
+  float v = base * (TX_LIGHT_AMBIENT + TX_LIGHT_DIFFUSE * fmaxf(ndotl, 0)) + (ndotl > 0 ? TX_LIGHT_SPECULAR * s : 0);
+  return fminf(v, 1) * 255;
+}
+
+// at the centre pixel the normal points at the viewer: the lighting model gives the colour
+static void lit_sphere_centre_colour(void** state) {
+  (void)state;
+  const float base[3] = {0.5f, 0.3f, 0.2f};
+  const float lights[2][3] = {{0, 0, -1}, {-0.57735f, -0.57735f, -0.57735f}};
+  for (int k = 0; k < 2; k++) {
+    tx_view_def d = scene_def();
+    memcpy(d.light_dir, lights[k], sizeof d.light_dir);
+    float sp[4] = {0, 0, 0, 0.2f};
+    tx_scene s = spheres_scene(&d, sp, 1, base);
+    frame f = {0};
+    render(&f, &d, TX_STEREO_MONO, &s);
+    // n = (0, 0, 1); l = -light; h = normalize(l + v), v = (0, 0, 1)
+    float l[3] = {-lights[k][0], -lights[k][1], -lights[k][2]}, h[3] = {l[0], l[1], l[2] + 1};
+    float hn = sqrtf(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
+    float ndotl = l[2], ndoth = h[2] / hn;
+    // the four pixels around the centre straddle it; average them
+    double got[3] = {0, 0, 0};
+    for (int y = H / 2 - 1; y <= H / 2; y++)
+      for (int x = W / 2 - 1; x <= W / 2; x++)
+        for (int c = 0; c < 3; c++) got[c] += at(&f, x, y)[c] / 4.0;
+    for (int c = 0; c < 3; c++) {
+      float want = expected_channel(base[c], ndotl, ndoth);
+      if (fabs(got[c] - want) > 2.5) fail_msg("light %d channel %d: %.1f, expected %.1f", k, c, got[c], want);
+    }
+    release(&f);
+  }
+}
+
+// a sphere in front of the convergence plane sits further right for the left
+// eye than for the right (crossed); behind it, the other way round
+static void stereo_layouts_disparity(void** state) {
+  (void)state;
+  const float white[3] = {1, 1, 1};
+  const float zs[2] = {0.5f, -1.5f}; // 0.5 m and 2.5 m from the eyes; the plane is at 1 m
+  for (int k = 0; k < 2; k++) {
+    bool front = k == 0;
+    float sp[4] = {0, 0, zs[k], 0.03f};
+    int nl, nr;
+    // side by side: left eye in the left half
+    tx_view_def d = scene_def();
+    tx_scene s = spheres_scene(&d, sp, 1, white);
+    frame f = {0};
+    render(&f, &d, TX_STEREO_SBS, &s);
+    assert_int_equal(f.w, 2 * W);
+    double xl = centroid_x(&f, 0, W, 0, H, -1, &nl), xr = centroid_x(&f, W, 2 * W, 0, H, -1, &nr) - W;
+    assert_true(nl > 20 && nr > 20);
+    if (front ? !(xl > xr + 1) : !(xr > xl + 1)) fail_msg("sbs, z=%g: left %.2f right %.2f", zs[k], xl, xr);
+    release(&f);
+    // top-bottom: left eye on top
+    d = scene_def();
+    s = spheres_scene(&d, sp, 1, white);
+    render(&f, &d, TX_STEREO_TB, &s);
+    assert_int_equal(f.h, 2 * H);
+    double tl = centroid_x(&f, 0, W, 0, H, -1, &nl), tr = centroid_x(&f, 0, W, H, 2 * H, -1, &nr);
+    assert_true(nl > 20 && nr > 20);
+    assert_true(fabs(tl - xl) < 0.6 && fabs(tr - xr) < 0.6); // the same eyes as side by side
+    release(&f);
+    // anaglyph: the left eye in red, the right in green and blue
+    d = scene_def();
+    s = spheres_scene(&d, sp, 1, white);
+    render(&f, &d, TX_STEREO_ANAGLYPH, &s);
+    double al = centroid_x(&f, 0, W, 0, H, 0, &nl), ar = centroid_x(&f, 0, W, 0, H, 2, &nr);
+    assert_true(nl > 20 && nr > 20);
+    assert_true(fabs(al - xl) < 0.6 && fabs(ar - xr) < 0.6);
+    release(&f);
+  }
+  // on the convergence plane the two eyes agree
+  float sp[4] = {0.05f, 0, 0, 0.03f};
+  tx_view_def d = scene_def();
+  tx_scene s = spheres_scene(&d, sp, 1, white);
+  frame f = {0};
+  render(&f, &d, TX_STEREO_SBS, &s);
+  int nl, nr;
+  double xl = centroid_x(&f, 0, W, 0, H, -1, &nl), xr = centroid_x(&f, W, 2 * W, 0, H, -1, &nr) - W;
+  assert_true(fabs(xl - xr) < 0.3);
+  release(&f);
+}
+
+// a quad facing the camera: lit flat; a triangle with an index past the vertices is skipped and counted
+static void mesh_and_bad_rows(void** state) {
+  (void)state;
+  tx_view_def d = scene_def();
+  const float x[12] = {-0.2f, -0.2f, 0, 0.2f, -0.2f, 0, 0.2f, 0.2f, 0, -0.2f, 0.2f, 0};
+  const int32_t tri[9] = {0, 1, 2, 0, 2, 3, 0, 2, 7};
+  const float sp[8] = {0, 0, 0.3f, NAN, 0.1f, 0.1f, 0.1f, 0.05f}; // a NaN sphere is skipped, the other drawn
+  d.items[0] = (tx_draw_item){.kind = TX_DRAW_MESH, .colour = {0.4f, 0.6f, 0.8f}};
+  d.items[1] = (tx_draw_item){.kind = TX_DRAW_SPHERES, .colour = {1, 0, 0}};
+  d.nitems = 2;
+  tx_scene s = {.count = 2};
+  s.items[0] = (tx_scene_item){&d.items[0], {x, tri}, {4, 3}};
+  s.items[1] = (tx_scene_item){&d.items[1], {sp}, {2}};
+  frame f = {0};
+  render(&f, &d, TX_STEREO_MONO, &s);
+  assert_int_equal(tx_renderer_skipped(f.r), 2);
+  const uint8_t* p = at(&f, W / 2 - 40, H / 2 + 30); // on the quad, away from the sphere
+  for (int c = 0; c < 3; c++) {
+    float want = expected_channel(d.items[0].colour[c], 1, 1);
+    if (fabs(p[c] - want) > 2.5) fail_msg("quad channel %d: %d, expected %.1f", c, p[c], want);
+  }
+  double lo[3], hi[3];
+  assert_true(tx_renderer_bounds(f.r, lo, hi));
+  assert_true(fabs(lo[0] + 0.2) < 1e-6 && fabs(hi[0] - 0.2) < 1e-6);
+  release(&f);
+  // the skin texture: a skin tone, red over green over blue, and not flat
+  d = scene_def();
+  d.items[0] = (tx_draw_item){.kind = TX_DRAW_MESH, .skin_texture = true};
+  d.nitems = 1;
+  s.count = 1;
+  s.items[0].rows[1] = 2;
+  render(&f, &d, TX_STEREO_MONO, &s);
+  double sum[3] = {0, 0, 0}, lo_r = 255, hi_r = 0;
+  int n = 0;
+  for (int y = H / 2 - 30; y < H / 2 + 30; y++)
+    for (int xx = W / 2 - 30; xx < W / 2 + 30; xx++, n++) {
+      const uint8_t* q = at(&f, xx, y);
+      for (int c = 0; c < 3; c++) sum[c] += q[c];
+      lo_r = fmin(lo_r, q[0]), hi_r = fmax(hi_r, q[0]);
+    }
+  assert_true(sum[0] > sum[1] && sum[1] > sum[2]);
+  assert_true(hi_r - lo_r > 10);
+  release(&f);
+}
+
+static void colour_map_and_png(void** state) {
+  (void)state;
+  float a[3], b[3], m[3];
+  tx_colour_map(0, a);
+  tx_colour_map(1, b);
+  tx_colour_map(NAN, m);
+  assert_true(a[2] > a[0] && b[0] > b[2]); // cold blue, hot red
+  assert_memory_equal(a, m, sizeof a);
+  // write bottom-up, read back top-down
+  uint8_t img[4 * 3 * 2];
+  for (int i = 0; i < 24; i++) img[i] = (uint8_t)(i * 10);
+  for (int i = 3; i < 24; i += 4) img[i] = 255;
+  char path[] = "/tmp/tx_png_XXXXXX";
+  int fd = mkstemp(path);
+  assert_true(fd >= 0);
+  close(fd);
+  char err[256];
+  assert_int_equal(tx_png_write(path, img, 3, 2, true, err, sizeof err), 0);
+  uint8_t* back;
+  int w, h;
+  assert_int_equal(tx_png_read(path, &back, &w, &h, err, sizeof err), 0);
+  assert_int_equal(w, 3);
+  assert_int_equal(h, 2);
+  assert_memory_equal(back, img + 12, 12); // the bottom row of the buffer is the file's top row
+  assert_memory_equal(back + 12, img, 12);
+  free(back);
+  remove(path);
+  assert_int_equal(tx_png_write("/nonexistent/dir/x.png", img, 3, 2, true, err, sizeof err), -1);
+  assert_non_null(strstr(err, "/nonexistent/dir/x.png"));
+}
+
+int main(void) {
+  tx_osmesa_bound_threads(-1);
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(sphere_silhouette),        cmocka_unit_test(lit_sphere_centre_colour),
+      cmocka_unit_test(stereo_layouts_disparity), cmocka_unit_test(mesh_and_bad_rows),
+      cmocka_unit_test(colour_map_and_png),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

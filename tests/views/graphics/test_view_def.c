@@ -1,0 +1,139 @@
+// A scenario's "view": what is accepted, the key paths of what is not, and
+// the draw list made from the model's naming conventions.
+#include "views/graphics/view_def.h"
+
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+#include <cmocka.h>
+
+static int parse(const char* text, tx_view_def* d, char* key, char* msg) {
+  json_error_t e;
+  json_t* j = json_loads(text, 0, &e);
+  assert_non_null(j);
+  *d = tx_view_def_default();
+  int rc = tx_view_def_from_json(j, d, key, 128, msg, 256);
+  json_decref(j);
+  return rc;
+}
+
+static void full_view(void** state) {
+  (void)state;
+  tx_view_def d;
+  char key[128], msg[256];
+  assert_int_equal(parse("{\"rate_hz\": 60, \"width\": 320, \"height\": 200, \"frame_every\": 3,"
+                         "\"camera\": {\"eye\": [0, 0.1, 0.3], \"target\": [0, 0, 0], \"fov_deg\": 30, \"near_m\": 0.02, \"far_m\": 3},"
+                         "\"stereo\": {\"interaxial_m\": 0.01, \"convergence_m\": 0.25},"
+                         "\"background\": [0, 0, 0], \"light\": [0, -1, 0],"
+                         "\"draw\": [{\"mesh\": \"skin\"}, {\"spheres\": \"tissue\", \"colour_by\": \"tissue.damage\", \"range\": [0, 2]},"
+                         "{\"segments\": \"thread\", \"colour\": [1, 1, 0]}, {\"tool\": \"device0\", \"radius_m\": 0.003, \"show_force\": true},"
+                         "{\"plane\": {\"point\": [0, -0.01, 0], \"normal\": [0, 2, 0], \"size_m\": 0.1}}]}",
+                         &d, key, msg),
+                   0);
+  assert_int_equal(d.width, 320);
+  assert_int_equal(d.height, 200);
+  assert_int_equal(d.frame_every, 3);
+  assert_false(d.auto_camera);
+  assert_true(fabs(d.camera.fov_y - 30 * M_PI / 180) < 1e-12);
+  assert_true(fabs(d.camera.interaxial - 0.01) < 1e-12);
+  assert_true(fabs(d.camera.convergence - 0.25) < 1e-12); // stereo.convergence_m wins over the target distance
+  assert_true(fabsf(d.light_dir[1] + 1) < 1e-6f);
+  assert_int_equal(d.nitems, 5);
+  assert_int_equal(d.items[0].kind, TX_DRAW_MESH);
+  assert_true(d.items[0].skin_texture); // a mesh without a colour wears the skin texture
+  assert_string_equal(d.items[1].scalar, "tissue.damage");
+  assert_true(d.items[1].range[1] == 2);
+  assert_int_equal(d.items[3].kind, TX_DRAW_TOOL);
+  assert_true(d.items[3].show_force);
+  assert_true(fabsf(d.items[4].plane[4] - 1) < 1e-6f); // the normal is made unit
+  assert_true(fabsf(d.items[4].plane[6] - 0.05f) < 1e-6f);
+  char comps[3][TX_NAME_MAX];
+  assert_int_equal(tx_draw_item_components(&d.items[0], comps), 2);
+  assert_string_equal(comps[0], "skin.x");
+  assert_string_equal(comps[1], "skin.tri");
+  assert_int_equal(tx_draw_item_components(&d.items[1], comps), 2);
+  assert_string_equal(comps[0], "tissue.spheres");
+  assert_string_equal(comps[1], "tissue.damage");
+  assert_int_equal(tx_draw_item_components(&d.items[3], comps), 2);
+  assert_string_equal(comps[1], "device0.force");
+  assert_int_equal(tx_draw_item_components(&d.items[4], comps), 0);
+  // the camera's own target distance is the convergence when stereo does not say
+  assert_int_equal(parse("{\"camera\": {\"eye\": [0, 0.3, 0.4], \"target\": [0, 0, 0]}}", &d, key, msg), 0);
+  assert_true(fabs(d.camera.convergence - 0.5) < 1e-12);
+  assert_true(fabs(d.camera.interaxial - 0.5 / 30) < 1e-12); // the 1/30 rule unless stereo.interaxial_m says
+  assert_false(d.interaxial_given);
+}
+
+static void expect_error(const char* text, const char* want_key, const char* want_msg) {
+  tx_view_def d;
+  char key[128], msg[256];
+  assert_int_equal(parse(text, &d, key, msg), -1);
+  assert_string_equal(key, want_key);
+  if (!strstr(msg, want_msg)) fail_msg("%s: message '%s' lacks '%s'", text, msg, want_msg);
+}
+
+static void errors_name_the_key(void** state) {
+  (void)state;
+  expect_error("{\"colour\": 1}", "colour", "unknown key");
+  expect_error("{\"width\": 0}", "width", "integer in [16, 4096]");
+  expect_error("{\"width\": 1.5}", "width", "integer");
+  expect_error("{\"rate_hz\": -30}", "rate_hz", "(0, 1000]");
+  expect_error("{\"frame_every\": 0}", "frame_every", "[1, ");
+  expect_error("{\"camera\": {\"eye\": [0, 0], \"target\": [0, 0, 0]}}", "camera.eye", "3 numbers");
+  expect_error("{\"camera\": {\"eye\": [0, 0, 0], \"target\": [0, 0, 0]}}", "camera", "differ");
+  expect_error("{\"camera\": {\"fov_deg\": 180}}", "camera.fov_deg", "[1, 170]");
+  expect_error("{\"camera\": {\"near_m\": 1, \"far_m\": 0.5}}", "camera", "near < far");
+  expect_error("{\"camera\": {\"zoom\": 2}}", "camera.zoom", "unknown key");
+  expect_error("{\"stereo\": {\"interaxial_m\": -0.01}}", "stereo.interaxial_m", "[0, 1]");
+  expect_error("{\"stereo\": {\"convergence_m\": 0}}", "stereo.convergence_m", "(0, 10000]");
+  expect_error("{\"stereo\": \"sbs\"}", "stereo", "an object");
+  expect_error("{\"background\": [0, 0, 2]}", "background", "[0, 1]");
+  expect_error("{\"light\": [0, 0, 0]}", "light", "non-zero");
+  expect_error("{\"draw\": []}", "draw", "1 to 16");
+  expect_error("{\"draw\": [3]}", "draw[0]", "an object");
+  expect_error("{\"draw\": [{}]}", "draw[0]", "one of mesh");
+  expect_error("{\"draw\": [{\"mesh\": \"a\", \"tool\": \"b\"}]}", "draw[0]", "exactly one");
+  expect_error("{\"draw\": [{\"mesh\": \"Skin!\"}]}", "draw[0].mesh", "component prefix");
+  expect_error("{\"draw\": [{\"mesh\": \"skin\", \"colur\": [1, 0, 0]}]}", "draw[0].colur", "unknown key");
+  expect_error("{\"draw\": [{\"mesh\": \"skin\"}, {\"spheres\": \"t\", \"colour\": [1, 0]}]}", "draw[1].colour", "3 numbers");
+  expect_error("{\"draw\": [{\"mesh\": \"skin\", \"colour_by\": \"skin.t\"}]}", "draw[0].colour_by", "only spheres");
+  expect_error("{\"draw\": [{\"spheres\": \"t\", \"range\": [0, 1]}]}", "draw[0].range", "needs colour_by");
+  expect_error("{\"draw\": [{\"spheres\": \"t\", \"colour_by\": \"t.d\", \"range\": [1, 1]}]}", "draw[0].range", "low < high");
+  expect_error("{\"draw\": [{\"spheres\": \"t\", \"texture\": \"skin\"}]}", "draw[0].texture", "only meshes");
+  expect_error("{\"draw\": [{\"mesh\": \"s\", \"texture\": \"wood\"}]}", "draw[0].texture", "\"skin\" or \"none\"");
+  expect_error("{\"draw\": [{\"tool\": \"device0\", \"radius_m\": 0}]}", "draw[0].radius_m", "(0, 1]");
+  expect_error("{\"draw\": [{\"tool\": \"device0\", \"show_force\": 1}]}", "draw[0].show_force", "true or false");
+  expect_error("{\"draw\": [{\"plane\": {\"normal\": [0, 0, 0]}}]}", "draw[0].plane.normal", "non-zero");
+  expect_error("{\"draw\": [{\"plane\": {\"size\": 1}}]}", "draw[0].plane.size", "unknown key");
+  expect_error("[1]", "", "an object");
+}
+
+static void automatic_draw_list(void** state) {
+  (void)state;
+  const char* written[] = {"tool0.force_model", "skin.x", "device0.pose", "skin.tri", "tissue.spheres", "tissue.damage",
+                           "lonely.x", "thread.segments", "device0.force", "probe.pose", "skin.thickness"};
+  tx_view_def d = tx_view_def_default();
+  assert_int_equal(tx_view_def_auto_draw(&d, written, 11), 4); // probe.pose is no device
+  assert_int_equal(d.items[0].kind, TX_DRAW_MESH); // skin.x with skin.tri; lonely.x has no triangles
+  assert_string_equal(d.items[0].name, "skin");
+  assert_int_equal(d.items[1].kind, TX_DRAW_TOOL);
+  assert_string_equal(d.items[1].name, "device0");
+  assert_true(d.items[1].show_force);
+  assert_int_equal(d.items[2].kind, TX_DRAW_SPHERES);
+  assert_string_equal(d.items[2].scalar, "tissue.damage");
+  assert_int_equal(d.items[3].kind, TX_DRAW_SEGMENTS);
+  const char* none[] = {"rates.mesh", "tool0.force_model"};
+  assert_int_equal(tx_view_def_auto_draw(&d, none, 2), 0);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(full_view),
+      cmocka_unit_test(errors_name_the_key),
+      cmocka_unit_test(automatic_draw_list),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,140 @@
+// A GLFW window: GL 3.3 core context, quad-buffer stereo when offered, and
+// mouse and keyboard input for the `mouse` device.
+#include "glfw_window.h"
+
+#include "../../controllers/haptics/device_mouse.h"
+
+#include <GLFW/glfw3.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define DRAG_M_PER_PX 0.0004 // tool travel per pixel of mouse drag
+#define SCROLL_M 0.002       // per scroll step
+#define KEY_M 0.002          // per key press (and repeat)
+
+struct tx_window {
+  GLFWwindow* w;
+  bool quad;
+  double tool[3];    // m, where the input has put the tool
+  uint32_t buttons;
+  double last_x, last_y; // px, the cursor at the last event
+  bool dragging;
+};
+
+static char glfw_error[256];
+static void on_error(int code, const char* text) {
+  (void)code;
+  snprintf(glfw_error, sizeof glfw_error, "%s", text);
+}
+
+static void publish(tx_window* t) { tx_mouse_input_set(t->tool, t->buttons); }
+
+static void on_button(GLFWwindow* w, int button, int action, int mods) {
+  (void)mods;
+  tx_window* t = glfwGetWindowUserPointer(w);
+  if (button == GLFW_MOUSE_BUTTON_LEFT) {
+    t->dragging = action == GLFW_PRESS;
+    glfwGetCursorPos(w, &t->last_x, &t->last_y);
+  }
+}
+
+static void on_cursor(GLFWwindow* w, double x, double y) {
+  tx_window* t = glfwGetWindowUserPointer(w);
+  if (t->dragging) {
+    t->tool[0] += (x - t->last_x) * DRAG_M_PER_PX;
+    t->tool[2] += (y - t->last_y) * DRAG_M_PER_PX; // down the screen is towards the viewer
+    publish(t);
+  }
+  t->last_x = x;
+  t->last_y = y;
+}
+
+static void on_scroll(GLFWwindow* w, double dx, double dy) {
+  (void)dx;
+  tx_window* t = glfwGetWindowUserPointer(w);
+  t->tool[1] += dy * SCROLL_M;
+  publish(t);
+}
+
+static void on_key(GLFWwindow* w, int key, int scancode, int action, int mods) {
+  (void)scancode;
+  (void)mods;
+  tx_window* t = glfwGetWindowUserPointer(w);
+  if (key == GLFW_KEY_ESCAPE && action == GLFW_PRESS) glfwSetWindowShouldClose(w, GLFW_TRUE);
+  if (key == GLFW_KEY_SPACE) {
+    if (action == GLFW_PRESS) t->buttons |= 1u;
+    if (action == GLFW_RELEASE) t->buttons &= ~1u;
+  }
+  if (action == GLFW_RELEASE) {
+    publish(t);
+    return;
+  }
+  switch (key) {
+  case GLFW_KEY_LEFT: case GLFW_KEY_A: t->tool[0] -= KEY_M; break;
+  case GLFW_KEY_RIGHT: case GLFW_KEY_D: t->tool[0] += KEY_M; break;
+  case GLFW_KEY_UP: case GLFW_KEY_W: t->tool[2] -= KEY_M; break;
+  case GLFW_KEY_DOWN: case GLFW_KEY_S: t->tool[2] += KEY_M; break;
+  case GLFW_KEY_Q: t->tool[1] += KEY_M; break;
+  case GLFW_KEY_E: t->tool[1] -= KEY_M; break;
+  default: break;
+  }
+  for (int i = 0; i < 3; i++) t->tool[i] = fmax(-TX_MOUSE_WORKSPACE_M, fmin(TX_MOUSE_WORKSPACE_M, t->tool[i]));
+  publish(t);
+}
+
+static GLFWwindow* make(int width, int height, bool quad) {
+  glfwDefaultWindowHints();
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  glfwWindowHint(GLFW_STEREO, quad ? GLFW_TRUE : GLFW_FALSE);
+  glfwWindowHint(GLFW_RESIZABLE, GLFW_TRUE);
+  return glfwCreateWindow(width, height, "tactus", NULL, NULL);
+}
+
+tx_window* tx_window_open(int width, int height, bool want_quad, char* err, size_t n) {
+  glfwSetErrorCallback(on_error);
+  if (!glfwInit()) return snprintf(err, n, "no window: GLFW: %s", glfw_error), NULL;
+  tx_window* t = calloc(1, sizeof *t);
+  if (!t) return snprintf(err, n, "out of memory"), NULL;
+  // quad buffers where the driver has them; otherwise the chosen mode in a plain window
+  if (want_quad && (t->w = make(width, height, true))) t->quad = true;
+  else t->w = make(width, height, false);
+  if (!t->w) {
+    free(t);
+    return snprintf(err, n, "no window: GLFW: %s", glfw_error), NULL;
+  }
+  glfwMakeContextCurrent(t->w);
+  glfwSwapInterval(0); // the view's rate paces frames, not the display
+  glfwSetWindowUserPointer(t->w, t);
+  glfwSetMouseButtonCallback(t->w, on_button);
+  glfwSetCursorPosCallback(t->w, on_cursor);
+  glfwSetScrollCallback(t->w, on_scroll);
+  glfwSetKeyCallback(t->w, on_key);
+  t->tool[1] = 0.02;
+  publish(t);
+  return t;
+}
+
+// GLFW stays initialised for the rest of the process: terminating it unloads
+// the GL driver, whose process-wide state then can no longer be told apart
+void tx_window_close(tx_window* t) {
+  if (!t) return;
+  glfwDestroyWindow(t->w);
+  free(t);
+}
+
+bool tx_window_is_quad(const tx_window* t) { return t->quad; }
+tx_gl_proc tx_window_proc(const char* name) { return (tx_gl_proc)glfwGetProcAddress(name); }
+void tx_window_framebuffer(const tx_window* t, int* width, int* height) { glfwGetFramebufferSize(t->w, width, height); }
+void tx_window_set_title(tx_window* t, const char* title) { glfwSetWindowTitle(t->w, title); }
+void tx_window_resize(tx_window* t, int width, int height) { glfwSetWindowSize(t->w, width, height); }
+
+bool tx_window_present(tx_window* t) {
+  glfwSwapBuffers(t->w);
+  glfwPollEvents();
+  return !glfwWindowShouldClose(t->w);
+}

@@ -1,0 +1,31 @@
+// Internal: a live GLFW window for a graphics view (X11, where DISPLAY is set).
+// Quad-buffered stereo is asked for when wanted and used when the context
+// offers it. Mouse and keyboard move the tool of a `--device mouse` device:
+//   drag with the left button   x and z (in the horizontal plane)
+//   scroll wheel, Q / E         y (up, down)
+//   arrow keys, W A S D         x and z in steps
+//   space                       button 0 (held)
+//   Esc or closing the window   ends the run (as Ctrl-C does)
+// GLFW is used from the view's rendering thread only.
+#ifndef TX_VIEWS_GRAPHICS_GLFW_WINDOW_H
+#define TX_VIEWS_GRAPHICS_GLFW_WINDOW_H
+
+#include "gl.h"
+
+#include <stdbool.h>
+#include <stddef.h>
+
+typedef struct tx_window tx_window;
+
+// NULL and a one-line message when no window can be made
+tx_window* tx_window_open(int width, int height, bool want_quad, char* err, size_t n);
+void tx_window_close(tx_window* w);
+bool tx_window_is_quad(const tx_window* w);
+tx_gl_proc tx_window_proc(const char* name);
+void tx_window_framebuffer(const tx_window* w, int* width, int* height);
+void tx_window_set_title(tx_window* w, const char* title);
+void tx_window_resize(tx_window* w, int width, int height);
+// show the frame and handle input; false once the window asked to close
+bool tx_window_present(tx_window* w);
+
+#endif

@@ -1,0 +1,673 @@
+// GL 3.3 core drawing of meshes, spheres, cylinders, tools and planes.
+#include "renderer.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define SPHERE_SLICES 32
+#define SPHERE_STACKS 20
+#define CYL_SIDES 16
+#define SKIN_TEX 512
+
+typedef struct mesh_slot {
+  GLuint vao, vbo, ebo;
+  float* verts;     // (n x 8) position m, normal, uv
+  uint32_t* idx;    // (m x 3) checked indices
+  size_t vcap, icap; // capacity in vertices and indices
+  uint32_t nverts, nidx;
+  float uv_basis[6]; // planar projection of the first frame: origin (u, v) and axes
+  uint32_t uv_for;  // vertex count the basis was made for
+  float colour[3];
+  bool textured;
+} mesh_slot;
+
+struct tx_renderer {
+  tx_gl gl;
+  GLuint mesh_prog, sphere_prog, cyl_prog;
+  GLuint sphere_vao, sphere_vbo, sphere_ebo, sphere_inst;
+  GLuint cyl_vao, cyl_vbo, cyl_inst;
+  GLuint skin_tex;
+  int sphere_nidx, cyl_nverts;
+  mesh_slot meshes[TX_DRAW_MAX + TX_DRAW_MAX];
+  int nmeshes;
+  float* spheres; // (n x 7) centre m, radius m, colour
+  size_t nspheres, sphere_cap, sphere_gpu_cap;
+  float* cyls;    // (n x 10) p0 m, p1 m, radius m, colour
+  size_t ncyls, cyl_cap, cyl_gpu_cap;
+  double lo[3], hi[3];
+  bool any;
+  uint64_t skipped;
+};
+
+// per-pixel Blinn-Phong with the viewer at infinity (as fixed-function GL's
+// default): the half vector is one per eye, and the highlight's power is five
+// squarings, which llvmpipe runs far faster than pow()
+static const char* const fs_src =
+    "#version 330 core\n"
+    "in vec3 v_normal; flat in vec3 v_colour; in vec2 v_uv;\n"
+    "uniform vec3 u_light; uniform vec3 u_view_dir; uniform vec3 u_half; uniform int u_textured;\n"
+    "uniform sampler2D u_tex; uniform vec4 u_lighting;\n"
+    "out vec4 frag;\n"
+    "void main() {\n"
+    "  vec3 n = normalize(v_normal);\n"
+    "  if (dot(n, u_view_dir) < 0.0) n = -n;\n" // two-sided: a cloth is seen from both sides
+    "  vec3 base = u_textured != 0 ? texture(u_tex, v_uv).rgb : v_colour;\n"
+    "  float diff = max(dot(n, -u_light), 0.0);\n"
+    "  float s = max(dot(n, u_half), 0.0);\n"
+    "  s *= s; s *= s; s *= s; s *= s; s *= s;\n"
+    "  float spec = diff > 0.0 ? s : 0.0;\n"
+    "  frag = vec4(base * (u_lighting.x + u_lighting.y * diff) + vec3(u_lighting.z * spec), 1.0);\n"
+    "}\n";
+
+static const char* const mesh_vs =
+    "#version 330 core\n"
+    "layout(location = 0) in vec3 a_pos; layout(location = 1) in vec3 a_normal; layout(location = 2) in vec2 a_uv;\n"
+    "uniform mat4 u_proj; uniform mat4 u_view; uniform vec3 u_colour;\n"
+    "out vec3 v_normal; flat out vec3 v_colour; out vec2 v_uv;\n"
+    "void main() {\n"
+    "  v_normal = a_normal; v_colour = u_colour; v_uv = a_uv;\n"
+    "  gl_Position = u_proj * u_view * vec4(a_pos, 1.0);\n"
+    "}\n";
+
+static const char* const sphere_vs =
+    "#version 330 core\n"
+    "layout(location = 0) in vec3 a_pos; layout(location = 1) in vec4 a_sphere; layout(location = 2) in vec3 a_colour;\n"
+    "uniform mat4 u_proj; uniform mat4 u_view;\n"
+    "out vec3 v_normal; flat out vec3 v_colour; out vec2 v_uv;\n"
+    "void main() {\n"
+    "  vec3 p = a_sphere.xyz + a_sphere.w * a_pos;\n"
+    "  v_normal = a_pos; v_colour = a_colour; v_uv = vec2(0.0);\n"
+    "  gl_Position = u_proj * u_view * vec4(p, 1.0);\n"
+    "}\n";
+
+static const char* const cyl_vs =
+    "#version 330 core\n"
+    "layout(location = 0) in vec3 a_pos; layout(location = 1) in vec3 a_p0; layout(location = 2) in vec4 a_p1r;\n"
+    "layout(location = 3) in vec3 a_colour;\n"
+    "uniform mat4 u_proj; uniform mat4 u_view;\n"
+    "out vec3 v_normal; flat out vec3 v_colour; out vec2 v_uv;\n"
+    "void main() {\n"
+    "  vec3 axis = a_p1r.xyz - a_p0; float len = length(axis);\n"
+    "  vec3 y = len > 1e-9 ? axis / len : vec3(0.0, 1.0, 0.0);\n"
+    "  vec3 t = abs(y.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);\n"
+    "  vec3 x = normalize(cross(t, y)); vec3 z = cross(x, y);\n"
+    "  vec3 radial = x * a_pos.x + z * a_pos.z;\n"
+    "  vec3 p = a_p0 + y * (a_pos.y * len) + radial * a_p1r.w;\n"
+    "  v_normal = radial; v_colour = a_colour; v_uv = vec2(0.0);\n"
+    "  gl_Position = u_proj * u_view * vec4(p, 1.0);\n"
+    "}\n";
+
+static GLuint compile(tx_gl* gl, GLenum kind, const char* src, char* err, size_t n) {
+  GLuint s = gl->CreateShader(kind);
+  gl->ShaderSource(s, 1, &src, NULL);
+  gl->CompileShader(s);
+  GLint ok = 0;
+  gl->GetShaderiv(s, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[512] = "";
+    gl->GetShaderInfoLog(s, sizeof log, NULL, log);
+    for (char* c = log; *c; c++)
+      if (*c == '\n') *c = ' ';
+    snprintf(err, n, "shader does not compile: %s", log);
+    gl->DeleteShader(s);
+    return 0;
+  }
+  return s;
+}
+
+static GLuint program(tx_gl* gl, const char* vs, char* err, size_t n) {
+  GLuint v = compile(gl, GL_VERTEX_SHADER, vs, err, n), f = v ? compile(gl, GL_FRAGMENT_SHADER, fs_src, err, n) : 0;
+  if (!v || !f) return 0;
+  GLuint p = gl->CreateProgram();
+  gl->AttachShader(p, v);
+  gl->AttachShader(p, f);
+  gl->LinkProgram(p);
+  gl->DeleteShader(v);
+  gl->DeleteShader(f);
+  GLint ok = 0;
+  gl->GetProgramiv(p, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[512] = "";
+    gl->GetProgramInfoLog(p, sizeof log, NULL, log);
+    snprintf(err, n, "shaders do not link: %s", log);
+    gl->DeleteProgram(p);
+    return 0;
+  }
+  return p;
+}
+
+void tx_colour_map(float t, float rgb[3]) {
+  static const float stops[5][3] = {{0.1f, 0.2f, 0.9f}, {0.1f, 0.8f, 0.9f}, {0.2f, 0.8f, 0.2f}, {0.95f, 0.9f, 0.15f},
+                                    {0.9f, 0.15f, 0.1f}};
+  if (!(t > 0)) t = 0; // NaN too
+  if (t > 1) t = 1;
+  float x = t * 4;
+  int i = x >= 4 ? 3 : (int)x;
+  float f = x - (float)i;
+  for (int c = 0; c < 3; c++) rgb[c] = stops[i][c] * (1 - f) + stops[i + 1][c] * f;
+}
+
+// tileable value noise: a hashed lattice of the given period, smoothly interpolated
+static float lattice(int x, int y, int period, uint32_t seed) {
+  x = ((x % period) + period) % period;
+  y = ((y % period) + period) % period;
+  uint32_t h = (uint32_t)x * 374761393u + (uint32_t)y * 668265263u + seed * 2246822519u;
+  h = (h ^ (h >> 13)) * 1274126177u;
+  return (float)((h ^ (h >> 16)) & 0xffff) / 65535.0f;
+}
+
+static float noise(float u, float v, int period, uint32_t seed) {
+  int x = (int)floorf(u), y = (int)floorf(v);
+  float fx = u - (float)x, fy = v - (float)y;
+  fx = fx * fx * (3 - 2 * fx);
+  fy = fy * fy * (3 - 2 * fy);
+  float a = lattice(x, y, period, seed), b = lattice(x + 1, y, period, seed), c = lattice(x, y + 1, period, seed),
+        d = lattice(x + 1, y + 1, period, seed);
+  return (a * (1 - fx) + b * fx) * (1 - fy) + (c * (1 - fx) + d * fx) * fy;
+}
+
+void tx_skin_texture(uint8_t* rgb, int size) {
+  // a mottled base tone (four octaves), fine pores, and faint creases
+  static const float light[3] = {0.93f, 0.74f, 0.63f}, dark[3] = {0.78f, 0.55f, 0.46f}, pore[3] = {0.62f, 0.40f, 0.34f};
+  for (int y = 0; y < size; y++)
+    for (int x = 0; x < size; x++) {
+      float u = (float)x / (float)size, v = (float)y / (float)size, m = 0, amp = 0.5f;
+      for (int o = 0; o < 4; o++, amp *= 0.5f) {
+        int period = 4 << o;
+        m += amp * noise(u * (float)period, v * (float)period, period, 11u + (uint32_t)o);
+      }
+      float p = noise(u * 96, v * 96, 96, 7u), crease = noise(u * 12, v * 48, 12, 3u);
+      float pores = p > 0.8f ? (p - 0.8f) * 5 : 0;
+      float lines = fabsf(crease - 0.5f) < 0.02f ? 0.35f : 0;
+      for (int c = 0; c < 3; c++) {
+        float base = dark[c] + (light[c] - dark[c]) * m * 1.1f;
+        float val = base * (1 - pores * 0.6f - lines * 0.3f) + pore[c] * pores * 0.3f;
+        rgb[3 * (y * size + x) + c] = (uint8_t)(fminf(fmaxf(val, 0), 1) * 255 + 0.5f);
+      }
+    }
+}
+
+static void make_sphere(tx_renderer* r) {
+  tx_gl* gl = &r->gl;
+  float v[(SPHERE_SLICES + 1) * (SPHERE_STACKS + 1) * 3];
+  uint32_t idx[SPHERE_SLICES * SPHERE_STACKS * 6];
+  int nv = 0, ni = 0;
+  for (int j = 0; j <= SPHERE_STACKS; j++) {
+    double th = M_PI * j / SPHERE_STACKS;
+    for (int i = 0; i <= SPHERE_SLICES; i++) {
+      double ph = 2 * M_PI * i / SPHERE_SLICES;
+      v[nv++] = (float)(sin(th) * cos(ph));
+      v[nv++] = (float)cos(th);
+      v[nv++] = (float)(sin(th) * sin(ph));
+    }
+  }
+  for (int j = 0; j < SPHERE_STACKS; j++)
+    for (int i = 0; i < SPHERE_SLICES; i++) {
+      uint32_t a = (uint32_t)(j * (SPHERE_SLICES + 1) + i), b = a + SPHERE_SLICES + 1;
+      uint32_t q[6] = {a, b, a + 1, a + 1, b, b + 1};
+      memcpy(idx + ni, q, sizeof q);
+      ni += 6;
+    }
+  r->sphere_nidx = ni;
+  gl->GenVertexArrays(1, &r->sphere_vao);
+  gl->BindVertexArray(r->sphere_vao);
+  gl->GenBuffers(1, &r->sphere_vbo);
+  gl->BindBuffer(GL_ARRAY_BUFFER, r->sphere_vbo);
+  gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nv * sizeof(float)), v, GL_STATIC_DRAW);
+  gl->EnableVertexAttribArray(0);
+  gl->VertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), 0);
+  gl->GenBuffers(1, &r->sphere_ebo);
+  gl->BindBuffer(GL_ELEMENT_ARRAY_BUFFER, r->sphere_ebo);
+  gl->BufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(ni * sizeof(uint32_t)), idx, GL_STATIC_DRAW);
+  gl->GenBuffers(1, &r->sphere_inst);
+  gl->BindBuffer(GL_ARRAY_BUFFER, r->sphere_inst);
+  gl->EnableVertexAttribArray(1);
+  gl->VertexAttribPointer(1, 4, GL_FLOAT, GL_FALSE, 7 * sizeof(float), 0);
+  gl->VertexAttribDivisor(1, 1);
+  gl->EnableVertexAttribArray(2);
+  gl->VertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, 7 * sizeof(float), (void*)(4 * sizeof(float)));
+  gl->VertexAttribDivisor(2, 1);
+  gl->BindVertexArray(0);
+}
+
+static void make_cylinder(tx_renderer* r) {
+  tx_gl* gl = &r->gl;
+  float v[CYL_SIDES * 6 * 3];
+  int nv = 0;
+  for (int i = 0; i < CYL_SIDES; i++) {
+    double a0 = 2 * M_PI * i / CYL_SIDES, a1 = 2 * M_PI * (i + 1) / CYL_SIDES;
+    float c0 = (float)cos(a0), s0 = (float)sin(a0), c1 = (float)cos(a1), s1 = (float)sin(a1);
+    float q[18] = {c0, 0, s0, c0, 1, s0, c1, 0, s1, c1, 0, s1, c0, 1, s0, c1, 1, s1};
+    memcpy(v + nv, q, sizeof q);
+    nv += 18;
+  }
+  r->cyl_nverts = nv / 3;
+  gl->GenVertexArrays(1, &r->cyl_vao);
+  gl->BindVertexArray(r->cyl_vao);
+  gl->GenBuffers(1, &r->cyl_vbo);
+  gl->BindBuffer(GL_ARRAY_BUFFER, r->cyl_vbo);
+  gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nv * sizeof(float)), v, GL_STATIC_DRAW);
+  gl->EnableVertexAttribArray(0);
+  gl->VertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), 0);
+  gl->GenBuffers(1, &r->cyl_inst);
+  gl->BindBuffer(GL_ARRAY_BUFFER, r->cyl_inst);
+  const GLsizei stride = 10 * sizeof(float);
+  gl->EnableVertexAttribArray(1);
+  gl->VertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride, 0);
+  gl->VertexAttribDivisor(1, 1);
+  gl->EnableVertexAttribArray(2);
+  gl->VertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, stride, (void*)(3 * sizeof(float)));
+  gl->VertexAttribDivisor(2, 1);
+  gl->EnableVertexAttribArray(3);
+  gl->VertexAttribPointer(3, 3, GL_FLOAT, GL_FALSE, stride, (void*)(7 * sizeof(float)));
+  gl->VertexAttribDivisor(3, 1);
+  gl->BindVertexArray(0);
+}
+
+tx_renderer* tx_renderer_create(tx_gl_loader load, char* err, size_t n) {
+  tx_renderer* r = calloc(1, sizeof *r);
+  if (!r) return snprintf(err, n, "out of memory"), NULL;
+  const char* missing = NULL;
+  if (!tx_gl_load(&r->gl, load, &missing)) {
+    snprintf(err, n, "the GL context lacks %s (GL 3.3 core is needed)", missing);
+    free(r);
+    return NULL;
+  }
+  tx_gl* gl = &r->gl;
+  if (!(r->mesh_prog = program(gl, mesh_vs, err, n)) || !(r->sphere_prog = program(gl, sphere_vs, err, n)) ||
+      !(r->cyl_prog = program(gl, cyl_vs, err, n))) {
+    tx_renderer_destroy(r);
+    return NULL;
+  }
+  make_sphere(r);
+  make_cylinder(r);
+  uint8_t* tex = malloc(SKIN_TEX * SKIN_TEX * 3);
+  if (!tex) {
+    tx_renderer_destroy(r);
+    return snprintf(err, n, "out of memory"), NULL;
+  }
+  tx_skin_texture(tex, SKIN_TEX);
+  gl->GenTextures(1, &r->skin_tex);
+  gl->BindTexture(GL_TEXTURE_2D, r->skin_tex);
+  gl->PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  gl->TexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, SKIN_TEX, SKIN_TEX, 0, GL_RGB, GL_UNSIGNED_BYTE, tex);
+  gl->GenerateMipmap(GL_TEXTURE_2D);
+  gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
+  gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  free(tex);
+  if (gl->GetError() != GL_NO_ERROR) {
+    tx_renderer_destroy(r);
+    return snprintf(err, n, "GL error while setting up the renderer"), NULL;
+  }
+  return r;
+}
+
+void tx_renderer_destroy(tx_renderer* r) {
+  if (!r) return;
+  tx_gl* gl = &r->gl;
+  if (gl->DeleteProgram) {
+    for (int i = 0; i < TX_DRAW_MAX * 2; i++) {
+      mesh_slot* m = &r->meshes[i];
+      if (m->vao) gl->DeleteVertexArrays(1, &m->vao), gl->DeleteBuffers(1, &m->vbo), gl->DeleteBuffers(1, &m->ebo);
+      free(m->verts);
+      free(m->idx);
+    }
+    if (r->sphere_vao) gl->DeleteVertexArrays(1, &r->sphere_vao);
+    if (r->cyl_vao) gl->DeleteVertexArrays(1, &r->cyl_vao);
+    GLuint bufs[5] = {r->sphere_vbo, r->sphere_ebo, r->sphere_inst, r->cyl_vbo, r->cyl_inst};
+    for (int i = 0; i < 5; i++)
+      if (bufs[i]) gl->DeleteBuffers(1, &bufs[i]);
+    if (r->skin_tex) gl->DeleteTextures(1, &r->skin_tex);
+    if (r->mesh_prog) gl->DeleteProgram(r->mesh_prog);
+    if (r->sphere_prog) gl->DeleteProgram(r->sphere_prog);
+    if (r->cyl_prog) gl->DeleteProgram(r->cyl_prog);
+  }
+  free(r->spheres);
+  free(r->cyls);
+  free(r);
+}
+
+const tx_gl* tx_renderer_gl(const tx_renderer* r) { return &r->gl; }
+uint64_t tx_renderer_skipped(const tx_renderer* r) { return r->skipped; }
+
+static bool grow(void** p, size_t* cap, size_t need, size_t elem) {
+  if (need <= *cap) return true;
+  size_t c = *cap ? *cap : 64;
+  while (c < need) c *= 2;
+  void* q = realloc(*p, c * elem);
+  if (!q) return false;
+  *p = q;
+  *cap = c;
+  return true;
+}
+
+static void include(tx_renderer* r, const float p[3], float pad) {
+  for (int i = 0; i < 3; i++) {
+    r->lo[i] = fmin(r->lo[i], p[i] - pad);
+    r->hi[i] = fmax(r->hi[i], p[i] + pad);
+  }
+  r->any = true;
+}
+
+static bool finite_n(const float* v, int n) {
+  for (int i = 0; i < n; i++)
+    if (!isfinite(v[i])) return false;
+  return true;
+}
+
+static void add_sphere(tx_renderer* r, const float c[3], float radius, const float colour[3]) {
+  if (!grow((void**)&r->spheres, &r->sphere_cap, r->nspheres + 1, 7 * sizeof(float))) return;
+  float* s = r->spheres + 7 * r->nspheres++;
+  memcpy(s, c, 3 * sizeof(float));
+  s[3] = radius;
+  memcpy(s + 4, colour, 3 * sizeof(float));
+  include(r, c, radius);
+}
+
+static void add_cylinder(tx_renderer* r, const float p0[3], const float p1[3], float radius, const float colour[3]) {
+  if (!grow((void**)&r->cyls, &r->cyl_cap, r->ncyls + 1, 10 * sizeof(float))) return;
+  float* s = r->cyls + 10 * r->ncyls++;
+  memcpy(s, p0, 3 * sizeof(float));
+  memcpy(s + 3, p1, 3 * sizeof(float));
+  s[6] = radius;
+  memcpy(s + 7, colour, 3 * sizeof(float));
+  include(r, p0, radius);
+  include(r, p1, radius);
+}
+
+// a planar texture projection: the two axes of largest extent of the first frame
+static void uv_basis(mesh_slot* m, const float* x, uint32_t nv) {
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (uint32_t i = 0; i < nv; i++)
+    for (int c = 0; c < 3; c++)
+      if (isfinite(x[3 * i + c])) lo[c] = fminf(lo[c], x[3 * i + c]), hi[c] = fmaxf(hi[c], x[3 * i + c]);
+  int flat = 0;
+  for (int c = 1; c < 3; c++)
+    if (hi[c] - lo[c] < hi[flat] - lo[flat]) flat = c;
+  int a = flat == 0 ? 1 : 0, b = flat == 2 ? 1 : 2;
+  m->uv_basis[0] = isfinite(lo[a]) ? lo[a] : 0;
+  m->uv_basis[1] = isfinite(lo[b]) ? lo[b] : 0;
+  m->uv_basis[2] = (float)a;
+  m->uv_basis[3] = (float)b;
+  m->uv_for = nv;
+}
+
+#define UV_PER_M 20.0f // the texture repeats every 5 cm
+
+// vertices with area-weighted normals, and the triangles whose indices are in range
+static void fill_mesh(tx_renderer* r, mesh_slot* m, const float* x, uint32_t nv, const int32_t* tri, uint32_t nt) {
+  if (!grow((void**)&m->verts, &m->vcap, nv, 8 * sizeof(float)) ||
+      !grow((void**)&m->idx, &m->icap, (size_t)nt * 3, sizeof(uint32_t))) {
+    m->nverts = m->nidx = 0;
+    return;
+  }
+  if (m->uv_for != nv) uv_basis(m, x, nv);
+  int a = (int)m->uv_basis[2], b = (int)m->uv_basis[3];
+  for (uint32_t i = 0; i < nv; i++) {
+    float* v = m->verts + 8 * i;
+    bool ok = finite_n(x + 3 * i, 3);
+    for (int c = 0; c < 3; c++) v[c] = ok ? x[3 * i + c] : 0, v[3 + c] = 0;
+    v[6] = (v[a] - m->uv_basis[0]) * UV_PER_M;
+    v[7] = (v[b] - m->uv_basis[1]) * UV_PER_M;
+    if (ok) include(r, v, 0);
+    else r->skipped++;
+  }
+  m->nidx = 0;
+  for (uint32_t t = 0; t < nt; t++) {
+    const int32_t* q = tri + 3 * t;
+    if (q[0] < 0 || q[1] < 0 || q[2] < 0 || (uint32_t)q[0] >= nv || (uint32_t)q[1] >= nv || (uint32_t)q[2] >= nv) {
+      r->skipped++;
+      continue;
+    }
+    float *p0 = m->verts + 8 * q[0], *p1 = m->verts + 8 * q[1], *p2 = m->verts + 8 * q[2];
+    float e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]}, e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+    float nrm[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+    for (int k = 0; k < 3; k++)
+      for (int c = 0; c < 3; c++) m->verts[8 * q[k] + 3 + c] += nrm[c];
+    for (int k = 0; k < 3; k++) m->idx[m->nidx++] = (uint32_t)q[k];
+  }
+  for (uint32_t i = 0; i < nv; i++) {
+    float* n = m->verts + 8 * i + 3;
+    float l = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (l > 0) n[0] /= l, n[1] /= l, n[2] /= l;
+    else n[1] = 1;
+  }
+  m->nverts = nv;
+}
+
+static mesh_slot* slot(tx_renderer* r) {
+  mesh_slot* m = &r->meshes[r->nmeshes++];
+  if (!m->vao) {
+    tx_gl* gl = &r->gl;
+    gl->GenVertexArrays(1, &m->vao);
+    gl->BindVertexArray(m->vao);
+    gl->GenBuffers(1, &m->vbo);
+    gl->GenBuffers(1, &m->ebo);
+    gl->BindBuffer(GL_ARRAY_BUFFER, m->vbo);
+    gl->BindBuffer(GL_ELEMENT_ARRAY_BUFFER, m->ebo);
+    for (int a = 0; a < 3; a++) gl->EnableVertexAttribArray((GLuint)a);
+    gl->VertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 8 * sizeof(float), 0);
+    gl->VertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 8 * sizeof(float), (void*)(3 * sizeof(float)));
+    gl->VertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, 8 * sizeof(float), (void*)(6 * sizeof(float)));
+    gl->BindVertexArray(0);
+  }
+  return m;
+}
+
+static void upload_mesh(tx_renderer* r, mesh_slot* m) {
+  tx_gl* gl = &r->gl;
+  gl->BindVertexArray(m->vao);
+  gl->BindBuffer(GL_ARRAY_BUFFER, m->vbo);
+  gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(m->nverts * 8 * sizeof(float)), m->verts, GL_STREAM_DRAW);
+  gl->BufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(m->nidx * sizeof(uint32_t)), m->idx, GL_STREAM_DRAW);
+  gl->BindVertexArray(0);
+}
+
+static void scalar_colour(const tx_draw_item* it, const float* scalar, uint32_t nscalar, uint32_t i, float out[3]) {
+  if (!scalar || i >= nscalar) {
+    memcpy(out, it->colour, 3 * sizeof(float));
+    return;
+  }
+  tx_colour_map((scalar[i] - it->range[0]) / (it->range[1] - it->range[0]), out);
+}
+
+// rotate v by the unit quaternion (w, x, y, z)
+static void rotate(const double q[4], const float v[3], float out[3]) {
+  double w = q[0], x = q[1], y = q[2], z = q[3];
+  double t[3] = {2 * (y * v[2] - z * v[1]), 2 * (z * v[0] - x * v[2]), 2 * (x * v[1] - y * v[0])};
+  out[0] = (float)(v[0] + w * t[0] + (y * t[2] - z * t[1]));
+  out[1] = (float)(v[1] + w * t[1] + (z * t[0] - x * t[2]));
+  out[2] = (float)(v[2] + w * t[2] + (x * t[1] - y * t[0]));
+}
+
+void tx_renderer_upload(tx_renderer* r, const tx_scene* s) {
+  r->nmeshes = 0;
+  r->nspheres = r->ncyls = 0;
+  r->any = false;
+  for (int i = 0; i < 3; i++) r->lo[i] = INFINITY, r->hi[i] = -INFINITY;
+  for (int k = 0; k < s->count; k++) {
+    const tx_scene_item* si = &s->items[k];
+    const tx_draw_item* it = si->item;
+    switch (it->kind) {
+    case TX_DRAW_MESH: {
+      mesh_slot* m = slot(r);
+      fill_mesh(r, m, si->data[0], si->rows[0], si->data[1], si->rows[1]);
+      memcpy(m->colour, it->colour, sizeof m->colour);
+      m->textured = it->skin_texture;
+      upload_mesh(r, m);
+      break;
+    }
+    case TX_DRAW_PLANE: {
+      // a square around the point, spanned by two directions normal to the plane's normal
+      const float* p = it->plane;
+      float nrm[3] = {p[3], p[4], p[5]}, t[3] = {0, 1, 0};
+      if (fabsf(nrm[1]) > 0.9f) t[0] = 1, t[1] = 0;
+      float u[3] = {t[1] * nrm[2] - t[2] * nrm[1], t[2] * nrm[0] - t[0] * nrm[2], t[0] * nrm[1] - t[1] * nrm[0]};
+      float lu = sqrtf(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+      for (int c = 0; c < 3; c++) u[c] /= lu;
+      float v[3] = {nrm[1] * u[2] - nrm[2] * u[1], nrm[2] * u[0] - nrm[0] * u[2], nrm[0] * u[1] - nrm[1] * u[0]};
+      float x[12];
+      const float corners[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+      for (int q = 0; q < 4; q++)
+        for (int c = 0; c < 3; c++) x[3 * q + c] = p[c] + p[6] * (corners[q][0] * u[c] + corners[q][1] * v[c]);
+      const int32_t tri[6] = {0, 1, 2, 0, 2, 3};
+      mesh_slot* m = slot(r);
+      fill_mesh(r, m, x, 4, tri, 2);
+      memcpy(m->colour, it->colour, sizeof m->colour);
+      m->textured = false;
+      upload_mesh(r, m);
+      break;
+    }
+    case TX_DRAW_SPHERES: {
+      const float* sp = si->data[0];
+      const float* scalar = *it->scalar ? si->data[1] : NULL;
+      uint32_t nscalar = *it->scalar ? si->rows[1] : 0;
+      for (uint32_t i = 0; i < si->rows[0]; i++) {
+        if (!finite_n(sp + 4 * i, 4) || !(sp[4 * i + 3] > 0)) {
+          r->skipped++;
+          continue;
+        }
+        float colour[3];
+        scalar_colour(it, scalar, nscalar, i, colour);
+        add_sphere(r, sp + 4 * i, sp[4 * i + 3], colour);
+      }
+      break;
+    }
+    case TX_DRAW_SEGMENTS: {
+      const float* sg = si->data[0];
+      const float* scalar = *it->scalar ? si->data[1] : NULL;
+      uint32_t nscalar = *it->scalar ? si->rows[1] : 0;
+      for (uint32_t i = 0; i < si->rows[0]; i++) {
+        if (!finite_n(sg + 7 * i, 7) || !(sg[7 * i + 6] > 0)) {
+          r->skipped++;
+          continue;
+        }
+        float colour[3];
+        scalar_colour(it, scalar, nscalar, i, colour);
+        add_cylinder(r, sg + 7 * i, sg + 7 * i + 3, sg[7 * i + 6], colour);
+      }
+      break;
+    }
+    case TX_DRAW_TOOL: {
+      const double* pose = si->data[0];
+      if (!si->rows[0]) break;
+      bool ok = true;
+      for (int c = 0; c < 7; c++) ok = ok && isfinite(pose[c]);
+      double qn = sqrt(pose[3] * pose[3] + pose[4] * pose[4] + pose[5] * pose[5] + pose[6] * pose[6]);
+      if (!ok || !(qn > 1e-9)) {
+        r->skipped++;
+        break;
+      }
+      double q[4] = {pose[3] / qn, pose[4] / qn, pose[5] / qn, pose[6] / qn};
+      float p[3] = {(float)pose[0], (float)pose[1], (float)pose[2]};
+      add_sphere(r, p, it->radius, it->colour);
+      // the instrument's shaft leaves the HIP along the tool's own +Y axis
+      const float axis[3] = {0, 16 * it->radius, 0}, grey[3] = {0.7f, 0.72f, 0.75f};
+      float a[3], tip[3];
+      rotate(q, axis, a);
+      for (int c = 0; c < 3; c++) tip[c] = p[c] + a[c];
+      add_cylinder(r, p, tip, 0.35f * it->radius, grey);
+      if (it->show_force && si->rows[1]) {
+        const double* f = si->data[1];
+        float end[3];
+        const float yellow[3] = {0.95f, 0.85f, 0.1f};
+        for (int c = 0; c < 3; c++) end[c] = p[c] + (float)f[c] * it->force_scale;
+        if (finite_n(end, 3)) add_cylinder(r, p, end, 0.45f * it->radius, yellow); // wider than the shaft it may run along
+      }
+      break;
+    }
+    }
+  }
+  tx_gl* gl = &r->gl;
+  // instance buffers keep their size and grow by doubling
+  if (r->nspheres) {
+    gl->BindBuffer(GL_ARRAY_BUFFER, r->sphere_inst);
+    if (r->nspheres > r->sphere_gpu_cap) {
+      r->sphere_gpu_cap = r->sphere_cap;
+      gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(r->sphere_gpu_cap * 7 * sizeof(float)), NULL, GL_STREAM_DRAW);
+    }
+    gl->BufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)(r->nspheres * 7 * sizeof(float)), r->spheres);
+  }
+  if (r->ncyls) {
+    gl->BindBuffer(GL_ARRAY_BUFFER, r->cyl_inst);
+    if (r->ncyls > r->cyl_gpu_cap) {
+      r->cyl_gpu_cap = r->cyl_cap;
+      gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(r->cyl_gpu_cap * 10 * sizeof(float)), NULL, GL_STREAM_DRAW);
+    }
+    gl->BufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)(r->ncyls * 10 * sizeof(float)), r->cyls);
+  }
+}
+
+bool tx_renderer_bounds(const tx_renderer* r, double lo[3], double hi[3]) {
+  if (!r->any) return false;
+  memcpy(lo, r->lo, sizeof r->lo);
+  memcpy(hi, r->hi, sizeof r->hi);
+  return true;
+}
+
+static void common_uniforms(tx_renderer* r, GLuint prog, const tx_view_def* d, const float view[16], const float proj[16],
+                            const double eye[3]) {
+  tx_gl* gl = &r->gl;
+  gl->UseProgram(prog);
+  gl->UniformMatrix4fv(gl->GetUniformLocation(prog, "u_proj"), 1, GL_FALSE, proj);
+  gl->UniformMatrix4fv(gl->GetUniformLocation(prog, "u_view"), 1, GL_FALSE, view);
+  gl->Uniform3fv(gl->GetUniformLocation(prog, "u_light"), 1, d->light_dir);
+  // view matrix rows: the third is the camera's backward axis, towards the viewer
+  float back[3] = {view[2], view[6], view[10]}, half[3];
+  float hl = 0;
+  for (int i = 0; i < 3; i++) half[i] = back[i] - d->light_dir[i], hl += half[i] * half[i];
+  hl = hl > 0 ? sqrtf(hl) : 1;
+  for (int i = 0; i < 3; i++) half[i] /= hl;
+  gl->Uniform3fv(gl->GetUniformLocation(prog, "u_view_dir"), 1, back);
+  gl->Uniform3fv(gl->GetUniformLocation(prog, "u_half"), 1, half);
+  (void)eye;
+  const float lighting[4] = {TX_LIGHT_AMBIENT, TX_LIGHT_DIFFUSE, TX_LIGHT_SPECULAR, TX_LIGHT_SHININESS};
+  gl->Uniform4fv(gl->GetUniformLocation(prog, "u_lighting"), 1, lighting);
+  gl->Uniform1i(gl->GetUniformLocation(prog, "u_textured"), 0);
+  gl->Uniform1i(gl->GetUniformLocation(prog, "u_tex"), 0);
+}
+
+void tx_renderer_draw(tx_renderer* r, const tx_view_def* d, const tx_camera* c, tx_eye eye, int x, int y, int w, int h,
+                      bool clear_colour) {
+  tx_gl* gl = &r->gl;
+  float view[16], proj[16];
+  tx_camera_matrices(c, eye, (double)w / (double)h, view, proj);
+  double e[3];
+  tx_camera_eye_position(c, eye, e);
+  gl->Viewport(x, y, w, h);
+  gl->Enable(GL_SCISSOR_TEST);
+  gl->Scissor(x, y, w, h);
+  gl->ClearColor(d->background[0], d->background[1], d->background[2], 1);
+  gl->Clear(GL_DEPTH_BUFFER_BIT | (clear_colour ? GL_COLOR_BUFFER_BIT : 0));
+  gl->Disable(GL_SCISSOR_TEST);
+  gl->Enable(GL_DEPTH_TEST);
+
+  common_uniforms(r, r->mesh_prog, d, view, proj, e);
+  gl->ActiveTexture(GL_TEXTURE0);
+  gl->BindTexture(GL_TEXTURE_2D, r->skin_tex);
+  GLint colour_at = gl->GetUniformLocation(r->mesh_prog, "u_colour"),
+        textured_at = gl->GetUniformLocation(r->mesh_prog, "u_textured");
+  for (int i = 0; i < r->nmeshes; i++) {
+    mesh_slot* m = &r->meshes[i];
+    if (!m->nidx) continue;
+    gl->Uniform3fv(colour_at, 1, m->colour);
+    gl->Uniform1i(textured_at, m->textured);
+    gl->BindVertexArray(m->vao);
+    gl->DrawElements(GL_TRIANGLES, (GLsizei)m->nidx, GL_UNSIGNED_INT, 0);
+  }
+  if (r->nspheres) {
+    common_uniforms(r, r->sphere_prog, d, view, proj, e);
+    gl->BindVertexArray(r->sphere_vao);
+    gl->DrawElementsInstanced(GL_TRIANGLES, r->sphere_nidx, GL_UNSIGNED_INT, 0, (GLsizei)r->nspheres);
+  }
+  if (r->ncyls) {
+    common_uniforms(r, r->cyl_prog, d, view, proj, e);
+    gl->BindVertexArray(r->cyl_vao);
+    gl->DrawArraysInstanced(GL_TRIANGLES, 0, r->cyl_nverts, (GLsizei)r->ncyls);
+  }
+  gl->BindVertexArray(0);
+}

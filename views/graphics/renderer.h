@@ -1,0 +1,57 @@
+// Internal: draws a view's items with GL 3.3 core (on OSMesa or in a GLFW
+// window): triangle meshes with a procedural skin texture, instanced spheres
+// and cylinders, tools, planes; per-pixel Blinn-Phong lighting from one
+// directional light, two-sided. Needs a current context; one renderer per context.
+//
+//     tx_renderer* r = tx_renderer_create(loader, err, sizeof err);
+//     tx_renderer_upload(r, &def, &scene);                  // once per frame
+//     tx_renderer_draw(r, &def, &def.camera, TX_EYE_LEFT, 0, 0, w, h);
+//     tx_renderer_draw(r, &def, &def.camera, TX_EYE_RIGHT, w, 0, w, h);
+#ifndef TX_VIEWS_GRAPHICS_RENDERER_H
+#define TX_VIEWS_GRAPHICS_RENDERER_H
+
+#include "gl.h"
+#include "view_def.h"
+
+#include <stdint.h>
+
+// the lighting model, shared with the tests that check a lit pixel:
+// colour = base * (AMBIENT + DIFFUSE * max(n.l, 0)) + SPECULAR * max(n.h, 0)^32 (where n.l > 0),
+// l towards the light, h the half vector of l and the direction to the viewer (at infinity)
+#define TX_LIGHT_AMBIENT 0.25f
+#define TX_LIGHT_DIFFUSE 0.65f
+#define TX_LIGHT_SPECULAR 0.2f
+#define TX_LIGHT_SHININESS 32.0f // five squarings in the shader
+
+typedef struct tx_scene_item {
+  const tx_draw_item* item;
+  const void* data[3]; // the item's components, in tx_draw_item_components order
+  uint32_t rows[3];    // rows in use of each
+} tx_scene_item;
+
+typedef struct tx_scene {
+  tx_scene_item items[TX_DRAW_MAX];
+  int count;
+} tx_scene;
+
+typedef struct tx_renderer tx_renderer;
+
+tx_renderer* tx_renderer_create(tx_gl_loader load, char* err, size_t n);
+void tx_renderer_destroy(tx_renderer* r);
+const tx_gl* tx_renderer_gl(const tx_renderer* r);
+// take one frame's geometry (shared by both eyes); rows that are not finite or
+// index past the vertices are skipped and counted
+void tx_renderer_upload(tx_renderer* r, const tx_scene* s);
+// the box around what the last upload holds, m; false when it holds nothing
+bool tx_renderer_bounds(const tx_renderer* r, double lo[3], double hi[3]);
+// clear the viewport (colour too when clear_colour) and draw one eye into it
+void tx_renderer_draw(tx_renderer* r, const tx_view_def* d, const tx_camera* c, tx_eye eye, int x, int y, int w, int h,
+                      bool clear_colour);
+// rows skipped so far as not finite or out of range
+uint64_t tx_renderer_skipped(const tx_renderer* r);
+// scalar to colour along the map (blue, cyan, green, yellow, red) for t in [0, 1]
+void tx_colour_map(float t, float rgb[3]);
+// the procedural skin texture, size x size RGB (for tests and the renderer)
+void tx_skin_texture(uint8_t* rgb, int size);
+
+#endif

@@ -1,0 +1,350 @@
+// A scenario's "view" object to a checked tx_view_def.
+#include "view_def.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+tx_view_def tx_view_def_default(void) {
+  tx_view_def d = {.camera = tx_camera_default(), .auto_camera = true, .width = 640, .height = 480, .frame_every = 10,
+                   .background = {0.12f, 0.13f, 0.16f}, .light_dir = {-0.3f, -1.0f, -0.5f}};
+  float l = sqrtf(d.light_dir[0] * d.light_dir[0] + d.light_dir[1] * d.light_dir[1] + d.light_dir[2] * d.light_dir[2]);
+  for (int i = 0; i < 3; i++) d.light_dir[i] /= l;
+  return d;
+}
+
+typedef struct where {
+  char* key;
+  size_t kn;
+  char* msg;
+  size_t mn;
+} where;
+
+static int bad(const where* w, const char* key, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
+static int bad(const where* w, const char* key, const char* fmt, ...) {
+  snprintf(w->key, w->kn, "%s", key);
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(w->msg, w->mn, fmt, ap);
+  va_end(ap);
+  return -1;
+}
+
+static const char* kind_of(const json_t* v) {
+  switch (json_typeof(v)) {
+  case JSON_OBJECT: return "an object";
+  case JSON_ARRAY: return "an array";
+  case JSON_STRING: return "a string";
+  case JSON_INTEGER: case JSON_REAL: return "a number";
+  case JSON_TRUE: case JSON_FALSE: return "a boolean";
+  default: return "null";
+  }
+}
+
+static int check_keys(const where* w, const char* at, const json_t* obj, const char* const* known) {
+  const char* k;
+  json_t* v;
+  json_object_foreach((json_t*)obj, k, v) {
+    bool ok = false;
+    for (const char* const* q = known; *q && !ok; q++) ok = strcmp(*q, k) == 0;
+    if (ok) continue;
+    char list[256] = "", key[160];
+    for (const char* const* q = known; *q; q++) {
+      size_t len = strlen(list);
+      snprintf(list + len, sizeof list - len, "%s%s", len ? ", " : "", *q);
+    }
+    snprintf(key, sizeof key, "%s%s%s", at, *at ? "." : "", k);
+    return bad(w, key, "unknown key (known: %s)", list);
+  }
+  return 0;
+}
+
+// n finite numbers in [lo, hi]
+static int numbers(const where* w, const char* key, const json_t* v, int n, double lo, double hi, double* out) {
+  if (!json_is_array(v) || (int)json_array_size(v) != n)
+    return bad(w, key, "expected an array of %d numbers, got %s", n, kind_of(v));
+  for (int i = 0; i < n; i++) {
+    const json_t* e = json_array_get(v, (size_t)i);
+    double x = json_number_value(e);
+    if (!json_is_number(e) || !isfinite(x) || x < lo || x > hi)
+      return bad(w, key, "entry %d: expected a number in [%g, %g]", i, lo, hi);
+    out[i] = x;
+  }
+  return 0;
+}
+
+static int number(const where* w, const char* key, const json_t* v, double lo, double hi, bool open_lo, double* out) {
+  double x = json_number_value(v);
+  if (!json_is_number(v) || !isfinite(x) || x < lo || x > hi || (open_lo && x == lo))
+    return bad(w, key, "expected a number in %s%g, %g], got %s", open_lo ? "(" : "[", lo, hi,
+               json_is_number(v) ? "an out-of-range number" : kind_of(v));
+  *out = x;
+  return 0;
+}
+
+static int integer(const where* w, const char* key, const json_t* v, int lo, int hi, int* out) {
+  if (!json_is_integer(v) || json_integer_value(v) < lo || json_integer_value(v) > hi)
+    return bad(w, key, "expected an integer in [%d, %d]", lo, hi);
+  *out = (int)json_integer_value(v);
+  return 0;
+}
+
+// component prefixes: the model's name characters, short enough for a suffix
+static bool plain_name(const char* s) {
+  if (!*s || strlen(s) > TX_NAME_MAX - 10) return false;
+  for (; *s; s++)
+    if (!((*s >= 'a' && *s <= 'z') || (*s >= '0' && *s <= '9') || *s == '_' || *s == '.')) return false;
+  return true;
+}
+
+static int read_camera(const where* w, const json_t* cam, tx_view_def* d) {
+  static const char* const keys[] = {"eye", "target", "up", "fov_deg", "near_m", "far_m", NULL};
+  if (!json_is_object(cam)) return bad(w, "camera", "expected an object, got %s", kind_of(cam));
+  if (check_keys(w, "camera", cam, keys)) return -1;
+  tx_camera* c = &d->camera;
+  const json_t* v;
+  if ((v = json_object_get(cam, "eye")) && numbers(w, "camera.eye", v, 3, -1e4, 1e4, c->eye)) return -1;
+  if ((v = json_object_get(cam, "target")) && numbers(w, "camera.target", v, 3, -1e4, 1e4, c->target)) return -1;
+  if ((v = json_object_get(cam, "up")) && numbers(w, "camera.up", v, 3, -1e4, 1e4, c->up)) return -1;
+  double deg = c->fov_y * 180 / M_PI;
+  if ((v = json_object_get(cam, "fov_deg")) && number(w, "camera.fov_deg", v, 1, 170, false, &deg)) return -1;
+  c->fov_y = deg * M_PI / 180;
+  if ((v = json_object_get(cam, "near_m")) && number(w, "camera.near_m", v, 0, 100, true, &c->near_m)) return -1;
+  if ((v = json_object_get(cam, "far_m")) && number(w, "camera.far_m", v, 0, 1e5, true, &c->far_m)) return -1;
+  double dx = c->target[0] - c->eye[0], dy = c->target[1] - c->eye[1], dz = c->target[2] - c->eye[2];
+  c->convergence = sqrt(dx * dx + dy * dy + dz * dz); // the target is on the zero-parallax plane unless told otherwise
+  d->auto_camera = false;
+  const char* problem = tx_camera_check(c);
+  if (problem) return bad(w, "camera", "%s", problem);
+  return 0;
+}
+
+static int read_item(const where* w, size_t i, const json_t* e, tx_draw_item* it) {
+  static const char* const keys[] = {"mesh", "spheres", "segments", "tool", "plane", "colour", "colour_by",
+                                     "range", "texture", "radius_m", "show_force", "force_scale_m_per_n", NULL};
+  char at[48], key[96];
+  snprintf(at, sizeof at, "draw[%zu]", i);
+  if (!json_is_object(e)) return bad(w, at, "expected an object, got %s", kind_of(e));
+  if (check_keys(w, at, e, keys)) return -1;
+  static const struct { const char* key; tx_draw_kind kind; } kinds[] = {
+      {"mesh", TX_DRAW_MESH}, {"spheres", TX_DRAW_SPHERES}, {"segments", TX_DRAW_SEGMENTS}, {"tool", TX_DRAW_TOOL},
+      {"plane", TX_DRAW_PLANE}};
+  *it = (tx_draw_item){.colour = {0.8f, 0.8f, 0.8f}, .range = {0, 1}, .radius = 0.005f, .force_scale = 0.01f};
+  for (size_t k = 0; k < sizeof kinds / sizeof kinds[0]; k++) {
+    const json_t* v = json_object_get(e, kinds[k].key);
+    if (!v) continue;
+    if (it->kind) return bad(w, at, "expected exactly one of mesh, spheres, segments, tool, plane");
+    it->kind = kinds[k].kind;
+    snprintf(key, sizeof key, "%s.%s", at, kinds[k].key);
+    if (it->kind == TX_DRAW_PLANE) {
+      static const char* const pkeys[] = {"point", "normal", "size_m", NULL};
+      if (!json_is_object(v)) return bad(w, key, "expected an object, got %s", kind_of(v));
+      if (check_keys(w, key, v, pkeys)) return -1;
+      double p[3] = {0, 0, 0}, nrm[3] = {0, 1, 0}, size = 0.2;
+      const json_t* q;
+      char sub[128];
+      snprintf(sub, sizeof sub, "%s.point", key);
+      if ((q = json_object_get(v, "point")) && numbers(w, sub, q, 3, -1e4, 1e4, p)) return -1;
+      snprintf(sub, sizeof sub, "%s.normal", key);
+      if ((q = json_object_get(v, "normal")) && numbers(w, sub, q, 3, -1e4, 1e4, nrm)) return -1;
+      double l = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+      if (!(l > 1e-6)) return bad(w, sub, "expected a non-zero direction");
+      snprintf(sub, sizeof sub, "%s.size_m", key);
+      if ((q = json_object_get(v, "size_m")) && number(w, sub, q, 0, 1e4, true, &size)) return -1;
+      for (int c = 0; c < 3; c++) it->plane[c] = (float)p[c], it->plane[3 + c] = (float)(nrm[c] / l);
+      it->plane[6] = (float)(size / 2);
+      continue;
+    }
+    if (!json_is_string(v) || !plain_name(json_string_value(v)))
+      return bad(w, key, "expected a component prefix of 1-%d characters of a-z 0-9 _ .", TX_NAME_MAX - 10);
+    snprintf(it->name, sizeof it->name, "%s", json_string_value(v));
+  }
+  if (!it->kind) return bad(w, at, "expected one of mesh, spheres, segments, tool, plane");
+  double tmp[3];
+  const json_t* v;
+  snprintf(key, sizeof key, "%s.colour", at);
+  if ((v = json_object_get(e, "colour"))) {
+    if (numbers(w, key, v, 3, 0, 1, tmp)) return -1;
+    for (int c = 0; c < 3; c++) it->colour[c] = (float)tmp[c];
+  } else if (it->kind == TX_DRAW_TOOL) {
+    it->colour[0] = 0.85f, it->colour[1] = 0.25f, it->colour[2] = 0.2f;
+  } else if (it->kind == TX_DRAW_PLANE) {
+    it->colour[0] = 0.45f, it->colour[1] = 0.5f, it->colour[2] = 0.6f;
+  }
+  snprintf(key, sizeof key, "%s.colour_by", at);
+  if ((v = json_object_get(e, "colour_by"))) {
+    if (it->kind != TX_DRAW_SPHERES && it->kind != TX_DRAW_SEGMENTS)
+      return bad(w, key, "only spheres and segments take a colour map");
+    if (!json_is_string(v) || !plain_name(json_string_value(v)))
+      return bad(w, key, "expected a component name such as tissue.damage");
+    snprintf(it->scalar, sizeof it->scalar, "%s", json_string_value(v));
+  }
+  snprintf(key, sizeof key, "%s.range", at);
+  if ((v = json_object_get(e, "range"))) {
+    if (!*it->scalar) return bad(w, key, "a range needs colour_by");
+    if (numbers(w, key, v, 2, -1e30, 1e30, tmp)) return -1;
+    if (!(tmp[1] > tmp[0])) return bad(w, key, "expected [low, high] with low < high");
+    it->range[0] = (float)tmp[0], it->range[1] = (float)tmp[1];
+  }
+  snprintf(key, sizeof key, "%s.texture", at);
+  it->skin_texture = it->kind == TX_DRAW_MESH && !json_object_get(e, "colour");
+  if ((v = json_object_get(e, "texture"))) {
+    if (it->kind != TX_DRAW_MESH) return bad(w, key, "only meshes take a texture");
+    const char* t = json_string_value(v);
+    if (!t || (strcmp(t, "skin") != 0 && strcmp(t, "none") != 0)) return bad(w, key, "expected \"skin\" or \"none\"");
+    it->skin_texture = strcmp(t, "skin") == 0;
+  }
+  double x;
+  snprintf(key, sizeof key, "%s.radius_m", at);
+  if ((v = json_object_get(e, "radius_m"))) {
+    if (it->kind != TX_DRAW_TOOL) return bad(w, key, "only tools take a radius");
+    if (number(w, key, v, 0, 1, true, &x)) return -1;
+    it->radius = (float)x;
+  }
+  snprintf(key, sizeof key, "%s.show_force", at);
+  if ((v = json_object_get(e, "show_force"))) {
+    if (it->kind != TX_DRAW_TOOL) return bad(w, key, "only tools show a force");
+    if (!json_is_boolean(v)) return bad(w, key, "expected true or false, got %s", kind_of(v));
+    it->show_force = json_is_true(v);
+  }
+  snprintf(key, sizeof key, "%s.force_scale_m_per_n", at);
+  if ((v = json_object_get(e, "force_scale_m_per_n"))) {
+    if (it->kind != TX_DRAW_TOOL) return bad(w, key, "only tools show a force");
+    if (number(w, key, v, 0, 10, true, &x)) return -1;
+    it->force_scale = (float)x;
+  }
+  return 0;
+}
+
+int tx_view_def_from_json(const json_t* view, tx_view_def* d, char* key, size_t kn, char* msg, size_t mn) {
+  where w = {key, kn, msg, mn};
+  static const char* const keys[] = {"rate_hz", "width", "height", "frame_every", "camera", "stereo",
+                                     "background", "light", "draw", NULL};
+  if (!json_is_object(view)) return bad(&w, "", "expected an object, got %s", kind_of(view));
+  if (check_keys(&w, "", view, keys)) return -1;
+  const json_t* v;
+  if ((v = json_object_get(view, "rate_hz"))) {
+    double hz;
+    if (number(&w, "rate_hz", v, 0, 1000, true, &hz)) return -1;
+  }
+  if ((v = json_object_get(view, "width")) && integer(&w, "width", v, 16, TX_VIEW_SIDE_MAX, &d->width)) return -1;
+  if ((v = json_object_get(view, "height")) && integer(&w, "height", v, 16, TX_VIEW_SIDE_MAX, &d->height)) return -1;
+  if ((v = json_object_get(view, "frame_every")) && integer(&w, "frame_every", v, 1, 1000000, &d->frame_every))
+    return -1;
+  if ((v = json_object_get(view, "camera")) && read_camera(&w, v, d)) return -1;
+  if ((v = json_object_get(view, "stereo"))) {
+    static const char* const skeys[] = {"interaxial_m", "convergence_m", NULL};
+    if (!json_is_object(v)) return bad(&w, "stereo", "expected an object, got %s", kind_of(v));
+    if (check_keys(&w, "stereo", v, skeys)) return -1;
+    const json_t* q;
+    if ((q = json_object_get(v, "interaxial_m")) && number(&w, "stereo.interaxial_m", q, 0, 1, false, &d->camera.interaxial))
+      return -1;
+    d->interaxial_given = q != NULL;
+    if ((q = json_object_get(v, "convergence_m")) &&
+        number(&w, "stereo.convergence_m", q, 0, 1e4, true, &d->camera.convergence))
+      return -1;
+    d->convergence_given = q != NULL;
+  }
+  double c[3];
+  if ((v = json_object_get(view, "background"))) {
+    if (numbers(&w, "background", v, 3, 0, 1, c)) return -1;
+    for (int i = 0; i < 3; i++) d->background[i] = (float)c[i];
+  }
+  if ((v = json_object_get(view, "light"))) {
+    if (numbers(&w, "light", v, 3, -1e4, 1e4, c)) return -1;
+    double l = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    if (!(l > 1e-6)) return bad(&w, "light", "expected a non-zero direction");
+    for (int i = 0; i < 3; i++) d->light_dir[i] = (float)(c[i] / l);
+  }
+  // the 1/30 rule of stereography: comfortable depth for a scene at the convergence distance
+  if (!d->interaxial_given) d->camera.interaxial = d->camera.convergence / 30;
+  if ((v = json_object_get(view, "draw"))) {
+    if (!json_is_array(v) || json_array_size(v) == 0 || json_array_size(v) > TX_DRAW_MAX)
+      return bad(&w, "draw", "expected an array of 1 to %d entries", TX_DRAW_MAX);
+    d->nitems = 0;
+    size_t i;
+    json_t* e;
+    json_array_foreach(v, i, e) {
+      if (read_item(&w, i, e, &d->items[d->nitems])) return -1;
+      d->nitems++;
+    }
+  }
+  return 0;
+}
+
+static bool has(const char* const* written, int count, const char* name) {
+  for (int i = 0; i < count; i++)
+    if (strcmp(written[i], name) == 0) return true;
+  return false;
+}
+
+// NAME from "NAME.suffix" when the written name ends in that suffix
+static bool prefix_of(const char* comp, const char* suffix, char out[TX_NAME_MAX]) {
+  size_t n = strlen(comp), s = strlen(suffix);
+  if (n <= s || strcmp(comp + n - s, suffix) != 0 || n - s >= TX_NAME_MAX - 10) return false;
+  memcpy(out, comp, n - s);
+  out[n - s] = 0;
+  return true;
+}
+
+int tx_view_def_auto_draw(tx_view_def* d, const char* const* written, int count) {
+  d->nitems = 0;
+  static const char* const scalars[] = {"damage", "temperature", NULL};
+  for (int i = 0; i < count && d->nitems < TX_DRAW_MAX; i++) {
+    char name[TX_NAME_MAX], other[TX_NAME_MAX + 16];
+    tx_draw_item it = {.colour = {0.8f, 0.8f, 0.8f}, .range = {0, 1}, .radius = 0.005f, .force_scale = 0.01f};
+    if (prefix_of(written[i], ".x", name)) {
+      snprintf(other, sizeof other, "%s.tri", name);
+      if (!has(written, count, other)) continue;
+      it.kind = TX_DRAW_MESH;
+      it.skin_texture = true;
+    } else if (prefix_of(written[i], ".spheres", name)) {
+      it.kind = TX_DRAW_SPHERES;
+      for (const char* const* q = scalars; *q && !*it.scalar; q++) {
+        snprintf(other, sizeof other, "%s.%s", name, *q);
+        if (has(written, count, other) && strlen(other) < sizeof it.scalar) memcpy(it.scalar, other, strlen(other) + 1);
+      }
+    } else if (prefix_of(written[i], ".segments", name)) {
+      it.kind = TX_DRAW_SEGMENTS;
+      it.colour[0] = 0.9f, it.colour[1] = 0.85f, it.colour[2] = 0.5f;
+    } else if (prefix_of(written[i], ".pose", name) && strncmp(name, "device", 6) == 0) {
+      it.kind = TX_DRAW_TOOL;
+      it.colour[0] = 0.85f, it.colour[1] = 0.25f, it.colour[2] = 0.2f;
+      snprintf(other, sizeof other, "%s.force", name);
+      it.show_force = has(written, count, other);
+    } else {
+      continue;
+    }
+    memcpy(it.name, name, sizeof it.name);
+    d->items[d->nitems++] = it;
+  }
+  return d->nitems;
+}
+
+// prefix + suffix into a component name; prefixes are checked short enough on input
+static void join(char out[TX_NAME_MAX], const char* prefix, const char* suffix) {
+  size_t k = 0;
+  for (; *prefix && k < TX_NAME_MAX - 1; prefix++) out[k++] = *prefix;
+  for (; *suffix && k < TX_NAME_MAX - 1; suffix++) out[k++] = *suffix;
+  out[k] = 0;
+}
+
+int tx_draw_item_components(const tx_draw_item* it, char out[3][TX_NAME_MAX]) {
+  int n = 0;
+  switch (it->kind) {
+  case TX_DRAW_MESH:
+    join(out[n++], it->name, ".x");
+    join(out[n++], it->name, ".tri");
+    break;
+  case TX_DRAW_SPHERES: join(out[n++], it->name, ".spheres"); break;
+  case TX_DRAW_SEGMENTS: join(out[n++], it->name, ".segments"); break;
+  case TX_DRAW_TOOL:
+    join(out[n++], it->name, ".pose");
+    if (it->show_force) join(out[n++], it->name, ".force");
+    break;
+  case TX_DRAW_PLANE: break;
+  }
+  if (*it->scalar) join(out[n++], it->scalar, "");
+  return n;
+}

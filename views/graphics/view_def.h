@@ -1,0 +1,65 @@
+// Internal: what a graphics view draws and from where, read from a scenario's
+// "view" object (docs/views.md). No GL here: the loader checks a "view" even in
+// a build without graphics.
+//
+//     tx_view_def d = tx_view_def_default();
+//     char key[128], msg[256];
+//     if (tx_view_def_from_json(json, &d, key, sizeof key, msg, sizeof msg)) error at "view.KEY: MSG"
+//
+// Drawn components follow the model's naming conventions:
+//   mesh NAME      NAME.x (f32 N x 3, m) and NAME.tri (i32 M x 3, vertex indices)
+//   spheres NAME   NAME.spheres (f32 N x 4: x y z radius, m), optional scalar NAME.Q (f32 N x 1)
+//   segments NAME  NAME.segments (f32 N x 7: x0 y0 z0 x1 y1 z1 radius, m)
+//   tool NAME      NAME.pose (f64 1 x 7: x y z m, qw qx qy qz), optional NAME.force (f64 1 x 3, N)
+//   plane          a fixed square (no component): point, normal and size in the view itself
+#ifndef TX_VIEWS_GRAPHICS_VIEW_DEF_H
+#define TX_VIEWS_GRAPHICS_VIEW_DEF_H
+
+#include "stereo.h"
+
+#include <tactus/model.h>
+
+#include <jansson.h>
+#include <stdbool.h>
+#include <stddef.h>
+
+#define TX_DRAW_MAX 16     // draw entries of one view
+#define TX_VIEW_SIDE_MAX 4096 // px, largest width or height of one eye
+
+typedef enum tx_draw_kind { TX_DRAW_MESH = 1, TX_DRAW_SPHERES, TX_DRAW_SEGMENTS, TX_DRAW_TOOL, TX_DRAW_PLANE } tx_draw_kind;
+
+typedef struct tx_draw_item {
+  tx_draw_kind kind;
+  char name[TX_NAME_MAX];   // component prefix ("skin" for skin.x and skin.tri); "" for a plane
+  char scalar[TX_NAME_MAX]; // colour-map component, e.g. "tissue.damage" (f32 N x 1); "" for a plain colour
+  float colour[3];          // 1, linear RGB in [0, 1]
+  float range[2];           // scalar values mapped to the ends of the colour map
+  bool skin_texture;        // meshes: the procedural skin texture instead of the plain colour
+  bool show_force;          // tools: a line along NAME.force
+  float radius;             // m, tools: radius of the HIP sphere
+  float force_scale;        // m/N, tools: length of the force line per newton
+  float plane[7];           // planes: point (m), unit normal, half size (m)
+} tx_draw_item;
+
+typedef struct tx_view_def {
+  tx_camera camera;       // cyclopean camera and the stereo geometry
+  bool auto_camera;       // no "camera" given: frame the first snapshot's bounding box
+  bool interaxial_given;  // stereo.interaxial_m was given; else it is the convergence distance / 30
+  bool convergence_given; // stereo.convergence_m was given; else the eye-target distance
+  int width, height;      // px, one eye's image
+  int frame_every;        // png: write every Nth rendered frame (and the last)
+  float background[3];    // 1, linear RGB
+  float light_dir[3];     // 1, direction the light shines from (towards the scene), unit
+  tx_draw_item items[TX_DRAW_MAX];
+  int nitems;
+} tx_view_def;
+
+tx_view_def tx_view_def_default(void);
+// read a "view" object (rate_hz is the caller's); 0, or -1 with the key path (relative to the view) and a message
+int tx_view_def_from_json(const json_t* view, tx_view_def* d, char* key, size_t kn, char* msg, size_t mn);
+// draw entries for every component that follows the naming conventions, from the names written in a model
+int tx_view_def_auto_draw(tx_view_def* d, const char* const* written, int count);
+// the components an item reads, in order; returns how many (at most 3)
+int tx_draw_item_components(const tx_draw_item* it, char out[3][TX_NAME_MAX]);
+
+#endif
