@@ -2,8 +2,13 @@
 #include "loader.h"
 #include "rates/rates_worker.h"
 
+#include <tactus/config.h>
+
 #include "../controllers/collision/wall.h"
 #include "../controllers/haptics/haptics_controller.h"
+#if TX_WITH_BULLET
+#include "../controllers/physics/skin_controller.h"
+#endif
 
 #include <pthread.h>
 
@@ -11,6 +16,9 @@ static void register_all(void) {
   tx_register_controller(&tx_rates_worker);
   tx_register_controller(&tx_collision_wall);
   tx_register_controller(&tx_haptics_controller);
+#if TX_WITH_BULLET
+  tx_register_controller(&tx_physics_skin);
+#endif
 }
 
 void tx_register_builtin(void) {
