@@ -2,6 +2,7 @@
 #include "loader.h"
 #include "rates/rates_worker.h"
 
+#include "../controllers/collision/hip_collision.h"
 #include "../controllers/collision/wall.h"
 #include "../controllers/haptics/haptics_controller.h"
 
@@ -10,6 +11,7 @@
 static void register_all(void) {
   tx_register_controller(&tx_rates_worker);
   tx_register_controller(&tx_collision_wall);
+  tx_register_controller(&tx_collision_hip);
   tx_register_controller(&tx_haptics_controller);
 }
 

@@ -1,0 +1,108 @@
+// The simplified method: per-ray contact points, eq. 5, 7 and 8 of the
+// SutureHap conference paper (eq. 3 of the journal paper).
+#include "hip.h"
+
+#include "../range_check.h"
+
+#include <math.h>
+#include <string.h>
+
+tx_hip_def tx_hip_def_default(void) {
+  return (tx_hip_def){
+      .radius = 0.0005, // 0.05 cm
+      .rays = 26,
+      .alpha = 20.0, // 0.2 N/cm
+      .k = 0.3,
+      .slide_max = 0.003, // 0.3 cm
+      .pierce_range = 0.01,
+  };
+}
+
+const char* tx_hip_def_check(const tx_hip_def* d) {
+  const char* e;
+  if ((e = tx_check_range("hip", "radius", d->radius, 0, true, 0.05, false, "m"))) return e;
+  if (d->rays != 26 && d->rays != 98) return tx_check_fail("hip: rays = %d, must be 26 or 98", d->rays);
+  if ((e = tx_check_range("hip", "alpha", d->alpha, 0, false, 1e6, false, "N/m"))) return e;
+  if ((e = tx_check_range("hip", "k", d->k, 0, false, 1, true, "1"))) return e;
+  if ((e = tx_check_range("hip", "slide_max", d->slide_max, 0, true, 1, false, "m"))) return e;
+  if ((e = tx_check_range("hip", "pierce_range", d->pierce_range, 0, true, 1, false, "m"))) return e;
+  return NULL;
+}
+
+void tx_hip_init(tx_hip* h, const tx_hip_def* def) {
+  memset(h, 0, sizeof *h);
+  h->def = *def;
+  h->nrays = tx_hip_rays(def->rays, h->dir);
+}
+
+void tx_hip_reset(tx_hip* h) {
+  memset(h->on, 0, sizeof h->on);
+  h->touching = false;
+  h->pierced = false;
+}
+
+static double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+void tx_hip_query(tx_hip* h, tx_tri_bvh* b, const float* x, double thickness, const double c[3], tx_hip_out* out) {
+  memset(out, 0, sizeof *out);
+  const double r = h->def.radius;
+  const double reach = r + 0.5 * thickness; // contact: mid-plane closer than this
+  double sum[3] = {0, 0, 0}, kk[9] = {0}, towards[3] = {0, 0, 0};
+  double nearest = reach;
+  int n = 0;
+  for (int i = 0; i < h->nrays; i++) {
+    const double* d = h->dir[i];
+    tx_ray_hit hit;
+    // contact needs t < reach; a hit exactly at reach is not yet one
+    if (!tx_tri_bvh_ray(b, x, c, d, reach, &hit) || !(hit.t < reach)) {
+      h->on[i] = false;
+      continue;
+    }
+    double p[3] = {c[0] + hit.t * d[0], c[1] + hit.t * d[1], c[2] + hit.t * d[2]}; // P_n
+    if (!h->on[i]) { // first contact: the ray's point at the HIP's radius
+      h->on[i] = true;
+      for (int a = 0; a < 3; a++) h->p_in[i][a] = c[a] + r * d[a];
+    }
+    double rn[3] = {p[0] - h->p_in[i][0], p[1] - h->p_in[i][1], p[2] - h->p_in[i][2]}; // eq. 5
+    // eq. 8: past slide_max along the skin, the first contact point follows the hand
+    double along = dot(rn, hit.n);
+    double tang[3] = {rn[0] - along * hit.n[0], rn[1] - along * hit.n[1], rn[2] - along * hit.n[2]};
+    if (sqrt(dot(tang, tang)) > h->def.slide_max) {
+      for (int a = 0; a < 3; a++) {
+        h->p_in[i][a] = p[a] - h->def.k * rn[a];
+        rn[a] = p[a] - h->p_in[i][a];
+      }
+      h->resets++;
+    }
+    for (int a = 0; a < 3; a++) sum[a] += rn[a], towards[a] += d[a];
+    for (int a = 0; a < 3; a++)
+      for (int e = 0; e < 3; e++) kk[3 * a + e] += hit.n[a] * hit.n[e];
+    if (hit.t < nearest) nearest = hit.t;
+    n++;
+  }
+  if (n == 0) { // contact over: a later touch starts afresh
+    h->touching = false;
+    h->pierced = false;
+    return;
+  }
+  if (!h->touching) { // contact begins: remember which way the skin lies
+    double l = sqrt(dot(towards, towards));
+    if (l > 0)
+      for (int a = 0; a < 3; a++) h->approach[a] = towards[a] / l;
+    else
+      memcpy(h->approach, h->dir[0], sizeof h->approach);
+    h->touching = true;
+  }
+  if (!h->pierced) { // through the skin: no skin left ahead along the approach
+    tx_ray_hit ahead;
+    if (!tx_tri_bvh_ray(b, x, c, h->approach, h->def.pierce_range, &ahead)) h->pierced = true;
+  }
+  out->depth = reach - nearest;
+  if (h->pierced) {
+    out->pierced = true;
+    return;
+  }
+  out->contacts = n;
+  for (int a = 0; a < 3; a++) out->f[a] = -h->def.alpha * sum[a] / n; // eq. 7
+  for (int a = 0; a < 9; a++) out->k[a] = -h->def.alpha * kk[a] / n;
+}
