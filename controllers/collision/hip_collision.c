@@ -121,8 +121,7 @@ static bool take_skin(tx_ctx* c, hip_ctl* h, tx_snapshot x, tx_snapshot tri) {
     return false;
   }
   uint32_t ntri = tri.rows;
-  bool same = h->bvh_ready && ntri == h->bvh.ntri && x.rows == h->bvh.nx &&
-              tx_tri_bvh_hash(tri.data, ntri) == h->bvh.topo_hash;
+  bool same = h->bvh_ready && x.rows == h->bvh.nx && tx_tri_bvh_same(&h->bvh, tri.data, ntri);
   if (same) {
     tx_tri_bvh_refit(&h->bvh, x.data);
     h->refits++;

@@ -5,7 +5,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <tactus/model.h>
 
 #define LEAF_MAX 4
 #define STACK_MAX 64
@@ -16,36 +15,40 @@ int tx_tri_bvh_init(tx_tri_bvh* b, uint32_t tri_cap) {
   b->tri_cap = tri_cap;
   b->nodes = calloc(2 * (size_t)tri_cap, sizeof *b->nodes);
   b->tri = calloc(3 * (size_t)tri_cap, sizeof *b->tri);
+  b->raw = calloc(3 * (size_t)tri_cap, sizeof *b->raw);
   b->order = calloc(tri_cap, sizeof *b->order);
   b->cen = calloc(3 * (size_t)tri_cap, sizeof *b->cen);
-  if (!b->nodes || !b->tri || !b->order || !b->cen) return tx_tri_bvh_free(b), -1;
+  if (!b->nodes || !b->tri || !b->raw || !b->order || !b->cen) return tx_tri_bvh_free(b), -1;
   return 0;
 }
 
 void tx_tri_bvh_free(tx_tri_bvh* b) {
   free(b->nodes);
   free(b->tri);
+  free(b->raw);
   free(b->order);
   free(b->cen);
   memset(b, 0, sizeof *b);
 }
 
-uint64_t tx_tri_bvh_hash(const int32_t* tri, uint32_t ntri) {
-  return tx_hash(TX_HASH_SEED ^ ntri, tri, (size_t)ntri * 3 * sizeof *tri);
+bool tx_tri_bvh_same(const tx_tri_bvh* b, const int32_t* tri, uint32_t ntri) {
+  return b->nnodes > 0 && ntri == b->ntri && memcmp(tri, b->raw, 3 * (size_t)ntri * sizeof *tri) == 0;
 }
 
-// box of the triangles order[first .. first + count)
-static void leaf_box(const tx_tri_bvh* b, const float* x, tx_bvh_node* nd) {
-  for (int a = 0; a < 3; a++) nd->lo[a] = INFINITY, nd->hi[a] = -INFINITY;
-  for (uint32_t i = nd->first; i < nd->first + nd->count; i++) {
-    const int32_t* t = b->tri + 3 * (size_t)b->order[i];
-    for (int v = 0; v < 3; v++)
-      for (int a = 0; a < 3; a++) {
-        float p = x[3 * (size_t)t[v] + a];
-        if (p < nd->lo[a]) nd->lo[a] = p;
-        if (p > nd->hi[a]) nd->hi[a] = p;
-      }
+// box of the leaf's triangles, in locals: stores to the box cannot alias the reads of x
+static inline void leaf_box(const tx_tri_bvh* b, const float* restrict x, tx_bvh_node* nd) {
+  float lo0 = INFINITY, lo1 = INFINITY, lo2 = INFINITY, hi0 = -INFINITY, hi1 = -INFINITY, hi2 = -INFINITY;
+  const int32_t* t = b->tri + 3 * (size_t)nd->first;
+  const int32_t* end = t + 3 * (size_t)nd->count;
+  for (; t < end; t++) {
+    const float* p = x + 3 * (size_t)*t;
+    float p0 = p[0], p1 = p[1], p2 = p[2];
+    lo0 = p0 < lo0 ? p0 : lo0, hi0 = p0 > hi0 ? p0 : hi0;
+    lo1 = p1 < lo1 ? p1 : lo1, hi1 = p1 > hi1 ? p1 : hi1;
+    lo2 = p2 < lo2 ? p2 : lo2, hi2 = p2 > hi2 ? p2 : hi2;
   }
+  nd->lo[0] = lo0, nd->lo[1] = lo1, nd->lo[2] = lo2;
+  nd->hi[0] = hi0, nd->hi[1] = hi1, nd->hi[2] = hi2;
 }
 
 // put the triangle of rank k (by centroid along axis) at order[k], smaller ones before it
@@ -70,14 +73,14 @@ static void select_kth(tx_tri_bvh* b, uint32_t lo, uint32_t hi, uint32_t k, int 
   }
 }
 
-// build the subtree over order[first .. first + count); returns its node index
-static uint32_t build_node(tx_tri_bvh* b, const float* x, uint32_t first, uint32_t count) {
+// shape the subtree over order[first .. first + count); returns its node index.
+// Boxes are filled afterwards by a refit, once the triangles are in leaf order.
+static uint32_t build_node(tx_tri_bvh* b, uint32_t first, uint32_t count) {
   uint32_t id = b->nnodes++;
   tx_bvh_node* nd = &b->nodes[id];
   if (count <= LEAF_MAX) {
     nd->first = first;
     nd->count = count;
-    leaf_box(b, x, nd);
     return id;
   }
   // split the centroids at the median of their longest extent
@@ -93,17 +96,11 @@ static uint32_t build_node(tx_tri_bvh* b, const float* x, uint32_t first, uint32
     if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
   uint32_t half = count / 2;
   select_kth(b, first, first + count, first + half, axis);
-  build_node(b, x, first, half); // the left child is id + 1
-  uint32_t right = build_node(b, x, first + half, count - half);
+  build_node(b, first, half); // the left child is id + 1
+  uint32_t right = build_node(b, first + half, count - half);
   nd = &b->nodes[id];
   nd->first = right;
   nd->count = 0;
-  const tx_bvh_node* l = &b->nodes[id + 1];
-  const tx_bvh_node* r = &b->nodes[right];
-  for (int a = 0; a < 3; a++) {
-    nd->lo[a] = fminf(l->lo[a], r->lo[a]);
-    nd->hi[a] = fmaxf(l->hi[a], r->hi[a]);
-  }
   return id;
 }
 
@@ -111,19 +108,20 @@ int tx_tri_bvh_build(tx_tri_bvh* b, const float* x, uint32_t nx, const int32_t* 
   if (ntri > b->tri_cap) return -1;
   for (size_t i = 0; i < 3 * (size_t)ntri; i++)
     if (tri[i] < 0 || (uint32_t)tri[i] >= nx) return -1;
-  memcpy(b->tri, tri, 3 * (size_t)ntri * sizeof *tri);
   b->ntri = ntri;
   b->nx = nx;
   b->nnodes = 0;
-  b->topo_hash = tx_tri_bvh_hash(tri, ntri);
+  memcpy(b->raw, tri, 3 * (size_t)ntri * sizeof *tri);
   for (uint32_t i = 0; i < ntri; i++) {
     b->order[i] = i;
-    for (int a = 0; a < 3; a++) {
-      const int32_t* t = tri + 3 * (size_t)i;
+    const int32_t* t = tri + 3 * (size_t)i;
+    for (int a = 0; a < 3; a++)
       b->cen[3 * (size_t)i + a] = (x[3 * (size_t)t[0] + a] + x[3 * (size_t)t[1] + a] + x[3 * (size_t)t[2] + a]) / 3.0f;
-    }
   }
-  if (ntri > 0) build_node(b, x, 0, ntri);
+  // the split only permutes order; the triangles follow it, so leaves read memory in sequence
+  if (ntri > 0) build_node(b, 0, ntri);
+  for (uint32_t i = 0; i < ntri; i++) memcpy(b->tri + 3 * (size_t)i, tri + 3 * (size_t)b->order[i], 3 * sizeof *tri);
+  tx_tri_bvh_refit(b, x);
   return 0;
 }
 
@@ -138,14 +136,14 @@ void tx_tri_bvh_refit(tx_tri_bvh* b, const float* x) {
     const tx_bvh_node* l = &b->nodes[i + 1];
     const tx_bvh_node* r = &b->nodes[nd->first];
     for (int a = 0; a < 3; a++) {
-      nd->lo[a] = fminf(l->lo[a], r->lo[a]);
-      nd->hi[a] = fmaxf(l->hi[a], r->hi[a]);
+      float lo = l->lo[a] < r->lo[a] ? l->lo[a] : r->lo[a], hi = l->hi[a] > r->hi[a] ? l->hi[a] : r->hi[a];
+      nd->lo[a] = lo, nd->hi[a] = hi;
     }
   }
 }
 
-// does o + t d meet the box for some t in [0, tmax]?
-static bool ray_box(const tx_bvh_node* nd, const double o[3], const double inv[3], double tmax) {
+// entry distance of o + t d into the box within [0, tmax], or -1 (inv: 1/d, finite)
+static inline double ray_box(const tx_bvh_node* nd, const double o[3], const double inv[3], double tmax) {
   double t0 = 0, t1 = tmax;
   for (int a = 0; a < 3; a++) {
     double ta = (nd->lo[a] - o[a]) * inv[a], tb = (nd->hi[a] - o[a]) * inv[a];
@@ -154,15 +152,11 @@ static bool ray_box(const tx_bvh_node* nd, const double o[3], const double inv[3
       ta = tb;
       tb = t;
     }
-    if (isnan(ta) || isnan(tb)) { // direction parallel to this slab: inside it or never
-      if (o[a] < nd->lo[a] || o[a] > nd->hi[a]) return false;
-      continue;
-    }
     if (ta > t0) t0 = ta;
     if (tb < t1) t1 = tb;
-    if (t0 > t1) return false;
+    if (t0 > t1) return -1;
   }
-  return true;
+  return t0;
 }
 
 // Moller-Trumbore, either side; distance or -1
@@ -193,37 +187,52 @@ static double ray_tri(const double o[3], const double d[3], const float* p0, con
 bool tx_tri_bvh_ray(tx_tri_bvh* b, const float* x, const double o[3], const double d[3], double tmax, tx_ray_hit* hit) {
   if (b->nnodes == 0) return false;
   double inv[3];
-  for (int a = 0; a < 3; a++) inv[a] = 1.0 / d[a]; // +-inf on a zero component
+  for (int a = 0; a < 3; a++) // a zero component gets a huge slope, so its slab test stays finite
+    inv[a] = 1.0 / (fabs(d[a]) > 1e-30 ? d[a] : (d[a] < 0 ? -1e-30 : 1e-30));
   uint32_t stack[STACK_MAX];
-  int sp = 0;
-  stack[sp++] = 0;
+  double enter[STACK_MAX]; // entry distance of each stacked node
   bool found = false;
   double best = tmax;
-  uint64_t visited = 0;
+  uint64_t visited = 1;
+  double t_root = ray_box(&b->nodes[0], o, inv, best);
+  if (t_root < 0) {
+    b->visited += visited;
+    return false;
+  }
+  int sp = 0;
+  stack[sp] = 0;
+  enter[sp++] = t_root;
   while (sp > 0) {
-    const tx_bvh_node* nd = &b->nodes[stack[--sp]];
-    visited++;
-    if (!ray_box(nd, o, inv, best)) continue;
+    sp--;
+    if (enter[sp] > best) continue; // a nearer hit was found since it was stacked
+    const tx_bvh_node* nd = &b->nodes[stack[sp]];
     if (nd->count == 0) {
+      // both children: the nearer one is searched first, the farther skipped once beaten
+      uint32_t l = (uint32_t)(nd - b->nodes) + 1, r = nd->first;
+      double tl = ray_box(&b->nodes[l], o, inv, best), tr = ray_box(&b->nodes[r], o, inv, best);
+      visited += 2;
+      if (tl >= 0 && tr >= 0 && tl < tr) {
+        uint32_t u = l;
+        double tu = tl;
+        l = r, tl = tr, r = u, tr = tu;
+      }
       // the depth of a median-split tree is log2(triangles), far below STACK_MAX
-      if (sp + 2 > STACK_MAX) continue;
-      stack[sp++] = nd->first;
-      stack[sp++] = (uint32_t)(nd - b->nodes) + 1;
+      if (tl >= 0 && sp < STACK_MAX) stack[sp] = l, enter[sp++] = tl;
+      if (tr >= 0 && sp < STACK_MAX) stack[sp] = r, enter[sp++] = tr;
       continue;
     }
     for (uint32_t i = nd->first; i < nd->first + nd->count; i++) {
-      uint32_t id = b->order[i];
-      const int32_t* t = b->tri + 3 * (size_t)id;
+      const int32_t* t = b->tri + 3 * (size_t)i;
       double n[3];
       double th = ray_tri(o, d, x + 3 * (size_t)t[0], x + 3 * (size_t)t[1], x + 3 * (size_t)t[2], n);
       if (th >= 0 && th <= best) {
-        double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        if (!(l > 0)) continue; // a degenerate triangle has no side
+        double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!(len > 0)) continue; // a degenerate triangle has no side
         best = th;
         found = true;
         hit->t = th;
-        hit->tri = id;
-        for (int a = 0; a < 3; a++) hit->n[a] = n[a] / l;
+        hit->tri = b->order[i];
+        for (int a = 0; a < 3; a++) hit->n[a] = n[a] / len;
       }
     }
   }

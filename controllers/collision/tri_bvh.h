@@ -32,10 +32,10 @@ typedef struct tx_tri_bvh {
   uint32_t nx;         // vertices the current build indexes
   uint32_t nnodes;     // nodes in use
   tx_bvh_node* nodes;  // (2 tri_cap) the tree, parents before children
-  int32_t* tri;        // (tri_cap x 3) vertex indices of the current build
-  uint32_t* order;     // (tri_cap) triangle ids in leaf order
+  int32_t* tri;        // (tri_cap x 3) vertex indices, in leaf order
+  uint32_t* order;     // (tri_cap) triangle ids (rows of the built array) in leaf order
   float* cen;          // (tri_cap x 3) m, centroids, scratch for building
-  uint64_t topo_hash;  // hash of the triangle set of the current build
+  int32_t* raw;        // (tri_cap x 3) the triangle array as given to the current build
   uint64_t visited;    // nodes visited by queries since the last reset (for cost checks)
 } tx_tri_bvh;
 
@@ -48,8 +48,8 @@ typedef struct tx_ray_hit {
 // allocate for up to tri_cap triangles; 0, or -1 when out of memory
 int tx_tri_bvh_init(tx_tri_bvh* b, uint32_t tri_cap);
 void tx_tri_bvh_free(tx_tri_bvh* b);
-// hash of a triangle set, as kept in topo_hash
-uint64_t tx_tri_bvh_hash(const int32_t* tri, uint32_t ntri);
+// is tri (ntri rows) the triangle array of the current build? (one memcmp)
+bool tx_tri_bvh_same(const tx_tri_bvh* b, const int32_t* tri, uint32_t ntri);
 // build over ntri triangles of x (nx vertices); -1 if ntri > tri_cap or an index is outside [0, nx)
 int tx_tri_bvh_build(tx_tri_bvh* b, const float* x, uint32_t nx, const int32_t* tri, uint32_t ntri);
 // recompute every box from moved vertices (same triangle set)

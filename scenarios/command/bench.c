@@ -2,6 +2,7 @@
 // percentiles of one run on this machine; they are printed, never asserted.
 #include "command.h"
 #include "run.h"
+#include "bench_hip.h"
 
 #include "../../controllers/stats.h"
 
@@ -263,6 +264,11 @@ static int bench_haptics(const bench_args* a) {
   return 0;
 }
 
+static int bench_hip(const bench_args* a) {
+  (void)a;
+  return tx_bench_hip();
+}
+
 static const struct {
   const char* name;
   int (*run)(const bench_args*);
@@ -272,6 +278,7 @@ static const struct {
     {"model", bench_model, "publish + acquire of a 10404x3 f32 component"},
     {"overhead", bench_overhead, "framework cost of an empty controller step"},
     {"haptics", bench_haptics, "haptics tick cost, 1 kHz under load, 10 kHz idle"},
+    {"hip", bench_hip, "collision.hip query (98 rays) on 10404 and 102400 particles, and the refit"},
 };
 
 int tx_cmd_bench(int argc, char** argv) {
