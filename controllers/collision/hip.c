@@ -15,6 +15,7 @@ tx_hip_def tx_hip_def_default(void) {
       .k = 0.3,
       .slide_max = 0.003, // 0.3 cm
       .pierce_range = 0.01,
+      .hold = 5e-5, // 0.005 cm
   };
 }
 
@@ -26,6 +27,7 @@ const char* tx_hip_def_check(const tx_hip_def* d) {
   if ((e = tx_check_range("hip", "k", d->k, 0, false, 1, true, "1"))) return e;
   if ((e = tx_check_range("hip", "slide_max", d->slide_max, 0, true, 1, false, "m"))) return e;
   if ((e = tx_check_range("hip", "pierce_range", d->pierce_range, 0, true, 1, false, "m"))) return e;
+  if ((e = tx_check_range("hip", "hold", d->hold, 0, false, 0.01, false, "m"))) return e;
   return NULL;
 }
 
@@ -48,13 +50,17 @@ void tx_hip_query(tx_hip* h, tx_tri_bvh* b, const float* x, double thickness, co
   const double r = h->def.radius;
   const double reach = r + 0.5 * thickness; // contact: mid-plane closer than this
   double sum[3] = {0, 0, 0}, kk[9] = {0}, towards[3] = {0, 0, 0};
-  double nearest = reach;
+  double nearest = reach + h->def.hold;
   int n = 0;
+  // every ray starts at c and ends within reach: one walk finds what they can meet
+  uint32_t roots[TX_BVH_ROOTS_MAX];
+  int nroots = tx_tri_bvh_gather(b, c, reach + h->def.hold, roots);
   for (int i = 0; i < h->nrays; i++) {
     const double* d = h->dir[i];
     tx_ray_hit hit;
-    // contact needs t < reach; a hit exactly at reach is not yet one
-    if (!tx_tri_bvh_ray(b, x, c, d, reach, &hit) || !(hit.t < reach)) {
+    // contact begins at t < reach and holds up to reach + hold
+    double limit = h->on[i] ? reach + h->def.hold : reach;
+    if (!tx_tri_bvh_ray_from(b, roots, nroots, x, c, d, limit, &hit) || !(hit.t < limit)) {
       h->on[i] = false;
       continue;
     }
@@ -97,7 +103,7 @@ void tx_hip_query(tx_hip* h, tx_tri_bvh* b, const float* x, double thickness, co
     tx_ray_hit ahead;
     if (!tx_tri_bvh_ray(b, x, c, h->approach, h->def.pierce_range, &ahead)) h->pierced = true;
   }
-  out->depth = reach - nearest;
+  out->depth = reach > nearest ? reach - nearest : 0;
   if (h->pierced) {
     out->pierced = true;
     return;

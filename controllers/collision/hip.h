@@ -1,9 +1,10 @@
 // Internal: the simplified ray-casting method of the suturing papers, the
 // force of a deformable skin on a haptic interaction point (HIP).
 //
-// The HIP is a sphere of radius r at c that casts 26 or 98 rays d_n. A ray is
-// in contact while it meets the skin's mid-plane (the triangle mesh) at a
-// distance t_n < r + h/2 (h: skin thickness). For each ray in contact:
+// The HIP is a sphere of radius r at c that casts 26 or 98 rays d_n. A ray
+// comes into contact when it meets the skin's mid-plane (the triangle mesh)
+// at a distance t_n < r + h/2 (h: skin thickness), and stays in contact up to
+// r + h/2 + hold. For each ray in contact:
 //   P_in  where the ray crossed the HIP's radius when its contact began: c + r d_n
 //   P_n   where it meets the mid-plane now:                            c + t_n d_n
 //   R_n = P_n - P_in                                  (the conference paper, eq. 5)
@@ -31,6 +32,8 @@ typedef struct tx_hip_def {
   double k;             // 1, eq. 8 factor, < 1 (the papers' maximum-distance constant 0.3)
   double slide_max;     // m, tangential displacement that triggers eq. 8 (the papers' 0.3 units = 3 mm)
   double pierce_range;  // m, how far along the approach the skin is looked for before the HIP counts as through
+  double hold;          // m, a ray in contact stays so up to r + h/2 + hold: the physics leaves the skin
+                        // exactly at r + h/2 from the HIP, and rounding must not break a contact there
 } tx_hip_def;
 
 tx_hip_def tx_hip_def_default(void);

@@ -53,6 +53,7 @@ static int configure(tx_setup* s, void** self) {
   def.k = tx_param_num(s, "k", def.k, 0, 0.999);
   def.slide_max = tx_param_num(s, "slide_max_m", def.slide_max, 1e-6, 1);
   def.pierce_range = tx_param_num(s, "pierce_range_m", def.pierce_range, 1e-5, 1);
+  def.hold = tx_param_num(s, "hold_m", def.hold, 0, 0.01);
   if (def.rays != 26 && def.rays != 98) return tx_setup_fail(s, "rays", "must be 26 or 98, got %d", def.rays);
   const char* err = tx_hip_def_check(&def);
   if (err) return tx_setup_fail(s, NULL, "%s", err);

@@ -7,7 +7,7 @@
 
 
 #define LEAF_MAX 4
-#define STACK_MAX 64
+#define STACK_MAX 128 // tree depth (log2 of the triangles) plus up to TX_BVH_ROOTS_MAX roots
 
 int tx_tri_bvh_init(tx_tri_bvh* b, uint32_t tri_cap) {
   memset(b, 0, sizeof *b);
@@ -171,12 +171,14 @@ static double ray_tri(const double o[3], const double d[3], const float* p0, con
   if (fabs(det) < 1e-30) return -1;
   double inv = 1.0 / det;
   double u = (s[0] * pv[0] + s[1] * pv[1] + s[2] * pv[2]) * inv;
-  if (u < 0 || u > 1) return -1;
+  // a hair of slack on the barycentric bounds: a ray along an edge two triangles share meets both
+  const double eps = 1e-9;
+  if (u < -eps || u > 1 + eps) return -1;
   qv[0] = s[1] * e1[2] - s[2] * e1[1];
   qv[1] = s[2] * e1[0] - s[0] * e1[2];
   qv[2] = s[0] * e1[1] - s[1] * e1[0];
   double v = (d[0] * qv[0] + d[1] * qv[1] + d[2] * qv[2]) * inv;
-  if (v < 0 || u + v > 1) return -1;
+  if (v < -eps || u + v > 1 + eps) return -1;
   double t = (e2[0] * qv[0] + e2[1] * qv[1] + e2[2] * qv[2]) * inv;
   n[0] = e1[1] * e2[2] - e1[2] * e2[1];
   n[1] = e1[2] * e2[0] - e1[0] * e2[2];
@@ -184,8 +186,9 @@ static double ray_tri(const double o[3], const double d[3], const float* p0, con
   return t;
 }
 
-bool tx_tri_bvh_ray(tx_tri_bvh* b, const float* x, const double o[3], const double d[3], double tmax, tx_ray_hit* hit) {
-  if (b->nnodes == 0) return false;
+bool tx_tri_bvh_ray_from(tx_tri_bvh* b, const uint32_t* roots, int nroots, const float* x, const double o[3],
+                         const double d[3], double tmax, tx_ray_hit* hit) {
+  if (b->nnodes == 0 || nroots <= 0) return false;
   double inv[3];
   for (int a = 0; a < 3; a++) // a zero component gets a huge slope, so its slab test stays finite
     inv[a] = 1.0 / (fabs(d[a]) > 1e-30 ? d[a] : (d[a] < 0 ? -1e-30 : 1e-30));
@@ -193,15 +196,13 @@ bool tx_tri_bvh_ray(tx_tri_bvh* b, const float* x, const double o[3], const doub
   double enter[STACK_MAX]; // entry distance of each stacked node
   bool found = false;
   double best = tmax;
-  uint64_t visited = 1;
-  double t_root = ray_box(&b->nodes[0], o, inv, best);
-  if (t_root < 0) {
-    b->visited += visited;
-    return false;
-  }
+  uint64_t visited = 0;
   int sp = 0;
-  stack[sp] = 0;
-  enter[sp++] = t_root;
+  for (int i = 0; i < nroots && i < TX_BVH_ROOTS_MAX; i++) {
+    double t = ray_box(&b->nodes[roots[i]], o, inv, best);
+    visited++;
+    if (t >= 0) stack[sp] = roots[i], enter[sp++] = t;
+  }
   while (sp > 0) {
     sp--;
     if (enter[sp] > best) continue; // a nearer hit was found since it was stacked
@@ -238,4 +239,52 @@ bool tx_tri_bvh_ray(tx_tri_bvh* b, const float* x, const double o[3], const doub
   }
   b->visited += visited;
   return found;
+}
+
+bool tx_tri_bvh_ray(tx_tri_bvh* b, const float* x, const double o[3], const double d[3], double tmax, tx_ray_hit* hit) {
+  const uint32_t root = 0;
+  return tx_tri_bvh_ray_from(b, &root, 1, x, o, d, tmax, hit);
+}
+
+// squared distance from c to the box
+static inline double box_dist2(const tx_bvh_node* nd, const double c[3]) {
+  double s = 0;
+  for (int a = 0; a < 3; a++) {
+    double e = c[a] < nd->lo[a] ? nd->lo[a] - c[a] : c[a] > nd->hi[a] ? c[a] - nd->hi[a] : 0;
+    s += e * e;
+  }
+  return s;
+}
+
+int tx_tri_bvh_gather(tx_tri_bvh* b, const double c[3], double radius, uint32_t roots[TX_BVH_ROOTS_MAX]) {
+  if (b->nnodes == 0) return 0;
+  uint32_t stack[STACK_MAX];
+  int sp = 0, n = 0;
+  stack[sp++] = 0;
+  double r2 = radius * radius;
+  uint64_t visited = 0;
+  while (sp > 0) {
+    uint32_t id = stack[--sp];
+    const tx_bvh_node* nd = &b->nodes[id];
+    visited++;
+    if (box_dist2(nd, c) > r2) continue;
+    // stop at boxes no wider than the sphere: the rays' own walk goes on from there
+    double w = 0;
+    for (int a = 0; a < 3; a++)
+      if (nd->hi[a] - nd->lo[a] > w) w = nd->hi[a] - nd->lo[a];
+    if (nd->count || w <= radius) {
+      if (n == TX_BVH_ROOTS_MAX) { // too many: the rays start from the top instead
+        b->visited += visited;
+        roots[0] = 0;
+        return 1;
+      }
+      roots[n++] = id;
+      continue;
+    }
+    if (sp + 2 > STACK_MAX) continue;
+    stack[sp++] = nd->first;
+    stack[sp++] = id + 1;
+  }
+  b->visited += visited;
+  return n;
 }

@@ -54,6 +54,15 @@ bool tx_tri_bvh_same(const tx_tri_bvh* b, const int32_t* tri, uint32_t ntri);
 int tx_tri_bvh_build(tx_tri_bvh* b, const float* x, uint32_t nx, const int32_t* tri, uint32_t ntri);
 // recompute every box from moved vertices (same triangle set)
 void tx_tri_bvh_refit(tx_tri_bvh* b, const float* x);
+// Many short rays from one point (the HIP's) share one walk: gather the
+// subtrees whose boxes meet the sphere (c, radius) and are no wider than it,
+// then start each ray's walk from them. Returns how many (the root alone when
+// more than TX_BVH_ROOTS_MAX would be needed; 0 when nothing is near).
+#define TX_BVH_ROOTS_MAX 48
+int tx_tri_bvh_gather(tx_tri_bvh* b, const double c[3], double radius, uint32_t roots[TX_BVH_ROOTS_MAX]);
+// nearest triangle hit by o + t d, 0 <= t <= tmax, searching only below the given roots
+bool tx_tri_bvh_ray_from(tx_tri_bvh* b, const uint32_t* roots, int nroots, const float* x, const double o[3],
+                         const double d[3], double tmax, tx_ray_hit* hit);
 // nearest triangle hit by o + t d, 0 <= t <= tmax (d unit, either side of a triangle counts)
 bool tx_tri_bvh_ray(tx_tri_bvh* b, const float* x, const double o[3], const double d[3], double tmax, tx_ray_hit* hit);
 

@@ -114,6 +114,13 @@ static void test_contact_threshold_radius_plus_half_thickness(void** state) {
   o = query(&h, s, CX, REACH - 1e-7, CZ);
   assert_int_equal(o.contacts, 1); // only the straight-down ray is that close
   assert_true(o.f[1] > 0);
+  // a contact, once made, holds up to reach + hold (0.05 mm), then lets go
+  o = query(&h, s, CX, REACH + 4e-5, CZ);
+  assert_int_equal(o.contacts, 1);
+  o = query(&h, s, CX, REACH + 6e-5, CZ);
+  assert_int_equal(o.contacts, 0);
+  o = query(&h, s, CX, REACH + 4e-5, CZ); // and a new one starts only below reach again
+  assert_int_equal(o.contacts, 0);
   drop(s);
 }
 
@@ -241,6 +248,35 @@ static void test_pierced_gives_zero_until_contact_ends(void** state) {
   drop(s);
 }
 
+// BVH nodes one 98-ray query visits on an n x n skin of the same spacing
+static uint64_t query_nodes(uint32_t n) {
+  float* x = malloc(sizeof(float) * 3 * n * n);
+  int32_t* tri = malloc(sizeof(int32_t) * 6 * (n - 1) * (n - 1));
+  assert_non_null(x);
+  assert_non_null(tri);
+  uint32_t m = tx_skin_grid(n, SPACING, x, tri);
+  tx_skin_dent(x, n * n, (double[3]){0, 0, 0}, 2e-3, 4e-3);
+  tx_tri_bvh b;
+  assert_int_equal(tx_tri_bvh_init(&b, m), 0);
+  assert_int_equal(tx_tri_bvh_build(&b, x, n * n, tri, m), 0);
+  tx_hip h = make_hip(98);
+  tx_hip_out o;
+  b.visited = 0;
+  tx_hip_query(&h, &b, x, H, (double[3]){CX, -2e-3 + 0.6 * REACH, CZ}, &o);
+  assert_true(o.contacts > 0);
+  uint64_t v = b.visited;
+  tx_tri_bvh_free(&b);
+  free(x);
+  free(tri);
+  return v;
+}
+
+static void test_query_cost_independent_of_far_triangles(void** state) {
+  (void)state;
+  uint64_t small = query_nodes(41), large = query_nodes(401); // 3200 and 320000 triangles
+  assert_true(large < 2 * small);
+}
+
 static void test_query_allocates_nothing(void** state) {
   (void)state;
   skin* s = flat();
@@ -263,6 +299,7 @@ int main(void) {
       cmocka_unit_test(test_dented_skin_pushes_straight_back),
       cmocka_unit_test(test_eq8_moves_first_contact_after_slide),
       cmocka_unit_test(test_pierced_gives_zero_until_contact_ends),
+      cmocka_unit_test(test_query_cost_independent_of_far_triangles),
       cmocka_unit_test(test_query_allocates_nothing),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
