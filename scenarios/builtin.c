@@ -5,6 +5,7 @@
 #include "../controllers/collision/hip_collision.h"
 #include "../controllers/collision/wall.h"
 #include "../controllers/haptics/haptics_controller.h"
+#include "../views/force_curve.h"
 
 #include <pthread.h>
 
@@ -12,6 +13,7 @@ static void register_all(void) {
   tx_register_controller(&tx_rates_worker);
   tx_register_controller(&tx_collision_wall);
   tx_register_controller(&tx_collision_hip);
+  tx_register_controller(&tx_view_force_curve);
   tx_register_controller(&tx_haptics_controller);
 }
 
