@@ -15,7 +15,7 @@ tx_hip_def tx_hip_def_default(void) {
       .k = 0.3,
       .slide_max = 0.003, // 0.3 cm
       .pierce_range = 0.01,
-      .hold = 5e-5, // 0.005 cm
+      .hold = 5e-4, // 0.05 cm: the skin may lead the HIP by its speed over one physics period
   };
 }
 
@@ -49,40 +49,28 @@ void tx_hip_query(tx_hip* h, tx_tri_bvh* b, const float* x, double thickness, co
   memset(out, 0, sizeof *out);
   const double r = h->def.radius;
   const double reach = r + 0.5 * thickness; // contact: mid-plane closer than this
-  double sum[3] = {0, 0, 0}, kk[9] = {0}, towards[3] = {0, 0, 0};
-  double nearest = reach + h->def.hold;
+  double nearest = reach + h->def.hold, towards[3] = {0, 0, 0};
+  double t[TX_HIP_RAYS_MAX], normal[TX_HIP_RAYS_MAX][3];
   int n = 0;
   // every ray starts at c and ends within reach: one walk finds what they can meet
   uint32_t roots[TX_BVH_ROOTS_MAX];
   int nroots = tx_tri_bvh_gather(b, c, reach + h->def.hold, roots);
+  // which rays touch: contact begins at t < reach and holds up to reach + hold
   for (int i = 0; i < h->nrays; i++) {
     const double* d = h->dir[i];
     tx_ray_hit hit;
-    // contact begins at t < reach and holds up to reach + hold
     double limit = h->on[i] ? reach + h->def.hold : reach;
     if (!tx_tri_bvh_ray_from(b, roots, nroots, x, c, d, limit, &hit) || !(hit.t < limit)) {
       h->on[i] = false;
       continue;
     }
-    double p[3] = {c[0] + hit.t * d[0], c[1] + hit.t * d[1], c[2] + hit.t * d[2]}; // P_n
     if (!h->on[i]) { // first contact: the ray's point at the HIP's radius
       h->on[i] = true;
       for (int a = 0; a < 3; a++) h->p_in[i][a] = c[a] + r * d[a];
     }
-    double rn[3] = {p[0] - h->p_in[i][0], p[1] - h->p_in[i][1], p[2] - h->p_in[i][2]}; // eq. 5
-    // eq. 8: past slide_max along the skin, the first contact point follows the hand
-    double along = dot(rn, hit.n);
-    double tang[3] = {rn[0] - along * hit.n[0], rn[1] - along * hit.n[1], rn[2] - along * hit.n[2]};
-    if (sqrt(dot(tang, tang)) > h->def.slide_max) {
-      for (int a = 0; a < 3; a++) {
-        h->p_in[i][a] = p[a] - h->def.k * rn[a];
-        rn[a] = p[a] - h->p_in[i][a];
-      }
-      h->resets++;
-    }
-    for (int a = 0; a < 3; a++) sum[a] += rn[a], towards[a] += d[a];
-    for (int a = 0; a < 3; a++)
-      for (int e = 0; e < 3; e++) kk[3 * a + e] += hit.n[a] * hit.n[e];
+    t[i] = hit.t;
+    memcpy(normal[i], hit.n, sizeof normal[i]);
+    for (int a = 0; a < 3; a++) towards[a] += d[a];
     if (hit.t < nearest) nearest = hit.t;
     n++;
   }
@@ -108,7 +96,29 @@ void tx_hip_query(tx_hip* h, tx_tri_bvh* b, const float* x, double thickness, co
     out->pierced = true;
     return;
   }
+  double sum[3] = {0, 0, 0}, kk[9] = {0};
+  const double* a_n = h->approach;
+  for (int i = 0; i < h->nrays; i++) {
+    if (!h->on[i]) continue;
+    const double* d = h->dir[i];
+    double p[3] = {c[0] + t[i] * d[0], c[1] + t[i] * d[1], c[2] + t[i] * d[2]}; // P_n
+    double rn[3] = {p[0] - h->p_in[i][0], p[1] - h->p_in[i][1], p[2] - h->p_in[i][2]}; // eq. 5
+    // eq. 8: past slide_max along the skin (across the direction it was met from),
+    // the first contact point follows the hand
+    double along = dot(rn, a_n);
+    double tang[3] = {rn[0] - along * a_n[0], rn[1] - along * a_n[1], rn[2] - along * a_n[2]};
+    if (sqrt(dot(tang, tang)) > h->def.slide_max) {
+      for (int e = 0; e < 3; e++) {
+        h->p_in[i][e] = p[e] - h->def.k * rn[e];
+        rn[e] = p[e] - h->p_in[i][e];
+      }
+      h->resets++;
+    }
+    for (int e = 0; e < 3; e++) sum[e] += rn[e];
+    for (int e = 0; e < 3; e++)
+      for (int f = 0; f < 3; f++) kk[3 * e + f] += normal[i][e] * normal[i][f];
+  }
   out->contacts = n;
-  for (int a = 0; a < 3; a++) out->f[a] = -h->def.alpha * sum[a] / n; // eq. 7
-  for (int a = 0; a < 9; a++) out->k[a] = -h->def.alpha * kk[a] / n;
+  for (int e = 0; e < 3; e++) out->f[e] = -h->def.alpha * sum[e] / n; // eq. 7
+  for (int e = 0; e < 9; e++) out->k[e] = -h->def.alpha * kk[e] / n;
 }

@@ -9,8 +9,8 @@
 //   P_n   where it meets the mid-plane now:                            c + t_n d_n
 //   R_n = P_n - P_in                                  (the conference paper, eq. 5)
 //   F   = -alpha sum(R_n) / N, N the rays in contact    (eq. 7; journal eq. 3)
-// When the part of R_n along the skin (normal to the hit triangle's normal)
-// grows past slide_max, P_in moves after the hand: P_in = P_n - k R_n (eq. 8),
+// When the part of R_n along the skin (across the direction toward the skin
+// in which the contact began) grows past slide_max, P_in moves after the hand: P_in = P_n - k R_n (eq. 8),
 // which turns sliding into a steady drag. Once the HIP has gone through the
 // skin (the ray toward the skin along which contact began finds no skin any
 // more) the force is zero until no ray touches the skin.
@@ -33,7 +33,8 @@ typedef struct tx_hip_def {
   double slide_max;     // m, tangential displacement that triggers eq. 8 (the papers' 0.3 units = 3 mm)
   double pierce_range;  // m, how far along the approach the skin is looked for before the HIP counts as through
   double hold;          // m, a ray in contact stays so up to r + h/2 + hold: the physics leaves the skin
-                        // exactly at r + h/2 from the HIP, and rounding must not break a contact there
+                        // at r + h/2 from the HIP it last saw, which may lead the HIP of now by its
+                        // speed over one physics period
 } tx_hip_def;
 
 tx_hip_def tx_hip_def_default(void);

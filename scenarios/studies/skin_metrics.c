@@ -22,8 +22,9 @@ tx_skin_metrics tx_skin_measure(const tx_skin_series* s, double steady_from, dou
     if (s->contacts[i] > 0) m.contact = i;
   if (m.contact >= 0) {
     m.contact_pos = s->pos[m.contact];
+    // through the skin, or out of contact once links have torn: the hole opened under the HIP
     for (int i = m.contact; i < s->n && m.rupture < 0; i++)
-      if (s->pierced[i] > 0) m.rupture = i;
+      if (s->pierced[i] > 0 || (s->contacts[i] == 0 && s->torn[i] > s->torn[m.contact])) m.rupture = i;
     int end = m.rupture >= 0 ? m.rupture : s->n;
     // the pushed phase: contact .. rupture
     for (int i = m.contact; i < end; i++)

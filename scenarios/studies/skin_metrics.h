@@ -24,7 +24,7 @@ typedef struct tx_skin_series {
 
 typedef struct tx_skin_metrics {
   int contact;            // first tick in contact, -1 if never
-  int rupture;            // first tick pierced after contact, -1 if never
+  int rupture;            // first tick after contact that is pierced, or out of contact with links torn; -1 if never
   double contact_pos;     // m, HIP position at first contact (NaN without)
   double peak;            // N, largest |force| from contact to rupture (or to the end)
   double r2;              // linear fit of force on position over contact .. rupture: R^2 (NaN if < 3 ticks)

@@ -114,12 +114,12 @@ static void test_contact_threshold_radius_plus_half_thickness(void** state) {
   o = query(&h, s, CX, REACH - 1e-7, CZ);
   assert_int_equal(o.contacts, 1); // only the straight-down ray is that close
   assert_true(o.f[1] > 0);
-  // a contact, once made, holds up to reach + hold (0.05 mm), then lets go
-  o = query(&h, s, CX, REACH + 4e-5, CZ);
+  // a contact, once made, holds up to reach + hold (0.5 mm), then lets go
+  o = query(&h, s, CX, REACH + 4e-4, CZ);
   assert_int_equal(o.contacts, 1);
-  o = query(&h, s, CX, REACH + 6e-5, CZ);
+  o = query(&h, s, CX, REACH + 6e-4, CZ);
   assert_int_equal(o.contacts, 0);
-  o = query(&h, s, CX, REACH + 4e-5, CZ); // and a new one starts only below reach again
+  o = query(&h, s, CX, REACH + 4e-4, CZ); // and a new one starts only below reach again
   assert_int_equal(o.contacts, 0);
   drop(s);
 }
@@ -214,6 +214,30 @@ static void test_eq8_moves_first_contact_after_slide(void** state) {
   drop(s);
 }
 
+// pushed straight in, a skin whose triangle under the HIP tilts (the side of
+// a narrow dent) must not move P_in: eq. 8 is for sliding across the skin
+static void test_eq8_not_for_a_straight_push_into_tilted_skin(void** state) {
+  (void)state;
+  skin* s = flat();
+  tx_hip h = make_hip(26);
+  const double y = 2.4e-3, depth = 8e-3;
+  query(&h, s, CX, y, CZ);
+  tx_skin_dent(s->x, N * N, (double[3]){CX + 1.5e-3, 0, CZ}, depth, 2e-3);
+  tx_tri_bvh_refit(&s->bvh, s->x);
+  tx_ray_hit hit;
+  assert_true(tx_tri_bvh_ray(&s->bvh, s->x, (double[3]){CX, y - 5e-3, CZ}, (double[3]){0, -1, 0}, 0.02, &hit));
+  assert_true(hit.n[1] < 0.8); // the triangle under the HIP leans over
+  double skin_y = y - 5e-3 - hit.t;
+  tx_hip_out o = query(&h, s, CX, y - 5e-3, CZ);
+  assert_int_equal(h.resets, 0);
+  // the straight-down ray's R = (0, skin_y - (y - r), 0) is over 5 mm long, and more than
+  // slide_max of it lies along the leaning triangle: measured against the hit normal, eq. 8
+  // would have fired; the force still points out of the skin
+  assert_true(y - R - skin_y > 5e-3);
+  assert_true(o.contacts > 1 && o.f[1] > 0);
+  drop(s);
+}
+
 static void test_pierced_gives_zero_until_contact_ends(void** state) {
   (void)state;
   skin* s = flat();
@@ -298,6 +322,7 @@ int main(void) {
       cmocka_unit_test(test_26_and_98_rays_by_hand),
       cmocka_unit_test(test_dented_skin_pushes_straight_back),
       cmocka_unit_test(test_eq8_moves_first_contact_after_slide),
+      cmocka_unit_test(test_eq8_not_for_a_straight_push_into_tilted_skin),
       cmocka_unit_test(test_pierced_gives_zero_until_contact_ends),
       cmocka_unit_test(test_query_cost_independent_of_far_triangles),
       cmocka_unit_test(test_query_allocates_nothing),
