@@ -4,8 +4,10 @@
 
 #include <tactus/config.h>
 
+#include "../controllers/collision/hip_collision.h"
 #include "../controllers/collision/wall.h"
 #include "../controllers/haptics/haptics_controller.h"
+#include "../views/force_curve.h"
 #if TX_WITH_BULLET
 #include "../controllers/physics/skin_controller.h"
 #endif
@@ -15,6 +17,8 @@
 static void register_all(void) {
   tx_register_controller(&tx_rates_worker);
   tx_register_controller(&tx_collision_wall);
+  tx_register_controller(&tx_collision_hip);
+  tx_register_controller(&tx_view_force_curve);
   tx_register_controller(&tx_haptics_controller);
 #if TX_WITH_BULLET
   tx_register_controller(&tx_physics_skin);

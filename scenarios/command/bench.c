@@ -3,6 +3,7 @@
 #include "bench_cloth.h"
 #include "command.h"
 #include "run.h"
+#include "bench_hip.h"
 
 #include "../../controllers/stats.h"
 
@@ -265,6 +266,10 @@ static int bench_haptics(const bench_args* a) {
 }
 
 static int bench_cloth(const bench_args* a) { return tx_bench_cloth(a->duration_s); }
+static int bench_hip(const bench_args* a) {
+  (void)a;
+  return tx_bench_hip();
+}
 
 static const struct {
   const char* name;
@@ -276,6 +281,7 @@ static const struct {
     {"overhead", bench_overhead, "framework cost of an empty controller step"},
     {"haptics", bench_haptics, "haptics tick cost, 1 kHz under load, 10 kHz idle"},
     {"cloth", bench_cloth, "skin physics step at 10404 particles with rupture; overhead vs a bare Bullet loop"},
+    {"hip", bench_hip, "collision.hip query (98 rays) on 10404 and 102400 particles, and the refit"},
 };
 
 int tx_cmd_bench(int argc, char** argv) {

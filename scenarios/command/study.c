@@ -14,6 +14,7 @@ static const struct {
 } studies[] = {
     {"haptic-stability", tx_study_haptic_stability,
      "largest stable wall stiffness vs Colgate's bound, with and without passivity control"},
+    {"skin-paper", tx_study_skin_paper, "the SutureHap journal paper's skin tests (Figs. 15-19) and the 60 Hz hold"},
 };
 
 int tx_cmd_study(int argc, char** argv) {

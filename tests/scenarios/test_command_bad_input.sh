@@ -165,6 +165,21 @@ expect_bad "study --set out of range" "damping" -- study haptic-stability --set 
 expect_bad "study --set not a number" "--set device.period=abc" -- study haptic-stability --set device.period=abc --out "$WORK/st"
 expect_bad "study unwritable --out" "--out /dev/null/x" -- study haptic-stability --out /dev/null/x
 expect_bad "study without a name" "study" "NAME" -- study
+# collision.hip and view.force_curve parameters (the HIP needs no skin writer to be refused)
+printf '{"name": "t", "controllers": [{"name": "hip", "type": "collision.hip", "rate_hz": 4000},
+  {"name": "curve", "type": "view.force_curve", "rate_hz": 1000, "params": {"force": "tool0.force_model"}}]}\n' >"$S/hip.json"
+expect_bad "hip rays not 26 or 98" "--set hip.rays=27" "26 or 98" -- run "$S/hip.json" --set hip.rays=27
+expect_bad "hip radius out of range" "--set hip.radius_m=1" "out of range" -- run "$S/hip.json" --set hip.radius_m=1
+expect_bad "hip k of 1" "--set hip.k=1" "out of range" -- run "$S/hip.json" --set hip.k=1
+expect_bad "hip alpha not a number" "--set hip.alpha=soft" -- run "$S/hip.json" --set hip.alpha=soft
+expect_bad "force curve bad axis" "--set curve.axis=w" "x, y or z" -- run "$S/hip.json" --set curve.axis=w
+expect_bad "force curve file with a path" "--set curve.file=../x" "base name" -- run "$S/hip.json" --set curve.file=../x
+# built without Bullet, suturing-skin itself is refused: its physics.skin is unknown
+if "$TACTUS" describe suturing-skin >/dev/null 2>&1; then
+  expect_bad "skin-paper --set bad HIP rays" "hip.rays" -- study skin-paper --set hip.rays=7 --out "$WORK/sp"
+else
+  expect_bad "skin-paper without Bullet" "physics.skin" -- study skin-paper --out "$WORK/sp"
+fi
 expect_bad "describe with two names" "describe" -- describe rates rates
 expect_bad "list with an argument" "list" -- list extra
 

@@ -1,0 +1,124 @@
+// The simplified method: per-ray contact points, eq. 5, 7 and 8 of the
+// SutureHap conference paper (eq. 3 of the journal paper).
+#include "hip.h"
+
+#include "../range_check.h"
+
+#include <math.h>
+#include <string.h>
+
+tx_hip_def tx_hip_def_default(void) {
+  return (tx_hip_def){
+      .radius = 0.0005, // 0.05 cm
+      .rays = 26,
+      .alpha = 20.0, // 0.2 N/cm
+      .k = 0.3,
+      .slide_max = 0.003, // 0.3 cm
+      .pierce_range = 0.01,
+      .hold = 5e-4, // 0.05 cm: the skin may lead the HIP by its speed over one physics period
+  };
+}
+
+const char* tx_hip_def_check(const tx_hip_def* d) {
+  const char* e;
+  if ((e = tx_check_range("hip", "radius", d->radius, 0, true, 0.05, false, "m"))) return e;
+  if (d->rays != 26 && d->rays != 98) return tx_check_fail("hip: rays = %d, must be 26 or 98", d->rays);
+  if ((e = tx_check_range("hip", "alpha", d->alpha, 0, false, 1e6, false, "N/m"))) return e;
+  if ((e = tx_check_range("hip", "k", d->k, 0, false, 1, true, "1"))) return e;
+  if ((e = tx_check_range("hip", "slide_max", d->slide_max, 0, true, 1, false, "m"))) return e;
+  if ((e = tx_check_range("hip", "pierce_range", d->pierce_range, 0, true, 1, false, "m"))) return e;
+  if ((e = tx_check_range("hip", "hold", d->hold, 0, false, 0.01, false, "m"))) return e;
+  return NULL;
+}
+
+void tx_hip_init(tx_hip* h, const tx_hip_def* def) {
+  memset(h, 0, sizeof *h);
+  h->def = *def;
+  h->nrays = tx_hip_rays(def->rays, h->dir);
+}
+
+void tx_hip_reset(tx_hip* h) {
+  memset(h->on, 0, sizeof h->on);
+  h->touching = false;
+  h->pierced = false;
+}
+
+static double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+void tx_hip_query(tx_hip* h, tx_tri_bvh* b, const float* x, double thickness, const double c[3], tx_hip_out* out) {
+  memset(out, 0, sizeof *out);
+  const double r = h->def.radius;
+  const double reach = r + 0.5 * thickness; // contact: mid-plane closer than this
+  double nearest = reach + h->def.hold, towards[3] = {0, 0, 0};
+  double t[TX_HIP_RAYS_MAX], normal[TX_HIP_RAYS_MAX][3];
+  int n = 0;
+  // every ray starts at c and ends within reach: one walk finds what they can meet
+  uint32_t roots[TX_BVH_ROOTS_MAX];
+  int nroots = tx_tri_bvh_gather(b, c, reach + h->def.hold, roots);
+  // which rays touch: contact begins at t < reach and holds up to reach + hold
+  for (int i = 0; i < h->nrays; i++) {
+    const double* d = h->dir[i];
+    tx_ray_hit hit;
+    double limit = h->on[i] ? reach + h->def.hold : reach;
+    if (!tx_tri_bvh_ray_from(b, roots, nroots, x, c, d, limit, &hit) || !(hit.t < limit)) {
+      h->on[i] = false;
+      continue;
+    }
+    if (!h->on[i]) { // first contact: the ray's point at the HIP's radius
+      h->on[i] = true;
+      for (int a = 0; a < 3; a++) h->p_in[i][a] = c[a] + r * d[a];
+    }
+    t[i] = hit.t;
+    memcpy(normal[i], hit.n, sizeof normal[i]);
+    for (int a = 0; a < 3; a++) towards[a] += d[a];
+    if (hit.t < nearest) nearest = hit.t;
+    n++;
+  }
+  if (n == 0) { // contact over: a later touch starts afresh
+    h->touching = false;
+    h->pierced = false;
+    return;
+  }
+  if (!h->touching) { // contact begins: remember which way the skin lies
+    double l = sqrt(dot(towards, towards));
+    if (l > 0)
+      for (int a = 0; a < 3; a++) h->approach[a] = towards[a] / l;
+    else
+      memcpy(h->approach, h->dir[0], sizeof h->approach);
+    h->touching = true;
+  }
+  if (!h->pierced) { // through the skin: no skin left ahead along the approach
+    tx_ray_hit ahead;
+    if (!tx_tri_bvh_ray(b, x, c, h->approach, h->def.pierce_range, &ahead)) h->pierced = true;
+  }
+  out->depth = reach > nearest ? reach - nearest : 0;
+  if (h->pierced) {
+    out->pierced = true;
+    return;
+  }
+  double sum[3] = {0, 0, 0}, kk[9] = {0};
+  const double* a_n = h->approach;
+  for (int i = 0; i < h->nrays; i++) {
+    if (!h->on[i]) continue;
+    const double* d = h->dir[i];
+    double p[3] = {c[0] + t[i] * d[0], c[1] + t[i] * d[1], c[2] + t[i] * d[2]}; // P_n
+    double rn[3] = {p[0] - h->p_in[i][0], p[1] - h->p_in[i][1], p[2] - h->p_in[i][2]}; // eq. 5
+    // eq. 8: past slide_max along the skin (across the direction it was met from),
+    // the first contact point follows the hand
+    double along = dot(rn, a_n);
+    double tang[3] = {rn[0] - along * a_n[0], rn[1] - along * a_n[1], rn[2] - along * a_n[2]};
+    if (sqrt(dot(tang, tang)) > h->def.slide_max) {
+      for (int e = 0; e < 3; e++) {
+        h->p_in[i][e] = p[e] - h->def.k * rn[e];
+        rn[e] = p[e] - h->p_in[i][e];
+      }
+      h->resets++;
+    }
+    for (int e = 0; e < 3; e++) sum[e] += rn[e];
+    for (int e = 0; e < 3; e++)
+      for (int f = 0; f < 3; f++) kk[3 * e + f] += normal[i][e] * normal[i][f];
+  }
+  out->contacts = n;
+  for (int e = 0; e < 3; e++) out->f[e] = -h->def.alpha * sum[e] / n; // eq. 7
+  for (int e = 0; e < 9; e++) out->k[e] = -h->def.alpha * kk[e] / n;
+}

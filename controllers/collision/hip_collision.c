@@ -1,0 +1,229 @@
+// collision.hip: the HIP's rays against the skin of the latest physics
+// publish, refitting (or, when the triangle set changed, rebuilding) a BVH
+// once per publish, and the local force model for the haptics controller.
+//
+// Between two physics publishes the skin is frozen while the hand moves on,
+// so the force computed on it is the force at the pose the physics last saw.
+// The model therefore anchors F0 at that pose (x0, looked up in a short
+// history of poses by the publish's simulation time) and K, the rays' estimate
+// of how the force grows as the skin is pushed along its normals, carries the
+// force along with the hand until the next publish.
+#include "hip_collision.h"
+
+#include "hip.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define HISTORY 1024 // poses kept: 0.25 s at 4 kHz, longer than a 20 Hz physics period
+
+typedef struct hip_ctl {
+  tx_hip hip;               // the method's state
+  tx_tri_bvh bvh;           // over the skin's live triangles
+  bool bvh_ready;           // built for the current triangle set
+  bool skin_ok;             // the latest skin publish was taken (finite, a valid mesh)
+  uint32_t tri_cap;         // triangles the BVH was sized for
+  tx_port pose, x, tri, thickness;           // reads
+  tx_port model, state, spheres;             // writes
+  uint64_t x_seq, tri_seq;  // last publishes seen
+  double hist_c[HISTORY][3]; // m, recent HIP centres
+  int64_t hist_t[HISTORY];  // ns, their simulation times
+  uint64_t hist_n;          // centres written so far
+  double x_snap[3];         // m, HIP centre when the current skin was published
+  bool touch_at_snap;       // in contact when the current skin was published
+  double onset[3];          // m, HIP centre where the current contact began
+  double last_c[3];         // m, last finite pose
+  tx_warning w_pose, w_skin, w_mesh; // non-finite pose, non-finite skin, triangle set too large or bad
+  tx_result r_peak, r_contacts, r_pierced, r_rebuilds, r_refits, r_resets;
+  double peak;              // N, largest force sent
+  uint64_t max_contacts, pierces, rebuilds, refits;
+  bool was_pierced;
+} hip_ctl;
+
+static int configure(tx_setup* s, void** self) {
+  hip_ctl* h = calloc(1, sizeof *h);
+  if (!h) return -1;
+  *self = h;
+  tx_hip_def def = tx_hip_def_default();
+  def.radius = tx_param_num(s, "radius_m", def.radius, 1e-5, 0.05);
+  def.rays = (int)tx_param_int(s, "rays", def.rays, 26, 98);
+  def.alpha = tx_param_num(s, "alpha", def.alpha, 0, 1e6);
+  def.k = tx_param_num(s, "k", def.k, 0, 0.999);
+  def.slide_max = tx_param_num(s, "slide_max_m", def.slide_max, 1e-6, 1);
+  def.pierce_range = tx_param_num(s, "pierce_range_m", def.pierce_range, 1e-5, 1);
+  def.hold = tx_param_num(s, "hold_m", def.hold, 0, 0.01);
+  if (def.rays != 26 && def.rays != 98) return tx_setup_fail(s, "rays", "must be 26 or 98, got %d", def.rays);
+  const char* err = tx_hip_def_check(&def);
+  if (err) return tx_setup_fail(s, NULL, "%s", err);
+  tx_hip_init(&h->hip, &def);
+  const char* pose = tx_param_str(s, "pose", "device0.pose");
+  const char* skin = tx_param_str(s, "skin", "skin");
+  const char* model = tx_param_str(s, "force_model", "tool0.force_model");
+  const char* state = tx_param_str(s, "state", "hip0.state");
+  const char* spheres = tx_param_str(s, "spheres", "hip0.spheres");
+  if (!pose || !skin || !model || !state || !spheres) return -1;
+  char name[3][TX_NAME_MAX];
+  if (snprintf(name[0], TX_NAME_MAX, "%s.x", skin) >= TX_NAME_MAX) return tx_setup_fail(s, "skin", "name too long");
+  snprintf(name[1], TX_NAME_MAX, "%s.tri", skin);
+  snprintf(name[2], TX_NAME_MAX, "%s.thickness", skin);
+  h->pose = tx_setup_read_as(s, pose, TX_F64, 7);
+  h->x = tx_setup_read_as(s, name[0], TX_F32, 3);
+  h->tri = tx_setup_read_as(s, name[1], TX_I32, 3);
+  h->thickness = tx_setup_read_as(s, name[2], TX_F64, 1);
+  h->model = tx_setup_write(s, &(tx_component_def){model, TX_F64, 1, 15, "N, m, N/m"});
+  h->state = tx_setup_write(s, &(tx_component_def){state, TX_F64, 1, 7, "1, N, m"});
+  h->spheres = tx_setup_write(s, &(tx_component_def){spheres, TX_F32, 1, 4, "m"});
+  h->w_pose = tx_setup_warning(s, "pose_not_finite");
+  h->w_skin = tx_setup_warning(s, "skin_not_finite");
+  h->w_mesh = tx_setup_warning(s, "skin_mesh_rejected");
+  h->r_peak = tx_setup_result(s, "peak_force_N");
+  h->r_contacts = tx_setup_result(s, "max_contacts");
+  h->r_pierced = tx_setup_result(s, "pierces");
+  h->r_rebuilds = tx_setup_result(s, "bvh_rebuilds");
+  h->r_refits = tx_setup_result(s, "bvh_refits");
+  h->r_resets = tx_setup_result(s, "eq8_updates");
+  return 0;
+}
+
+static int init(tx_ctx* c, void* self) {
+  hip_ctl* h = self;
+  // before the skin's first publish a read holds its full capacity: size the BVH by it
+  tx_snapshot tri = tx_read(c, h->tri);
+  h->tri_cap = tri.rows > 0 ? tri.rows : 1;
+  if (tx_tri_bvh_init(&h->bvh, h->tri_cap)) return -1;
+  return 0;
+}
+
+// the HIP centre at simulation time t, from the history (the newest not after t)
+static void centre_at(const hip_ctl* h, int64_t t, double out[3]) {
+  uint64_t n = h->hist_n < HISTORY ? h->hist_n : HISTORY;
+  for (uint64_t i = 0; i < n; i++) {
+    uint64_t j = (h->hist_n - 1 - i) % HISTORY;
+    if (h->hist_t[j] <= t || i == n - 1) {
+      memcpy(out, h->hist_c[j], 3 * sizeof *out);
+      return;
+    }
+  }
+  memcpy(out, h->last_c, 3 * sizeof *out);
+}
+
+static bool all_finite(const float* v, size_t n) {
+  for (size_t i = 0; i < n; i++)
+    if (!isfinite(v[i])) return false;
+  return true;
+}
+
+// a new skin publish: refit, or rebuild when the triangle set changed; false if unusable
+static bool take_skin(tx_ctx* c, hip_ctl* h, tx_snapshot x, tx_snapshot tri) {
+  if (!all_finite(x.data, (size_t)x.rows * 3)) {
+    tx_warn(c, h->w_skin);
+    return false;
+  }
+  uint32_t ntri = tri.rows;
+  bool same = h->bvh_ready && x.rows == h->bvh.nx && tx_tri_bvh_same(&h->bvh, tri.data, ntri);
+  if (same) {
+    tx_tri_bvh_refit(&h->bvh, x.data);
+    h->refits++;
+    return true;
+  }
+  if (tx_tri_bvh_build(&h->bvh, x.data, x.rows, tri.data, ntri)) {
+    tx_warn(c, h->w_mesh); // more triangles than at start, or an index outside the particles
+    h->bvh_ready = false;
+    return false;
+  }
+  h->bvh_ready = true;
+  h->rebuilds++;
+  return true;
+}
+
+static void step(tx_ctx* c, void* self) {
+  hip_ctl* h = self;
+  const double* pose = tx_read(c, h->pose).data;
+  double centre[3] = {pose[0], pose[1], pose[2]};
+  if (!(isfinite(centre[0]) && isfinite(centre[1]) && isfinite(centre[2]))) {
+    tx_warn(c, h->w_pose);
+    memcpy(centre, h->last_c, sizeof centre); // hold the last good pose
+  }
+  memcpy(h->last_c, centre, sizeof centre);
+  uint64_t slot = h->hist_n++ % HISTORY;
+  memcpy(h->hist_c[slot], centre, sizeof centre);
+  h->hist_t[slot] = tx_sim_ns(c);
+
+  // a new physics publish: take the skin and remember where the HIP was then
+  tx_snapshot x = tx_read(c, h->x), tri = tx_read(c, h->tri);
+  double thickness = ((const double*)tx_read(c, h->thickness).data)[0];
+  if (!isfinite(thickness) || thickness < 0) thickness = 0;
+  if (x.seq != 0 && (x.seq != h->x_seq || tri.seq != h->tri_seq)) {
+    h->x_seq = x.seq;
+    h->tri_seq = tri.seq;
+    h->skin_ok = take_skin(c, h, x, tri);
+    centre_at(h, x.sim_ns, h->x_snap);
+    h->touch_at_snap = h->hip.touching && !h->hip.pierced;
+  }
+
+  tx_hip_out out;
+  if (h->skin_ok && h->bvh_ready) {
+    bool was_touching = h->hip.touching;
+    tx_hip_query(&h->hip, &h->bvh, x.data, thickness, centre, &out);
+    if (!was_touching && h->hip.touching) memcpy(h->onset, centre, sizeof centre);
+  } else {
+    tx_hip_reset(&h->hip);
+    memset(&out, 0, sizeof out);
+  }
+  if (out.pierced && !h->was_pierced) h->pierces++;
+  h->was_pierced = out.pierced;
+
+  // the local model: F0 at the pose the skin answers to, K from the rays
+  double* m = tx_write(c, h->model);
+  memset(m, 0, 15 * sizeof *m);
+  bool force = out.contacts > 0;
+  const double* x0 = !force ? centre : h->touch_at_snap ? h->x_snap : h->onset;
+  memcpy(m + 3, x0, 3 * sizeof *m);
+  if (force) {
+    memcpy(m, out.f, 3 * sizeof *m);
+    memcpy(m + 6, out.k, 9 * sizeof *m);
+    double f = sqrt(out.f[0] * out.f[0] + out.f[1] * out.f[1] + out.f[2] * out.f[2]);
+    if (f > h->peak) h->peak = f;
+    if ((uint64_t)out.contacts > h->max_contacts) h->max_contacts = (uint64_t)out.contacts;
+  }
+  double* st = tx_write(c, h->state);
+  st[0] = out.contacts;
+  st[1] = out.pierced;
+  memcpy(st + 2, out.f, 3 * sizeof *st);
+  st[5] = out.depth;
+  st[6] = (double)h->hip.resets;
+  float* sp = tx_write(c, h->spheres);
+  sp[0] = (float)centre[0];
+  sp[1] = (float)centre[1];
+  sp[2] = (float)centre[2];
+  sp[3] = (float)h->hip.def.radius;
+}
+
+static void finish(tx_ctx* c, void* self) {
+  hip_ctl* h = self;
+  tx_set_result(c, h->r_peak, h->peak);
+  tx_set_result(c, h->r_contacts, (double)h->max_contacts);
+  tx_set_result(c, h->r_pierced, (double)h->pierces);
+  tx_set_result(c, h->r_rebuilds, (double)h->rebuilds);
+  tx_set_result(c, h->r_refits, (double)h->refits);
+  tx_set_result(c, h->r_resets, (double)h->hip.resets);
+}
+
+static void fini(void* self) {
+  hip_ctl* h = self;
+  if (!h) return;
+  tx_tri_bvh_free(&h->bvh);
+  free(h);
+}
+
+const tx_controller_class tx_collision_hip = {
+    .type = "collision.hip",
+    .summary = "the suturing papers' ray-casting HIP against the skin mesh: F = -alpha sum(R_n)/N, eq. 8, local model F0, x0, K",
+    .configure = configure,
+    .init = init,
+    .step = step,
+    .finish = finish,
+    .fini = fini,
+};
