@@ -34,7 +34,8 @@
 //              max_speed and within 10 m of the patch (a kinetic energy
 //              bound per particle); otherwise the whole patch, its torn
 //              links included, goes back to the state after the last good
-//              step and the step reports TX_CLOTH_FAULT
+//              step and the step reports TX_CLOTH_FAULT; the HIP starts the
+//              next step where it now is, so the faulty move is not replayed
 //
 //     tx_cloth_def d = tx_cloth_def_default();
 //     tx_cloth* c = tx_cloth_create(&d);          // NULL and tx_error() on bad input

@@ -503,6 +503,8 @@ static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& fr
 }
 
 // the HIP over one substep from h0 to h1, in moves of at most half the contact distance
+static void rupture(tx_cloth* c);
+
 static void sweep_contact(tx_cloth* c, const btVector3& h0, const btVector3& h1, double dt, bool count) {
   const double rc = c->hip_radius + 0.5 * c->def.thickness;
   if (c->hip_radius <= 0 || rc <= 0) return;
@@ -514,6 +516,10 @@ static void sweep_contact(tx_cloth* c, const btVector3& h0, const btVector3& h1,
     btVector3 h = h0.lerp(h1, (btScalar)k / (btScalar)moves);
     project_contact(c, h, h0, dt, count && k == moves, false);
   }
+  // a HIP this fast drags the skin further than the links can follow within
+  // the substep, and the solve would spread the strain before anyone saw it:
+  // what it overstretched tears now
+  if (moves > 1) rupture(c);
 }
 
 // every particle finite, slower than max_speed and near the patch
@@ -647,6 +653,8 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
     if (!healthy(c)) {
       c->faults++;
       tx_cloth_restore(c);
+      // the HIP's move that led here is not replayed: it starts the next step where it is
+      for (int a = 0; a < 3; a++) c->hip_prev[a] = c->hip[a];
       return TX_CLOTH_FAULT;
     }
     rupture(c);
