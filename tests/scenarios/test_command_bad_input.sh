@@ -185,11 +185,13 @@ if "$TACTUS" describe suturing-skin >/dev/null 2>&1; then
   expect_bad "skin gravity not a boolean" "--set skin.gravity=9.81" -- run suturing-skin --set skin.gravity=9.81
   expect_bad "skin unknown parameter" "--set skin.stiffnes=1" "unknown parameter" -- run suturing-skin --set skin.stiffnes=1
   expect_bad "skin-stability takes no --set" "--set skin.iterations=3" -- study skin-stability --set skin.iterations=3 --out "$WORK/ss"
+  expect_bad "skin-accuracy takes no --set" "--set skin.iterations=3" -- study skin-accuracy --set skin.iterations=3 --out "$WORK/sa"
   expect_bad "skin-stability unwritable --out" "--out /dev/null/x" -- study skin-stability --out /dev/null/x
 else
   expect_bad "skin-paper without Bullet" "physics.skin" -- study skin-paper --out "$WORK/sp"
   expect_bad "skin-stability without Bullet" "Bullet" -- study skin-stability --out "$WORK/ss"
   expect_bad "bench cloth without Bullet" "Bullet" -- bench cloth
+  expect_bad "skin-accuracy without Bullet" "Bullet" -- study skin-accuracy --out "$WORK/sa"
 fi
 expect_bad "describe with two names" "describe" -- describe rates rates
 expect_bad "list with an argument" "list" -- list extra
