@@ -179,7 +179,7 @@ static int run_setting(const setting* s, const char* device, curve* out, row* r,
 static int write_plot(const char* dir, const row* rows, char* err, size_t en) {
   // one series per sweep; the reference itself has no error to draw on a log axis
   static const char* sweeps[] = {"spacing", "iterations", "rate", "real time"};
-  static const int colours[] = {1, 3, 9, 2};
+  static const int colours[] = {1, 3, 9, 13};
   double x[4][NSETTINGS], y[4][NSETTINGS];
   tx_plot_series s[4];
   int ns = 0;
@@ -195,7 +195,7 @@ static int write_plot(const char* dir, const row* rows, char* err, size_t en) {
   }
   char path[4200];
   snprintf(path, sizeof path, "%s/skin-accuracy.png", dir);
-  tx_plot p = {"Skin force curve error against run time (pierce-down; reference 0.1 cm, 20 iterations, 120 Hz)",
+  tx_plot p = {"Skin force error vs run time (pierce-down; ref. 0.1 cm, 20 it, 120 Hz)",
                "run time (CPU s per simulated s)", "RMS force error (% of the reference peak)",
                true, true, s, ns};
   return tx_plot_png(path, &p, err, en);

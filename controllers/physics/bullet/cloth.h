@@ -130,7 +130,7 @@ void tx_cloth_restore(tx_cloth* c);
 // overwrite one particle's position (m) and velocity (m/s), unchecked, so
 // tests can inject a fault; false for a bad index
 bool tx_cloth_poke(tx_cloth* c, int i, const double x[3], const double v[3]);
-// one particle's position (m) as doubles, for tests
+// one particle's position (m) as doubles, for tests; NaN for a bad index
 void tx_cloth_particle(const tx_cloth* c, int i, double out[3]);
 
 #ifdef __cplusplus

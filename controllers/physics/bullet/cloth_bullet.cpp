@@ -10,7 +10,6 @@ extern "C" {
 }
 
 #include <BulletSoftBody/btSoftBody.h>
-#include <BulletSoftBody/btSoftBodyHelpers.h>
 
 #include <algorithm>
 #include <algorithm>
@@ -370,11 +369,11 @@ extern "C" tx_cloth_status tx_cloth_set_hip(tx_cloth* c, const double pos[3], do
 // ---------------------------------------------------------------------------
 // stepping
 
-// Bullet's per-iteration stiffness that makes `iterations` passes correct a
-// link by the implicit spring's fraction k dt^2 w / (1 + k dt^2 w)
-static btScalar link_stiffness(double k, double dt, double w, int iterations) {
+// Bullet's per-iteration link stiffness for a spring k (N/m) over a substep
+// dt: the fraction k dt^2 w / (1 + k dt^2 w) of the stretch that an implicit
+// spring removes in one substep (w: the two inverse masses, 1/kg)
+static btScalar link_stiffness(double k, double dt, double w) {
   if (k <= 0) return 0;
-  (void)iterations;
   double a = k * dt * dt * w;
   double s = a / (1 + a);
   if (!(s > 1e-9)) s = 1e-9; // Bullet divides by it
@@ -384,9 +383,8 @@ static btScalar link_stiffness(double k, double dt, double w, int iterations) {
 static void prepare(tx_cloth* c, double dt) {
   if (dt == c->prepared_dt) return;
   double w = 2 / c->node_mass;
-  c->stretch_mat->m_kLST = link_stiffness(c->def.stretch_stiffness, dt, w, c->def.iterations);
-  c->bend_mat->m_kLST = link_stiffness(c->def.bend_stiffness > 0 ? c->def.bend_stiffness : 1e-12, dt, w,
-                                       c->def.iterations);
+  c->stretch_mat->m_kLST = link_stiffness(c->def.stretch_stiffness, dt, w);
+  c->bend_mat->m_kLST = link_stiffness(c->def.bend_stiffness > 0 ? c->def.bend_stiffness : 1e-12, dt, w);
   c->body->updateLinkConstants();
   c->body->m_cfg.kDP = (btScalar)(1 - std::exp(-c->def.damping * dt));
   c->prepared_dt = dt;
@@ -707,6 +705,10 @@ extern "C" bool tx_cloth_poke(tx_cloth* c, int i, const double x[3], const doubl
 }
 
 extern "C" void tx_cloth_particle(const tx_cloth* c, int i, double out[3]) {
+  if (i < 0 || i >= c->n) {
+    out[0] = out[1] = out[2] = NAN;
+    return;
+  }
   const btVector3& x = c->body->m_nodes[i].m_x;
   for (int a = 0; a < 3; a++) out[a] = x[a];
 }
