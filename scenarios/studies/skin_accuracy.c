@@ -34,6 +34,8 @@
 #include <string.h>
 #include <time.h>
 
+#if TX_WITH_BULLET
+
 #define TICKS_MAX 4000 // 3 s at 1 kHz, and room
 
 // ---------------------------------------------------------------------------
@@ -202,10 +204,6 @@ static int write_plot(const char* dir, const row* rows, char* err, size_t en) {
 }
 
 int tx_study_skin_accuracy(const tx_study_args* a) {
-#if !TX_WITH_BULLET
-  (void)a;
-  return tx_bad_input("study skin-accuracy: this build has no Bullet (configured with TX_WITH_BULLET=OFF)");
-#else
   if (a->nsets) return tx_bad_input("--set %s: skin-accuracy takes no --set (its settings are fixed)", a->sets[0]);
   char path[4200], device[4300], err[1024];
   snprintf(path, sizeof path, "%s/motion-pierce-down.csv", a->out_dir);
@@ -309,5 +307,13 @@ int tx_study_skin_accuracy(const tx_study_args* a) {
   }
   free(curves);
   return rc;
-#endif
 }
+
+#else
+
+int tx_study_skin_accuracy(const tx_study_args* a) {
+  (void)a;
+  return tx_bad_input("study skin-accuracy: this build has no Bullet (configured with TX_WITH_BULLET=OFF)");
+}
+
+#endif
