@@ -294,8 +294,10 @@ int tx_cmd_bench(int argc, char** argv) {
     if (c == 'o') a.out = optarg;
     else if (c == 'd') {
       if (!tx_parse_num(optarg, 0.1, 3600, &a.duration_s)) return tx_bad_input("--duration %s: expected seconds in [0.1, 3600]", optarg);
-    } else if (c == 'h') optind = argc + 1;
-    else if (optopt && strncmp(argv[optind - 1], "--", 2) != 0) // inside a group of short options
+    } else if (c == 'h') {
+      optind = argc + 1; // --help: list the benchmarks; reading on would pass the end of argv
+      break;
+    } else if (optopt && strncmp(argv[optind - 1], "--", 2) != 0) // inside a group of short options
       return tx_bad_input("bench: unknown option '-%c'", optopt);
     else return tx_bad_input("bench: unknown or incomplete option '%s'", argv[optind - 1]);
   }

@@ -18,7 +18,7 @@ static const struct {
     {"skin-stability", tx_study_skin_stability,
      "the skin under stiffness x1e-3..x1e3, steps 1/20..1/1000 s, a teleporting and a 10 m/s HIP, zero thickness"},
     {"skin-accuracy", tx_study_skin_accuracy,
-     "pierce-down force curve error against physics cost over spacing, iterations and rate"},
+     "pierce-down force curve error against run time over spacing, iterations and rate"},
 };
 
 int tx_cmd_study(int argc, char** argv) {
