@@ -3,7 +3,8 @@
 // force (F64 1x3, default device0.force: what the device was sent), and
 // optionally the HIP state (hip0.state) and the skin's torn-link count
 // (skin.torn); it writes nothing. When the run ends it leaves, in the run's
-// folder, NAME.csv (t_s, x y z m, fx fy fz N, contacts, pierced, torn) and
+// folder, NAME.csv (t_s, x y z m, fx fy fz N, contacts, pierced, torn,
+// skin_t_s: the time of the skin publish the force was computed on) and
 // NAME.png, the force along `axis` against the position along it in cm (the
 // suturing papers' plots). Parameters: pose, force, state ("" for none),
 // torn ("" for none), axis (x, y or z), file (default force_displacement),

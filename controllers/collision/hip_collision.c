@@ -2,12 +2,12 @@
 // publish, refitting (or, when the triangle set changed, rebuilding) a BVH
 // once per publish, and the local force model for the haptics controller.
 //
-// Between two physics publishes the skin is frozen while the hand moves on,
-// so the force computed on it is the force at the pose the physics last saw.
-// The model therefore anchors F0 at that pose (x0, looked up in a short
-// history of poses by the publish's simulation time) and K, the rays' estimate
-// of how the force grows as the skin is pushed along its normals, carries the
-// force along with the hand until the next publish.
+// Between two physics publishes the skin is frozen while the hand moves on.
+// The force computed on the frozen skin is the force where the skin last
+// settled around the HIP, so the model anchors F0 at x0, the point where the
+// HIP would just touch that skin along the direction it came from, and K,
+// the rays' estimate of how the force grows as the skin is pushed along its
+// normals, carries the force along with the hand until the next publish.
 #include "hip_collision.h"
 
 #include "hip.h"
@@ -16,8 +16,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#define HISTORY 1024 // poses kept: 0.25 s at 4 kHz, longer than a 20 Hz physics period
 
 typedef struct hip_ctl {
   tx_hip hip;               // the method's state
@@ -28,12 +26,7 @@ typedef struct hip_ctl {
   tx_port pose, x, tri, thickness;           // reads
   tx_port model, state, spheres;             // writes
   uint64_t x_seq, tri_seq;  // last publishes seen
-  double hist_c[HISTORY][3]; // m, recent HIP centres
-  int64_t hist_t[HISTORY];  // ns, their simulation times
-  uint64_t hist_n;          // centres written so far
-  double x_snap[3];         // m, HIP centre when the current skin was published
-  bool touch_at_snap;       // in contact when the current skin was published
-  double onset[3];          // m, HIP centre where the current contact began
+  int64_t skin_ns;          // simulation time of the skin publish in use
   double last_c[3];         // m, last finite pose
   tx_warning w_pose, w_skin, w_mesh; // non-finite pose, non-finite skin, triangle set too large or bad
   tx_result r_peak, r_contacts, r_pierced, r_rebuilds, r_refits, r_resets;
@@ -54,6 +47,10 @@ static int configure(tx_setup* s, void** self) {
   def.slide_max = tx_param_num(s, "slide_max_m", def.slide_max, 1e-6, 1);
   def.pierce_range = tx_param_num(s, "pierce_range_m", def.pierce_range, 1e-5, 1);
   def.hold = tx_param_num(s, "hold_m", def.hold, 0, 0.01);
+  const char* join = tx_param_str(s, "join", "anchor");
+  if (!join) return -1;
+  if (strcmp(join, "anchor") && strcmp(join, "own")) return tx_setup_fail(s, "join", "expected \"anchor\" or \"own\", got \"%s\"", join);
+  def.join_anchor = strcmp(join, "anchor") == 0;
   if (def.rays != 26 && def.rays != 98) return tx_setup_fail(s, "rays", "must be 26 or 98, got %d", def.rays);
   const char* err = tx_hip_def_check(&def);
   if (err) return tx_setup_fail(s, NULL, "%s", err);
@@ -73,7 +70,7 @@ static int configure(tx_setup* s, void** self) {
   h->tri = tx_setup_read_as(s, name[1], TX_I32, 3);
   h->thickness = tx_setup_read_as(s, name[2], TX_F64, 1);
   h->model = tx_setup_write(s, &(tx_component_def){model, TX_F64, 1, 15, "N, m, N/m"});
-  h->state = tx_setup_write(s, &(tx_component_def){state, TX_F64, 1, 7, "1, N, m"});
+  h->state = tx_setup_write(s, &(tx_component_def){state, TX_F64, 1, 8, "1, N, m, s"});
   h->spheres = tx_setup_write(s, &(tx_component_def){spheres, TX_F32, 1, 4, "m"});
   h->w_pose = tx_setup_warning(s, "pose_not_finite");
   h->w_skin = tx_setup_warning(s, "skin_not_finite");
@@ -94,19 +91,6 @@ static int init(tx_ctx* c, void* self) {
   h->tri_cap = tri.rows > 0 ? tri.rows : 1;
   if (tx_tri_bvh_init(&h->bvh, h->tri_cap)) return -1;
   return 0;
-}
-
-// the HIP centre at simulation time t, from the history (the newest not after t)
-static void centre_at(const hip_ctl* h, int64_t t, double out[3]) {
-  uint64_t n = h->hist_n < HISTORY ? h->hist_n : HISTORY;
-  for (uint64_t i = 0; i < n; i++) {
-    uint64_t j = (h->hist_n - 1 - i) % HISTORY;
-    if (h->hist_t[j] <= t || i == n - 1) {
-      memcpy(out, h->hist_c[j], 3 * sizeof *out);
-      return;
-    }
-  }
-  memcpy(out, h->last_c, 3 * sizeof *out);
 }
 
 static bool all_finite(const float* v, size_t n) {
@@ -147,11 +131,8 @@ static void step(tx_ctx* c, void* self) {
     memcpy(centre, h->last_c, sizeof centre); // hold the last good pose
   }
   memcpy(h->last_c, centre, sizeof centre);
-  uint64_t slot = h->hist_n++ % HISTORY;
-  memcpy(h->hist_c[slot], centre, sizeof centre);
-  h->hist_t[slot] = tx_sim_ns(c);
 
-  // a new physics publish: take the skin and remember where the HIP was then
+  // a new physics publish: take the skin
   tx_snapshot x = tx_read(c, h->x), tri = tx_read(c, h->tri);
   double thickness = ((const double*)tx_read(c, h->thickness).data)[0];
   if (!isfinite(thickness) || thickness < 0) thickness = 0;
@@ -159,28 +140,25 @@ static void step(tx_ctx* c, void* self) {
     h->x_seq = x.seq;
     h->tri_seq = tri.seq;
     h->skin_ok = take_skin(c, h, x, tri);
-    centre_at(h, x.sim_ns, h->x_snap);
-    h->touch_at_snap = h->hip.touching && !h->hip.pierced;
+    h->skin_ns = x.sim_ns;
   }
 
   tx_hip_out out;
   if (h->skin_ok && h->bvh_ready) {
-    bool was_touching = h->hip.touching;
     tx_hip_query(&h->hip, &h->bvh, x.data, thickness, centre, &out);
-    if (!was_touching && h->hip.touching) memcpy(h->onset, centre, sizeof centre);
   } else {
     tx_hip_reset(&h->hip);
     memset(&out, 0, sizeof out);
+    memcpy(out.x0, centre, sizeof centre);
   }
   if (out.pierced && !h->was_pierced) h->pierces++;
   h->was_pierced = out.pierced;
 
-  // the local model: F0 at the pose the skin answers to, K from the rays
+  // the local model: F0 where the frozen skin would just touch the HIP, K from the rays
   double* m = tx_write(c, h->model);
   memset(m, 0, 15 * sizeof *m);
   bool force = out.contacts > 0;
-  const double* x0 = !force ? centre : h->touch_at_snap ? h->x_snap : h->onset;
-  memcpy(m + 3, x0, 3 * sizeof *m);
+  memcpy(m + 3, force ? out.x0 : centre, 3 * sizeof *m);
   if (force) {
     memcpy(m, out.f, 3 * sizeof *m);
     memcpy(m + 6, out.k, 9 * sizeof *m);
@@ -194,6 +172,7 @@ static void step(tx_ctx* c, void* self) {
   memcpy(st + 2, out.f, 3 * sizeof *st);
   st[5] = out.depth;
   st[6] = (double)h->hip.resets;
+  st[7] = h->skin_ns * 1e-9;
   float* sp = tx_write(c, h->spheres);
   sp[0] = (float)centre[0];
   sp[1] = (float)centre[1];

@@ -86,7 +86,8 @@ static const skin_case cases[] = {
 
 typedef struct run_data {
   int n;
-  double t[TICKS_MAX], pos[3][TICKS_MAX], f[3][TICKS_MAX], contacts[TICKS_MAX], pierced[TICKS_MAX], torn[TICKS_MAX];
+  double t[TICKS_MAX], pos[3][TICKS_MAX], f[3][TICKS_MAX], contacts[TICKS_MAX], pierced[TICKS_MAX], torn[TICKS_MAX],
+      skin_t[TICKS_MAX];
   int push_axis, slide_axis; // 1 (y) for piercing; 0 or 2 when sliding (-1: none)
   tx_skin_metrics m;
 } run_data;
@@ -120,8 +121,9 @@ static int read_curve(const char* path, run_data* d) {
   if (!fgets(line, sizeof line, f)) return fclose(f), -1; // the header
   while (d->n < TICKS_MAX && fgets(line, sizeof line, f)) {
     int i = d->n;
-    if (sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &d->t[i], &d->pos[0][i], &d->pos[1][i], &d->pos[2][i],
-               &d->f[0][i], &d->f[1][i], &d->f[2][i], &d->contacts[i], &d->pierced[i], &d->torn[i]) != 10) {
+    if (sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &d->t[i], &d->pos[0][i], &d->pos[1][i],
+               &d->pos[2][i], &d->f[0][i], &d->f[1][i], &d->f[2][i], &d->contacts[i], &d->pierced[i], &d->torn[i],
+               &d->skin_t[i]) != 11) {
       fclose(f);
       return fprintf(stderr, "tactus: %s:%d: not a force curve row\n", path, i + 2), -1;
     }
@@ -161,8 +163,8 @@ static int run_case(const tx_study_args* a, const char* motions_dir, const skin_
   if (read_curve(path, d)) return 1;
   d->push_axis = 1;
   d->slide_axis = c->motion[0] == 's' ? c->motion[6] - 'x' : -1;
-  tx_skin_series s = {d->n, d->t, d->pos[1], d->f[1], d->slide_axis >= 0 ? d->f[d->slide_axis] : NULL, d->contacts,
-                      d->pierced, d->torn};
+  tx_skin_series s = {d->n,        d->t,           d->pos[1], d->f[1], d->slide_axis >= 0 ? d->f[d->slide_axis] : NULL,
+                      d->contacts, d->pierced,     d->torn,   d->skin_t};
   // sliding is steady from 1.5 s (after the descent) to 6.5 s (before the lift)
   d->m = tx_skin_measure(&s, 1.5, 6.5);
   return 0;
