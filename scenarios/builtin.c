@@ -2,10 +2,15 @@
 #include "loader.h"
 #include "rates/rates_worker.h"
 
+#include <tactus/config.h>
+
 #include "../controllers/collision/hip_collision.h"
 #include "../controllers/collision/wall.h"
 #include "../controllers/haptics/haptics_controller.h"
 #include "../views/force_curve.h"
+#if TX_WITH_BULLET
+#include "../controllers/physics/skin_controller.h"
+#endif
 
 #include <pthread.h>
 
@@ -15,6 +20,9 @@ static void register_all(void) {
   tx_register_controller(&tx_collision_hip);
   tx_register_controller(&tx_view_force_curve);
   tx_register_controller(&tx_haptics_controller);
+#if TX_WITH_BULLET
+  tx_register_controller(&tx_physics_skin);
+#endif
 }
 
 void tx_register_builtin(void) {
