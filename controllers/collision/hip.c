@@ -52,7 +52,7 @@ void tx_hip_query(tx_hip* h, tx_tri_bvh* b, const float* x, double thickness, co
   const double r = h->def.radius;
   const double reach = r + 0.5 * thickness; // contact: mid-plane closer than this
   double nearest = reach + h->def.hold, towards[3] = {0, 0, 0};
-  double t[TX_HIP_RAYS_MAX], normal[TX_HIP_RAYS_MAX][3];
+  double t[TX_HIP_RAYS_MAX];
   bool fresh[TX_HIP_RAYS_MAX] = {false};
   int n = 0;
   // every ray starts at c and ends within reach: one walk finds what they can meet
@@ -69,7 +69,6 @@ void tx_hip_query(tx_hip* h, tx_tri_bvh* b, const float* x, double thickness, co
     }
     t[i] = hit.t;
     if (!h->on[i]) fresh[i] = true; // its first contact point is set below, once the anchor is known
-    memcpy(normal[i], hit.n, sizeof normal[i]);
     for (int a = 0; a < 3; a++) towards[a] += d[a];
     if (hit.t < nearest) nearest = hit.t;
     n++;
@@ -118,7 +117,7 @@ void tx_hip_query(tx_hip* h, tx_tri_bvh* b, const float* x, double thickness, co
     out->pierced = true;
     return;
   }
-  double sum[3] = {0, 0, 0}, kk[9] = {0};
+  double sum[3] = {0, 0, 0};
   const double* a_n = h->approach;
   for (int i = 0; i < h->nrays; i++) {
     if (!h->on[i]) continue;
@@ -139,10 +138,10 @@ void tx_hip_query(tx_hip* h, tx_tri_bvh* b, const float* x, double thickness, co
       h->resets++;
     }
     for (int e = 0; e < 3; e++) sum[e] += rn[e];
-    for (int e = 0; e < 3; e++)
-      for (int f = 0; f < 3; f++) kk[3 * e + f] += normal[i][e] * normal[i][f];
   }
   out->contacts = n;
   for (int e = 0; e < 3; e++) out->f[e] = -h->def.alpha * sum[e] / n; // eq. 7
-  for (int e = 0; e < 9; e++) out->k[e] = -h->def.alpha * kk[e] / n;
+  // K = dF/dc with every contact point moving with the HIP, as the skin held at the HIP's
+  // surface does along the push and the rays' own hits do across it: each R_n grows with c
+  for (int e = 0; e < 3; e++) out->k[4 * e] = -h->def.alpha;
 }

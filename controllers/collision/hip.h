@@ -63,7 +63,8 @@ typedef struct tx_hip {
 
 typedef struct tx_hip_out {
   double f[3];   // N, force of the skin on the HIP
-  double k[9];   // N/m, row-major dF/dc estimated from the rays: -alpha mean(m_n m_n^T), m_n the hit normals
+  double k[9];   // N/m, row-major dF/dc from the rays: each R_n moves with the HIP while the skin is held
+                 // at its surface, so -alpha I in contact (0 without)
   int contacts;  // N, rays in contact (0 once pierced)
   bool pierced;  // the HIP is through the skin
   double depth;  // m, r + h/2 - the shortest contact distance (0 without contact)

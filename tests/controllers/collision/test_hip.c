@@ -134,8 +134,8 @@ static void test_one_ray_force_and_push(void** state) {
   // P_in = c + r d = (cx, y - r, cz), P_n = (cx, 0, cz): F = -alpha R = alpha (y - r) up
   assert_true(fabs(o.f[1] - ALPHA * (y - R)) < 1e-9);
   assert_true(fabs(o.f[0]) < 1e-12 && fabs(o.f[2]) < 1e-12);
-  // K = -alpha n n^T for the flat skin's normal n = y
-  for (int i = 0; i < 9; i++) assert_true(fabs(o.k[i] - (i == 4 ? -ALPHA : 0)) < 1e-9);
+  // K = -alpha I: every R_n grows with the HIP while the skin is held at its surface
+  for (int i = 0; i < 9; i++) assert_true(fabs(o.k[i] - (i % 4 == 0 ? -ALPHA : 0)) < 1e-9);
   assert_true(fabs(o.depth - (REACH - y)) < 1e-12);
   // the skin pushed down 1 mm with the HIP: the force grows by alpha x 1 mm
   const double push = 1e-3;
