@@ -65,10 +65,12 @@ int main(int argc, char** argv) {
     snprintf(what, sizeof what, "slide %s: steady tangential force against the motion", slides[i]);
     expect(mean < 0 && cv <= 0.25, what, mean, cv);
   }
+  // The paper's "denser skin, smoother force" is not asserted: with physics.skin's face contact
+  // the skin is held exactly at the HIP's surface on either mesh, and the finer mesh wraps the
+  // HIP so that more rays join the contact (docs/hip.md, "What does not reproduce"). The study
+  // prints both roughness values; here they must at least have been measured.
   a = get("0.1 cm, pierce", "roughness"), b = get("0.25 cm, pierce", "roughness");
-  expect(a < b, "denser skin, smoother pierce force", a, b);
-  a = get("0.1 cm, slide x", "roughness"), b = get("0.25 cm, slide x", "roughness");
-  expect(a < b, "denser skin, smoother slide force", a, b);
+  expect(isfinite(a) && isfinite(b), "roughness measured for both spacings", a, b);
   a = get("sample-and-hold", "max_step_n"), b = get("local model", "max_step_n");
   expect(a >= 10 * b, "largest 1 ms step: sample-and-hold >= 10x the local model", a, b);
   json_decref(doc);
