@@ -1,6 +1,8 @@
 // collision.hip: the HIP's rays against the skin of the latest physics
-// publish, refitting (or, when the triangle set changed, rebuilding) a BVH
-// once per publish, and the local force model for the haptics controller.
+// publish, and the local force model for the haptics controller. Each
+// publish is copied and a second BVH is refitted to it over a few steps (or
+// rebuilt at once when the triangle set changed) while the first still
+// answers; then the two swap, so no single 4 kHz step carries a whole refit.
 //
 // Between two physics publishes the skin is frozen while the hand moves on.
 // The force computed on the frozen skin is the force where the skin last
@@ -19,14 +21,17 @@
 
 typedef struct hip_ctl {
   tx_hip hip;               // the method's state
-  tx_tri_bvh bvh;           // over the skin's live triangles
-  bool bvh_ready;           // built for the current triangle set
-  bool skin_ok;             // the latest skin publish was taken (finite, a valid mesh)
-  uint32_t tri_cap;         // triangles the BVH was sized for
+  tx_tri_bvh tree[2];       // over the skin's live triangles: one answers queries, the other is refitted
+  float* xs[2];             // (xcap x 3) m, the particles each tree was fitted to, copied from the publish
+  int64_t ns[2];            // simulation time of the skin publish each tree holds
+  int act;                  // the tree queries use, -1 for none (no usable skin)
+  bool job;                 // the other tree is being refitted to a newer publish
+  uint32_t job_next;        // its nodes [0, job_next) are still to refit
+  uint32_t chunk;           // nodes refitted per step: a refit is spread over a few steps
+  uint32_t tri_cap, xcap;   // triangles and particles the trees and copies were sized for
   tx_port pose, x, tri, thickness;           // reads
   tx_port model, state, spheres;             // writes
   uint64_t x_seq, tri_seq;  // last publishes seen
-  int64_t skin_ns;          // simulation time of the skin publish in use
   double last_c[3];         // m, last finite pose
   tx_warning w_pose, w_skin, w_mesh; // non-finite pose, non-finite skin, triangle set too large or bad
   tx_result r_peak, r_contacts, r_pierced, r_rebuilds, r_refits, r_resets;
@@ -86,10 +91,19 @@ static int configure(tx_setup* s, void** self) {
 
 static int init(tx_ctx* c, void* self) {
   hip_ctl* h = self;
-  // before the skin's first publish a read holds its full capacity: size the BVH by it
-  tx_snapshot tri = tx_read(c, h->tri);
+  // before the skin's first publish a read holds its full capacity: size everything by it
+  tx_snapshot tri = tx_read(c, h->tri), x = tx_read(c, h->x);
   h->tri_cap = tri.rows > 0 ? tri.rows : 1;
-  if (tx_tri_bvh_init(&h->bvh, h->tri_cap)) return -1;
+  h->xcap = x.rows > 0 ? x.rows : 1;
+  h->act = -1;
+  for (int i = 0; i < 2; i++) {
+    if (tx_tri_bvh_init(&h->tree[i], h->tri_cap)) return -1;
+    if (!(h->xs[i] = calloc(3 * (size_t)h->xcap, sizeof(float)))) return -1;
+  }
+  // a refit spread over up to 8 steps at 4 kHz (2 ms, well inside a 120 Hz physics
+  // period); at 500 Hz and below it is done in the step that sees the publish
+  double spread = floor(tx_rate(c) / 500);
+  h->chunk = (uint32_t)(2 * (size_t)h->tri_cap / (spread < 1 ? 1 : spread > 16 ? 16 : spread)) + 1;
   return 0;
 }
 
@@ -99,27 +113,51 @@ static bool all_finite(const float* v, size_t n) {
   return true;
 }
 
-// a new skin publish: refit, or rebuild when the triangle set changed; false if unusable
-static bool take_skin(tx_ctx* c, hip_ctl* h, tx_snapshot x, tx_snapshot tri) {
-  if (!all_finite(x.data, (size_t)x.rows * 3)) {
+// a new skin publish: copy it beside the tree in use, then refit the other tree to it over the
+// next steps, or rebuild that tree now when the triangle set changed
+static void take_skin(tx_ctx* c, hip_ctl* h, tx_snapshot x, tx_snapshot tri) {
+  int b = h->act == 0 ? 1 : 0;
+  h->job = false;
+  if (x.rows > h->xcap) {
+    tx_warn(c, h->w_mesh);
+    h->act = -1;
+    return;
+  }
+  memcpy(h->xs[b], x.data, 3 * (size_t)x.rows * sizeof(float));
+  if (!all_finite(h->xs[b], 3 * (size_t)x.rows)) { // no force from a broken skin, until a good one
     tx_warn(c, h->w_skin);
-    return false;
+    h->act = -1;
+    return;
   }
-  uint32_t ntri = tri.rows;
-  bool same = h->bvh_ready && x.rows == h->bvh.nx && tx_tri_bvh_same(&h->bvh, tri.data, ntri);
-  if (same) {
-    tx_tri_bvh_refit(&h->bvh, x.data);
-    h->refits++;
-    return true;
+  h->ns[b] = x.sim_ns;
+  tx_tri_bvh* cur = h->act >= 0 ? &h->tree[h->act] : NULL;
+  if (cur && x.rows == cur->nx && tx_tri_bvh_same(cur, tri.data, tri.rows)) {
+    // the same triangles: the other tree takes this shape (if a rebuild left it behind) and is refitted
+    if (!(x.rows == h->tree[b].nx && tx_tri_bvh_same(&h->tree[b], tri.data, tri.rows))) tx_tri_bvh_copy(&h->tree[b], cur);
+    h->job = true;
+    h->job_next = h->tree[b].nnodes;
+    return;
   }
-  if (tx_tri_bvh_build(&h->bvh, x.data, x.rows, tri.data, ntri)) {
+  if (tx_tri_bvh_build(&h->tree[b], h->xs[b], x.rows, tri.data, tri.rows)) {
     tx_warn(c, h->w_mesh); // more triangles than at start, or an index outside the particles
-    h->bvh_ready = false;
-    return false;
+    h->act = -1;
+    return;
   }
-  h->bvh_ready = true;
+  h->act = b;
   h->rebuilds++;
-  return true;
+}
+
+// one step's share of the refit; the refitted tree takes over when it is whole
+static void refit_some(hip_ctl* h) {
+  int b = h->act == 0 ? 1 : 0;
+  uint32_t from = h->job_next > h->chunk ? h->job_next - h->chunk : 0;
+  tx_tri_bvh_refit_nodes(&h->tree[b], h->xs[b], from, h->job_next);
+  h->job_next = from;
+  if (from == 0) {
+    h->act = b;
+    h->job = false;
+    h->refits++;
+  }
 }
 
 static void step(tx_ctx* c, void* self) {
@@ -139,13 +177,13 @@ static void step(tx_ctx* c, void* self) {
   if (x.seq != 0 && (x.seq != h->x_seq || tri.seq != h->tri_seq)) {
     h->x_seq = x.seq;
     h->tri_seq = tri.seq;
-    h->skin_ok = take_skin(c, h, x, tri);
-    h->skin_ns = x.sim_ns;
+    take_skin(c, h, x, tri);
   }
+  if (h->job) refit_some(h);
 
   tx_hip_out out;
-  if (h->skin_ok && h->bvh_ready) {
-    tx_hip_query(&h->hip, &h->bvh, x.data, thickness, centre, &out);
+  if (h->act >= 0) {
+    tx_hip_query(&h->hip, &h->tree[h->act], h->xs[h->act], thickness, centre, &out);
   } else {
     tx_hip_reset(&h->hip);
     memset(&out, 0, sizeof out);
@@ -172,7 +210,7 @@ static void step(tx_ctx* c, void* self) {
   memcpy(st + 2, out.f, 3 * sizeof *st);
   st[5] = out.depth;
   st[6] = (double)h->hip.resets;
-  st[7] = h->skin_ns * 1e-9;
+  st[7] = h->act >= 0 ? h->ns[h->act] * 1e-9 : 0;
   float* sp = tx_write(c, h->spheres);
   sp[0] = (float)centre[0];
   sp[1] = (float)centre[1];
@@ -193,7 +231,10 @@ static void finish(tx_ctx* c, void* self) {
 static void fini(void* self) {
   hip_ctl* h = self;
   if (!h) return;
-  tx_tri_bvh_free(&h->bvh);
+  for (int i = 0; i < 2; i++) {
+    tx_tri_bvh_free(&h->tree[i]);
+    free(h->xs[i]);
+  }
   free(h);
 }
 
