@@ -16,6 +16,7 @@ typedef struct curve {
   tx_port pose, force, state, torn; // reads; state and torn may be invalid (id 0)
   int axis;                         // 0, 1, 2: x, y, z
   char file[64];                    // base name of the CSV and PNG
+  bool png;                         // draw the PNG too
   double* rows;                     // (cap x COLS) the samples
   uint64_t cap, n;                  // capacity and samples taken
   tx_warning w_full;                // the recording filled up
@@ -33,6 +34,7 @@ static int configure(tx_setup* s, void** self) {
   const char* axis = tx_param_str(s, "axis", "y");
   const char* file = tx_param_str(s, "file", "force_displacement");
   c->cap = (uint64_t)tx_param_int(s, "max_samples", 600000, 1, 10000000);
+  c->png = tx_param_bool(s, "png", true);
   if (!pose || !force || !state || !torn || !axis || !file) return -1;
   if (strlen(axis) != 1 || axis[0] < 'x' || axis[0] > 'z') return tx_setup_fail(s, "axis", "expected x, y or z, got \"%s\"", axis);
   c->axis = axis[0] - 'x';
@@ -95,6 +97,7 @@ static void finish(tx_ctx* ctx, void* self) {
     fprintf(stderr, "tactus: %s: cannot be written\n", path);
     return;
   }
+  if (!c->png) return;
   // the papers' plot: force along the axis (N) against the position along it (cm)
   double* xs = malloc(sizeof(double) * c->n);
   double* ys = malloc(sizeof(double) * c->n);

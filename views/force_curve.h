@@ -8,7 +8,9 @@
 // NAME.png, the force along `axis` against the position along it in cm (the
 // suturing papers' plots). Parameters: pose, force, state ("" for none),
 // torn ("" for none), axis (x, y or z), file (default force_displacement),
-// max_samples (the recording stops, with a warning, when it is full).
+// max_samples (the recording stops, with a warning, when it is full), png
+// (false: the CSV only; the PNG goes through PLplot and cairo, whose font
+// threads ThreadSanitizer cannot see into).
 #ifndef TX_VIEWS_FORCE_CURVE_H
 #define TX_VIEWS_FORCE_CURVE_H
 
