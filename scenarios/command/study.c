@@ -15,6 +15,10 @@ static const struct {
     {"haptic-stability", tx_study_haptic_stability,
      "largest stable wall stiffness vs Colgate's bound, with and without passivity control"},
     {"skin-paper", tx_study_skin_paper, "the SutureHap journal paper's skin tests (Figs. 15-19) and the 60 Hz hold"},
+    {"skin-stability", tx_study_skin_stability,
+     "the skin under stiffness x1e-3..x1e3, steps 1/20..1/1000 s, a teleporting and a 10 m/s HIP, zero thickness"},
+    {"skin-accuracy", tx_study_skin_accuracy,
+     "pierce-down force curve error against physics cost over spacing, iterations and rate"},
 };
 
 int tx_cmd_study(int argc, char** argv) {

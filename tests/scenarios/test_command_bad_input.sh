@@ -177,8 +177,21 @@ expect_bad "force curve file with a path" "--set curve.file=../x" "base name" --
 # built without Bullet, suturing-skin itself is refused: its physics.skin is unknown
 if "$TACTUS" describe suturing-skin >/dev/null 2>&1; then
   expect_bad "skin-paper --set bad HIP rays" "hip.rays" -- study skin-paper --set hip.rays=7 --out "$WORK/sp"
+  # physics.skin parameters
+  expect_bad "skin spacing not dividing the patch" "--set skin.spacing_m=0.003" "whole cells" -- run suturing-skin --set skin.spacing_m=0.003
+  expect_bad "skin thickness out of range" "--set skin.thickness_m=0.5" "out of range" -- run suturing-skin --set skin.thickness_m=0.5
+  expect_bad "skin iterations not a number" "--set skin.iterations=many" -- run suturing-skin --set skin.iterations=many
+  expect_bad "skin rate out of range" "suturing-skin.json" "controllers[0]" "20 to 120 Hz" -- run suturing-skin --set skin.rate_hz=500
+  expect_bad "skin gravity not a boolean" "--set skin.gravity=9.81" -- run suturing-skin --set skin.gravity=9.81
+  expect_bad "skin unknown parameter" "--set skin.stiffnes=1" "unknown parameter" -- run suturing-skin --set skin.stiffnes=1
+  expect_bad "skin-stability takes no --set" "--set skin.iterations=3" -- study skin-stability --set skin.iterations=3 --out "$WORK/ss"
+  expect_bad "skin-accuracy takes no --set" "--set skin.iterations=3" -- study skin-accuracy --set skin.iterations=3 --out "$WORK/sa"
+  expect_bad "skin-stability unwritable --out" "--out /dev/null/x" -- study skin-stability --out /dev/null/x
 else
   expect_bad "skin-paper without Bullet" "physics.skin" -- study skin-paper --out "$WORK/sp"
+  expect_bad "skin-stability without Bullet" "Bullet" -- study skin-stability --out "$WORK/ss"
+  expect_bad "bench cloth without Bullet" "Bullet" -- bench cloth
+  expect_bad "skin-accuracy without Bullet" "Bullet" -- study skin-accuracy --out "$WORK/sa"
 fi
 expect_bad "describe with two names" "describe" -- describe rates rates
 expect_bad "list with an argument" "list" -- list extra

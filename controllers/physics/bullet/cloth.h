@@ -34,7 +34,8 @@
 //              max_speed and within 10 m of the patch (a kinetic energy
 //              bound per particle); otherwise the whole patch, its torn
 //              links included, goes back to the state after the last good
-//              step and the step reports TX_CLOTH_FAULT
+//              step and the step reports TX_CLOTH_FAULT; the HIP starts the
+//              next step where it now is, so the faulty move is not replayed
 //
 //     tx_cloth_def d = tx_cloth_def_default();
 //     tx_cloth* c = tx_cloth_create(&d);          // NULL and tx_error() on bad input
@@ -129,7 +130,7 @@ void tx_cloth_restore(tx_cloth* c);
 // overwrite one particle's position (m) and velocity (m/s), unchecked, so
 // tests can inject a fault; false for a bad index
 bool tx_cloth_poke(tx_cloth* c, int i, const double x[3], const double v[3]);
-// one particle's position (m) as doubles, for tests
+// one particle's position (m) as doubles, for tests; NaN for a bad index
 void tx_cloth_particle(const tx_cloth* c, int i, double out[3]);
 
 #ifdef __cplusplus

@@ -10,7 +10,6 @@ extern "C" {
 }
 
 #include <BulletSoftBody/btSoftBody.h>
-#include <BulletSoftBody/btSoftBodyHelpers.h>
 
 #include <algorithm>
 #include <algorithm>
@@ -263,6 +262,34 @@ static bool build(tx_cloth* c) {
     }
   c->nlink = (int)c->info.size();
 
+  // Gauss-Seidel order in colours: no two links of one colour share a
+  // particle, so the solver's updates within a colour do not wait on each
+  // other (about a third fewer cycles at 10404 particles), and within a
+  // colour they follow the particles in memory order
+  {
+    btAlignedObjectArray<btSoftBody::Link>& links = c->body->m_links;
+    const btSoftBody::Node* base = &c->body->m_nodes[0];
+    auto colour = [&](int a, int b) {
+      int ax = a % nx, az = a / nx, dx = b % nx - ax, dz = b / nx - az;
+      if (dz == 0) return dx == 1 ? (ax & 1) : 8 + ((ax >> 1) & 1);     // stretch x, bending x
+      if (dx == 0) return dz == 1 ? 2 + (az & 1) : 10 + ((az >> 1) & 1); // stretch z, bending z
+      return (dx > 0 ? 4 : 6) + (az & 1);                                // the two diagonals
+    };
+    std::vector<std::pair<long long, int>> key((size_t)links.size());
+    for (int i = 0; i < links.size(); i++) {
+      int a = (int)(links[i].m_n[0] - base), b = (int)(links[i].m_n[1] - base);
+      if (a > b) std::swap(a, b);
+      key[(size_t)i] = {(long long)colour(a, b) << 32 | a, i};
+    }
+    std::sort(key.begin(), key.end());
+    std::vector<btSoftBody::Link> sorted((size_t)links.size());
+    for (size_t i = 0; i < key.size(); i++) sorted[i] = links[key[i].second];
+    for (int i = 0; i < links.size(); i++) {
+      links[i] = sorted[(size_t)i];
+      c->info[(size_t)(intptr_t)links[i].m_tag].slot = i;
+    }
+  }
+
   // rest lengths and constants now, so that Bullet never resets them to a deformed shape
   c->body->updateConstants();
   c->body->m_bUpdateRtCst = false;
@@ -370,11 +397,11 @@ extern "C" tx_cloth_status tx_cloth_set_hip(tx_cloth* c, const double pos[3], do
 // ---------------------------------------------------------------------------
 // stepping
 
-// Bullet's per-iteration stiffness that makes `iterations` passes correct a
-// link by the implicit spring's fraction k dt^2 w / (1 + k dt^2 w)
-static btScalar link_stiffness(double k, double dt, double w, int iterations) {
+// Bullet's per-iteration link stiffness for a spring k (N/m) over a substep
+// dt: the fraction k dt^2 w / (1 + k dt^2 w) of the stretch that an implicit
+// spring removes in one substep (w: the two inverse masses, 1/kg)
+static btScalar link_stiffness(double k, double dt, double w) {
   if (k <= 0) return 0;
-  (void)iterations;
   double a = k * dt * dt * w;
   double s = a / (1 + a);
   if (!(s > 1e-9)) s = 1e-9; // Bullet divides by it
@@ -384,9 +411,8 @@ static btScalar link_stiffness(double k, double dt, double w, int iterations) {
 static void prepare(tx_cloth* c, double dt) {
   if (dt == c->prepared_dt) return;
   double w = 2 / c->node_mass;
-  c->stretch_mat->m_kLST = link_stiffness(c->def.stretch_stiffness, dt, w, c->def.iterations);
-  c->bend_mat->m_kLST = link_stiffness(c->def.bend_stiffness > 0 ? c->def.bend_stiffness : 1e-12, dt, w,
-                                       c->def.iterations);
+  c->stretch_mat->m_kLST = link_stiffness(c->def.stretch_stiffness, dt, w);
+  c->bend_mat->m_kLST = link_stiffness(c->def.bend_stiffness > 0 ? c->def.bend_stiffness : 1e-12, dt, w);
   c->body->updateLinkConstants();
   c->body->m_cfg.kDP = (btScalar)(1 - std::exp(-c->def.damping * dt));
   c->prepared_dt = dt;
@@ -503,6 +529,8 @@ static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& fr
 }
 
 // the HIP over one substep from h0 to h1, in moves of at most half the contact distance
+static void rupture(tx_cloth* c);
+
 static void sweep_contact(tx_cloth* c, const btVector3& h0, const btVector3& h1, double dt, bool count) {
   const double rc = c->hip_radius + 0.5 * c->def.thickness;
   if (c->hip_radius <= 0 || rc <= 0) return;
@@ -514,6 +542,10 @@ static void sweep_contact(tx_cloth* c, const btVector3& h0, const btVector3& h1,
     btVector3 h = h0.lerp(h1, (btScalar)k / (btScalar)moves);
     project_contact(c, h, h0, dt, count && k == moves, false);
   }
+  // a HIP this fast drags the skin further than the links can follow within
+  // the substep, and the solve would spread the strain before anyone saw it:
+  // what it overstretched tears now
+  if (moves > 1) rupture(c);
 }
 
 // every particle finite, slower than max_speed and near the patch
@@ -647,6 +679,8 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
     if (!healthy(c)) {
       c->faults++;
       tx_cloth_restore(c);
+      // the HIP's move that led here is not replayed: it starts the next step where it is
+      for (int a = 0; a < 3; a++) c->hip_prev[a] = c->hip[a];
       return TX_CLOTH_FAULT;
     }
     rupture(c);
@@ -699,6 +733,10 @@ extern "C" bool tx_cloth_poke(tx_cloth* c, int i, const double x[3], const doubl
 }
 
 extern "C" void tx_cloth_particle(const tx_cloth* c, int i, double out[3]) {
+  if (i < 0 || i >= c->n) {
+    out[0] = out[1] = out[2] = NAN;
+    return;
+  }
   const btVector3& x = c->body->m_nodes[i].m_x;
   for (int a = 0; a < 3; a++) out[a] = x[a];
 }
