@@ -100,10 +100,12 @@ static int init(tx_ctx* c, void* self) {
     if (tx_tri_bvh_init(&h->tree[i], h->tri_cap)) return -1;
     if (!(h->xs[i] = calloc(3 * (size_t)h->xcap, sizeof(float)))) return -1;
   }
-  // a refit spread over up to 8 steps at 4 kHz (2 ms, well inside a 120 Hz physics
-  // period); at 500 Hz and below it is done in the step that sees the publish
+  // a refit of up to 8192 nodes (about 12000 triangles: the 1764-particle skin) is done in
+  // the step that sees the publish; a larger one is spread over up to 8 steps at 4 kHz
+  // (2 ms, well inside a 120 Hz physics period), or fewer at lower rates
   double spread = floor(tx_rate(c) / 500);
-  h->chunk = (uint32_t)(2 * (size_t)h->tri_cap / (spread < 1 ? 1 : spread > 16 ? 16 : spread)) + 1;
+  size_t share = 2 * (size_t)h->tri_cap / (spread < 1 ? 1 : spread > 16 ? 16 : spread) + 1;
+  h->chunk = (uint32_t)(share > 8192 ? share : 8192);
   return 0;
 }
 

@@ -75,7 +75,7 @@ static int run_size(uint32_t n, hip_bench_row* row) {
       bool good = finite_all(x, 3 * (size_t)count) && tx_tri_bvh_same(&b, tri, ntri);
       tx_samples_add(&tk, tx_mono_ns() - a);
       // the refit in the controller's shares (up to 8 steps at 4 kHz)
-      uint32_t chunk = 2 * ntri_max / 8 + 1;
+      uint32_t chunk = 2 * ntri_max / 8 + 1 > 8192 ? 2 * ntri_max / 8 + 1 : 8192;
       int64_t whole = 0;
       for (uint32_t to = b.nnodes; good && to > 0;) {
         uint32_t from = to > chunk ? to - chunk : 0;
