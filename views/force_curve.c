@@ -10,12 +10,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { COLS = 10 }; // t, x y z, fx fy fz, contacts, pierced, torn
+enum { COLS = 11 }; // t, x y z, fx fy fz, contacts, pierced, torn, skin_t
 
 typedef struct curve {
   tx_port pose, force, state, torn; // reads; state and torn may be invalid (id 0)
   int axis;                         // 0, 1, 2: x, y, z
   char file[64];                    // base name of the CSV and PNG
+  bool png;                         // draw the PNG too
   double* rows;                     // (cap x COLS) the samples
   uint64_t cap, n;                  // capacity and samples taken
   tx_warning w_full;                // the recording filled up
@@ -33,6 +34,7 @@ static int configure(tx_setup* s, void** self) {
   const char* axis = tx_param_str(s, "axis", "y");
   const char* file = tx_param_str(s, "file", "force_displacement");
   c->cap = (uint64_t)tx_param_int(s, "max_samples", 600000, 1, 10000000);
+  c->png = tx_param_bool(s, "png", true);
   if (!pose || !force || !state || !torn || !axis || !file) return -1;
   if (strlen(axis) != 1 || axis[0] < 'x' || axis[0] > 'z') return tx_setup_fail(s, "axis", "expected x, y or z, got \"%s\"", axis);
   c->axis = axis[0] - 'x';
@@ -44,7 +46,7 @@ static int configure(tx_setup* s, void** self) {
   if (!c->rows) return tx_setup_fail(s, "max_samples", "%llu samples do not fit in memory", (unsigned long long)c->cap);
   c->pose = tx_setup_read_as(s, pose, TX_F64, 7);
   c->force = tx_setup_read_as(s, force, TX_F64, 3);
-  if (*state) c->state = tx_setup_read_as(s, state, TX_F64, 7);
+  if (*state) c->state = tx_setup_read_as(s, state, TX_F64, 8);
   if (*torn) c->torn = tx_setup_read_as(s, torn, TX_I32, 1);
   c->w_full = tx_setup_warning(s, "recording_full");
   c->r_samples = tx_setup_result(s, "samples");
@@ -63,10 +65,10 @@ static void step(tx_ctx* ctx, void* self) {
   r[0] = tx_sim_ns(ctx) * 1e-9;
   memcpy(r + 1, p, 3 * sizeof *r);
   memcpy(r + 4, f, 3 * sizeof *r);
-  r[7] = r[8] = r[9] = 0;
+  r[7] = r[8] = r[9] = r[10] = 0;
   if (c->state.id) {
     const double* st = tx_read(ctx, c->state).data;
-    r[7] = st[0], r[8] = st[1];
+    r[7] = st[0], r[8] = st[1], r[10] = st[7];
   }
   if (c->torn.id) r[9] = ((const int32_t*)tx_read(ctx, c->torn).data)[0];
 }
@@ -84,17 +86,18 @@ static void finish(tx_ctx* ctx, void* self) {
     fprintf(stderr, "tactus: %s: cannot be written\n", path);
     return;
   }
-  fprintf(f, "t_s,x_m,y_m,z_m,fx_n,fy_n,fz_n,contacts,pierced,torn\n");
+  fprintf(f, "t_s,x_m,y_m,z_m,fx_n,fy_n,fz_n,contacts,pierced,torn,skin_t_s\n");
   for (uint64_t i = 0; i < c->n; i++) {
     const double* r = c->rows + COLS * i;
-    fprintf(f, "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.0f,%.0f,%.0f\n", r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7],
-            r[8], r[9]);
+    fprintf(f, "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.0f,%.0f,%.0f,%.6f\n", r[0], r[1], r[2], r[3], r[4], r[5], r[6],
+            r[7], r[8], r[9], r[10]);
   }
   if (fclose(f) != 0 || rename(tmp, path) != 0) {
     remove(tmp);
     fprintf(stderr, "tactus: %s: cannot be written\n", path);
     return;
   }
+  if (!c->png) return;
   // the papers' plot: force along the axis (N) against the position along it (cm)
   double* xs = malloc(sizeof(double) * c->n);
   double* ys = malloc(sizeof(double) * c->n);

@@ -16,6 +16,7 @@ tx_hip_def tx_hip_def_default(void) {
       .slide_max = 0.003, // 0.3 cm
       .pierce_range = 0.01,
       .hold = 5e-4, // 0.05 cm: the skin may lead the HIP by its speed over one physics period
+      .join_anchor = true,
   };
 }
 
@@ -47,10 +48,12 @@ static double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a
 
 void tx_hip_query(tx_hip* h, tx_tri_bvh* b, const float* x, double thickness, const double c[3], tx_hip_out* out) {
   memset(out, 0, sizeof *out);
+  memcpy(out->x0, c, sizeof out->x0);
   const double r = h->def.radius;
   const double reach = r + 0.5 * thickness; // contact: mid-plane closer than this
   double nearest = reach + h->def.hold, towards[3] = {0, 0, 0};
-  double t[TX_HIP_RAYS_MAX], normal[TX_HIP_RAYS_MAX][3];
+  double t[TX_HIP_RAYS_MAX];
+  bool fresh[TX_HIP_RAYS_MAX] = {false};
   int n = 0;
   // every ray starts at c and ends within reach: one walk finds what they can meet
   uint32_t roots[TX_BVH_ROOTS_MAX];
@@ -64,16 +67,29 @@ void tx_hip_query(tx_hip* h, tx_tri_bvh* b, const float* x, double thickness, co
       h->on[i] = false;
       continue;
     }
-    if (!h->on[i]) { // first contact: the ray's point at the HIP's radius
-      h->on[i] = true;
-      for (int a = 0; a < 3; a++) h->p_in[i][a] = c[a] + r * d[a];
-    }
     t[i] = hit.t;
-    memcpy(normal[i], hit.n, sizeof normal[i]);
+    if (!h->on[i]) fresh[i] = true; // its first contact point is set below, once the anchor is known
     for (int a = 0; a < 3; a++) towards[a] += d[a];
     if (hit.t < nearest) nearest = hit.t;
     n++;
   }
+  // the anchor: the HIP centre the rays already in contact measure from (mean of P_in - r d)
+  double anchor[3] = {c[0], c[1], c[2]};
+  int held = 0;
+  for (int i = 0; i < h->nrays; i++)
+    if (h->on[i] && !fresh[i]) {
+      if (held++ == 0) anchor[0] = anchor[1] = anchor[2] = 0;
+      for (int a = 0; a < 3; a++) anchor[a] += h->p_in[i][a] - r * h->dir[i][a];
+    }
+  for (int a = 0; a < 3 && held > 0; a++) anchor[a] /= held;
+  // first contact of a ray: the ray's point at the HIP's radius, now (each ray by its
+  // own onset) or as of the anchor (rays joining a contact start where it started)
+  for (int i = 0; i < h->nrays; i++)
+    if (fresh[i]) {
+      h->on[i] = true;
+      const double* base = h->def.join_anchor ? anchor : c;
+      for (int a = 0; a < 3; a++) h->p_in[i][a] = base[a] + r * h->dir[i][a];
+    }
   if (n == 0) { // contact over: a later touch starts afresh
     h->touching = false;
     h->pierced = false;
@@ -87,16 +103,21 @@ void tx_hip_query(tx_hip* h, tx_tri_bvh* b, const float* x, double thickness, co
       memcpy(h->approach, h->dir[0], sizeof h->approach);
     h->touching = true;
   }
-  if (!h->pierced) { // through the skin: no skin left ahead along the approach
-    tx_ray_hit ahead;
+  // through the skin: no skin left ahead along the approach. Where it is found, the
+  // HIP would just touch this (frozen) skin at x0 = c + (t - reach) approach
+  tx_ray_hit ahead;
+  memcpy(out->x0, c, sizeof out->x0);
+  if (!h->pierced) {
     if (!tx_tri_bvh_ray(b, x, c, h->approach, h->def.pierce_range, &ahead)) h->pierced = true;
+    else
+      for (int a = 0; a < 3; a++) out->x0[a] = c[a] + (ahead.t - reach) * h->approach[a];
   }
   out->depth = reach > nearest ? reach - nearest : 0;
   if (h->pierced) {
     out->pierced = true;
     return;
   }
-  double sum[3] = {0, 0, 0}, kk[9] = {0};
+  double sum[3] = {0, 0, 0};
   const double* a_n = h->approach;
   for (int i = 0; i < h->nrays; i++) {
     if (!h->on[i]) continue;
@@ -107,18 +128,20 @@ void tx_hip_query(tx_hip* h, tx_tri_bvh* b, const float* x, double thickness, co
     // the first contact point follows the hand
     double along = dot(rn, a_n);
     double tang[3] = {rn[0] - along * a_n[0], rn[1] - along * a_n[1], rn[2] - along * a_n[2]};
+    // (applied across the approach only: P_in = P_n - (R_normal + k R_tangential), so a slide
+    // drags without letting go of the push)
     if (sqrt(dot(tang, tang)) > h->def.slide_max) {
       for (int e = 0; e < 3; e++) {
-        h->p_in[i][e] = p[e] - h->def.k * rn[e];
+        h->p_in[i][e] += (1 - h->def.k) * tang[e];
         rn[e] = p[e] - h->p_in[i][e];
       }
       h->resets++;
     }
     for (int e = 0; e < 3; e++) sum[e] += rn[e];
-    for (int e = 0; e < 3; e++)
-      for (int f = 0; f < 3; f++) kk[3 * e + f] += normal[i][e] * normal[i][f];
   }
   out->contacts = n;
   for (int e = 0; e < 3; e++) out->f[e] = -h->def.alpha * sum[e] / n; // eq. 7
-  for (int e = 0; e < 9; e++) out->k[e] = -h->def.alpha * kk[e] / n;
+  // K = dF/dc with every contact point moving with the HIP, as the skin held at the HIP's
+  // surface does along the push and the rays' own hits do across it: each R_n grows with c
+  for (int e = 0; e < 3; e++) out->k[4 * e] = -h->def.alpha;
 }

@@ -5,13 +5,19 @@
 // comes into contact when it meets the skin's mid-plane (the triangle mesh)
 // at a distance t_n < r + h/2 (h: skin thickness), and stays in contact up to
 // r + h/2 + hold. For each ray in contact:
-//   P_in  where the ray crossed the HIP's radius when its contact began: c + r d_n
+//   P_in  where the ray crossed the HIP's radius when its contact began: c + r d_n.
+//         A ray joining a contact already made takes the contact's anchor A,
+//         the mean of (P_in - r d) over the rays in contact: P_in = A + r d_n,
+//         so that it measures the skin's displacement since the contact began
+//         (the first ray's onset, moved by eq. 8) instead of starting at zero
+//         and pulling the mean down (join_anchor; false: c + r d_n)
 //   P_n   where it meets the mid-plane now:                            c + t_n d_n
 //   R_n = P_n - P_in                                  (the conference paper, eq. 5)
 //   F   = -alpha sum(R_n) / N, N the rays in contact    (eq. 7; journal eq. 3)
-// When the part of R_n along the skin (across the direction toward the skin
-// in which the contact began) grows past slide_max, P_in moves after the hand: P_in = P_n - k R_n (eq. 8),
-// which turns sliding into a steady drag. Once the HIP has gone through the
+// When the part of R_n across the approach (the direction toward the skin in
+// which the contact began) grows past slide_max, P_in follows the hand by
+// eq. 8, P_in = P_n - k R_n, applied to that tangential part only: the push is
+// kept and a slide becomes a steady drag. Once the HIP has gone through the
 // skin (the ray toward the skin along which contact began finds no skin any
 // more) the force is zero until no ray touches the skin.
 //
@@ -35,6 +41,8 @@ typedef struct tx_hip_def {
   double hold;          // m, a ray in contact stays so up to r + h/2 + hold: the physics leaves the skin
                         // at r + h/2 from the HIP it last saw, which may lead the HIP of now by its
                         // speed over one physics period
+  bool join_anchor;     // a ray that comes into contact while others are takes their anchor (below);
+                        // false: its P_in is its own point at the HIP's radius at its own onset
 } tx_hip_def;
 
 tx_hip_def tx_hip_def_default(void);
@@ -55,10 +63,13 @@ typedef struct tx_hip {
 
 typedef struct tx_hip_out {
   double f[3];   // N, force of the skin on the HIP
-  double k[9];   // N/m, row-major dF/dc estimated from the rays: -alpha mean(m_n m_n^T), m_n the hit normals
+  double k[9];   // N/m, row-major dF/dc from the rays: each R_n moves with the HIP while the skin is held
+                 // at its surface, so -alpha I in contact (0 without)
   int contacts;  // N, rays in contact (0 once pierced)
   bool pierced;  // the HIP is through the skin
   double depth;  // m, r + h/2 - the shortest contact distance (0 without contact)
+  double x0[3];  // m, where the HIP would just touch this skin along the approach (c without contact):
+                 // the skin is frozen between physics publishes, the hand is not
 } tx_hip_out;
 
 void tx_hip_init(tx_hip* h, const tx_hip_def* def); // def must pass tx_hip_def_check

@@ -1,13 +1,15 @@
 // collision.hip: the HIP's rays against the skin of the latest physics
-// publish, refitting (or, when the triangle set changed, rebuilding) a BVH
-// once per publish, and the local force model for the haptics controller.
+// publish, and the local force model for the haptics controller. Each
+// publish is copied and a second BVH is refitted to it over a few steps (or
+// rebuilt at once when the triangle set changed) while the first still
+// answers; then the two swap, so no single 4 kHz step carries a whole refit.
 //
-// Between two physics publishes the skin is frozen while the hand moves on,
-// so the force computed on it is the force at the pose the physics last saw.
-// The model therefore anchors F0 at that pose (x0, looked up in a short
-// history of poses by the publish's simulation time) and K, the rays' estimate
-// of how the force grows as the skin is pushed along its normals, carries the
-// force along with the hand until the next publish.
+// Between two physics publishes the skin is frozen while the hand moves on.
+// The force computed on the frozen skin is the force where the skin last
+// settled around the HIP, so the model anchors F0 at x0, the point where the
+// HIP would just touch that skin along the direction it came from, and K,
+// the rays' estimate of how the force grows as the skin is pushed along its
+// normals, carries the force along with the hand until the next publish.
 #include "hip_collision.h"
 
 #include "hip.h"
@@ -17,23 +19,19 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define HISTORY 1024 // poses kept: 0.25 s at 4 kHz, longer than a 20 Hz physics period
-
 typedef struct hip_ctl {
   tx_hip hip;               // the method's state
-  tx_tri_bvh bvh;           // over the skin's live triangles
-  bool bvh_ready;           // built for the current triangle set
-  bool skin_ok;             // the latest skin publish was taken (finite, a valid mesh)
-  uint32_t tri_cap;         // triangles the BVH was sized for
+  tx_tri_bvh tree[2];       // over the skin's live triangles: one answers queries, the other is refitted
+  float* xs[2];             // (xcap x 3) m, the particles each tree was fitted to, copied from the publish
+  int64_t ns[2];            // simulation time of the skin publish each tree holds
+  int act;                  // the tree queries use, -1 for none (no usable skin)
+  bool job;                 // the other tree is being refitted to a newer publish
+  uint32_t job_next;        // its nodes [0, job_next) are still to refit
+  uint32_t chunk;           // nodes refitted per step: a refit is spread over a few steps
+  uint32_t tri_cap, xcap;   // triangles and particles the trees and copies were sized for
   tx_port pose, x, tri, thickness;           // reads
   tx_port model, state, spheres;             // writes
   uint64_t x_seq, tri_seq;  // last publishes seen
-  double hist_c[HISTORY][3]; // m, recent HIP centres
-  int64_t hist_t[HISTORY];  // ns, their simulation times
-  uint64_t hist_n;          // centres written so far
-  double x_snap[3];         // m, HIP centre when the current skin was published
-  bool touch_at_snap;       // in contact when the current skin was published
-  double onset[3];          // m, HIP centre where the current contact began
   double last_c[3];         // m, last finite pose
   tx_warning w_pose, w_skin, w_mesh; // non-finite pose, non-finite skin, triangle set too large or bad
   tx_result r_peak, r_contacts, r_pierced, r_rebuilds, r_refits, r_resets;
@@ -54,6 +52,10 @@ static int configure(tx_setup* s, void** self) {
   def.slide_max = tx_param_num(s, "slide_max_m", def.slide_max, 1e-6, 1);
   def.pierce_range = tx_param_num(s, "pierce_range_m", def.pierce_range, 1e-5, 1);
   def.hold = tx_param_num(s, "hold_m", def.hold, 0, 0.01);
+  const char* join = tx_param_str(s, "join", "anchor");
+  if (!join) return -1;
+  if (strcmp(join, "anchor") && strcmp(join, "own")) return tx_setup_fail(s, "join", "expected \"anchor\" or \"own\", got \"%s\"", join);
+  def.join_anchor = strcmp(join, "anchor") == 0;
   if (def.rays != 26 && def.rays != 98) return tx_setup_fail(s, "rays", "must be 26 or 98, got %d", def.rays);
   const char* err = tx_hip_def_check(&def);
   if (err) return tx_setup_fail(s, NULL, "%s", err);
@@ -73,7 +75,7 @@ static int configure(tx_setup* s, void** self) {
   h->tri = tx_setup_read_as(s, name[1], TX_I32, 3);
   h->thickness = tx_setup_read_as(s, name[2], TX_F64, 1);
   h->model = tx_setup_write(s, &(tx_component_def){model, TX_F64, 1, 15, "N, m, N/m"});
-  h->state = tx_setup_write(s, &(tx_component_def){state, TX_F64, 1, 7, "1, N, m"});
+  h->state = tx_setup_write(s, &(tx_component_def){state, TX_F64, 1, 8, "1, N, m, s"});
   h->spheres = tx_setup_write(s, &(tx_component_def){spheres, TX_F32, 1, 4, "m"});
   h->w_pose = tx_setup_warning(s, "pose_not_finite");
   h->w_skin = tx_setup_warning(s, "skin_not_finite");
@@ -89,24 +91,22 @@ static int configure(tx_setup* s, void** self) {
 
 static int init(tx_ctx* c, void* self) {
   hip_ctl* h = self;
-  // before the skin's first publish a read holds its full capacity: size the BVH by it
-  tx_snapshot tri = tx_read(c, h->tri);
+  // before the skin's first publish a read holds its full capacity: size everything by it
+  tx_snapshot tri = tx_read(c, h->tri), x = tx_read(c, h->x);
   h->tri_cap = tri.rows > 0 ? tri.rows : 1;
-  if (tx_tri_bvh_init(&h->bvh, h->tri_cap)) return -1;
-  return 0;
-}
-
-// the HIP centre at simulation time t, from the history (the newest not after t)
-static void centre_at(const hip_ctl* h, int64_t t, double out[3]) {
-  uint64_t n = h->hist_n < HISTORY ? h->hist_n : HISTORY;
-  for (uint64_t i = 0; i < n; i++) {
-    uint64_t j = (h->hist_n - 1 - i) % HISTORY;
-    if (h->hist_t[j] <= t || i == n - 1) {
-      memcpy(out, h->hist_c[j], 3 * sizeof *out);
-      return;
-    }
+  h->xcap = x.rows > 0 ? x.rows : 1;
+  h->act = -1;
+  for (int i = 0; i < 2; i++) {
+    if (tx_tri_bvh_init(&h->tree[i], h->tri_cap)) return -1;
+    if (!(h->xs[i] = calloc(3 * (size_t)h->xcap, sizeof(float)))) return -1;
   }
-  memcpy(out, h->last_c, 3 * sizeof *out);
+  // a refit of up to 8192 nodes (about 12000 triangles: the 1764-particle skin) is done in
+  // the step that sees the publish; a larger one is spread over up to 8 steps at 4 kHz
+  // (2 ms, well inside a 120 Hz physics period), or fewer at lower rates
+  double spread = floor(tx_rate(c) / 500);
+  size_t share = 2 * (size_t)h->tri_cap / (spread < 1 ? 1 : spread > 16 ? 16 : spread) + 1;
+  h->chunk = (uint32_t)(share > 8192 ? share : 8192);
+  return 0;
 }
 
 static bool all_finite(const float* v, size_t n) {
@@ -115,27 +115,51 @@ static bool all_finite(const float* v, size_t n) {
   return true;
 }
 
-// a new skin publish: refit, or rebuild when the triangle set changed; false if unusable
-static bool take_skin(tx_ctx* c, hip_ctl* h, tx_snapshot x, tx_snapshot tri) {
-  if (!all_finite(x.data, (size_t)x.rows * 3)) {
+// a new skin publish: copy it beside the tree in use, then refit the other tree to it over the
+// next steps, or rebuild that tree now when the triangle set changed
+static void take_skin(tx_ctx* c, hip_ctl* h, tx_snapshot x, tx_snapshot tri) {
+  int b = h->act == 0 ? 1 : 0;
+  h->job = false;
+  if (x.rows > h->xcap) {
+    tx_warn(c, h->w_mesh);
+    h->act = -1;
+    return;
+  }
+  memcpy(h->xs[b], x.data, 3 * (size_t)x.rows * sizeof(float));
+  if (!all_finite(h->xs[b], 3 * (size_t)x.rows)) { // no force from a broken skin, until a good one
     tx_warn(c, h->w_skin);
-    return false;
+    h->act = -1;
+    return;
   }
-  uint32_t ntri = tri.rows;
-  bool same = h->bvh_ready && x.rows == h->bvh.nx && tx_tri_bvh_same(&h->bvh, tri.data, ntri);
-  if (same) {
-    tx_tri_bvh_refit(&h->bvh, x.data);
-    h->refits++;
-    return true;
+  h->ns[b] = x.sim_ns;
+  tx_tri_bvh* cur = h->act >= 0 ? &h->tree[h->act] : NULL;
+  if (cur && x.rows == cur->nx && tx_tri_bvh_same(cur, tri.data, tri.rows)) {
+    // the same triangles: the other tree takes this shape (if a rebuild left it behind) and is refitted
+    if (!(x.rows == h->tree[b].nx && tx_tri_bvh_same(&h->tree[b], tri.data, tri.rows))) tx_tri_bvh_copy(&h->tree[b], cur);
+    h->job = true;
+    h->job_next = h->tree[b].nnodes;
+    return;
   }
-  if (tx_tri_bvh_build(&h->bvh, x.data, x.rows, tri.data, ntri)) {
+  if (tx_tri_bvh_build(&h->tree[b], h->xs[b], x.rows, tri.data, tri.rows)) {
     tx_warn(c, h->w_mesh); // more triangles than at start, or an index outside the particles
-    h->bvh_ready = false;
-    return false;
+    h->act = -1;
+    return;
   }
-  h->bvh_ready = true;
+  h->act = b;
   h->rebuilds++;
-  return true;
+}
+
+// one step's share of the refit; the refitted tree takes over when it is whole
+static void refit_some(hip_ctl* h) {
+  int b = h->act == 0 ? 1 : 0;
+  uint32_t from = h->job_next > h->chunk ? h->job_next - h->chunk : 0;
+  tx_tri_bvh_refit_nodes(&h->tree[b], h->xs[b], from, h->job_next);
+  h->job_next = from;
+  if (from == 0) {
+    h->act = b;
+    h->job = false;
+    h->refits++;
+  }
 }
 
 static void step(tx_ctx* c, void* self) {
@@ -147,40 +171,34 @@ static void step(tx_ctx* c, void* self) {
     memcpy(centre, h->last_c, sizeof centre); // hold the last good pose
   }
   memcpy(h->last_c, centre, sizeof centre);
-  uint64_t slot = h->hist_n++ % HISTORY;
-  memcpy(h->hist_c[slot], centre, sizeof centre);
-  h->hist_t[slot] = tx_sim_ns(c);
 
-  // a new physics publish: take the skin and remember where the HIP was then
+  // a new physics publish: take the skin
   tx_snapshot x = tx_read(c, h->x), tri = tx_read(c, h->tri);
   double thickness = ((const double*)tx_read(c, h->thickness).data)[0];
   if (!isfinite(thickness) || thickness < 0) thickness = 0;
   if (x.seq != 0 && (x.seq != h->x_seq || tri.seq != h->tri_seq)) {
     h->x_seq = x.seq;
     h->tri_seq = tri.seq;
-    h->skin_ok = take_skin(c, h, x, tri);
-    centre_at(h, x.sim_ns, h->x_snap);
-    h->touch_at_snap = h->hip.touching && !h->hip.pierced;
+    take_skin(c, h, x, tri);
   }
+  if (h->job) refit_some(h);
 
   tx_hip_out out;
-  if (h->skin_ok && h->bvh_ready) {
-    bool was_touching = h->hip.touching;
-    tx_hip_query(&h->hip, &h->bvh, x.data, thickness, centre, &out);
-    if (!was_touching && h->hip.touching) memcpy(h->onset, centre, sizeof centre);
+  if (h->act >= 0) {
+    tx_hip_query(&h->hip, &h->tree[h->act], h->xs[h->act], thickness, centre, &out);
   } else {
     tx_hip_reset(&h->hip);
     memset(&out, 0, sizeof out);
+    memcpy(out.x0, centre, sizeof centre);
   }
   if (out.pierced && !h->was_pierced) h->pierces++;
   h->was_pierced = out.pierced;
 
-  // the local model: F0 at the pose the skin answers to, K from the rays
+  // the local model: F0 where the frozen skin would just touch the HIP, K from the rays
   double* m = tx_write(c, h->model);
   memset(m, 0, 15 * sizeof *m);
   bool force = out.contacts > 0;
-  const double* x0 = !force ? centre : h->touch_at_snap ? h->x_snap : h->onset;
-  memcpy(m + 3, x0, 3 * sizeof *m);
+  memcpy(m + 3, force ? out.x0 : centre, 3 * sizeof *m);
   if (force) {
     memcpy(m, out.f, 3 * sizeof *m);
     memcpy(m + 6, out.k, 9 * sizeof *m);
@@ -194,6 +212,7 @@ static void step(tx_ctx* c, void* self) {
   memcpy(st + 2, out.f, 3 * sizeof *st);
   st[5] = out.depth;
   st[6] = (double)h->hip.resets;
+  st[7] = h->act >= 0 ? h->ns[h->act] * 1e-9 : 0;
   float* sp = tx_write(c, h->spheres);
   sp[0] = (float)centre[0];
   sp[1] = (float)centre[1];
@@ -214,7 +233,10 @@ static void finish(tx_ctx* c, void* self) {
 static void fini(void* self) {
   hip_ctl* h = self;
   if (!h) return;
-  tx_tri_bvh_free(&h->bvh);
+  for (int i = 0; i < 2; i++) {
+    tx_tri_bvh_free(&h->tree[i]);
+    free(h->xs[i]);
+  }
   free(h);
 }
 

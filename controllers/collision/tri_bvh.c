@@ -125,9 +125,23 @@ int tx_tri_bvh_build(tx_tri_bvh* b, const float* x, uint32_t nx, const int32_t* 
   return 0;
 }
 
-void tx_tri_bvh_refit(tx_tri_bvh* b, const float* x) {
+void tx_tri_bvh_refit(tx_tri_bvh* b, const float* x) { tx_tri_bvh_refit_nodes(b, x, 0, b->nnodes); }
+
+int tx_tri_bvh_copy(tx_tri_bvh* dst, const tx_tri_bvh* src) {
+  if (src->ntri > dst->tri_cap) return -1;
+  size_t t = 3 * (size_t)src->ntri;
+  memcpy(dst->nodes, src->nodes, src->nnodes * sizeof *src->nodes);
+  memcpy(dst->tri, src->tri, t * sizeof *src->tri);
+  memcpy(dst->raw, src->raw, t * sizeof *src->raw);
+  memcpy(dst->order, src->order, src->ntri * sizeof *src->order);
+  dst->ntri = src->ntri, dst->nx = src->nx, dst->nnodes = src->nnodes;
+  return 0;
+}
+
+void tx_tri_bvh_refit_nodes(tx_tri_bvh* b, const float* x, uint32_t from, uint32_t to) {
+  if (to > b->nnodes) to = b->nnodes;
   // children come after their parent, so walking backwards sees them first
-  for (uint32_t i = b->nnodes; i-- > 0;) {
+  for (uint32_t i = to; i-- > from;) {
     tx_bvh_node* nd = &b->nodes[i];
     if (nd->count) {
       leaf_box(b, x, nd);

@@ -54,6 +54,11 @@ bool tx_tri_bvh_same(const tx_tri_bvh* b, const int32_t* tri, uint32_t ntri);
 int tx_tri_bvh_build(tx_tri_bvh* b, const float* x, uint32_t nx, const int32_t* tri, uint32_t ntri);
 // recompute every box from moved vertices (same triangle set)
 void tx_tri_bvh_refit(tx_tri_bvh* b, const float* x);
+// the same for the nodes [from, to) only, last first: refitting [k, nnodes) then
+// [0, k) equals one whole refit, so the work can be spread over several calls
+void tx_tri_bvh_refit_nodes(tx_tri_bvh* b, const float* x, uint32_t from, uint32_t to);
+// make dst the same tree as src (dst sized for at least src's triangles); 0, or -1
+int tx_tri_bvh_copy(tx_tri_bvh* dst, const tx_tri_bvh* src);
 // Many short rays from one point (the HIP's) share one walk: gather the
 // subtrees whose boxes meet the sphere (c, radius) and are no wider than it,
 // then start each ray's walk from them. Returns how many (the root alone when

@@ -36,22 +36,19 @@ tx_skin_metrics tx_skin_measure(const tx_skin_series* s, double steady_from, dou
     }
     double sum = 0;
     int k = 0;
-    for (int i = m.contact + 1; i + 1 < end; i++, k++) {
+    for (int i = m.contact + 1; i + 1 < end; i++) {
+      if (s->tangent && (s->t[i] < steady_from || s->t[i] > steady_to)) continue; // a slide: its steady part
       double d2 = s->force[i + 1] - 2 * s->force[i] + s->force[i - 1];
-      sum += d2 * d2;
+      sum += d2 * d2, k++;
     }
     if (k > 0 && m.peak > 0) m.roughness = sqrt(sum / k) / m.peak;
-    // back to zero: the first zero-force tick from rupture on, against the last tear before it
+    // back to zero: the first zero-force tick from rupture on, against the skin publish it was computed on
     if (m.rupture >= 0) {
-      int zero = -1;
-      for (int i = m.rupture > 0 ? m.rupture - 1 : 0; i < s->n && zero < 0; i++)
-        if (s->force[i] == 0) zero = i;
-      if (zero >= 0) {
-        int tear = -1;
-        for (int i = zero; i > 0 && tear < 0; i--)
-          if (s->torn[i] > s->torn[i - 1]) tear = i;
-        if (tear >= 0) m.zero_after_s = s->t[zero] - s->t[tear];
-      }
+      for (int i = m.rupture > 0 ? m.rupture - 1 : 0; i < s->n; i++)
+        if (s->force[i] == 0) {
+          m.zero_after_s = s->t[i] - s->skin_t[i];
+          break;
+        }
     }
   }
   // sliding: means over 0.5 s windows of the steady part

@@ -20,6 +20,7 @@ typedef struct tx_skin_series {
   const double* contacts; // (n) rays in contact
   const double* pierced;  // (n) 1 once the HIP is through
   const double* torn;     // (n) links torn so far
+  const double* skin_t;   // (n) s, time of the skin publish the force was computed on
 } tx_skin_series;
 
 typedef struct tx_skin_metrics {
@@ -29,9 +30,10 @@ typedef struct tx_skin_metrics {
   double peak;            // N, largest |force| from contact to rupture (or to the end)
   double r2;              // linear fit of force on position over contact .. rupture: R^2 (NaN if < 3 ticks)
   double slope;           // N/m, that fit's slope
-  double zero_after_s;    // s, from the last tear publish before the force first returns to 0 after rupture, to it (NaN if none)
+  double zero_after_s;    // s, from the skin publish that showed the rupture to the first tick of zero force (NaN if none)
   double max_step;        // N, largest |force[i+1] - force[i]| from contact to rupture (excluded)
-  double roughness;       // 1, RMS of the second difference of force over contact .. rupture, over the peak
+  double roughness;       // 1, RMS of the second difference of force over contact .. rupture (a slide: its
+                          // steady part), over the peak
   double tangent_mean;    // N, mean tangential force over the steady part of a slide (NaN without tangent)
   double tangent_cv;      // 1, how much the 0.5 s means of that force vary: their std over their mean
 } tx_skin_metrics;

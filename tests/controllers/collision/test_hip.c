@@ -134,8 +134,8 @@ static void test_one_ray_force_and_push(void** state) {
   // P_in = c + r d = (cx, y - r, cz), P_n = (cx, 0, cz): F = -alpha R = alpha (y - r) up
   assert_true(fabs(o.f[1] - ALPHA * (y - R)) < 1e-9);
   assert_true(fabs(o.f[0]) < 1e-12 && fabs(o.f[2]) < 1e-12);
-  // K = -alpha n n^T for the flat skin's normal n = y
-  for (int i = 0; i < 9; i++) assert_true(fabs(o.k[i] - (i == 4 ? -ALPHA : 0)) < 1e-9);
+  // K = -alpha I: every R_n grows with the HIP while the skin is held at its surface
+  for (int i = 0; i < 9; i++) assert_true(fabs(o.k[i] - (i % 4 == 0 ? -ALPHA : 0)) < 1e-9);
   assert_true(fabs(o.depth - (REACH - y)) < 1e-12);
   // the skin pushed down 1 mm with the HIP: the force grows by alpha x 1 mm
   const double push = 1e-3;
@@ -176,6 +176,24 @@ static void test_26_and_98_rays_by_hand(void** state) {
   assert_true(fabs(f26 - ALPHA * sum / 21) < 0.1 * f26);
 }
 
+// rays joining a contact: by the contact's anchor (default) or each at its own onset
+static void test_joining_rays_anchor_or_own(void** state) {
+  (void)state;
+  skin* s = flat();
+  const double y0 = 2.4e-3, D = 0.6 * REACH;
+  for (int own = 0; own < 2; own++) {
+    tx_hip h = make_hip(26);
+    h.def.join_anchor = !own;
+    query(&h, s, CX, y0, CZ); // the down ray alone; it anchors the contact at y0
+    tx_hip_out o = query(&h, s, CX, D, CZ); // four 45-degree rays join
+    assert_int_equal(o.contacts, 5);
+    // anchor: P_in = (cx, y0, cz) + r d, so R_y = -(y0 - r / sqrt 2); own: P_in = c + r d, R_y = -(D - r / sqrt 2)
+    double joined = own ? D - R / sqrt(2.0) : y0 - R / sqrt(2.0);
+    assert_true(fabs(o.f[1] - ALPHA / 5 * (y0 - R + 4 * joined)) < 1e-9);
+  }
+  drop(s);
+}
+
 static void test_dented_skin_pushes_straight_back(void** state) {
   (void)state;
   skin* s = flat();
@@ -203,14 +221,14 @@ static void test_eq8_moves_first_contact_after_slide(void** state) {
   tx_hip_out o = query(&h, s, CX + 2e-3, y, CZ);
   assert_true(fabs(o.f[0] + ALPHA * 2e-3) < 1e-6 && fabs(o.f[1] - up) < 1e-6);
   assert_int_equal(h.resets, 0);
-  // 4 mm: past slide_max, P_in = P_n - k R, so R becomes k R
+  // 4 mm: past slide_max, eq. 8 across the approach: P_in moves (1 - k) R_t, R_t becomes k R_t
   o = query(&h, s, CX + 4e-3, y, CZ);
   assert_int_equal(h.resets, 1);
-  assert_true(fabs(o.f[0] + 0.3 * ALPHA * 4e-3) < 1e-6 && fabs(o.f[1] - 0.3 * up) < 1e-6);
-  // 1 mm more: the new first point stays, R = (0.3 x 4 + 1 mm, -0.3 (y - r), 0)
+  assert_true(fabs(o.f[0] + 0.3 * ALPHA * 4e-3) < 1e-6 && fabs(o.f[1] - up) < 1e-6);
+  // 1 mm more: the new first point stays, R = (0.3 x 4 + 1 mm, -(y - r), 0)
   o = query(&h, s, CX + 5e-3, y, CZ);
   assert_int_equal(h.resets, 1);
-  assert_true(fabs(o.f[0] + ALPHA * (1.2e-3 + 1e-3)) < 1e-6 && fabs(o.f[1] - 0.3 * up) < 1e-6);
+  assert_true(fabs(o.f[0] + ALPHA * (1.2e-3 + 1e-3)) < 1e-6 && fabs(o.f[1] - up) < 1e-6);
   drop(s);
 }
 
@@ -320,6 +338,7 @@ int main(void) {
       cmocka_unit_test(test_contact_threshold_radius_plus_half_thickness),
       cmocka_unit_test(test_one_ray_force_and_push),
       cmocka_unit_test(test_26_and_98_rays_by_hand),
+      cmocka_unit_test(test_joining_rays_anchor_or_own),
       cmocka_unit_test(test_dented_skin_pushes_straight_back),
       cmocka_unit_test(test_eq8_moves_first_contact_after_slide),
       cmocka_unit_test(test_eq8_not_for_a_straight_push_into_tilted_skin),

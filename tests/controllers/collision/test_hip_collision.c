@@ -108,18 +108,19 @@ static void test_touching_then_through(void** state) {
   const double* m = latest(s, "tool0.force_model");
   const double* st = latest(s, "hip0.state");
   // rays with |d_y| > 1 / 2.5 touch: the down ray, four at 45 and four at 54.7 degrees.
-  // Each began at y_on = 2.5 mm |d_y|, so P_in,y = y_on - r |d_y| = (h/2) |d_y| and
-  // P_n,y = 0 (the skin does not give): F_y = alpha (h/2) mean(|d_y|), within the
-  // 5 um a pose moves per 1 ms tick
+  // The down ray began at y_on = 2.5 mm and anchors the contact; the others joined it,
+  // P_in = (0, y_on, 0) + r d, and meet the still skin at y = 0: F_y = alpha mean(y_on - r |d_y|),
+  // within the 5 um a pose moves per 1 ms tick
   assert_int_equal((int)st[0], 9);
   double mean_dy = (1 + 4 / sqrt(2.0) + 4 / sqrt(3.0)) / 9;
-  assert_true(fabs(m[1] - 20.0 * 2e-3 * mean_dy) < 20.0 * 1e-5);
+  assert_true(fabs(m[1] - 20.0 * (2.5e-3 - 5e-4 * mean_dy)) < 20.0 * 1e-5);
   assert_true(fabs(m[0]) < 1e-9 && fabs(m[2]) < 1e-9);
   assert_true(fabs(m[6 + 4] + 20.0) < 1e-9); // K_yy = -alpha
   assert_true(st[1] == 0);
-  // x0 is the pose at the skin's last publish, no later than the pose now
-  assert_true(m[3 + 1] >= latest(s, "device0.pose")[1] - 1e-12);
-  assert_true(m[3 + 1] - latest(s, "device0.pose")[1] < 5e-3 / 60 + 1e-4);
+  // x0: where the HIP would just touch this skin coming down, r + h/2 above it
+  assert_true(fabs(m[3 + 1] - 2.5e-3) < 1e-9 && fabs(m[3]) < 1e-12);
+  // and the skin publish in use is the last 60 Hz one
+  assert_true(fabs(st[7] - 137 / 60.0) < 1e-6);
   tx_scenario_free(s);
 
   s = load("");

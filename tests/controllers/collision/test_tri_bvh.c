@@ -81,6 +81,30 @@ static void test_hits_match_brute_force_flat_and_dented(void** state) {
   drop(&m);
 }
 
+// a refit spread over several calls, on a copy of the tree, ends where one whole refit does
+static void test_split_refit_on_a_copy(void** state) {
+  (void)state;
+  mesh m = make(31, 0.001);
+  tx_tri_bvh a, b;
+  assert_int_equal(tx_tri_bvh_init(&a, m.ntri), 0);
+  assert_int_equal(tx_tri_bvh_init(&b, m.ntri), 0);
+  assert_int_equal(tx_tri_bvh_build(&a, m.x, m.n * m.n, m.tri, m.ntri), 0);
+  assert_int_equal(tx_tri_bvh_copy(&b, &a), 0);
+  assert_true(tx_tri_bvh_same(&b, m.tri, m.ntri));
+  tx_skin_dent(m.x, m.n * m.n, (double[3]){0.002, 0, 0.001}, 0.004, 0.004);
+  tx_tri_bvh_refit(&a, m.x);
+  for (uint32_t to = b.nnodes; to > 0;) { // in slices of 97 nodes, last first
+    uint32_t from = to > 97 ? to - 97 : 0;
+    tx_tri_bvh_refit_nodes(&b, m.x, from, to);
+    to = from;
+  }
+  assert_int_equal(a.nnodes, b.nnodes);
+  assert_memory_equal(a.nodes, b.nodes, a.nnodes * sizeof *a.nodes);
+  tx_tri_bvh_free(&a);
+  tx_tri_bvh_free(&b);
+  drop(&m);
+}
+
 static void test_bad_sets_refused(void** state) {
   (void)state;
   mesh m = make(5, 0.001);
@@ -130,6 +154,7 @@ static void test_query_cost_independent_of_far_triangles(void** state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_hits_match_brute_force_flat_and_dented),
+      cmocka_unit_test(test_split_refit_on_a_copy),
       cmocka_unit_test(test_bad_sets_refused),
       cmocka_unit_test(test_query_cost_independent_of_far_triangles),
   };

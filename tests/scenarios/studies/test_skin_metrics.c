@@ -13,10 +13,10 @@
 
 #define N 2000
 
-static double t[N], pos[N], force[N], tangent[N], contacts[N], pierced[N], torn[N];
+static double t[N], pos[N], force[N], tangent[N], contacts[N], pierced[N], torn[N], skin_t[N];
 
-// at 1 kHz: contact at tick 500 (y = -1 mm), a 20 N/m push at 5 mm/s, a tear
-// published at tick 1500, the force zero from tick 1501
+// at 1 kHz: contact at tick 500 (y = -1 mm), a 20 N/m push at 5 mm/s, links
+// torn from tick 1200, the force zero from tick 1501 (the skin of tick 1496)
 static tx_skin_series push(double noise, int hold) {
   for (int i = 0; i < N; i++) {
     t[i] = i * 1e-3;
@@ -24,10 +24,11 @@ static tx_skin_series push(double noise, int hold) {
     contacts[i] = i >= 500 ? 1 : 0;
     pierced[i] = i >= 1501 ? 1 : 0;
     torn[i] = i >= 1500 ? 3 : i >= 1200 ? 1 : 0;
+    skin_t[i] = (i - i % 17) * 1e-3; // a 60 Hz-ish physics: publishes every 17 ticks (1.496 s, 1.513 s, ...)
     int k = hold > 1 ? i - i % hold : i; // sample-and-hold of the sampled value
     force[i] = i >= 500 && i < 1501 ? -20 * (pos[k] + 1e-3) + noise * ((i % 2) ? 1 : -1) : 0;
   }
-  return (tx_skin_series){N, t, pos, force, NULL, contacts, pierced, torn};
+  return (tx_skin_series){N, t, pos, force, NULL, contacts, pierced, torn, skin_t};
 }
 
 static void test_linear_push_and_rupture(void** state) {
@@ -41,7 +42,7 @@ static void test_linear_push_and_rupture(void** state) {
   assert_true(fabs(m.slope + 20) < 1e-6);
   assert_true(fabs(m.peak - 20 * 5e-3 * 1.0) < 1e-9);      // 1000 ticks at 5 um each
   assert_true(fabs(m.max_step - 20 * 5e-6) < 1e-12);        // one tick of motion
-  assert_true(fabs(m.zero_after_s - 1e-3) < 1e-9);          // tear at 1.500 s, zero at 1.501 s
+  assert_true(fabs(m.zero_after_s - 5e-3) < 1e-9);          // skin of 1.496 s, zero at 1.501 s
   assert_true(m.roughness < 1e-9);                           // a straight line has no second difference
   assert_true(isnan(m.tangent_mean));
 }
