@@ -1,8 +1,10 @@
 // collision.hip: the HIP's rays against the skin of the latest physics
 // publish, and the local force model for the haptics controller. Each
-// publish is copied and a second BVH is refitted to it over a few steps (or
-// rebuilt at once when the triangle set changed) while the first still
-// answers; then the two swap, so no single 4 kHz step carries a whole refit.
+// publish is copied and a second BVH is refitted to it over a few steps
+// while the first still answers; then the two swap, so no single 4 kHz step
+// carries a whole refit. A tear (triangles gone, the rest in order) empties
+// the torn triangles in place; any other change of the triangle set rebuilds
+// the second tree at once.
 //
 // Between two physics publishes the skin is frozen while the hand moves on.
 // The force computed on the frozen skin is the force where the skin last
@@ -34,9 +36,9 @@ typedef struct hip_ctl {
   uint64_t x_seq, tri_seq;  // last publishes seen
   double last_c[3];         // m, last finite pose
   tx_warning w_pose, w_skin, w_mesh; // non-finite pose, non-finite skin, triangle set too large or bad
-  tx_result r_peak, r_contacts, r_pierced, r_rebuilds, r_refits, r_resets;
+  tx_result r_peak, r_contacts, r_pierced, r_rebuilds, r_refits, r_resets, r_tears;
   double peak;              // N, largest force sent
-  uint64_t max_contacts, pierces, rebuilds, refits;
+  uint64_t max_contacts, pierces, rebuilds, refits, tears; // tears: triangle sets shrunk without a rebuild
   bool was_pierced;
 } hip_ctl;
 
@@ -86,6 +88,7 @@ static int configure(tx_setup* s, void** self) {
   h->r_rebuilds = tx_setup_result(s, "bvh_rebuilds");
   h->r_refits = tx_setup_result(s, "bvh_refits");
   h->r_resets = tx_setup_result(s, "eq8_updates");
+  h->r_tears = tx_setup_result(s, "bvh_tears");
   return 0;
 }
 
@@ -134,8 +137,16 @@ static void take_skin(tx_ctx* c, hip_ctl* h, tx_snapshot x, tx_snapshot tri) {
   h->ns[b] = x.sim_ns;
   tx_tri_bvh* cur = h->act >= 0 ? &h->tree[h->act] : NULL;
   if (cur && x.rows == cur->nx && tx_tri_bvh_same(cur, tri.data, tri.rows)) {
-    // the same triangles: the other tree takes this shape (if a rebuild left it behind) and is refitted
+    // the same triangles: the other tree takes this shape (if it was left behind) and is refitted
     if (!(x.rows == h->tree[b].nx && tx_tri_bvh_same(&h->tree[b], tri.data, tri.rows))) tx_tri_bvh_copy(&h->tree[b], cur);
+    h->job = true;
+    h->job_next = h->tree[b].nnodes;
+    return;
+  }
+  if (cur && x.rows == cur->nx && tri.rows < cur->ntri && tx_tri_bvh_copy(&h->tree[b], cur) == 0 &&
+      tx_tri_bvh_remove(&h->tree[b], tri.data, tri.rows) == 0) {
+    // a tear took triangles out: they are emptied in the other tree's shape, which is refitted
+    h->tears++;
     h->job = true;
     h->job_next = h->tree[b].nnodes;
     return;
@@ -228,6 +239,7 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, h->r_rebuilds, (double)h->rebuilds);
   tx_set_result(c, h->r_refits, (double)h->refits);
   tx_set_result(c, h->r_resets, (double)h->hip.resets);
+  tx_set_result(c, h->r_tears, (double)h->tears);
 }
 
 static void fini(void* self) {

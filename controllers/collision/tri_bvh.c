@@ -17,8 +17,9 @@ int tx_tri_bvh_init(tx_tri_bvh* b, uint32_t tri_cap) {
   b->tri = calloc(3 * (size_t)tri_cap, sizeof *b->tri);
   b->raw = calloc(3 * (size_t)tri_cap, sizeof *b->raw);
   b->order = calloc(tri_cap, sizeof *b->order);
+  b->slot = calloc(tri_cap, sizeof *b->slot);
   b->cen = calloc(3 * (size_t)tri_cap, sizeof *b->cen);
-  if (!b->nodes || !b->tri || !b->raw || !b->order || !b->cen) return tx_tri_bvh_free(b), -1;
+  if (!b->nodes || !b->tri || !b->raw || !b->order || !b->slot || !b->cen) return tx_tri_bvh_free(b), -1;
   return 0;
 }
 
@@ -27,6 +28,7 @@ void tx_tri_bvh_free(tx_tri_bvh* b) {
   free(b->tri);
   free(b->raw);
   free(b->order);
+  free(b->slot);
   free(b->cen);
   memset(b, 0, sizeof *b);
 }
@@ -108,7 +110,7 @@ int tx_tri_bvh_build(tx_tri_bvh* b, const float* x, uint32_t nx, const int32_t* 
   if (ntri > b->tri_cap) return -1;
   for (size_t i = 0; i < 3 * (size_t)ntri; i++)
     if (tri[i] < 0 || (uint32_t)tri[i] >= nx) return -1;
-  b->ntri = ntri;
+  b->ntri = b->nslot = ntri;
   b->nx = nx;
   b->nnodes = 0;
   memcpy(b->raw, tri, 3 * (size_t)ntri * sizeof *tri);
@@ -120,7 +122,10 @@ int tx_tri_bvh_build(tx_tri_bvh* b, const float* x, uint32_t nx, const int32_t* 
   }
   // the split only permutes order; the triangles follow it, so leaves read memory in sequence
   if (ntri > 0) build_node(b, 0, ntri);
-  for (uint32_t i = 0; i < ntri; i++) memcpy(b->tri + 3 * (size_t)i, tri + 3 * (size_t)b->order[i], 3 * sizeof *tri);
+  for (uint32_t i = 0; i < ntri; i++) {
+    memcpy(b->tri + 3 * (size_t)i, tri + 3 * (size_t)b->order[i], 3 * sizeof *tri);
+    b->slot[b->order[i]] = i;
+  }
   tx_tri_bvh_refit(b, x);
   return 0;
 }
@@ -128,13 +133,38 @@ int tx_tri_bvh_build(tx_tri_bvh* b, const float* x, uint32_t nx, const int32_t* 
 void tx_tri_bvh_refit(tx_tri_bvh* b, const float* x) { tx_tri_bvh_refit_nodes(b, x, 0, b->nnodes); }
 
 int tx_tri_bvh_copy(tx_tri_bvh* dst, const tx_tri_bvh* src) {
-  if (src->ntri > dst->tri_cap) return -1;
-  size_t t = 3 * (size_t)src->ntri;
+  if (src->nslot > dst->tri_cap) return -1;
   memcpy(dst->nodes, src->nodes, src->nnodes * sizeof *src->nodes);
-  memcpy(dst->tri, src->tri, t * sizeof *src->tri);
-  memcpy(dst->raw, src->raw, t * sizeof *src->raw);
-  memcpy(dst->order, src->order, src->ntri * sizeof *src->order);
-  dst->ntri = src->ntri, dst->nx = src->nx, dst->nnodes = src->nnodes;
+  memcpy(dst->tri, src->tri, 3 * (size_t)src->nslot * sizeof *src->tri);
+  memcpy(dst->order, src->order, src->nslot * sizeof *src->order);
+  memcpy(dst->raw, src->raw, 3 * (size_t)src->ntri * sizeof *src->raw);
+  memcpy(dst->slot, src->slot, src->ntri * sizeof *src->slot);
+  dst->ntri = src->ntri, dst->nslot = src->nslot, dst->nx = src->nx, dst->nnodes = src->nnodes;
+  return 0;
+}
+
+int tx_tri_bvh_remove(tx_tri_bvh* b, const int32_t* tri, uint32_t ntri) {
+  if (b->nnodes == 0 || ntri > b->ntri) return -1;
+  // first make sure tri is the current array less some rows, in order
+  uint32_t j = 0;
+  for (uint32_t i = 0; i < b->ntri; i++)
+    if (j < ntri && memcmp(b->raw + 3 * (size_t)i, tri + 3 * (size_t)j, 3 * sizeof *tri) == 0) j++;
+  if (j != ntri) return -1;
+  // then empty the removed triangles where they sit, and renumber the kept rows
+  j = 0;
+  for (uint32_t i = 0; i < b->ntri; i++) {
+    uint32_t at = b->slot[i];
+    if (j < ntri && memcmp(b->raw + 3 * (size_t)i, tri + 3 * (size_t)j, 3 * sizeof *tri) == 0) {
+      b->slot[j] = at;
+      b->order[at] = j++;
+      continue;
+    }
+    int32_t* t = b->tri + 3 * (size_t)at; // all three corners on one particle: no area, no hit
+    t[1] = t[2] = t[0];
+    b->order[at] = UINT32_MAX;
+  }
+  memcpy(b->raw, tri, 3 * (size_t)ntri * sizeof *tri);
+  b->ntri = ntri;
   return 0;
 }
 

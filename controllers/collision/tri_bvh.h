@@ -11,6 +11,7 @@
 //     tx_tri_bvh_init(&b, max_triangles);
 //     tx_tri_bvh_build(&b, x, nx, tri, ntri);   // when the triangle set changes
 //     tx_tri_bvh_refit(&b, x);                  // when only the positions change
+//     tx_tri_bvh_remove(&b, tri, ntri);         // when triangles were torn out (then refit)
 //     tx_ray_hit h;
 //     if (tx_tri_bvh_ray(&b, x, o, d, tmax, &h)) { ... h.t, h.tri ... }
 //     tx_tri_bvh_free(&b);
@@ -28,12 +29,14 @@ typedef struct tx_bvh_node {
 
 typedef struct tx_tri_bvh {
   uint32_t tri_cap;    // triangles it can hold
-  uint32_t ntri;       // triangles in the current build
+  uint32_t ntri;       // triangles in the current array (the build's, less any removed since)
+  uint32_t nslot;      // leaf slots: the triangles at the build
   uint32_t nx;         // vertices the current build indexes
   uint32_t nnodes;     // nodes in use
   tx_bvh_node* nodes;  // (2 tri_cap) the tree, parents before children
   int32_t* tri;        // (tri_cap x 3) vertex indices, in leaf order
-  uint32_t* order;     // (tri_cap) triangle ids (rows of the built array) in leaf order
+  uint32_t* order;     // (tri_cap) triangle ids (rows of the current array) in leaf order; UINT32_MAX once removed
+  uint32_t* slot;      // (tri_cap) leaf position of each row of the current array
   float* cen;          // (tri_cap x 3) m, centroids, scratch for building
   int32_t* raw;        // (tri_cap x 3) the triangle array as given to the current build
   uint64_t visited;    // nodes visited by queries since the last reset (for cost checks)
@@ -57,6 +60,10 @@ void tx_tri_bvh_refit(tx_tri_bvh* b, const float* x);
 // the same for the nodes [from, to) only, last first: refitting [k, nnodes) then
 // [0, k) equals one whole refit, so the work can be spread over several calls
 void tx_tri_bvh_refit_nodes(tx_tri_bvh* b, const float* x, uint32_t from, uint32_t to);
+// the triangle array lost rows and kept the order of the rest (a tear): the
+// removed triangles are emptied in place, the tree keeps its shape; refit
+// after. 0, or -1 (tree unchanged) when tri is not such a subset: rebuild then
+int tx_tri_bvh_remove(tx_tri_bvh* b, const int32_t* tri, uint32_t ntri);
 // make dst the same tree as src (dst sized for at least src's triangles); 0, or -1
 int tx_tri_bvh_copy(tx_tri_bvh* dst, const tx_tri_bvh* src);
 // Many short rays from one point (the HIP's) share one walk: gather the

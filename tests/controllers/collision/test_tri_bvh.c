@@ -11,6 +11,7 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 typedef struct mesh {
   uint32_t n, ntri;
@@ -105,6 +106,33 @@ static void test_split_refit_on_a_copy(void** state) {
   drop(&m);
 }
 
+// torn triangles (rows gone, the rest in order) emptied in place answer as a tree built
+// on what is left; a reordered array is refused
+static void test_removed_triangles(void** state) {
+  (void)state;
+  mesh m = make(21, 0.001);
+  tx_tri_bvh b;
+  assert_int_equal(tx_tri_bvh_init(&b, m.ntri), 0);
+  assert_int_equal(tx_tri_bvh_build(&b, m.x, m.n * m.n, m.tri, m.ntri), 0);
+  for (int round = 0; round < 2; round++) { // two tears in a row
+    uint32_t kept = 0;
+    for (uint32_t t = 0; t < m.ntri; t++)
+      if (t % (5 + round) != 2) memmove(m.tri + 3 * kept++, m.tri + 3 * t, 3 * sizeof *m.tri);
+    m.ntri = kept;
+    assert_int_equal(tx_tri_bvh_remove(&b, m.tri, m.ntri), 0);
+    assert_true(tx_tri_bvh_same(&b, m.tri, m.ntri));
+    tx_skin_dent(m.x, m.n * m.n, (double[3]){0, 0, 0}, 0.001, 0.003);
+    tx_tri_bvh_refit(&b, m.x);
+    compare_rays(&b, &m);
+  }
+  int32_t swapped[6];
+  memcpy(swapped, m.tri + 3, 3 * sizeof *m.tri);
+  memcpy(swapped + 3, m.tri, 3 * sizeof *m.tri);
+  assert_int_equal(tx_tri_bvh_remove(&b, swapped, 2), -1);
+  tx_tri_bvh_free(&b);
+  drop(&m);
+}
+
 static void test_bad_sets_refused(void** state) {
   (void)state;
   mesh m = make(5, 0.001);
@@ -155,6 +183,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_hits_match_brute_force_flat_and_dented),
       cmocka_unit_test(test_split_refit_on_a_copy),
+      cmocka_unit_test(test_removed_triangles),
       cmocka_unit_test(test_bad_sets_refused),
       cmocka_unit_test(test_query_cost_independent_of_far_triangles),
   };
