@@ -3,8 +3,9 @@
 // publish is copied and a second BVH is refitted to it over a few steps
 // while the first still answers; then the two swap, so no single 4 kHz step
 // carries a whole refit. A tear (triangles gone, the rest in order) empties
-// the torn triangles in place; any other change of the triangle set rebuilds
-// the second tree at once.
+// the torn triangles in place and refits at once, so a hole shows in the step
+// that sees it; any other change of the triangle set rebuilds the second tree
+// at once.
 //
 // Between two physics publishes the skin is frozen while the hand moves on.
 // The force computed on the frozen skin is the force where the skin last
@@ -146,9 +147,10 @@ static void take_skin(tx_ctx* c, hip_ctl* h, tx_snapshot x, tx_snapshot tri) {
   if (cur && x.rows == cur->nx && tri.rows < cur->ntri && tx_tri_bvh_copy(&h->tree[b], cur) == 0 &&
       tx_tri_bvh_remove(&h->tree[b], tri.data, tri.rows) == 0) {
     // a tear took triangles out: they are emptied in the other tree's shape, which is refitted
+    // at once, so that a hole under the HIP counts in this very step
+    tx_tri_bvh_refit(&h->tree[b], h->xs[b]);
+    h->act = b;
     h->tears++;
-    h->job = true;
-    h->job_next = h->tree[b].nnodes;
     return;
   }
   if (tx_tri_bvh_build(&h->tree[b], h->xs[b], x.rows, tri.data, tri.rows)) {
