@@ -4,7 +4,7 @@
 #ifndef TX_SCENARIOS_COMMAND_BENCH_CLOTH_H
 #define TX_SCENARIOS_COMMAND_BENCH_CLOTH_H
 
-// duration_s: simulated seconds in all (two per round), 0 for the default 20
+// duration_s: simulated seconds of the run, 0 for the default 20
 int tx_bench_cloth(double duration_s);
 
 #endif

@@ -110,8 +110,9 @@ tx_cloth_status tx_cloth_step(tx_cloth* c, double dt);
 // out: (n x 3) positions, m
 void tx_cloth_positions(const tx_cloth* c, float* out);
 // out: (triangle_count x 3) room; fills the live triangles (vertex indices,
-// normals towards +y at rest) and returns how many
-int tx_cloth_triangles(const tx_cloth* c, int32_t* out);
+// normals towards +y at rest) and returns how many; the list is compacted
+// again only after links broke or came back
+int tx_cloth_triangles(tx_cloth* c, int32_t* out);
 // stretch and shear links broken so far
 int tx_cloth_torn(const tx_cloth* c);
 // force of the skin on the HIP over the last step (N, from the momentum the

@@ -49,6 +49,9 @@ struct tx_cloth {
 
   std::vector<int32_t> tri;        // (ntri x 3) vertex indices
   std::vector<uint8_t> tri_alive;  // (ntri)
+  std::vector<int32_t> live;       // (ntri x 3) the live triangles, compacted; rows: nlive
+  int nlive;                       // live triangles
+  bool live_dirty;                 // tri_alive changed since live was compacted
   std::vector<int32_t> node_tris;  // (n x 8) triangles around each particle, -1 padded
   std::vector<link_info> info;     // (nlink)
   std::vector<btSoftBody::Link> original; // (nlink) each link as built, to put broken ones back
@@ -213,6 +216,8 @@ static bool build(tx_cloth* c) {
       }
     }
   c->tri_alive.assign((size_t)c->ntri, 1);
+  c->live = c->tri;
+  c->nlive = c->ntri;
   c->node_tris.assign((size_t)c->n * 8, -1);
   for (int t = 0; t < c->ntri; t++)
     for (int k = 0; k < 3; k++) {
@@ -594,7 +599,7 @@ static void rupture(tx_cloth* c) {
     c->torn++;
     c->topology_dirty = true;
     for (int j = 0; j < 2; j++) {
-      if (li.tri[j] >= 0) c->tri_alive[(size_t)li.tri[j]] = 0;
+      if (li.tri[j] >= 0) c->tri_alive[(size_t)li.tri[j]] = 0, c->live_dirty = true;
       if (li.dep[j] >= 0) remove_link(c, li.dep[j]);
     }
   }
@@ -636,6 +641,7 @@ extern "C" void tx_cloth_restore(tx_cloth* c) {
       links.push_back(c->original[(size_t)id]);
     }
     std::memcpy(c->tri_alive.data(), c->good_tri.data(), (size_t)c->ntri);
+    c->live_dirty = true;
     c->prepared_dt = 0; // the restored links carry their build-time constants
     c->topology_dirty = false;
   }
@@ -702,14 +708,17 @@ extern "C" void tx_cloth_positions(const tx_cloth* c, float* out) {
   }
 }
 
-extern "C" int tx_cloth_triangles(const tx_cloth* c, int32_t* out) {
-  int m = 0;
-  for (int t = 0; t < c->ntri; t++) {
-    if (!c->tri_alive[(size_t)t]) continue;
-    std::memcpy(out + (size_t)m * 3, &c->tri[(size_t)t * 3], 3 * sizeof(int32_t));
-    m++;
+extern "C" int tx_cloth_triangles(tx_cloth* m, int32_t* out) {
+  // the compacted list changes only when links break or come back
+  if (m->live_dirty) {
+    int n = 0;
+    for (int t = 0; t < m->ntri; t++)
+      if (m->tri_alive[(size_t)t]) std::memcpy(&m->live[(size_t)n++ * 3], &m->tri[(size_t)t * 3], 3 * sizeof(int32_t));
+    m->nlive = n;
+    m->live_dirty = false;
   }
-  return m;
+  std::memcpy(out, m->live.data(), (size_t)m->nlive * 3 * sizeof(int32_t));
+  return m->nlive;
 }
 
 extern "C" double tx_cloth_max_strain(const tx_cloth* c) {
