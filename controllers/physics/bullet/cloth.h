@@ -107,8 +107,8 @@ tx_cloth_status tx_cloth_set_hip(tx_cloth* c, const double pos[3], double radius
 // advances by dt (s, in (0, 1]) in ceil(dt / max_substep) substeps
 tx_cloth_status tx_cloth_step(tx_cloth* c, double dt);
 
-// out: (n x 3) positions, m
-void tx_cloth_positions(const tx_cloth* c, float* out);
+// out: (n x 3) positions, m; true when every one is finite (the copy checks them)
+bool tx_cloth_positions(const tx_cloth* c, float* out);
 // out: (triangle_count x 3) room; fills the live triangles (vertex indices,
 // normals towards +y at rest) and returns how many; the list is compacted
 // again only after links broke or came back

@@ -699,13 +699,17 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
   return TX_CLOTH_OK;
 }
 
-extern "C" void tx_cloth_positions(const tx_cloth* c, float* out) {
+extern "C" bool tx_cloth_positions(const tx_cloth* c, float* out) {
   const btAlignedObjectArray<btSoftBody::Node>& nodes = c->body->m_nodes;
+  bool finite = true;
   for (int i = 0; i < c->n; i++) {
-    out[i * 3] = nodes[i].m_x[0];
-    out[i * 3 + 1] = nodes[i].m_x[1];
-    out[i * 3 + 2] = nodes[i].m_x[2];
+    const btVector3& x = nodes[i].m_x;
+    out[i * 3] = x[0];
+    out[i * 3 + 1] = x[1];
+    out[i * 3 + 2] = x[2];
+    finite &= std::isfinite(x[0]) & std::isfinite(x[1]) & std::isfinite(x[2]);
   }
+  return finite;
 }
 
 extern "C" int tx_cloth_triangles(tx_cloth* m, int32_t* out) {
