@@ -62,7 +62,7 @@ case "$target" in
 
     say "ThreadSanitizer: the model and scheduler tests"
     build_variant build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTX_SANITIZE=thread
-    TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" tsan ctest --test-dir build-tsan --output-on-failure -L tsan
+    TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$PWD/tests/tsan.supp" tsan ctest --test-dir build-tsan --output-on-failure -L tsan
 
     say "core only: every optional part off"
     build_variant build-core -DCMAKE_BUILD_TYPE=Release -DTX_WITH_BULLET=OFF -DTX_WITH_ODE=OFF \
