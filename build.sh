@@ -7,7 +7,7 @@ set -euo pipefail
 cd "$(dirname "$0")"
 
 jobs=$(nproc 2>/dev/null || echo 2)
-default_scenario=rates
+default_scenario=suturing-skin
 fuzz_seconds=${TX_FUZZ_SECONDS:-60}
 
 say() { printf '\n== %s\n' "$*" >&2; }

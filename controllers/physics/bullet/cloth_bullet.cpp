@@ -707,7 +707,7 @@ extern "C" bool tx_cloth_positions(const tx_cloth* c, float* out) {
     out[i * 3] = x[0];
     out[i * 3 + 1] = x[1];
     out[i * 3 + 2] = x[2];
-    finite &= std::isfinite(x[0]) & std::isfinite(x[1]) & std::isfinite(x[2]);
+    finite &= std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]);
   }
   return finite;
 }
