@@ -1,5 +1,5 @@
-// Internal: the published needle-force model form (Okamura, Simone and
-// O'Leary, "Force modeling for needle insertion into soft tissue"), used to
+// Internal: the published needle-force model form ("Force modeling for
+// needle insertion into soft tissue", IEEE TBME 2004), used to
 // generate reference insertion curves. Along the needle, with z the tip's
 // depth below the surface:
 //
