@@ -14,29 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
-#define TX_NO_ALLOC_COUNT 1
-#endif
-#endif
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__) || !defined(__GLIBC__)
-#define TX_NO_ALLOC_COUNT 1
-#endif
-
-static volatile int counting;
-static volatile long allocations;
-#ifndef TX_NO_ALLOC_COUNT
-extern void* __libc_malloc(size_t n);
-extern void* __libc_calloc(size_t n, size_t size);
-void* malloc(size_t n) {
-  if (counting) allocations++;
-  return __libc_malloc(n);
-}
-void* calloc(size_t n, size_t size) {
-  if (counting) allocations++;
-  return __libc_calloc(n, size);
-}
-#endif
+#include "tests/alloc_count.h"
 
 #define N 41          // particles per side
 #define SPACING 5e-4  // m: a 2 x 2 cm patch

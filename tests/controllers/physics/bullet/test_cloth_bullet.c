@@ -15,37 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-// count allocations by interposing malloc, calloc and realloc on glibc's
-// own; sanitizers bring their own allocator, so there the count is skipped
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
-#define TX_NO_ALLOC_COUNT 1
-#endif
-#endif
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__) || !defined(__GLIBC__)
-#define TX_NO_ALLOC_COUNT 1
-#endif
-
-static volatile int counting;
-static volatile long allocations;
-
-#ifndef TX_NO_ALLOC_COUNT
-extern void* __libc_malloc(size_t n);
-extern void* __libc_calloc(size_t n, size_t size);
-extern void* __libc_realloc(void* p, size_t n);
-void* malloc(size_t n) {
-  if (counting) allocations++;
-  return __libc_malloc(n);
-}
-void* calloc(size_t n, size_t size) {
-  if (counting) allocations++;
-  return __libc_calloc(n, size);
-}
-void* realloc(void* p, size_t n) {
-  if (counting) allocations++;
-  return __libc_realloc(p, n);
-}
-#endif
+#include "tests/alloc_count.h"
 
 static tx_cloth* make(int res, double gravity, double rupture) {
   tx_cloth_def d = tx_cloth_def_default();
