@@ -2,8 +2,10 @@
 // percentiles of one run on this machine; they are printed, never asserted.
 #include "bench_voxels.h"
 #include "bench_render.h"
+#include "bench_cloth.h"
 #include "command.h"
 #include "run.h"
+#include "bench_hip.h"
 
 #include "../../controllers/stats.h"
 
@@ -270,6 +272,11 @@ static int bench_haptics(const bench_args* a) {
 }
 
 static int bench_voxels(const bench_args* a) { return tx_bench_voxels(a->duration_s); }
+static int bench_cloth(const bench_args* a) { return tx_bench_cloth(a->duration_s); }
+static int bench_hip(const bench_args* a) {
+  (void)a;
+  return tx_bench_hip();
+}
 
 static const struct {
   const char* name;
@@ -282,6 +289,8 @@ static const struct {
     {"haptics", bench_haptics, "haptics tick cost, 1 kHz under load, 10 kHz idle"},
     {"voxels", bench_voxels, "needle in 250 to 100000 voxels: haptic Hz beside the voxel paper's Table 1"},
     {"render", bench_render, "graphics view frame times, mono and 2x640x480 stereo, beside 1 kHz haptics"},
+    {"cloth", bench_cloth, "skin physics step at 10404 particles with rupture; overhead vs a bare Bullet loop"},
+    {"hip", bench_hip, "collision.hip query (98 rays) on 10404 and 102400 particles, and the refit"},
 };
 
 int tx_cmd_bench(int argc, char** argv) {
@@ -295,10 +304,9 @@ int tx_cmd_bench(int argc, char** argv) {
     else if (c == 'd') {
       if (!tx_parse_num(optarg, 0.1, 3600, &a.duration_s)) return tx_bad_input("--duration %s: expected seconds in [0.1, 3600]", optarg);
     } else if (c == 'h') {
-      optind = argc + 1; // leave getopt before it reads past argv
+      optind = argc + 1; // --help: list the benchmarks; reading on would pass the end of argv
       break;
-    }
-    else if (optopt && strncmp(argv[optind - 1], "--", 2) != 0) // inside a group of short options
+    } else if (optopt && strncmp(argv[optind - 1], "--", 2) != 0) // inside a group of short options
       return tx_bad_input("bench: unknown option '-%c'", optopt);
     else return tx_bad_input("bench: unknown or incomplete option '%s'", argv[optind - 1]);
   }

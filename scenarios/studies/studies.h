@@ -15,5 +15,8 @@ typedef struct tx_study_args {
 int tx_study_haptic_stability(const tx_study_args* a);
 int tx_study_needle_fit(const tx_study_args* a);
 int tx_study_needle_stability(const tx_study_args* a);
+int tx_study_skin_paper(const tx_study_args* a);
+int tx_study_skin_stability(const tx_study_args* a);
+int tx_study_skin_accuracy(const tx_study_args* a);
 
 #endif

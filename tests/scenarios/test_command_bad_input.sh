@@ -225,6 +225,34 @@ expect_bad "needle-stability --set unknown" "--set k=1" "unknown key" -- study n
 expect_bad "needle-stability --set bad duration" "--set duration_s=-1" -- study needle-stability --set duration_s=-1 --out "$WORK/ns"
 expect_bad "haptic-stability with a file" "haptic-stability" "unexpected argument" -- study haptic-stability extra --out "$WORK/st"
 expect_bad "bench voxels --duration bad" "--duration" -- bench voxels --duration 0
+# collision.hip and view.force_curve parameters (the HIP needs no skin writer to be refused)
+printf '{"name": "t", "controllers": [{"name": "hip", "type": "collision.hip", "rate_hz": 4000},
+  {"name": "curve", "type": "view.force_curve", "rate_hz": 1000, "params": {"force": "tool0.force_model"}}]}\n' >"$S/hip.json"
+expect_bad "hip rays not 26 or 98" "--set hip.rays=27" "26 or 98" -- run "$S/hip.json" --set hip.rays=27
+expect_bad "hip radius out of range" "--set hip.radius_m=1" "out of range" -- run "$S/hip.json" --set hip.radius_m=1
+expect_bad "hip k of 1" "--set hip.k=1" "out of range" -- run "$S/hip.json" --set hip.k=1
+expect_bad "hip alpha not a number" "--set hip.alpha=soft" -- run "$S/hip.json" --set hip.alpha=soft
+expect_bad "force curve bad axis" "--set curve.axis=w" "x, y or z" -- run "$S/hip.json" --set curve.axis=w
+expect_bad "force curve file with a path" "--set curve.file=../x" "base name" -- run "$S/hip.json" --set curve.file=../x
+# built without Bullet, suturing-skin itself is refused: its physics.skin is unknown
+if "$TACTUS" describe suturing-skin >/dev/null 2>&1; then
+  expect_bad "skin-paper --set bad HIP rays" "hip.rays" -- study skin-paper --set hip.rays=7 --out "$WORK/sp"
+  # physics.skin parameters
+  expect_bad "skin spacing not dividing the patch" "--set skin.spacing_m=0.003" "whole cells" -- run suturing-skin --set skin.spacing_m=0.003
+  expect_bad "skin thickness out of range" "--set skin.thickness_m=0.5" "out of range" -- run suturing-skin --set skin.thickness_m=0.5
+  expect_bad "skin iterations not a number" "--set skin.iterations=many" -- run suturing-skin --set skin.iterations=many
+  expect_bad "skin rate out of range" "suturing-skin.json" "controllers[0]" "20 to 120 Hz" -- run suturing-skin --set skin.rate_hz=500
+  expect_bad "skin gravity not a boolean" "--set skin.gravity=9.81" -- run suturing-skin --set skin.gravity=9.81
+  expect_bad "skin unknown parameter" "--set skin.stiffnes=1" "unknown parameter" -- run suturing-skin --set skin.stiffnes=1
+  expect_bad "skin-stability takes no --set" "--set skin.iterations=3" -- study skin-stability --set skin.iterations=3 --out "$WORK/ss"
+  expect_bad "skin-accuracy takes no --set" "--set skin.iterations=3" -- study skin-accuracy --set skin.iterations=3 --out "$WORK/sa"
+  expect_bad "skin-stability unwritable --out" "--out /dev/null/x" -- study skin-stability --out /dev/null/x
+else
+  expect_bad "skin-paper without Bullet" "physics.skin" -- study skin-paper --out "$WORK/sp"
+  expect_bad "skin-stability without Bullet" "Bullet" -- study skin-stability --out "$WORK/ss"
+  expect_bad "bench cloth without Bullet" "Bullet" -- bench cloth
+  expect_bad "skin-accuracy without Bullet" "Bullet" -- study skin-accuracy --out "$WORK/sa"
+fi
 expect_bad "describe with two names" "describe" -- describe rates rates
 expect_bad "list with an argument" "list" -- list extra
 

@@ -1,0 +1,265 @@
+// collision.hip: the HIP's rays against the skin of the latest physics
+// publish, and the local force model for the haptics controller. Each
+// publish is copied and a second BVH is refitted to it over a few steps
+// while the first still answers; then the two swap, so no single 4 kHz step
+// carries a whole refit. A tear (triangles gone, the rest in order) empties
+// the torn triangles in place and refits at once, so a hole shows in the step
+// that sees it; any other change of the triangle set rebuilds the second tree
+// at once.
+//
+// Between two physics publishes the skin is frozen while the hand moves on.
+// The force computed on the frozen skin is the force where the skin last
+// settled around the HIP, so the model anchors F0 at x0, the point where the
+// HIP would just touch that skin along the direction it came from, and K,
+// the rays' estimate of how the force grows as the skin is pushed along its
+// normals, carries the force along with the hand until the next publish.
+#include "hip_collision.h"
+
+#include "hip.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct hip_ctl {
+  tx_hip hip;               // the method's state
+  tx_tri_bvh tree[2];       // over the skin's live triangles: one answers queries, the other is refitted
+  float* xs[2];             // (xcap x 3) m, the particles each tree was fitted to, copied from the publish
+  int64_t ns[2];            // simulation time of the skin publish each tree holds
+  int act;                  // the tree queries use, -1 for none (no usable skin)
+  bool job;                 // the other tree is being refitted to a newer publish
+  uint32_t job_next;        // its nodes [0, job_next) are still to refit
+  uint32_t chunk;           // nodes refitted per step: a refit is spread over a few steps
+  uint32_t tri_cap, xcap;   // triangles and particles the trees and copies were sized for
+  tx_port pose, x, tri, thickness;           // reads
+  tx_port model, state, spheres;             // writes
+  uint64_t x_seq, tri_seq;  // last publishes seen
+  double last_c[3];         // m, last finite pose
+  tx_warning w_pose, w_skin, w_mesh; // non-finite pose, non-finite skin, triangle set too large or bad
+  tx_result r_peak, r_contacts, r_pierced, r_rebuilds, r_refits, r_resets, r_tears;
+  double peak;              // N, largest force sent
+  uint64_t max_contacts, pierces, rebuilds, refits, tears; // tears: triangle sets shrunk without a rebuild
+  bool was_pierced;
+} hip_ctl;
+
+static int configure(tx_setup* s, void** self) {
+  hip_ctl* h = calloc(1, sizeof *h);
+  if (!h) return -1;
+  *self = h;
+  tx_hip_def def = tx_hip_def_default();
+  def.radius = tx_param_num(s, "radius_m", def.radius, 1e-5, 0.05);
+  def.rays = (int)tx_param_int(s, "rays", def.rays, 26, 98);
+  def.alpha = tx_param_num(s, "alpha", def.alpha, 0, 1e6);
+  def.k = tx_param_num(s, "k", def.k, 0, 0.999);
+  def.slide_max = tx_param_num(s, "slide_max_m", def.slide_max, 1e-6, 1);
+  def.pierce_range = tx_param_num(s, "pierce_range_m", def.pierce_range, 1e-5, 1);
+  def.hold = tx_param_num(s, "hold_m", def.hold, 0, 0.01);
+  const char* join = tx_param_str(s, "join", "anchor");
+  if (!join) return -1;
+  if (strcmp(join, "anchor") && strcmp(join, "own")) return tx_setup_fail(s, "join", "expected \"anchor\" or \"own\", got \"%s\"", join);
+  def.join_anchor = strcmp(join, "anchor") == 0;
+  if (def.rays != 26 && def.rays != 98) return tx_setup_fail(s, "rays", "must be 26 or 98, got %d", def.rays);
+  const char* err = tx_hip_def_check(&def);
+  if (err) return tx_setup_fail(s, NULL, "%s", err);
+  tx_hip_init(&h->hip, &def);
+  const char* pose = tx_param_str(s, "pose", "device0.pose");
+  const char* skin = tx_param_str(s, "skin", "skin");
+  const char* model = tx_param_str(s, "force_model", "tool0.force_model");
+  const char* state = tx_param_str(s, "state", "hip0.state");
+  const char* spheres = tx_param_str(s, "spheres", "hip0.spheres");
+  if (!pose || !skin || !model || !state || !spheres) return -1;
+  char name[3][TX_NAME_MAX];
+  if (snprintf(name[0], TX_NAME_MAX, "%s.x", skin) >= TX_NAME_MAX) return tx_setup_fail(s, "skin", "name too long");
+  snprintf(name[1], TX_NAME_MAX, "%s.tri", skin);
+  snprintf(name[2], TX_NAME_MAX, "%s.thickness", skin);
+  h->pose = tx_setup_read_as(s, pose, TX_F64, 7);
+  h->x = tx_setup_read_as(s, name[0], TX_F32, 3);
+  h->tri = tx_setup_read_as(s, name[1], TX_I32, 3);
+  h->thickness = tx_setup_read_as(s, name[2], TX_F64, 1);
+  h->model = tx_setup_write(s, &(tx_component_def){model, TX_F64, 1, 15, "N, m, N/m"});
+  h->state = tx_setup_write(s, &(tx_component_def){state, TX_F64, 1, 8, "1, N, m, s"});
+  h->spheres = tx_setup_write(s, &(tx_component_def){spheres, TX_F32, 1, 4, "m"});
+  h->w_pose = tx_setup_warning(s, "pose_not_finite");
+  h->w_skin = tx_setup_warning(s, "skin_not_finite");
+  h->w_mesh = tx_setup_warning(s, "skin_mesh_rejected");
+  h->r_peak = tx_setup_result(s, "peak_force_N");
+  h->r_contacts = tx_setup_result(s, "max_contacts");
+  h->r_pierced = tx_setup_result(s, "pierces");
+  h->r_rebuilds = tx_setup_result(s, "bvh_rebuilds");
+  h->r_refits = tx_setup_result(s, "bvh_refits");
+  h->r_resets = tx_setup_result(s, "eq8_updates");
+  h->r_tears = tx_setup_result(s, "bvh_tears");
+  return 0;
+}
+
+static int init(tx_ctx* c, void* self) {
+  hip_ctl* h = self;
+  // before the skin's first publish a read holds its full capacity: size everything by it
+  tx_snapshot tri = tx_read(c, h->tri), x = tx_read(c, h->x);
+  h->tri_cap = tri.rows > 0 ? tri.rows : 1;
+  h->xcap = x.rows > 0 ? x.rows : 1;
+  h->act = -1;
+  for (int i = 0; i < 2; i++) {
+    if (tx_tri_bvh_init(&h->tree[i], h->tri_cap)) return -1;
+    if (!(h->xs[i] = calloc(3 * (size_t)h->xcap, sizeof(float)))) return -1;
+  }
+  // a refit of up to 8192 nodes (about 12000 triangles: the 1764-particle skin) is done in
+  // the step that sees the publish; a larger one is spread over up to 8 steps at 4 kHz
+  // (2 ms, well inside a 120 Hz physics period), or fewer at lower rates
+  double spread = floor(tx_rate(c) / 500);
+  size_t share = 2 * (size_t)h->tri_cap / (spread < 1 ? 1 : spread > 16 ? 16 : spread) + 1;
+  h->chunk = (uint32_t)(share > 8192 ? share : 8192);
+  return 0;
+}
+
+static bool all_finite(const float* v, size_t n) {
+  for (size_t i = 0; i < n; i++)
+    if (!isfinite(v[i])) return false;
+  return true;
+}
+
+// a new skin publish: copy it beside the tree in use, then refit the other tree to it over the
+// next steps, or rebuild that tree now when the triangle set changed
+static void take_skin(tx_ctx* c, hip_ctl* h, tx_snapshot x, tx_snapshot tri) {
+  int b = h->act == 0 ? 1 : 0;
+  h->job = false;
+  if (x.rows > h->xcap) {
+    tx_warn(c, h->w_mesh);
+    h->act = -1;
+    return;
+  }
+  memcpy(h->xs[b], x.data, 3 * (size_t)x.rows * sizeof(float));
+  if (!all_finite(h->xs[b], 3 * (size_t)x.rows)) { // no force from a broken skin, until a good one
+    tx_warn(c, h->w_skin);
+    h->act = -1;
+    return;
+  }
+  h->ns[b] = x.sim_ns;
+  tx_tri_bvh* cur = h->act >= 0 ? &h->tree[h->act] : NULL;
+  if (cur && x.rows == cur->nx && tx_tri_bvh_same(cur, tri.data, tri.rows)) {
+    // the same triangles: the other tree takes this shape (if it was left behind) and is refitted
+    if (!(x.rows == h->tree[b].nx && tx_tri_bvh_same(&h->tree[b], tri.data, tri.rows))) tx_tri_bvh_copy(&h->tree[b], cur);
+    h->job = true;
+    h->job_next = h->tree[b].nnodes;
+    return;
+  }
+  if (cur && x.rows == cur->nx && tri.rows < cur->ntri && tx_tri_bvh_copy(&h->tree[b], cur) == 0 &&
+      tx_tri_bvh_remove(&h->tree[b], tri.data, tri.rows) == 0) {
+    // a tear took triangles out: they are emptied in the other tree's shape, which is refitted
+    // at once, so that a hole under the HIP counts in this very step
+    tx_tri_bvh_refit(&h->tree[b], h->xs[b]);
+    h->act = b;
+    h->tears++;
+    return;
+  }
+  if (tx_tri_bvh_build(&h->tree[b], h->xs[b], x.rows, tri.data, tri.rows)) {
+    tx_warn(c, h->w_mesh); // more triangles than at start, or an index outside the particles
+    h->act = -1;
+    return;
+  }
+  h->act = b;
+  h->rebuilds++;
+}
+
+// one step's share of the refit; the refitted tree takes over when it is whole
+static void refit_some(hip_ctl* h) {
+  int b = h->act == 0 ? 1 : 0;
+  uint32_t from = h->job_next > h->chunk ? h->job_next - h->chunk : 0;
+  tx_tri_bvh_refit_nodes(&h->tree[b], h->xs[b], from, h->job_next);
+  h->job_next = from;
+  if (from == 0) {
+    h->act = b;
+    h->job = false;
+    h->refits++;
+  }
+}
+
+static void step(tx_ctx* c, void* self) {
+  hip_ctl* h = self;
+  const double* pose = tx_read(c, h->pose).data;
+  double centre[3] = {pose[0], pose[1], pose[2]};
+  if (!(isfinite(centre[0]) && isfinite(centre[1]) && isfinite(centre[2]))) {
+    tx_warn(c, h->w_pose);
+    memcpy(centre, h->last_c, sizeof centre); // hold the last good pose
+  }
+  memcpy(h->last_c, centre, sizeof centre);
+
+  // a new physics publish: take the skin
+  tx_snapshot x = tx_read(c, h->x), tri = tx_read(c, h->tri);
+  double thickness = ((const double*)tx_read(c, h->thickness).data)[0];
+  if (!isfinite(thickness) || thickness < 0) thickness = 0;
+  if (x.seq != 0 && (x.seq != h->x_seq || tri.seq != h->tri_seq)) {
+    h->x_seq = x.seq;
+    h->tri_seq = tri.seq;
+    take_skin(c, h, x, tri);
+  }
+  if (h->job) refit_some(h);
+
+  tx_hip_out out;
+  if (h->act >= 0) {
+    tx_hip_query(&h->hip, &h->tree[h->act], h->xs[h->act], thickness, centre, &out);
+  } else {
+    tx_hip_reset(&h->hip);
+    memset(&out, 0, sizeof out);
+    memcpy(out.x0, centre, sizeof centre);
+  }
+  if (out.pierced && !h->was_pierced) h->pierces++;
+  h->was_pierced = out.pierced;
+
+  // the local model: F0 where the frozen skin would just touch the HIP, K from the rays
+  double* m = tx_write(c, h->model);
+  memset(m, 0, 15 * sizeof *m);
+  bool force = out.contacts > 0;
+  memcpy(m + 3, force ? out.x0 : centre, 3 * sizeof *m);
+  if (force) {
+    memcpy(m, out.f, 3 * sizeof *m);
+    memcpy(m + 6, out.k, 9 * sizeof *m);
+    double f = sqrt(out.f[0] * out.f[0] + out.f[1] * out.f[1] + out.f[2] * out.f[2]);
+    if (f > h->peak) h->peak = f;
+    if ((uint64_t)out.contacts > h->max_contacts) h->max_contacts = (uint64_t)out.contacts;
+  }
+  double* st = tx_write(c, h->state);
+  st[0] = out.contacts;
+  st[1] = out.pierced;
+  memcpy(st + 2, out.f, 3 * sizeof *st);
+  st[5] = out.depth;
+  st[6] = (double)h->hip.resets;
+  st[7] = h->act >= 0 ? h->ns[h->act] * 1e-9 : 0;
+  float* sp = tx_write(c, h->spheres);
+  sp[0] = (float)centre[0];
+  sp[1] = (float)centre[1];
+  sp[2] = (float)centre[2];
+  sp[3] = (float)h->hip.def.radius;
+}
+
+static void finish(tx_ctx* c, void* self) {
+  hip_ctl* h = self;
+  tx_set_result(c, h->r_peak, h->peak);
+  tx_set_result(c, h->r_contacts, (double)h->max_contacts);
+  tx_set_result(c, h->r_pierced, (double)h->pierces);
+  tx_set_result(c, h->r_rebuilds, (double)h->rebuilds);
+  tx_set_result(c, h->r_refits, (double)h->refits);
+  tx_set_result(c, h->r_resets, (double)h->hip.resets);
+  tx_set_result(c, h->r_tears, (double)h->tears);
+}
+
+static void fini(void* self) {
+  hip_ctl* h = self;
+  if (!h) return;
+  for (int i = 0; i < 2; i++) {
+    tx_tri_bvh_free(&h->tree[i]);
+    free(h->xs[i]);
+  }
+  free(h);
+}
+
+const tx_controller_class tx_collision_hip = {
+    .type = "collision.hip",
+    .summary = "the suturing papers' ray-casting HIP against the skin mesh: F = -alpha sum(R_n)/N, eq. 8, local model F0, x0, K",
+    .configure = configure,
+    .init = init,
+    .step = step,
+    .finish = finish,
+    .fini = fini,
+};

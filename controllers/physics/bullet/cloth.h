@@ -1,0 +1,140 @@
+// Internal: the skin patch as a Bullet soft body, behind a C interface.
+//
+// A rectangular patch in the plane y = center[1] (Y up), res[0] x res[1]
+// particles on a regular grid, each cell split into two triangles along an
+// alternating diagonal. Bullet (btSoftBody, position-based links) moves the
+// particles; the links are the springs of the suturing conference paper's
+// eq. 1: stretch links along x and z, shear links along both diagonals of a
+// cell (8 neighbours for an inner particle, the paper's Fig. 2) and bending
+// links two spacings long along x and z.
+//
+//   stiffness  the paper's k (N/m) per link, turned into Bullet's per-iteration
+//              link stiffness k dt^2 w / (1 + k dt^2 w) (w: the two inverse
+//              masses; the implicit spring's correction over one substep), so
+//              any k is stable; a very stiff link is limited by iterations
+//   rupture    a stretch or shear link whose strain (length - reference) /
+//              reference passes rupture_strain breaks (the reference is the
+//              rest length, or with gravity the length once the patch hangs
+//              after settle_time): it leaves Bullet, and the
+//              triangles it bordered (the two of its cell for a diagonal)
+//              leave the mesh, so a hole opens; bending links across it go too
+//   HIP        a kinematic sphere (the haptic interaction point). Its contact
+//              is a point-triangle constraint against every live triangle:
+//              the closest point of a triangle within radius + thickness / 2
+//              of the centre is projected out to that distance, moving the
+//              triangle's three particles by their barycentric weights
+//              (inverse mass weighted), before and after each substep's
+//              Bullet solve. Bullet's own node-vs-rigid contact tests
+//              particles only, and a 0.5 mm sphere slips between particles
+//              2.5 mm apart; the face test cannot. A fast HIP is swept in
+//              moves of at most half the contact distance, and the side it
+//              came from decides which way a triangle is pushed, so it never
+//              tunnels through an intact skin.
+//   faults     after every substep every particle must be finite, slower than
+//              max_speed and within 10 m of the patch (a kinetic energy
+//              bound per particle); otherwise the whole patch, its torn
+//              links included, goes back to the state after the last good
+//              step and the step reports TX_CLOTH_FAULT; the HIP starts the
+//              next step where it now is, so the faulty move is not replayed
+//
+//     tx_cloth_def d = tx_cloth_def_default();
+//     tx_cloth* c = tx_cloth_create(&d);          // NULL and tx_error() on bad input
+//     tx_cloth_set_hip(c, (double[3]){0, 0.01, 0}, 0.0005);
+//     if (tx_cloth_step(c, 1.0 / 60) == TX_CLOTH_FAULT) { ... count a warning ... }
+//     tx_cloth_positions(c, x);                    // (n x 3) floats, m
+//     int m = tx_cloth_triangles(c, tri);          // live triangles only
+//     tx_cloth_destroy(c);
+//
+// Create allocates everything; step, the getters and the HIP calls never
+// allocate. One thread at a time per cloth.
+#ifndef TX_CONTROLLERS_PHYSICS_BULLET_CLOTH_H
+#define TX_CONTROLLERS_PHYSICS_BULLET_CLOTH_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct tx_cloth_def {
+  double size[2];           // m, edge lengths along x and z; 0.1 (the papers' 10 x 10 cm patch)
+  int res[2];               // particles along x and z, in [2, 1024]; 42 (0.25 cm spacing: 1764 particles)
+  double center[3];         // m, centre of the patch; 0 (mid-plane y = 0)
+  double thickness;         // m, in [0, 0.02]; 0.004 (the papers' 0.4 cm); only the contact uses it
+  double mass;              // kg, the whole patch, spread evenly; 0.044 (10 x 10 x 0.4 cm at 1100 kg/m^3)
+  double stretch_stiffness; // N/m, k of eq. 1 for stretch and shear links, in (0, 1e9]; 2000 (E t for 0.5 MPa, 4 mm)
+  double bend_stiffness;    // N/m, k of the bending links, in [0, 1e9]; 20
+  double damping;           // 1/s, decay rate of particle velocities (b of eq. 1 per unit mass), in [0, 1e4]; 5
+  double gravity;           // m/s^2, along -y, in [0, 100]; 0 (9.81 with gravity on)
+  bool fixed_border;        // the outer ring of particles cannot move; true
+  double rupture_strain;    // 1, a stretch or shear link breaks above this strain, in [0, 100]; 0.6; 0: never
+  int iterations;           // Bullet position iterations per substep, in [1, 200]; 10
+  double max_substep;       // s, a step is split into substeps of at most this, in [1e-5, 0.1]; 1/60
+  double max_speed;         // m/s, a faster particle is a blow-up, in (0, 1e4]; 100
+  double settle_time;       // s, with gravity the patch first hangs this long without rupture, and the
+                            // hanging lengths become the rupture reference, in [0, 10]; 1
+} tx_cloth_def;
+
+typedef struct tx_cloth tx_cloth;
+
+typedef enum tx_cloth_status {
+  TX_CLOTH_OK = 0,    // stepped
+  TX_CLOTH_FAULT = 1, // non-finite or blown up: put back to the last good state
+  TX_CLOTH_BAD = 2,   // bad argument: nothing done, tx_error() set
+} tx_cloth_status;
+
+// the defaults above
+tx_cloth_def tx_cloth_def_default(void);
+
+// NULL when every field is finite and in range; otherwise one line naming
+// the field, its value and the range (valid until the next check on this thread)
+const char* tx_cloth_def_check(const tx_cloth_def* def);
+
+// builds the patch at rest, flat; NULL (and tx_error()) on bad input or no memory
+tx_cloth* tx_cloth_create(const tx_cloth_def* def);
+void tx_cloth_destroy(tx_cloth* c);
+
+const tx_cloth_def* tx_cloth_get_def(const tx_cloth* c);
+int tx_cloth_particle_count(const tx_cloth* c);  // res[0] res[1]
+int tx_cloth_triangle_count(const tx_cloth* c);  // 2 (res[0] - 1)(res[1] - 1), live or not
+int tx_cloth_link_count(const tx_cloth* c);      // links in Bullet now (stretch, shear, bending)
+
+// the HIP: centre (m) and radius (m, in [0, 0.1]; 0 removes it). The next
+// step moves it in a straight line from where it was to here.
+tx_cloth_status tx_cloth_set_hip(tx_cloth* c, const double pos[3], double radius);
+
+// advances by dt (s, in (0, 1]) in ceil(dt / max_substep) substeps
+tx_cloth_status tx_cloth_step(tx_cloth* c, double dt);
+
+// out: (n x 3) positions, m
+void tx_cloth_positions(const tx_cloth* c, float* out);
+// out: (triangle_count x 3) room; fills the live triangles (vertex indices,
+// normals towards +y at rest) and returns how many; the list is compacted
+// again only after links broke or came back
+int tx_cloth_triangles(tx_cloth* c, int32_t* out);
+// stretch and shear links broken so far
+int tx_cloth_torn(const tx_cloth* c);
+// force of the skin on the HIP over the last step (N, from the momentum the
+// contact gave the particles); zero without contact
+void tx_cloth_contact_force(const tx_cloth* c, double out[3]);
+// the largest strain (length - rest) / rest of a stretch or shear link now
+double tx_cloth_max_strain(const tx_cloth* c);
+// faults found and recovered so far
+int tx_cloth_faults(const tx_cloth* c);
+
+// the state after the last good step: saved by every good step, and put
+// back by a fault or by restore
+void tx_cloth_save(tx_cloth* c);
+void tx_cloth_restore(tx_cloth* c);
+
+// overwrite one particle's position (m) and velocity (m/s), unchecked, so
+// tests can inject a fault; false for a bad index
+bool tx_cloth_poke(tx_cloth* c, int i, const double x[3], const double v[3]);
+// one particle's position (m) as doubles, for tests; NaN for a bad index
+void tx_cloth_particle(const tx_cloth* c, int i, double out[3]);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

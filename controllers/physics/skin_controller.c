@@ -1,0 +1,143 @@
+// physics.skin: the suturing skin patch (the SutureHap papers' cloth) on a
+// Bullet soft body, with the HIP as a kinematic sphere that follows the
+// device pose. Every step publishes the particles, the live triangles, the
+// thickness and the torn-link count; a numerical fault is counted and the
+// patch goes back to its last good state, so the model never holds a NaN.
+#include "skin_controller.h"
+
+#include "bullet/cloth.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct skin {
+  tx_cloth* cloth;     // the patch; made in configure, stepped only by this instance
+  double hip_radius;   // m, 0: no HIP
+  double dt;           // s, one step at the instance's rate
+  tx_port pose;        // read: the pose the HIP follows (f64 1 x 7)
+  tx_port x, tri, thickness, torn; // written: skin.*
+  tx_warning fault, bad_pose;
+  tx_result torn_result, fault_result;
+} skin;
+
+static int configure(tx_setup* s, void** self) {
+  skin* k = calloc(1, sizeof *k);
+  if (!k) return -1;
+  *self = k;
+  double rate = tx_setup_rate(s);
+  if (!(rate >= TX_SKIN_RATE_MIN_HZ && rate <= TX_SKIN_RATE_MAX_HZ))
+    return tx_setup_fail(s, NULL, "physics.skin runs at %g to %g Hz, not %g", TX_SKIN_RATE_MIN_HZ, TX_SKIN_RATE_MAX_HZ,
+                         rate);
+  k->dt = 1.0 / rate;
+
+  // the patch, in metres (the papers' centimetres / 100)
+  tx_cloth_def d = tx_cloth_def_default();
+  double size = tx_param_num(s, "size_m", 0.1, 0.01, 1);
+  double spacing = tx_param_num(s, "spacing_m", 0.0025, 0.0005, 0.05);
+  d.thickness = tx_param_num(s, "thickness_m", d.thickness, 0, 0.02);
+  d.mass = tx_param_num(s, "mass_kg", d.mass, 1e-6, 100);
+  d.stretch_stiffness = tx_param_num(s, "stretch_stiffness", d.stretch_stiffness, 1e-6, 1e9);
+  d.bend_stiffness = tx_param_num(s, "bend_stiffness", d.bend_stiffness, 0, 1e9);
+  d.damping = tx_param_num(s, "damping", d.damping, 0, 1e4);
+  d.gravity = tx_param_bool(s, "gravity", false) ? 9.81 : 0;
+  d.fixed_border = tx_param_bool(s, "fixed_border", d.fixed_border);
+  d.rupture_strain = tx_param_num(s, "rupture_strain", d.rupture_strain, 0, 100);
+  d.iterations = (int)tx_param_int(s, "iterations", d.iterations, 1, 200);
+  d.max_substep = tx_param_num(s, "max_substep_s", d.max_substep, 1e-5, 0.1);
+  d.max_speed = tx_param_num(s, "max_speed", d.max_speed, 1e-3, 1e4);
+  k->hip_radius = tx_param_num(s, "hip_radius_m", 0.0005, 0, 0.01);
+  const char* pose = tx_param_str(s, "pose", "device0.pose");
+  if (!pose) return -1;
+
+  // the papers' counts: size / spacing + 1 cells a side (42 x 42 particles at
+  // 0.25 cm, 102 x 102 at 0.1 cm), so the edge is size + spacing
+  double cells = size / spacing;
+  if (fabs(cells - lround(cells)) > 1e-6 * cells)
+    return tx_setup_fail(s, "spacing_m", "%g m does not divide size_m = %g m into whole cells", spacing, size);
+  int res = (int)lround(cells) + 2;
+  if (res > 1024) return tx_setup_fail(s, "spacing_m", "%g m gives %d particles a side, at most 1024", spacing, res);
+  d.size[0] = d.size[1] = (res - 1) * spacing;
+  d.res[0] = d.res[1] = res;
+  const char* bad = tx_cloth_def_check(&d);
+  if (bad) return tx_setup_fail(s, NULL, "%s", bad);
+  k->cloth = tx_cloth_create(&d);
+  if (!k->cloth) return tx_setup_fail(s, NULL, "%s", tx_error());
+
+  uint32_t n = (uint32_t)tx_cloth_particle_count(k->cloth), m = (uint32_t)tx_cloth_triangle_count(k->cloth);
+  if (k->hip_radius > 0) k->pose = tx_setup_read_as(s, pose, TX_F64, 7);
+  k->x = tx_setup_write(s, &(tx_component_def){"skin.x", TX_F32, n, 3, "m"});
+  k->tri = tx_setup_write(s, &(tx_component_def){"skin.tri", TX_I32, m, 3, "1"});
+  k->thickness = tx_setup_write(s, &(tx_component_def){"skin.thickness", TX_F64, 1, 1, "m"});
+  k->torn = tx_setup_write(s, &(tx_component_def){"skin.torn", TX_I32, 1, 1, "1"});
+  k->fault = tx_setup_warning(s, "numerical_fault");
+  k->bad_pose = tx_setup_warning(s, "bad_pose");
+  k->torn_result = tx_setup_result(s, "torn_links");
+  k->fault_result = tx_setup_result(s, "faults");
+  return 0;
+}
+
+// every coordinate finite: the model must never hold a NaN
+static bool finite_all(const float* x, uint32_t count) {
+  for (uint32_t i = 0; i < count; i++)
+    if (!isfinite(x[i])) return false;
+  return true;
+}
+
+static void publish(tx_ctx* c, skin* k) {
+  uint32_t n = (uint32_t)tx_cloth_particle_count(k->cloth);
+  float* x = tx_write(c, k->x);
+  tx_cloth_positions(k->cloth, x);
+  if (!finite_all(x, n * 3)) { // cannot happen after the cloth's own check; kept as the last guard
+    tx_warn(c, k->fault);
+    tx_cloth_restore(k->cloth);
+    tx_cloth_positions(k->cloth, x);
+  }
+  int32_t* tri = tx_write(c, k->tri);
+  tx_write_rows(c, k->tri, (uint32_t)tx_cloth_triangles(k->cloth, tri));
+  double* h = tx_write(c, k->thickness);
+  h[0] = tx_cloth_get_def(k->cloth)->thickness;
+  int32_t* torn = tx_write(c, k->torn);
+  torn[0] = tx_cloth_torn(k->cloth);
+}
+
+static int init(tx_ctx* c, void* self) {
+  publish(c, self); // the patch at rest, at time 0
+  return 0;
+}
+
+static void step(tx_ctx* c, void* self) {
+  skin* k = self;
+  if (k->pose.id) {
+    tx_snapshot p = tx_read(c, k->pose);
+    if (p.seq > 0) { // nothing published yet: the HIP waits
+      const double* pose = p.data;
+      if (tx_cloth_set_hip(k->cloth, pose, k->hip_radius) != TX_CLOTH_OK) tx_warn(c, k->bad_pose);
+    }
+  }
+  if (tx_cloth_step(k->cloth, k->dt) == TX_CLOTH_FAULT) tx_warn(c, k->fault);
+  publish(c, k);
+}
+
+static void finish(tx_ctx* c, void* self) {
+  skin* k = self;
+  tx_set_result(c, k->torn_result, tx_cloth_torn(k->cloth));
+  tx_set_result(c, k->fault_result, tx_cloth_faults(k->cloth));
+}
+
+static void fini(void* self) {
+  skin* k = self;
+  if (!k) return;
+  tx_cloth_destroy(k->cloth);
+  free(k);
+}
+
+const tx_controller_class tx_physics_skin = {
+    .type = "physics.skin",
+    .summary = "suturing skin on a Bullet soft body: rupture, HIP contact; writes skin.x, skin.tri, skin.thickness, skin.torn",
+    .configure = configure,
+    .init = init,
+    .step = step,
+    .finish = finish,
+    .fini = fini,
+};

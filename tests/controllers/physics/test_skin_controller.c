@@ -1,0 +1,142 @@
+// physics.skin through the loader, in lockstep beside the haptics
+// controller's scripted pierce-down: what it publishes, the HIP following
+// device0.pose through the skin, parameter checks, and the warning a fault
+// leaves.
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include "scenarios/loader.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+static tx_scenario* load(const char* skin_params, double rate, char* err, size_t en) {
+  char text[2048];
+  snprintf(text, sizeof text,
+           "{\"name\":\"t\",\"controllers\":["
+           "{\"name\":\"skin\",\"type\":\"physics.skin\",\"rate_hz\":%g,\"params\":{%s}},"
+           "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:pierce-down\"}}]}",
+           rate, skin_params);
+  return tx_scenario_load_text("test", text, strlen(text), NULL, err, en);
+}
+
+static void run(tx_scenario* s, double seconds) {
+  tx_run_options o = {.duration_s = seconds, .lockstep = true};
+  tx_run_result r;
+  char err[256];
+  assert_int_equal(tx_system_run(s->system, &o, &r, err, sizeof err), 0);
+}
+
+static tx_snapshot latest(tx_scenario* s, const char* name) {
+  tx_model* m = tx_system_model(s->system);
+  tx_comp c = tx_model_find(m, name);
+  assert_true(c.id != 0);
+  return tx_model_latest(m, c);
+}
+
+static uint64_t warnings(tx_scenario* s, const char* key) {
+  for (int w = 0; w < tx_system_warnings(s->system); w++)
+    if (strcmp(tx_system_warning_key(s->system, w), key) == 0) return tx_system_warning_count(s->system, w);
+  fail_msg("no warning %s", key);
+  return 0;
+}
+
+// the papers' two densities, published whole at 60 Hz
+static void publishes_the_skin(void** state) {
+  (void)state;
+  char err[512];
+  tx_scenario* s = load("", 60, err, sizeof err);
+  if (!s) fail_msg("%s", err);
+  run(s, 0.5);
+  tx_snapshot x = latest(s, "skin.x"), tri = latest(s, "skin.tri"), h = latest(s, "skin.thickness"),
+              torn = latest(s, "skin.torn");
+  assert_int_equal(x.rows, 1764);
+  assert_int_equal(x.cols, 3);
+  assert_int_equal(tri.rows, 3362);
+  assert_int_equal(x.seq, 31); // the publish of init, then 30 steps
+  assert_int_equal(tri.seq, 31);
+  assert_float_equal(((const double*)h.data)[0], 0.004, 1e-12);
+  assert_int_equal(((const int*)torn.data)[0], 0);
+  // a corner particle at the edge of 10 cm plus one spacing
+  const float* p = x.data;
+  assert_float_equal(p[0], -0.05125, 1e-6);
+  assert_float_equal(p[3] - p[0], 0.0025, 1e-6);
+  tx_scenario_free(s);
+
+  s = load("\"spacing_m\":0.001", 60, err, sizeof err);
+  if (!s) fail_msg("%s", err);
+  run(s, 1.0 / 60);
+  assert_int_equal(latest(s, "skin.x").rows, 10404);
+  assert_int_equal(latest(s, "skin.tri").rows, 2 * 101 * 101);
+  tx_scenario_free(s);
+}
+
+// pierce-down moves the HIP from 1 cm above to 1 cm below at 5 mm/s: the
+// skin goes down under it, tears, and the HIP ends below a hole
+static void hip_follows_the_device_and_pierces(void** state) {
+  (void)state;
+  char err[512];
+  tx_scenario* s = load("\"hip_radius_m\":0.0005", 60, err, sizeof err);
+  if (!s) fail_msg("%s", err);
+  run(s, 2.6); // the HIP at 0.5 mm, the skin's surface 2.5 mm below it
+  const float* x = latest(s, "skin.x").data;
+  float low = 1;
+  for (int i = 0; i < 1764; i++) low = x[3 * i + 1] < low ? x[3 * i + 1] : low;
+  print_message("  HIP at %.2f mm: skin lowest at %.2f mm\n", ((const double*)latest(s, "device0.pose").data)[1] * 1e3,
+                low * 1e3);
+  assert_true(low < -0.001);
+  assert_int_equal(((const int*)latest(s, "skin.torn").data)[0], 0);
+  tx_scenario_free(s);
+  s = load("\"hip_radius_m\":0.0005", 60, err, sizeof err); // a run starts the script again
+  run(s, 5.0); // on to -1 cm: through
+  int torn = ((const int*)latest(s, "skin.torn").data)[0];
+  tx_snapshot tri = latest(s, "skin.tri");
+  print_message("  at the end: %d links torn, %u triangles left\n", torn, tri.rows);
+  assert_true(torn > 0);
+  assert_true(tri.rows < 3362);
+  assert_int_equal(warnings(s, "skin.numerical_fault"), 0);
+  // every published coordinate is finite and every live triangle indexes a particle
+  x = latest(s, "skin.x").data;
+  for (int i = 0; i < 1764 * 3; i++) assert_true(isfinite(x[i]));
+  const int* t = tri.data;
+  for (uint32_t i = 0; i < tri.rows * 3; i++) assert_true(t[i] >= 0 && t[i] < 1764);
+  tx_scenario_free(s);
+}
+
+// parameters out of range name themselves; rates outside 20-120 Hz are refused
+static void bad_parameters_are_named(void** state) {
+  (void)state;
+  char err[512];
+  struct {
+    const char* params;
+    double rate;
+    const char* expect;
+  } cases[] = {
+      {"\"spacing_m\":0.003", 60, "params.spacing_m"},
+      {"\"thickness_m\":-0.001", 60, "params.thickness_m"},
+      {"\"iterations\":0", 60, "params.iterations"},
+      {"\"gravity\":3", 60, "params.gravity"},
+      {"\"rupture_strain\":\"x\"", 60, "params.rupture_strain"},
+      {"\"stiffnes\":1", 60, "params.stiffnes"},
+      {"", 10, "20 to 120 Hz"},
+      {"", 240, "20 to 120 Hz"},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    tx_scenario* s = load(cases[i].params, cases[i].rate, err, sizeof err);
+    if (s) fail_msg("case %zu loaded", i);
+    if (!strstr(err, cases[i].expect)) fail_msg("case %zu: '%s' does not name %s", i, err, cases[i].expect);
+    assert_null(strchr(err, '\n'));
+  }
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(publishes_the_skin),
+      cmocka_unit_test(hip_follows_the_device_and_pierces),
+      cmocka_unit_test(bad_parameters_are_named),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

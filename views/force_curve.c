@@ -1,0 +1,137 @@
+// view.force_curve: records a tool's force and position at its rate into
+// memory taken at configure, and writes a CSV and a force-displacement PNG
+// once the run is over.
+#include "force_curve.h"
+
+#include "plot.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { COLS = 11 }; // t, x y z, fx fy fz, contacts, pierced, torn, skin_t
+
+typedef struct curve {
+  tx_port pose, force, state, torn; // reads; state and torn may be invalid (id 0)
+  int axis;                         // 0, 1, 2: x, y, z
+  char file[64];                    // base name of the CSV and PNG
+  bool png;                         // draw the PNG too
+  double* rows;                     // (cap x COLS) the samples
+  uint64_t cap, n;                  // capacity and samples taken
+  tx_warning w_full;                // the recording filled up
+  tx_result r_samples;
+} curve;
+
+static int configure(tx_setup* s, void** self) {
+  curve* c = calloc(1, sizeof *c);
+  if (!c) return -1;
+  *self = c;
+  const char* pose = tx_param_str(s, "pose", "device0.pose");
+  const char* force = tx_param_str(s, "force", "device0.force");
+  const char* state = tx_param_str(s, "state", "hip0.state");
+  const char* torn = tx_param_str(s, "torn", "skin.torn");
+  const char* axis = tx_param_str(s, "axis", "y");
+  const char* file = tx_param_str(s, "file", "force_displacement");
+  c->cap = (uint64_t)tx_param_int(s, "max_samples", 600000, 1, 10000000);
+  c->png = tx_param_bool(s, "png", true);
+  if (!pose || !force || !state || !torn || !axis || !file) return -1;
+  if (strlen(axis) != 1 || axis[0] < 'x' || axis[0] > 'z') return tx_setup_fail(s, "axis", "expected x, y or z, got \"%s\"", axis);
+  c->axis = axis[0] - 'x';
+  size_t len = strlen(file);
+  if (len == 0 || len >= sizeof c->file || strspn(file, "abcdefghijklmnopqrstuvwxyz0123456789_-") != len)
+    return tx_setup_fail(s, "file", "expected a base name of letters, digits, _ and - (at most 63), got \"%s\"", file);
+  memcpy(c->file, file, len + 1);
+  c->rows = malloc(sizeof(double) * COLS * c->cap);
+  if (!c->rows) return tx_setup_fail(s, "max_samples", "%llu samples do not fit in memory", (unsigned long long)c->cap);
+  c->pose = tx_setup_read_as(s, pose, TX_F64, 7);
+  c->force = tx_setup_read_as(s, force, TX_F64, 3);
+  if (*state) c->state = tx_setup_read_as(s, state, TX_F64, 8);
+  if (*torn) c->torn = tx_setup_read_as(s, torn, TX_I32, 1);
+  c->w_full = tx_setup_warning(s, "recording_full");
+  c->r_samples = tx_setup_result(s, "samples");
+  return 0;
+}
+
+static void step(tx_ctx* ctx, void* self) {
+  curve* c = self;
+  if (c->n == c->cap) {
+    tx_warn(ctx, c->w_full);
+    return;
+  }
+  double* r = c->rows + COLS * c->n++;
+  const double* p = tx_read(ctx, c->pose).data;
+  const double* f = tx_read(ctx, c->force).data;
+  r[0] = tx_sim_ns(ctx) * 1e-9;
+  memcpy(r + 1, p, 3 * sizeof *r);
+  memcpy(r + 4, f, 3 * sizeof *r);
+  r[7] = r[8] = r[9] = r[10] = 0;
+  if (c->state.id) {
+    const double* st = tx_read(ctx, c->state).data;
+    r[7] = st[0], r[8] = st[1], r[10] = st[7];
+  }
+  if (c->torn.id) r[9] = ((const int32_t*)tx_read(ctx, c->torn).data)[0];
+}
+
+static void finish(tx_ctx* ctx, void* self) {
+  curve* c = self;
+  tx_set_result(ctx, c->r_samples, (double)c->n);
+  const char* dir = tx_record_dir(ctx);
+  if (!dir || c->n == 0) return;
+  char path[4200], tmp[4300], err[512];
+  snprintf(path, sizeof path, "%s/%s.csv", dir, c->file);
+  snprintf(tmp, sizeof tmp, "%s.tmp", path);
+  FILE* f = fopen(tmp, "w"); // written aside, renamed once whole
+  if (!f) {
+    fprintf(stderr, "tactus: %s: cannot be written\n", path);
+    return;
+  }
+  fprintf(f, "t_s,x_m,y_m,z_m,fx_n,fy_n,fz_n,contacts,pierced,torn,skin_t_s\n");
+  for (uint64_t i = 0; i < c->n; i++) {
+    const double* r = c->rows + COLS * i;
+    fprintf(f, "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.0f,%.0f,%.0f,%.6f\n", r[0], r[1], r[2], r[3], r[4], r[5], r[6],
+            r[7], r[8], r[9], r[10]);
+  }
+  if (fclose(f) != 0 || rename(tmp, path) != 0) {
+    remove(tmp);
+    fprintf(stderr, "tactus: %s: cannot be written\n", path);
+    return;
+  }
+  if (!c->png) return;
+  // the papers' plot: force along the axis (N) against the position along it (cm)
+  double* xs = malloc(sizeof(double) * c->n);
+  double* ys = malloc(sizeof(double) * c->n);
+  if (!xs || !ys) {
+    free(xs), free(ys);
+    return;
+  }
+  for (uint64_t i = 0; i < c->n; i++) {
+    xs[i] = 100.0 * c->rows[COLS * i + 1 + c->axis];
+    ys[i] = c->rows[COLS * i + 4 + c->axis];
+  }
+  char xl[64], yl[64];
+  snprintf(xl, sizeof xl, "HIP %c (cm)", 'x' + c->axis);
+  snprintf(yl, sizeof yl, "force F%c on the device (N)", 'x' + c->axis);
+  tx_plot_series s = {"force", xs, ys, (int)(c->n > 2147483647u ? 2147483647u : c->n), false, 1};
+  tx_plot p = {"force against displacement", xl, yl, false, false, &s, 1};
+  snprintf(path, sizeof path, "%s/%s.png", dir, c->file);
+  if (tx_plot_png(path, &p, err, sizeof err)) fprintf(stderr, "tactus: %s\n", err);
+  free(xs);
+  free(ys);
+}
+
+static void fini(void* self) {
+  curve* c = self;
+  if (!c) return;
+  free(c->rows);
+  free(c);
+}
+
+const tx_controller_class tx_view_force_curve = {
+    .type = "view.force_curve",
+    .summary = "records a tool's force against its position; writes NAME.csv and a force-displacement NAME.png",
+    .configure = configure,
+    .step = step,
+    .finish = finish,
+    .fini = fini,
+};
