@@ -650,18 +650,17 @@ static void common_uniforms(tx_renderer* r, GLuint prog, const tx_view_def* d, c
 }
 
 void tx_renderer_draw(tx_renderer* r, const tx_view_def* d, const tx_camera* c, tx_eye eye, int x, int y, int w, int h,
-                      bool clear_colour) {
+                      unsigned clear) {
   tx_gl* gl = &r->gl;
   float view[16], proj[16];
   tx_camera_matrices(c, eye, (double)w / (double)h, view, proj);
   double e[3];
   tx_camera_eye_position(c, eye, e);
   gl->Viewport(x, y, w, h);
-  gl->Enable(GL_SCISSOR_TEST);
-  gl->Scissor(x, y, w, h);
-  gl->ClearColor(d->background[0], d->background[1], d->background[2], 1);
-  gl->Clear(GL_DEPTH_BUFFER_BIT | (clear_colour ? GL_COLOR_BUFFER_BIT : 0));
-  gl->Disable(GL_SCISSOR_TEST);
+  if (clear) {
+    gl->ClearColor(d->background[0], d->background[1], d->background[2], 1);
+    gl->Clear(clear);
+  }
   gl->Enable(GL_DEPTH_TEST);
 
   common_uniforms(r, r->mesh_prog, d, view, proj, e);
