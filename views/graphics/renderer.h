@@ -1,6 +1,7 @@
 // Internal: draws a view's items with GL 3.3 core (on OSMesa or in a GLFW
-// window): triangle meshes with a procedural skin texture, instanced spheres
-// and cylinders, tools, planes; per-pixel Blinn-Phong lighting from one
+// window): triangle meshes with a procedural skin texture, ray-cast sphere
+// impostors (exact silhouette, depth and normal per pixel), instanced
+// cylinders, tools, planes; per-pixel Blinn-Phong lighting from one
 // directional light, two-sided. Needs a current context; one renderer per context.
 //
 //     tx_renderer* r = tx_renderer_create(loader, err, sizeof err);
