@@ -12,46 +12,68 @@
 #include <string.h>
 
 #if TX_WITH_OSMESA
-#define SIDE 102     // 102 x 102 = 10404 particles, as the journal paper's densest skin
-#define SPACING 0.001 // m between particles: a 10.1 cm square (0.1 units of 1 cm)
+#define SIDE_MAX 102 // 102 x 102 = 10404 particles, as the journal paper's densest skin
 
-// bench.skin: a cloth-sized mesh that ripples at its rate, and one sphere (the HIP's size of voxel)
+// bench.skin: a cloth-sized mesh of side x side particles spacing_m apart that
+// ripples at its rate, and a block of voxels (one sphere the HIP's size when voxels = 1)
 typedef struct skin {
   tx_port x, tri, ball;
+  int side;       // particles along an edge
+  double spacing; // m between particles
+  int voxels;     // spheres in ball.spheres
 } skin;
 
 static int skin_configure(tx_setup* s, void** self) {
   skin* k = calloc(1, sizeof *k);
   if (!k) return -1;
   *self = k;
-  k->x = tx_setup_write(s, &(tx_component_def){"skin.x", TX_F32, SIDE * SIDE, 3, "m"});
-  k->tri = tx_setup_write(s, &(tx_component_def){"skin.tri", TX_I32, 2 * (SIDE - 1) * (SIDE - 1), 3, "1"});
-  k->ball = tx_setup_write(s, &(tx_component_def){"ball.spheres", TX_F32, 1, 4, "m"});
+  k->side = (int)tx_param_int(s, "side", 42, 2, SIDE_MAX);
+  k->spacing = tx_param_num(s, "spacing_m", 0.0025, 1e-4, 0.1);
+  k->voxels = (int)tx_param_int(s, "voxels", 1, 1, 100000);
+  const uint32_t n = (uint32_t)(k->side * k->side), m = (uint32_t)(2 * (k->side - 1) * (k->side - 1));
+  k->x = tx_setup_write(s, &(tx_component_def){"skin.x", TX_F32, n, 3, "m"});
+  k->tri = tx_setup_write(s, &(tx_component_def){"skin.tri", TX_I32, m, 3, "1"});
+  k->ball = tx_setup_write(s, &(tx_component_def){"ball.spheres", TX_F32, (uint32_t)k->voxels, 4, "m"});
   return 0;
 }
 
 static void skin_step(tx_ctx* c, void* self) {
   skin* k = self;
-  double t = (double)tx_sim_ns(c) * 1e-9, half = 0.5 * SPACING * (SIDE - 1);
+  const int side = k->side;
+  const double sp = k->spacing;
+  double t = (double)tx_sim_ns(c) * 1e-9, half = 0.5 * sp * (side - 1);
   float* x = tx_write(c, k->x);
-  for (int j = 0; j < SIDE; j++)
-    for (int i = 0; i < SIDE; i++) {
-      float* p = x + 3 * (j * SIDE + i);
-      p[0] = (float)(i * SPACING - half);
-      p[2] = (float)(j * SPACING - half);
+  for (int j = 0; j < side; j++)
+    for (int i = 0; i < side; i++) {
+      float* p = x + 3 * (j * side + i);
+      p[0] = (float)(i * sp - half);
+      p[2] = (float)(j * sp - half);
       p[1] = (float)(0.004 * sin(60 * p[0] + 3 * t) * cos(45 * p[2] - 2 * t));
     }
   if (tx_step_index(c) == 0) { // the triangles never change
     int32_t* tri = tx_write(c, k->tri);
-    for (int j = 0, m = 0; j < SIDE - 1; j++)
-      for (int i = 0; i < SIDE - 1; i++, m += 6) {
-        int32_t a = j * SIDE + i, b = a + 1, d = a + SIDE, e = d + 1;
+    for (int j = 0, m = 0; j < side - 1; j++)
+      for (int i = 0; i < side - 1; i++, m += 6) {
+        int32_t a = j * side + i, b = a + 1, d = a + side, e = d + 1;
         int32_t q[6] = {a, d, b, b, d, e};
         memcpy(tri + m, q, sizeof q);
       }
   }
   float* ball = tx_write(c, k->ball);
-  ball[0] = (float)(0.03 * cos(t)), ball[1] = 0.012f, ball[2] = (float)(0.03 * sin(t)), ball[3] = 0.005f;
+  if (k->voxels == 1) {
+    ball[0] = (float)(0.03 * cos(t)), ball[1] = 0.012f, ball[2] = (float)(0.03 * sin(t)), ball[3] = 0.005f;
+    return;
+  }
+  // a cube of voxels 1 mm apart (radius 0.55 mm, touching as packed tissue), sitting on the skin
+  int edge = (int)ceil(cbrt((double)k->voxels));
+  for (int i = 0; i < k->voxels; i++) {
+    int a = i % edge, b = (i / edge) % edge, d = i / (edge * edge);
+    float* q = ball + 4 * i;
+    q[0] = (float)(0.001 * (a - 0.5 * (edge - 1)));
+    q[1] = (float)(0.006 + 0.001 * b + 0.0002 * sin(4 * t + a));
+    q[2] = (float)(0.001 * (d - 0.5 * (edge - 1)));
+    q[3] = 0.00055f;
+  }
 }
 
 static void skin_fini(void* self) { free(self); }
@@ -66,6 +88,9 @@ typedef struct render_case {
   const char* name;
   const char* stereo;
   int eyes;
+  int side;       // skin particles along an edge
+  double spacing; // m
+  int voxels;     // spheres drawn beside the skin
   double frames, dropped, p50, p99, cpu50, threads;
   tx_controller_stats haptics, view;
   double seconds;
@@ -83,13 +108,15 @@ static int run_case(render_case* rc, const char* dir, double seconds) {
   char text[2048], err[1024];
   snprintf(text, sizeof text,
            "{\"name\":\"bench-render\",\"controllers\":["
-           "{\"name\":\"skin\",\"type\":\"bench.skin\",\"rate_hz\":60},"
+           "{\"name\":\"skin\",\"type\":\"bench.skin\",\"rate_hz\":60,"
+           "\"params\":{\"side\":%d,\"spacing_m\":%.17g,\"voxels\":%d}},"
            "{\"name\":\"wall\",\"type\":\"collision.wall\",\"rate_hz\":60},"
            "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,"
            "\"params\":{\"device\":\"scripted:pierce-down\",\"force_model\":\"tool0.force_model\",\"record\":false}}],"
            "\"view\":{\"rate_hz\":30,\"width\":640,\"height\":480,\"frame_every\":1000000,"
-           "\"camera\":{\"eye\":[0,0.07,0.11],\"target\":[0,0,0]},"
-           "\"draw\":[{\"mesh\":\"skin\"},{\"spheres\":\"ball\"},{\"tool\":\"device0\",\"show_force\":true}]}}");
+           "\"camera\":{\"eye\":[0,0.09,0.15],\"target\":[0,-0.012,0]},"
+           "\"draw\":[{\"mesh\":\"skin\"},{\"spheres\":\"ball\"},{\"tool\":\"device0\",\"show_force\":true}]}}",
+           rc->side, rc->spacing, rc->voxels);
   tx_load_options lo = {.view = "png", .stereo = rc->stereo};
   tx_scenario* sc = tx_scenario_load_text("bench-render", text, strlen(text), &lo, err, sizeof err);
   if (!sc) return fprintf(stderr, "tactus: %s\n", err), 1;
@@ -127,22 +154,33 @@ int tx_bench_render(const char* out, double duration_s) {
   if (!tx_find_controller(skin_class.type)) tx_register_controller(&skin_class);
   char dir[4096], err[1024];
   if (tx_out_dir(out, "bench-render", dir, sizeof dir, err, sizeof err)) return tx_bad_input("%s", err);
-  render_case cases[] = {{.name = "mono", .stereo = "mono", .eyes = 1}, {.name = "sbs", .stereo = "sbs", .eyes = 2}};
-  printf("bench render: a %d-vertex, %d-triangle mesh, a sphere and a tool, OSMesa (llvmpipe), "
-         "view at 30 Hz beside haptics at 1 kHz, %g s per case, real time\n\n",
-         SIDE * SIDE, 2 * (SIDE - 1) * (SIDE - 1), seconds);
-  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
+  // the camera is the suturing-skin scenario's (the whole patch in view: the
+  // cost is mostly per pixel, so a close-up costs more); its default skin (0.25 cm spacing: 42 x 42), the
+  // journal paper's densest (0.1 cm: 102 x 102), and blocks of voxels
+  render_case cases[] = {
+      {.name = "mono", .stereo = "mono", .eyes = 1, .side = 42, .spacing = 0.0025, .voxels = 1},
+      {.name = "sbs", .stereo = "sbs", .eyes = 2, .side = 42, .spacing = 0.0025, .voxels = 1},
+      {.name = "sbs-10404", .stereo = "sbs", .eyes = 2, .side = 102, .spacing = 0.001, .voxels = 1},
+      {.name = "voxels-1000", .stereo = "mono", .eyes = 1, .side = 42, .spacing = 0.0025, .voxels = 1000},
+      {.name = "voxels-20000", .stereo = "mono", .eyes = 1, .side = 42, .spacing = 0.0025, .voxels = 20000}};
+  const size_t ncases = sizeof cases / sizeof cases[0];
+  printf("bench render: the suturing skin's mesh (42 x 42 particles, 3362 triangles; and 102 x 102, 20402\n"
+         "triangles), a sphere or a block of voxels (ray-cast spheres) and a tool, OSMesa (llvmpipe), view at 30 Hz\n"
+         "beside haptics at 1 kHz, %g s per case, real time\n\n",
+         seconds);
+  for (size_t i = 0; i < ncases; i++)
     if (run_case(&cases[i], dir, seconds)) return 1;
-  printf("  %-26s %8s %9s %9s %9s %9s %8s %10s %14s\n", "case", "frames", "frame p50", "frame p99", "cpu p50", "eye Hz",
+  printf("  %-37s %8s %9s %9s %9s %9s %8s %10s %14s\n", "case", "frames", "frame p50", "frame p99", "cpu p50", "eye Hz",
          "dropped", "capacity", "haptics missed");
-  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+  for (size_t i = 0; i < ncases; i++) {
     const render_case* c = &cases[i];
     double hz = c->frames / c->seconds, cap = 1000.0 / c->p50;
     double missed = 100.0 * (double)c->haptics.missed / (double)(c->haptics.steps + c->haptics.missed);
     char name[64], hm[32];
-    snprintf(name, sizeof name, "%s, %s", c->eyes == 1 ? "mono 640x480" : "stereo 2x640x480", c->name);
+    snprintf(name, sizeof name, "%s %d x %d, %d sphere%s", c->eyes == 1 ? "mono 640x480" : "stereo 2x640x480", c->side,
+             c->side, c->voxels, c->voxels == 1 ? "" : "s");
     snprintf(hm, sizeof hm, "%.3f%%", missed);
-    printf("  %-26s %8.0f %7.2fms %7.2fms %7.2fms %9.1f %8.0f %8.1fHz %14s\n", name, c->frames, c->p50, c->p99, c->cpu50,
+    printf("  %-37s %8.0f %7.2fms %7.2fms %7.2fms %9.1f %8.0f %8.1fHz %14s\n", name, c->frames, c->p50, c->p99, c->cpu50,
            hz, c->dropped, cap, hm);
   }
   printf("  (frame: upload, every eye drawn, glFinish, wall time; cpu: the rendering thread's CPU time for it, which\n"
@@ -164,7 +202,7 @@ int tx_bench_render(const char* out, double duration_s) {
   snprintf(measured, sizeof measured, "%.3f%% (%llu of %llu)", missed, (unsigned long long)st->haptics.missed,
            (unsigned long long)(st->haptics.steps + st->haptics.missed));
   print_bench_target("haptics 1 kHz beside stereo rendering, missed", measured, "<= 0.1%", missed <= 0.1);
-  printf("frames: %s/{mono,sbs}/frames/\n", dir);
+  printf("frames: %s/{mono,sbs,sbs-10404,voxels-1000,voxels-20000}/frames/\n", dir);
   return 0;
 }
 #else

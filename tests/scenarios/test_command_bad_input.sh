@@ -178,6 +178,8 @@ expect_bad "view: eye on the target" "view.camera" "differ" -- run "$S/view_came
 view_scenario view_size.json '{"width": 100000}'
 expect_bad "view: too wide" "view.width" -- run "$S/view_size.json" --lockstep --view png
 view_scenario view_rate.json '{"rate_hz": "fast"}'
+view_scenario view_cut.json '{"draw": [{"tool": "device0", "cut": {"normal": [0, 0, 1]}}]}'
+expect_bad "view: a cut on a tool" "view.draw[0].cut" "only spheres" -- run "$S/view_cut.json" --lockstep
 expect_bad "view: rate not a number" "view.rate_hz" -- run "$S/view_rate.json" --lockstep --view png
 view_scenario view_missing.json '{"draw": [{"mesh": "skin"}]}'
 expect_bad "view: draws what nobody writes" "$S/view_missing.json: view.draw" "skin.x" -- run "$S/view_missing.json" --lockstep --view png

@@ -6,8 +6,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define SPHERE_SLICES 32
-#define SPHERE_STACKS 20
 #define CYL_SIDES 16
 #define SKIN_TEX 512
 
@@ -26,10 +24,10 @@ typedef struct mesh_slot {
 struct tx_renderer {
   tx_gl gl;
   GLuint mesh_prog, sphere_prog, cyl_prog;
-  GLuint sphere_vao, sphere_vbo, sphere_ebo, sphere_inst;
+  GLuint sphere_vao, sphere_vbo, sphere_inst;
   GLuint cyl_vao, cyl_vbo, cyl_inst;
   GLuint skin_tex;
-  int sphere_nidx, cyl_nverts;
+  int cyl_nverts;
   mesh_slot meshes[TX_DRAW_MAX + TX_DRAW_MAX];
   int nmeshes;
   float* spheres; // (n x 7) centre m, radius m, colour
@@ -44,21 +42,69 @@ struct tx_renderer {
 // per-pixel Blinn-Phong with the viewer at infinity (as fixed-function GL's
 // default): the half vector is one per eye, and the highlight's power is five
 // squarings, which llvmpipe runs far faster than pow()
+#define SHADE_GLSL \
+  "uniform vec3 u_light; uniform vec3 u_view_dir; uniform vec3 u_half; uniform vec4 u_lighting;\n" \
+  "vec3 shade(vec3 n, vec3 base) {\n" \
+  "  float diff = max(dot(n, -u_light), 0.0);\n" \
+  "  float s = max(dot(n, u_half), 0.0);\n" \
+  "  s *= s; s *= s; s *= s; s *= s; s *= s;\n" \
+  "  float spec = diff > 0.0 ? s : 0.0;\n" \
+  "  return base * (u_lighting.x + u_lighting.y * diff) + vec3(u_lighting.z * spec);\n" \
+  "}\n"
+
 static const char* const fs_src =
     "#version 330 core\n"
     "in vec3 v_normal; flat in vec3 v_colour; in vec2 v_uv;\n"
-    "uniform vec3 u_light; uniform vec3 u_view_dir; uniform vec3 u_half; uniform int u_textured;\n"
-    "uniform sampler2D u_tex; uniform vec4 u_lighting;\n"
+    "uniform int u_textured; uniform sampler2D u_tex;\n"
+    SHADE_GLSL
     "out vec4 frag;\n"
     "void main() {\n"
     "  vec3 n = normalize(v_normal);\n"
     "  if (dot(n, u_view_dir) < 0.0) n = -n;\n" // two-sided: a cloth is seen from both sides
     "  vec3 base = u_textured != 0 ? texture(u_tex, v_uv).rgb : v_colour;\n"
-    "  float diff = max(dot(n, -u_light), 0.0);\n"
-    "  float s = max(dot(n, u_half), 0.0);\n"
-    "  s *= s; s *= s; s *= s; s *= s; s *= s;\n"
-    "  float spec = diff > 0.0 ? s : 0.0;\n"
-    "  frag = vec4(base * (u_lighting.x + u_lighting.y * diff) + vec3(u_lighting.z * spec), 1.0);\n"
+    "  frag = vec4(shade(n, base), 1.0);\n"
+    "}\n";
+
+// spheres are ray-cast impostors: one quad per sphere, facing the eye and just
+// covering the cone of rays that touch it; each pixel intersects its ray with
+// the sphere exactly, so the silhouette, normal and depth are exact at any size
+// and a sphere costs four vertices instead of a tessellation
+static const char* const sphere_vs =
+    "#version 330 core\n"
+    "layout(location = 0) in vec2 a_corner; layout(location = 1) in vec4 a_sphere; layout(location = 2) in vec3 a_colour;\n"
+    "uniform mat4 u_proj; uniform mat4 u_view;\n"
+    "out vec3 v_ray; flat out vec4 v_sphere; flat out vec3 v_colour;\n"
+    "void main() {\n"
+    "  vec3 c = (u_view * vec4(a_sphere.xyz, 1.0)).xyz; float r = a_sphere.w;\n" // view space: the eye at the origin
+    "  float d2 = dot(c, c);\n"
+    "  v_sphere = vec4(c, r); v_colour = a_colour;\n"
+    "  if (d2 <= r * r * 1.0001) { gl_Position = vec4(2.0, 2.0, 2.0, 1.0); v_ray = vec3(0.0); return; }\n" // the eye inside: nothing
+    "  vec3 w = c / sqrt(d2);\n"
+    "  vec3 t = abs(w.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);\n"
+    "  vec3 u = normalize(cross(t, w)); vec3 v = cross(w, u);\n"
+    "  float h = r * sqrt(d2 / (d2 - r * r));\n" // the tangent cone's radius in the plane through the centre
+    "  vec3 p = c + h * (a_corner.x * u + a_corner.y * v);\n"
+    "  v_ray = p;\n"
+    "  gl_Position = u_proj * vec4(p, 1.0);\n"
+    "}\n";
+
+static const char* const sphere_fs =
+    "#version 330 core\n"
+    "in vec3 v_ray; flat in vec4 v_sphere; flat in vec3 v_colour;\n"
+    "uniform mat4 u_proj; uniform mat4 u_view;\n"
+    SHADE_GLSL
+    "out vec4 frag;\n"
+    "void main() {\n"
+    "  vec3 dir = normalize(v_ray); vec3 c = v_sphere.xyz; float r = v_sphere.w;\n"
+    "  float b = dot(dir, c); float disc = b * b - dot(c, c) + r * r;\n"
+    "  if (disc < 0.0) discard;\n"
+    "  vec3 p = (b - sqrt(disc)) * dir;\n" // the nearer hit
+    "  vec4 clip = u_proj * vec4(p, 1.0);\n"
+    "  float z = clip.z / clip.w;\n"
+    "  if (z < -1.0) discard;\n" // before the near plane
+    "  gl_FragDepth = 0.5 * z + 0.5;\n"
+    "  vec3 n = ((p - c) / r) * mat3(u_view);\n" // back to world space: the view's rotation transposed
+    "  frag = vec4(shade(n, v_colour), 1.0);\n"
     "}\n";
 
 static const char* const mesh_vs =
@@ -69,17 +115,6 @@ static const char* const mesh_vs =
     "void main() {\n"
     "  v_normal = a_normal; v_colour = u_colour; v_uv = a_uv;\n"
     "  gl_Position = u_proj * u_view * vec4(a_pos, 1.0);\n"
-    "}\n";
-
-static const char* const sphere_vs =
-    "#version 330 core\n"
-    "layout(location = 0) in vec3 a_pos; layout(location = 1) in vec4 a_sphere; layout(location = 2) in vec3 a_colour;\n"
-    "uniform mat4 u_proj; uniform mat4 u_view;\n"
-    "out vec3 v_normal; flat out vec3 v_colour; out vec2 v_uv;\n"
-    "void main() {\n"
-    "  vec3 p = a_sphere.xyz + a_sphere.w * a_pos;\n"
-    "  v_normal = a_pos; v_colour = a_colour; v_uv = vec2(0.0);\n"
-    "  gl_Position = u_proj * u_view * vec4(p, 1.0);\n"
     "}\n";
 
 static const char* const cyl_vs =
@@ -117,8 +152,8 @@ static GLuint compile(tx_gl* gl, GLenum kind, const char* src, char* err, size_t
   return s;
 }
 
-static GLuint program(tx_gl* gl, const char* vs, char* err, size_t n) {
-  GLuint v = compile(gl, GL_VERTEX_SHADER, vs, err, n), f = v ? compile(gl, GL_FRAGMENT_SHADER, fs_src, err, n) : 0;
+static GLuint program(tx_gl* gl, const char* vs, const char* fs, char* err, size_t n) {
+  GLuint v = compile(gl, GL_VERTEX_SHADER, vs, err, n), f = v ? compile(gl, GL_FRAGMENT_SHADER, fs, err, n) : 0;
   if (!v || !f) return 0;
   GLuint p = gl->CreateProgram();
   gl->AttachShader(p, v);
@@ -191,36 +226,14 @@ void tx_skin_texture(uint8_t* rgb, int size) {
 
 static void make_sphere(tx_renderer* r) {
   tx_gl* gl = &r->gl;
-  float v[(SPHERE_SLICES + 1) * (SPHERE_STACKS + 1) * 3];
-  uint32_t idx[SPHERE_SLICES * SPHERE_STACKS * 6];
-  int nv = 0, ni = 0;
-  for (int j = 0; j <= SPHERE_STACKS; j++) {
-    double th = M_PI * j / SPHERE_STACKS;
-    for (int i = 0; i <= SPHERE_SLICES; i++) {
-      double ph = 2 * M_PI * i / SPHERE_SLICES;
-      v[nv++] = (float)(sin(th) * cos(ph));
-      v[nv++] = (float)cos(th);
-      v[nv++] = (float)(sin(th) * sin(ph));
-    }
-  }
-  for (int j = 0; j < SPHERE_STACKS; j++)
-    for (int i = 0; i < SPHERE_SLICES; i++) {
-      uint32_t a = (uint32_t)(j * (SPHERE_SLICES + 1) + i), b = a + SPHERE_SLICES + 1;
-      uint32_t q[6] = {a, b, a + 1, a + 1, b, b + 1};
-      memcpy(idx + ni, q, sizeof q);
-      ni += 6;
-    }
-  r->sphere_nidx = ni;
+  const float corners[8] = {-1, -1, 1, -1, -1, 1, 1, 1}; // a triangle strip
   gl->GenVertexArrays(1, &r->sphere_vao);
   gl->BindVertexArray(r->sphere_vao);
   gl->GenBuffers(1, &r->sphere_vbo);
   gl->BindBuffer(GL_ARRAY_BUFFER, r->sphere_vbo);
-  gl->BufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nv * sizeof(float)), v, GL_STATIC_DRAW);
+  gl->BufferData(GL_ARRAY_BUFFER, sizeof corners, corners, GL_STATIC_DRAW);
   gl->EnableVertexAttribArray(0);
-  gl->VertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), 0);
-  gl->GenBuffers(1, &r->sphere_ebo);
-  gl->BindBuffer(GL_ELEMENT_ARRAY_BUFFER, r->sphere_ebo);
-  gl->BufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(ni * sizeof(uint32_t)), idx, GL_STATIC_DRAW);
+  gl->VertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float), 0);
   gl->GenBuffers(1, &r->sphere_inst);
   gl->BindBuffer(GL_ARRAY_BUFFER, r->sphere_inst);
   gl->EnableVertexAttribArray(1);
@@ -276,8 +289,8 @@ tx_renderer* tx_renderer_create(tx_gl_loader load, char* err, size_t n) {
     return NULL;
   }
   tx_gl* gl = &r->gl;
-  if (!(r->mesh_prog = program(gl, mesh_vs, err, n)) || !(r->sphere_prog = program(gl, sphere_vs, err, n)) ||
-      !(r->cyl_prog = program(gl, cyl_vs, err, n))) {
+  if (!(r->mesh_prog = program(gl, mesh_vs, fs_src, err, n)) || !(r->sphere_prog = program(gl, sphere_vs, sphere_fs, err, n)) ||
+      !(r->cyl_prog = program(gl, cyl_vs, fs_src, err, n))) {
     tx_renderer_destroy(r);
     return NULL;
   }
@@ -318,8 +331,8 @@ void tx_renderer_destroy(tx_renderer* r) {
     }
     if (r->sphere_vao) gl->DeleteVertexArrays(1, &r->sphere_vao);
     if (r->cyl_vao) gl->DeleteVertexArrays(1, &r->cyl_vao);
-    GLuint bufs[5] = {r->sphere_vbo, r->sphere_ebo, r->sphere_inst, r->cyl_vbo, r->cyl_inst};
-    for (int i = 0; i < 5; i++)
+    GLuint bufs[4] = {r->sphere_vbo, r->sphere_inst, r->cyl_vbo, r->cyl_inst};
+    for (int i = 0; i < 4; i++)
       if (bufs[i]) gl->DeleteBuffers(1, &bufs[i]);
     if (r->skin_tex) gl->DeleteTextures(1, &r->skin_tex);
     if (r->mesh_prog) gl->DeleteProgram(r->mesh_prog);
@@ -531,6 +544,11 @@ void tx_renderer_upload(tx_renderer* r, const tx_scene* s) {
           r->skipped++;
           continue;
         }
+        if (it->has_cut) { // cut away: not drawn, and not an error
+          const float* c = sp + 4 * i;
+          float side = (c[0] - it->cut[0]) * it->cut[3] + (c[1] - it->cut[1]) * it->cut[4] + (c[2] - it->cut[2]) * it->cut[5];
+          if (side > 0) continue;
+        }
         float colour[3];
         scalar_colour(it, scalar, nscalar, i, colour);
         add_sphere(r, sp + 4 * i, sp[4 * i + 3], colour);
@@ -632,18 +650,17 @@ static void common_uniforms(tx_renderer* r, GLuint prog, const tx_view_def* d, c
 }
 
 void tx_renderer_draw(tx_renderer* r, const tx_view_def* d, const tx_camera* c, tx_eye eye, int x, int y, int w, int h,
-                      bool clear_colour) {
+                      unsigned clear) {
   tx_gl* gl = &r->gl;
   float view[16], proj[16];
   tx_camera_matrices(c, eye, (double)w / (double)h, view, proj);
   double e[3];
   tx_camera_eye_position(c, eye, e);
   gl->Viewport(x, y, w, h);
-  gl->Enable(GL_SCISSOR_TEST);
-  gl->Scissor(x, y, w, h);
-  gl->ClearColor(d->background[0], d->background[1], d->background[2], 1);
-  gl->Clear(GL_DEPTH_BUFFER_BIT | (clear_colour ? GL_COLOR_BUFFER_BIT : 0));
-  gl->Disable(GL_SCISSOR_TEST);
+  if (clear) {
+    gl->ClearColor(d->background[0], d->background[1], d->background[2], 1);
+    gl->Clear(clear);
+  }
   gl->Enable(GL_DEPTH_TEST);
 
   common_uniforms(r, r->mesh_prog, d, view, proj, e);
@@ -662,7 +679,7 @@ void tx_renderer_draw(tx_renderer* r, const tx_view_def* d, const tx_camera* c, 
   if (r->nspheres) {
     common_uniforms(r, r->sphere_prog, d, view, proj, e);
     gl->BindVertexArray(r->sphere_vao);
-    gl->DrawElementsInstanced(GL_TRIANGLES, r->sphere_nidx, GL_UNSIGNED_INT, 0, (GLsizei)r->nspheres);
+    gl->DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, (GLsizei)r->nspheres);
   }
   if (r->ncyls) {
     common_uniforms(r, r->cyl_prog, d, view, proj, e);

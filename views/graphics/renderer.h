@@ -1,12 +1,13 @@
 // Internal: draws a view's items with GL 3.3 core (on OSMesa or in a GLFW
-// window): triangle meshes with a procedural skin texture, instanced spheres
-// and cylinders, tools, planes; per-pixel Blinn-Phong lighting from one
+// window): triangle meshes with a procedural skin texture, ray-cast sphere
+// impostors (exact silhouette, depth and normal per pixel), instanced
+// cylinders, tools, planes; per-pixel Blinn-Phong lighting from one
 // directional light, two-sided. Needs a current context; one renderer per context.
 //
 //     tx_renderer* r = tx_renderer_create(loader, err, sizeof err);
 //     tx_renderer_upload(r, &def, &scene);                  // once per frame
-//     tx_renderer_draw(r, &def, &def.camera, TX_EYE_LEFT, 0, 0, w, h);
-//     tx_renderer_draw(r, &def, &def.camera, TX_EYE_RIGHT, w, 0, w, h);
+//     tx_renderer_draw(r, &def, &def.camera, TX_EYE_LEFT, 0, 0, w, h, GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+//     tx_renderer_draw(r, &def, &def.camera, TX_EYE_RIGHT, w, 0, w, h, 0);  // the eyes tile the image
 #ifndef TX_VIEWS_GRAPHICS_RENDERER_H
 #define TX_VIEWS_GRAPHICS_RENDERER_H
 
@@ -44,9 +45,10 @@ const tx_gl* tx_renderer_gl(const tx_renderer* r);
 void tx_renderer_upload(tx_renderer* r, const tx_scene* s);
 // the box around what the last upload holds, m; false when it holds nothing
 bool tx_renderer_bounds(const tx_renderer* r, double lo[3], double hi[3]);
-// clear the viewport (colour too when clear_colour) and draw one eye into it
+// clear the whole image first (clear: GL_COLOR_BUFFER_BIT and/or
+// GL_DEPTH_BUFFER_BIT, or 0), then draw one eye into the viewport
 void tx_renderer_draw(tx_renderer* r, const tx_view_def* d, const tx_camera* c, tx_eye eye, int x, int y, int w, int h,
-                      bool clear_colour);
+                      unsigned clear);
 // rows skipped so far as not finite or out of range
 uint64_t tx_renderer_skipped(const tx_renderer* r);
 // scalar to colour along the map (blue, cyan, green, yellow, red) for t in [0, 1]

@@ -122,7 +122,7 @@ static int read_camera(const where* w, const json_t* cam, tx_view_def* d) {
 
 static int read_item(const where* w, size_t i, const json_t* e, tx_draw_item* it) {
   static const char* const keys[] = {"mesh", "spheres", "segments", "tool", "plane", "colour", "colour_by",
-                                     "range", "texture", "radius_m", "show_force", "force_scale_m_per_n", NULL};
+                                     "range", "texture", "radius_m", "show_force", "force_scale_m_per_n", "cut", NULL};
   char at[48], key[96];
   snprintf(at, sizeof at, "draw[%zu]", i);
   if (!json_is_object(e)) return bad(w, at, "expected an object, got %s", kind_of(e));
@@ -213,6 +213,25 @@ static int read_item(const where* w, size_t i, const json_t* e, tx_draw_item* it
     if (it->kind != TX_DRAW_TOOL) return bad(w, key, "only tools show a force");
     if (number(w, key, v, 0, 10, true, &x)) return -1;
     it->force_scale = (float)x;
+  }
+  // a cutaway: the inside of a block of voxels, where a needle does its damage
+  snprintf(key, sizeof key, "%s.cut", at);
+  if ((v = json_object_get(e, "cut"))) {
+    static const char* const ckeys[] = {"point", "normal", NULL};
+    if (it->kind != TX_DRAW_SPHERES) return bad(w, key, "only spheres take a cut");
+    if (!json_is_object(v)) return bad(w, key, "expected an object, got %s", kind_of(v));
+    if (check_keys(w, key, v, ckeys)) return -1;
+    double p[3] = {0, 0, 0}, nrm[3] = {0, 0, 1};
+    const json_t* q;
+    char sub[128];
+    snprintf(sub, sizeof sub, "%s.point", key);
+    if ((q = json_object_get(v, "point")) && numbers(w, sub, q, 3, -1e4, 1e4, p)) return -1;
+    snprintf(sub, sizeof sub, "%s.normal", key);
+    if ((q = json_object_get(v, "normal")) && numbers(w, sub, q, 3, -1e4, 1e4, nrm)) return -1;
+    double l = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+    if (!(l > 1e-6)) return bad(w, sub, "expected a non-zero direction");
+    for (int c = 0; c < 3; c++) it->cut[c] = (float)p[c], it->cut[3 + c] = (float)(nrm[c] / l);
+    it->has_cut = true;
   }
   return 0;
 }

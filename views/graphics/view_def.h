@@ -39,6 +39,8 @@ typedef struct tx_draw_item {
   float radius;             // m, tools: radius of the HIP sphere
   float force_scale;        // m/N, tools: length of the force line per newton
   float plane[7];           // planes: point (m), unit normal, half size (m)
+  bool has_cut;             // spheres: a cutaway plane is given
+  float cut[6];             // spheres: point (m) and unit normal of the cutaway; centres on the normal's side are not drawn
 } tx_draw_item;
 
 typedef struct tx_view_def {

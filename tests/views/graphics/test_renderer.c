@@ -282,12 +282,38 @@ static void colour_map_and_png(void** state) {
   assert_non_null(strstr(err, "/nonexistent/dir/x.png"));
 }
 
+// impostor depth: a small near sphere (red on the map) is drawn over a big far
+// one (blue) whatever the order; a sphere beyond the cut plane is not drawn
+static void sphere_depth_and_cut(void** state) {
+  (void)state;
+  tx_view_def d = scene_def();
+  const float sp[12] = {0, 0, 0.3f, 0.05f, 0, 0, 0, 0.2f, 0.28f, 0, 0, 0.08f};
+  const float scalar[3] = {1, 0, 1};
+  d.items[0] = (tx_draw_item){.kind = TX_DRAW_SPHERES, .range = {0, 1}, .scalar = "s", .has_cut = true,
+                              .cut = {0.25f, 0, 0, 1, 0, 0}};
+  d.nitems = 1;
+  tx_scene s = {.count = 1};
+  s.items[0] = (tx_scene_item){&d.items[0], {sp, scalar}, {3, 3}};
+  frame f = {0};
+  render(&f, &d, TX_STEREO_MONO, &s);
+  const uint8_t* c = at(&f, W / 2, H / 2);
+  if (!(c[0] > 2 * c[2])) fail_msg("centre (%d, %d, %d): the near red sphere should hide the far blue one", c[0], c[1], c[2]);
+  const uint8_t* b = at(&f, W / 2 + 30, H / 2); // on the big sphere, off the small one
+  if (!(b[2] > 2 * b[0])) fail_msg("(%d, %d, %d): expected the blue sphere", b[0], b[1], b[2]);
+  // the cut sphere's centre projects to x = 0.28 / (1 tan 20 deg) of the half width
+  int cx = (int)(W / 2 + 0.28 / tan(20 * M_PI / 180) * (H / 2));
+  const uint8_t* g = at(&f, cx, H / 2);
+  if (lit(g, -1)) fail_msg("(%d, %d, %d) at x = %d: the sphere beyond the cut is drawn", g[0], g[1], g[2], cx);
+  assert_int_equal(tx_renderer_skipped(f.r), 0); // cut away is not an error
+  release(&f);
+}
+
 int main(void) {
   tx_osmesa_bound_threads(-1);
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(sphere_silhouette),        cmocka_unit_test(lit_sphere_centre_colour),
       cmocka_unit_test(stereo_layouts_disparity), cmocka_unit_test(mesh_and_bad_rows),
-      cmocka_unit_test(colour_map_and_png),
+      cmocka_unit_test(colour_map_and_png),       cmocka_unit_test(sphere_depth_and_cut),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

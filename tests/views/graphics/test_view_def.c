@@ -60,6 +60,13 @@ static void full_view(void** state) {
   assert_int_equal(tx_draw_item_components(&d.items[3], comps), 2);
   assert_string_equal(comps[1], "device0.force");
   assert_int_equal(tx_draw_item_components(&d.items[4], comps), 0);
+  assert_false(d.items[1].has_cut);
+  // a cutaway of spheres: a point and a direction made unit
+  assert_int_equal(parse("{\"draw\": [{\"spheres\": \"t\", \"cut\": {\"point\": [0, 0.5, 0], \"normal\": [0, 0, 3]}}]}", &d,
+                         key, msg),
+                   0);
+  assert_true(d.items[0].has_cut);
+  assert_true(fabsf(d.items[0].cut[1] - 0.5f) < 1e-6f && fabsf(d.items[0].cut[5] - 1) < 1e-6f);
   // the camera's own target distance is the convergence when stereo does not say
   assert_int_equal(parse("{\"camera\": {\"eye\": [0, 0.3, 0.4], \"target\": [0, 0, 0]}}", &d, key, msg), 0);
   assert_true(fabs(d.camera.convergence - 0.5) < 1e-12);
@@ -100,6 +107,10 @@ static void errors_name_the_key(void** state) {
   expect_error("{\"draw\": [{\"mesh\": \"skin\", \"colur\": [1, 0, 0]}]}", "draw[0].colur", "unknown key");
   expect_error("{\"draw\": [{\"mesh\": \"skin\"}, {\"spheres\": \"t\", \"colour\": [1, 0]}]}", "draw[1].colour", "3 numbers");
   expect_error("{\"draw\": [{\"mesh\": \"skin\", \"colour_by\": \"skin.t\"}]}", "draw[0].colour_by", "only spheres");
+  expect_error("{\"draw\": [{\"mesh\": \"skin\", \"cut\": {}}]}", "draw[0].cut", "only spheres");
+  expect_error("{\"draw\": [{\"spheres\": \"t\", \"cut\": {\"normal\": [0, 0, 0]}}]}", "draw[0].cut.normal", "non-zero");
+  expect_error("{\"draw\": [{\"spheres\": \"t\", \"cut\": {\"side\": 1}}]}", "draw[0].cut.side", "unknown key");
+  expect_error("{\"draw\": [{\"spheres\": \"t\", \"cut\": [0, 0, 1]}]}", "draw[0].cut", "an object");
   expect_error("{\"draw\": [{\"spheres\": \"t\", \"range\": [0, 1]}]}", "draw[0].range", "needs colour_by");
   expect_error("{\"draw\": [{\"spheres\": \"t\", \"colour_by\": \"t.d\", \"range\": [1, 1]}]}", "draw[0].range", "low < high");
   expect_error("{\"draw\": [{\"spheres\": \"t\", \"texture\": \"skin\"}]}", "draw[0].texture", "only meshes");
