@@ -38,8 +38,10 @@ port_of() {
 }
 
 # device0.csv: |F| was at least 0.5 N in the 50 ms before the last new state, and is
-# exactly zero within 10 ms after it (the stream stopped there)
-zero_within_10ms() {
+# exactly zero within 10 haptic ticks (10 ms at 1 kHz) after it: the stream stopped
+# there. Ticks, not wall time, are counted: a machine that pauses the process for a
+# few ms delays a tick, not the watchdog's decision. The wall time is printed.
+zero_within_10_ticks() {
   awk -F, 'NR > 1 {
       t[NR] = $1; f[NR] = sqrt($5 * $5 + $6 * $6 + $7 * $7)
       if (f[NR] > 3.3) { print "force " f[NR] " N above the 3.3 N clamp at " $1 " s"; bad = 1 }
@@ -52,8 +54,8 @@ zero_within_10ms() {
       for (i = last; i > 1 && t[i] > t[last] - 0.050; i--) if (f[i] > before) before = f[i]
       for (i = last; i <= NR; i++) if (f[i] == 0) break
       if (i > NR) { printf "the force never reached zero after the last new state at %.3f s\n", t[last]; exit 1 }
-      printf "last new state at %.3f s (|F| up to %.3f N before it); zero %.1f ms later\n", t[last], before, (t[i] - t[last]) * 1e3
-      exit !(before >= 0.5 && t[i] - t[last] <= 0.0105)
+      printf "last new state at %.3f s (|F| up to %.3f N before it); zero %d ticks (%.1f ms) later\n", t[last], before, i - last, (t[i] - t[last]) * 1e3
+      exit !(before >= 0.5 && i - last <= 10)
     }' "$1"
 }
 
@@ -133,7 +135,7 @@ else
   [ "$drc" -eq 0 ] || fail "closed loop: tactus-device exit status $drc: $(head -n 1 "$WORK/dev1.err")"
   [ -s "$WORK/loop/report.json" ] || fail "closed loop: no report.json"
   if [ -s "$WORK/loop/device0.csv" ]; then
-    msg=$(zero_within_10ms "$WORK/loop/device0.csv") || fail "closed loop: $msg"
+    msg=$(zero_within_10_ticks "$WORK/loop/device0.csv") || fail "closed loop: $msg"
     echo "closed loop: $msg"
   else
     fail "closed loop: no device0.csv"
@@ -168,7 +170,7 @@ else
     [ "$drc" -eq 0 ] || fail "lossy: tactus-device exit status $drc"
     [ -s "$WORK/lossy/report.json" ] || fail "lossy: no report.json"
     if [ -s "$WORK/lossy/device0.csv" ]; then
-      msg=$(zero_within_10ms "$WORK/lossy/device0.csv") || fail "lossy: $msg"
+      msg=$(zero_within_10_ticks "$WORK/lossy/device0.csv") || fail "lossy: $msg"
       echo "lossy: $msg"
     else
       fail "lossy: no device0.csv"
