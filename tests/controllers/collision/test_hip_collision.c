@@ -9,6 +9,7 @@
 
 #include "controllers/collision/skin_grid.h"
 #include "scenarios/loader.h"
+#include "tests/scenario_support.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -71,32 +72,6 @@ static tx_scenario* load(const char* skin_params) {
   tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL, err, sizeof err);
   if (!s) fail_msg("%s", err);
   return s;
-}
-
-static void run(tx_scenario* s, double seconds) {
-  tx_run_options o = {.duration_s = seconds, .lockstep = true};
-  tx_run_result r;
-  char err[256];
-  assert_int_equal(tx_system_run(s->system, &o, &r, err, sizeof err), 0);
-}
-
-static const double* latest(tx_scenario* s, const char* name) {
-  tx_model* m = tx_system_model(s->system);
-  return tx_model_latest(m, tx_model_find(m, name)).data;
-}
-
-static double result(tx_scenario* s, const char* key) {
-  for (int i = 0; i < tx_system_results(s->system); i++)
-    if (strcmp(tx_system_result_key(s->system, i), key) == 0) return tx_system_result(s->system, i);
-  fail_msg("no result %s", key);
-  return NAN;
-}
-
-static uint64_t warnings(tx_scenario* s, const char* key) {
-  for (int w = 0; w < tx_system_warnings(s->system); w++)
-    if (strcmp(tx_system_warning_key(s->system, w), key) == 0) return tx_system_warning_count(s->system, w);
-  fail_msg("no warning %s", key);
-  return 0;
 }
 
 // pierce-down starts at y = 10 mm and moves down at 5 mm/s from 0.5 s: it

@@ -7,6 +7,7 @@
 #include <cmocka.h>
 
 #include "scenarios/loader.h"
+#include "tests/scenario_support.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -31,25 +32,6 @@ static tx_scenario* load(double wall_hz, double stiffness, const char* device, c
   return load_text(text);
 }
 
-static void run(tx_scenario* s, double seconds) {
-  tx_run_options o = {.duration_s = seconds, .lockstep = true};
-  tx_run_result r;
-  char err[256];
-  assert_int_equal(tx_system_run(s->system, &o, &r, err, sizeof err), 0);
-}
-
-static const double* latest(tx_scenario* s, const char* name) {
-  tx_model* m = tx_system_model(s->system);
-  return tx_model_latest(m, tx_model_find(m, name)).data;
-}
-
-static uint64_t warnings(tx_scenario* s, const char* key) {
-  for (int w = 0; w < tx_system_warnings(s->system); w++)
-    if (strcmp(tx_system_warning_key(s->system, w), key) == 0) return tx_system_warning_count(s->system, w);
-  fail_msg("no warning %s", key);
-  return 0;
-}
-
 // pierce-down at 5 mm/s into a 300 N/m wall; after 3 s the hand is 2.5 mm deep
 static void local_model_follows_the_hand_between_frames(void** state) {
   (void)state;
@@ -70,13 +52,6 @@ static void local_model_follows_the_hand_between_frames(void** state) {
   assert_int_equal(warnings(local, "haptics.force_clamped"), 0);
   tx_scenario_free(local);
   tx_scenario_free(hold);
-}
-
-static double result(tx_scenario* s, const char* key) {
-  for (int k = 0; k < tx_system_results(s->system); k++)
-    if (strcmp(tx_system_result_key(s->system, k), key) == 0) return tx_system_result(s->system, k);
-  fail_msg("no result %s", key);
-  return NAN;
 }
 
 // pressed 10 mm into a 300 N/m wall, the wall holds 1/2 k x^2 = 15 mJ: the

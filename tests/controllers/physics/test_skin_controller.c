@@ -8,6 +8,7 @@
 #include <cmocka.h>
 
 #include "scenarios/loader.h"
+#include "tests/scenario_support.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -23,27 +24,6 @@ static tx_scenario* load(const char* skin_params, double rate, char* err, size_t
   return tx_scenario_load_text("test", text, strlen(text), NULL, err, en);
 }
 
-static void run(tx_scenario* s, double seconds) {
-  tx_run_options o = {.duration_s = seconds, .lockstep = true};
-  tx_run_result r;
-  char err[256];
-  assert_int_equal(tx_system_run(s->system, &o, &r, err, sizeof err), 0);
-}
-
-static tx_snapshot latest(tx_scenario* s, const char* name) {
-  tx_model* m = tx_system_model(s->system);
-  tx_comp c = tx_model_find(m, name);
-  assert_true(c.id != 0);
-  return tx_model_latest(m, c);
-}
-
-static uint64_t warnings(tx_scenario* s, const char* key) {
-  for (int w = 0; w < tx_system_warnings(s->system); w++)
-    if (strcmp(tx_system_warning_key(s->system, w), key) == 0) return tx_system_warning_count(s->system, w);
-  fail_msg("no warning %s", key);
-  return 0;
-}
-
 // the papers' two densities, published whole at 60 Hz
 static void publishes_the_skin(void** state) {
   (void)state;
@@ -51,8 +31,8 @@ static void publishes_the_skin(void** state) {
   tx_scenario* s = load("", 60, err, sizeof err);
   if (!s) fail_msg("%s", err);
   run(s, 0.5);
-  tx_snapshot x = latest(s, "skin.x"), tri = latest(s, "skin.tri"), h = latest(s, "skin.thickness"),
-              torn = latest(s, "skin.torn");
+  tx_snapshot x = latest_snapshot(s, "skin.x"), tri = latest_snapshot(s, "skin.tri"), h = latest_snapshot(s, "skin.thickness"),
+              torn = latest_snapshot(s, "skin.torn");
   assert_int_equal(x.rows, 1764);
   assert_int_equal(x.cols, 3);
   assert_int_equal(tri.rows, 3362);
@@ -69,8 +49,8 @@ static void publishes_the_skin(void** state) {
   s = load("\"spacing_m\":0.001", 60, err, sizeof err);
   if (!s) fail_msg("%s", err);
   run(s, 1.0 / 60);
-  assert_int_equal(latest(s, "skin.x").rows, 10404);
-  assert_int_equal(latest(s, "skin.tri").rows, 2 * 101 * 101);
+  assert_int_equal(latest_snapshot(s, "skin.x").rows, 10404);
+  assert_int_equal(latest_snapshot(s, "skin.tri").rows, 2 * 101 * 101);
   tx_scenario_free(s);
 }
 
@@ -82,24 +62,24 @@ static void hip_follows_the_device_and_pierces(void** state) {
   tx_scenario* s = load("\"hip_radius_m\":0.0005", 60, err, sizeof err);
   if (!s) fail_msg("%s", err);
   run(s, 2.6); // the HIP at 0.5 mm, the skin's surface 2.5 mm below it
-  const float* x = latest(s, "skin.x").data;
+  const float* x = latest_snapshot(s, "skin.x").data;
   float low = 1;
   for (int i = 0; i < 1764; i++) low = x[3 * i + 1] < low ? x[3 * i + 1] : low;
-  print_message("  HIP at %.2f mm: skin lowest at %.2f mm\n", ((const double*)latest(s, "device0.pose").data)[1] * 1e3,
+  print_message("  HIP at %.2f mm: skin lowest at %.2f mm\n", ((const double*)latest_snapshot(s, "device0.pose").data)[1] * 1e3,
                 low * 1e3);
   assert_true(low < -0.001);
-  assert_int_equal(((const int*)latest(s, "skin.torn").data)[0], 0);
+  assert_int_equal(((const int*)latest_snapshot(s, "skin.torn").data)[0], 0);
   tx_scenario_free(s);
   s = load("\"hip_radius_m\":0.0005", 60, err, sizeof err); // a run starts the script again
   run(s, 5.0); // on to -1 cm: through
-  int torn = ((const int*)latest(s, "skin.torn").data)[0];
-  tx_snapshot tri = latest(s, "skin.tri");
+  int torn = ((const int*)latest_snapshot(s, "skin.torn").data)[0];
+  tx_snapshot tri = latest_snapshot(s, "skin.tri");
   print_message("  at the end: %d links torn, %u triangles left\n", torn, tri.rows);
   assert_true(torn > 0);
   assert_true(tri.rows < 3362);
   assert_int_equal(warnings(s, "skin.numerical_fault"), 0);
   // every published coordinate is finite and every live triangle indexes a particle
-  x = latest(s, "skin.x").data;
+  x = latest_snapshot(s, "skin.x").data;
   for (int i = 0; i < 1764 * 3; i++) assert_true(isfinite(x[i]));
   const int* t = tri.data;
   for (uint32_t i = 0; i < tri.rows * 3; i++) assert_true(t[i] >= 0 && t[i] < 1764);

@@ -9,6 +9,7 @@
 
 #include "controllers/voxel/recording.h"
 #include "scenarios/loader.h"
+#include "tests/scenario_support.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -20,32 +21,11 @@
 #error "TX_SOURCE_DIR must name the source tree"
 #endif
 
-static const void* latest(tx_scenario* s, const char* name, uint32_t* rows) {
+static const void* latest_rows(tx_scenario* s, const char* name, uint32_t* rows) {
   tx_model* m = tx_system_model(s->system);
   tx_snapshot snap = tx_model_latest(m, tx_model_find(m, name));
   if (rows) *rows = snap.rows;
   return snap.data;
-}
-
-static double result(tx_scenario* s, const char* key) {
-  for (int k = 0; k < tx_system_results(s->system); k++)
-    if (strcmp(tx_system_result_key(s->system, k), key) == 0) return tx_system_result(s->system, k);
-  fail_msg("no result %s", key);
-  return NAN;
-}
-
-static uint64_t warning(tx_scenario* s, const char* key) {
-  for (int w = 0; w < tx_system_warnings(s->system); w++)
-    if (strcmp(tx_system_warning_key(s->system, w), key) == 0) return tx_system_warning_count(s->system, w);
-  fail_msg("no warning %s", key);
-  return 0;
-}
-
-static void run(tx_scenario* s, double seconds) {
-  tx_run_options o = {.duration_s = seconds, .lockstep = true};
-  tx_run_result r;
-  char err[256];
-  assert_int_equal(tx_system_run(s->system, &o, &r, err, sizeof err), 0);
 }
 
 // the shipped scenario for 1.6 s: from 1 mm above at 0.2 s at 3 mm/s, the
@@ -57,11 +37,11 @@ static void shipped_scenario_inserts(void** state) {
   tx_scenario* s = tx_scenario_load(TX_SOURCE_DIR "/scenarios/needle-voxel/needle-voxel.json", NULL, err, sizeof err);
   if (!s) fail_msg("%s", err);
   run(s, 1.6);
-  const double* pose = latest(s, "device0.pose", NULL);
+  const double* pose = latest_rows(s, "device0.pose", NULL);
   const double tick = 3e-6 + 1e-9; // m the hand moves in 1 ms
   assert_true(fabs(pose[1] - (0.001 - 0.003 * 1.4)) <= tick);
-  const double* fm = latest(s, "tool0.force_model", NULL);
-  const double* nf = latest(s, "needle.force", NULL);
+  const double* fm = latest_rows(s, "tool0.force_model", NULL);
+  const double* nf = latest_rows(s, "needle.force", NULL);
   print_message("  3.2 mm deep: force %.4f N (stiffness %.4f, friction %.4f, cutting %.4f), K_yy %.1f N/m, depth %.2f mm\n",
                 fm[1], nf[4], nf[7], nf[10], fm[6 + 4], nf[12] * 1e3);
   assert_true(fm[1] > 0);                      // resists: pushes the needle up, out
@@ -70,26 +50,26 @@ static void shipped_scenario_inserts(void** state) {
   for (int a = 0; a < 3; a++) assert_true(fabs(nf[a] - (nf[3 + a] + nf[6 + a] + nf[9 + a])) < 1e-12);
   assert_true(fabs(nf[12] - 3.2e-3) <= 2 * tick);
   // what the device was sent is that force, within the device's safety limits
-  const double* sent = latest(s, "device0.force", NULL);
+  const double* sent = latest_rows(s, "device0.force", NULL);
   assert_true(sent[1] > 0 && sent[1] <= 3.3 + 1e-9);
   // the drawables: 1000 spheres and damage, one needle segment from hub to tip
   uint32_t rows;
-  const float* sp = latest(s, "tissue.spheres", &rows);
+  const float* sp = latest_rows(s, "tissue.spheres", &rows);
   assert_int_equal(rows, 1000);
   assert_true(sp[3] > 0 && sp[3] <= 0.2178e-3f * 1.0000001f); // the scenario's radius, or less where damaged
-  const float* dmg = latest(s, "tissue.damage", &rows);
+  const float* dmg = latest_rows(s, "tissue.damage", &rows);
   assert_int_equal(rows, 1000);
   int damaged = 0;
   for (int i = 0; i < 1000; i++) damaged += dmg[i] > 0;
-  const float* seg = latest(s, "needle.segments", &rows);
+  const float* seg = latest_rows(s, "needle.segments", &rows);
   assert_int_equal(rows, 1);
   // drawn up to 16 ticks ago: the hub 40 mm above the tip
   assert_true(fabsf(seg[4] - (float)pose[1]) <= 17 * (float)tick && fabsf(seg[1] - seg[4] - 0.04f) < 1e-6f);
   assert_true(fabsf(seg[6] - 0.635e-3f) < 1e-9f);
   assert_true(result(s, "needle.peak_force_n") >= fm[1]);
   assert_true(result(s, "needle.voxels_cut") > 0 && damaged > 0);
-  assert_int_equal(warning(s, "needle.recovered"), 0);
-  assert_int_equal(warning(s, "haptics.force_non_finite"), 0);
+  assert_int_equal(warnings(s, "needle.recovered"), 0);
+  assert_int_equal(warnings(s, "haptics.force_non_finite"), 0);
   tx_scenario_free(s);
 }
 
