@@ -83,6 +83,21 @@ static int number(const where* w, const char* key, const json_t* v, double lo, d
   return 0;
 }
 
+// an object's "point" and unit "normal" (defaults given in p and nrm) into out
+// (6): the point, then the normal scaled to unit length
+static int point_normal(const where* w, const char* key, const json_t* v, double p[3], double nrm[3], float out[6]) {
+  const json_t* q;
+  char sub[128];
+  snprintf(sub, sizeof sub, "%s.point", key);
+  if ((q = json_object_get(v, "point")) && numbers(w, sub, q, 3, -1e4, 1e4, p)) return -1;
+  snprintf(sub, sizeof sub, "%s.normal", key);
+  if ((q = json_object_get(v, "normal")) && numbers(w, sub, q, 3, -1e4, 1e4, nrm)) return -1;
+  double l = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+  if (!(l > 1e-6)) return bad(w, sub, "expected a non-zero direction");
+  for (int c = 0; c < 3; c++) out[c] = (float)p[c], out[3 + c] = (float)(nrm[c] / l);
+  return 0;
+}
+
 static int integer(const where* w, const char* key, const json_t* v, int lo, int hi, int* out) {
   if (!json_is_integer(v) || json_integer_value(v) < lo || json_integer_value(v) > hi)
     return bad(w, key, "expected an integer in [%d, %d]", lo, hi);
@@ -142,17 +157,11 @@ static int read_item(const where* w, size_t i, const json_t* e, tx_draw_item* it
       if (!json_is_object(v)) return bad(w, key, "expected an object, got %s", kind_of(v));
       if (check_keys(w, key, v, pkeys)) return -1;
       double p[3] = {0, 0, 0}, nrm[3] = {0, 1, 0}, size = 0.2;
+      if (point_normal(w, key, v, p, nrm, it->plane)) return -1;
       const json_t* q;
       char sub[128];
-      snprintf(sub, sizeof sub, "%s.point", key);
-      if ((q = json_object_get(v, "point")) && numbers(w, sub, q, 3, -1e4, 1e4, p)) return -1;
-      snprintf(sub, sizeof sub, "%s.normal", key);
-      if ((q = json_object_get(v, "normal")) && numbers(w, sub, q, 3, -1e4, 1e4, nrm)) return -1;
-      double l = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
-      if (!(l > 1e-6)) return bad(w, sub, "expected a non-zero direction");
       snprintf(sub, sizeof sub, "%s.size_m", key);
       if ((q = json_object_get(v, "size_m")) && number(w, sub, q, 0, 1e4, true, &size)) return -1;
-      for (int c = 0; c < 3; c++) it->plane[c] = (float)p[c], it->plane[3 + c] = (float)(nrm[c] / l);
       it->plane[6] = (float)(size / 2);
       continue;
     }
@@ -222,15 +231,7 @@ static int read_item(const where* w, size_t i, const json_t* e, tx_draw_item* it
     if (!json_is_object(v)) return bad(w, key, "expected an object, got %s", kind_of(v));
     if (check_keys(w, key, v, ckeys)) return -1;
     double p[3] = {0, 0, 0}, nrm[3] = {0, 0, 1};
-    const json_t* q;
-    char sub[128];
-    snprintf(sub, sizeof sub, "%s.point", key);
-    if ((q = json_object_get(v, "point")) && numbers(w, sub, q, 3, -1e4, 1e4, p)) return -1;
-    snprintf(sub, sizeof sub, "%s.normal", key);
-    if ((q = json_object_get(v, "normal")) && numbers(w, sub, q, 3, -1e4, 1e4, nrm)) return -1;
-    double l = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
-    if (!(l > 1e-6)) return bad(w, sub, "expected a non-zero direction");
-    for (int c = 0; c < 3; c++) it->cut[c] = (float)p[c], it->cut[3 + c] = (float)(nrm[c] / l);
+    if (point_normal(w, key, v, p, nrm, it->cut)) return -1;
     it->has_cut = true;
   }
   return 0;

@@ -13,6 +13,8 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "tests/temp_file.h"
+
 static tx_device_state at(tx_device_handle* h, double t) {
   tx_device_state s;
   assert_true(h->backend->read(h->device, t, &s));
@@ -65,16 +67,6 @@ static void every_named_motion_opens(void** state) {
     if (strstr(names[i], "slide")) assert_true(fabs(s.pos[1] - sign * 0.002) < 1e-12); // sliding in contact
     tx_device_close(&h);
   }
-}
-
-static char* write_file(const char* text) {
-  static char path[64];
-  snprintf(path, sizeof path, "/tmp/tx-scripted-XXXXXX.csv");
-  int fd = mkstemps(path, 4);
-  assert_true(fd >= 0);
-  assert_int_equal(write(fd, text, strlen(text)), (ssize_t)strlen(text));
-  close(fd);
-  return path;
 }
 
 static void waypoint_file_is_interpolated(void** state) {

@@ -13,15 +13,7 @@
 #include <string.h>
 #include <unistd.h>
 
-static char* write_file(const char* text) {
-  static char path[64];
-  snprintf(path, sizeof path, "/tmp/tx-recording-XXXXXX.csv");
-  int fd = mkstemps(path, 4);
-  assert_true(fd >= 0);
-  assert_int_equal(write(fd, text, strlen(text)), (ssize_t)strlen(text));
-  close(fd);
-  return path;
-}
+#include "tests/temp_file.h"
 
 static void round_trip(void** state) {
   (void)state;
