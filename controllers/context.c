@@ -50,6 +50,15 @@ void tx_warn(tx_ctx* c, tx_warning w) {
     atomic_fetch_add_explicit(&c->sys->warning_counts[w.id - 1], 1, memory_order_relaxed);
 }
 
+void tx_stop_run(tx_ctx* c, const char* reason) {
+  tx_system* s = c->sys;
+  int expected = 0;
+  if (!atomic_compare_exchange_strong(&s->halt_claim, &expected, 1)) return; // the first reason wins
+  snprintf(s->halt_reason, sizeof s->halt_reason, "%s: %s", c->in->name, reason ? reason : "stopped");
+  s->halt_sim_ns = c->sim_ns;
+  atomic_store_explicit(&s->halt, true, memory_order_release);
+}
+
 static void trace_publish(tx_system* s, const instance* in, const port* pt) {
   tx_snapshot snap = tx_model_latest(s->model, pt->comp);
   const tx_component_def* def = tx_model_def(s->model, pt->comp);

@@ -26,7 +26,7 @@ int tx_run_lockstep(tx_system* s, const tx_run_options* o, tx_run_result* r, cha
       int64_t tk = tx_tick_ns(s->groups[k].rate_hz, next[k]);
       if (g < 0 || tk < t) g = k, t = tk;
     }
-    if (t >= end_ns) break;
+    if (t >= end_ns || tx_system_halted(s)) break;
     for (int m = 0; m < s->groups[g].count; m++) {
       instance* in = s->inst[s->groups[g].members[m]];
       if (in->steps == 0) in->first_start_ns = t;

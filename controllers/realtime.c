@@ -78,7 +78,7 @@ static void* worker_main(void* arg) {
 
   int64_t prev_start = 0;
   uint64_t prev_k = 0;
-  for (uint64_t k = 0; !atomic_load_explicit(w->stop, memory_order_relaxed);) {
+  for (uint64_t k = 0; !atomic_load_explicit(w->stop, memory_order_relaxed) && !tx_system_halted(s);) {
     int64_t release = t0 + tx_tick_ns(g->rate_hz, k);
     if (release >= end) break;
     sleep_until(release);
@@ -232,7 +232,7 @@ int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r, cha
   pthread_cond_broadcast(&gt.cond);
   pthread_mutex_unlock(&gt.mutex);
 
-  while (rc == 0 && !atomic_load(&stop)) {
+  while (rc == 0 && !atomic_load(&stop) && !tx_system_halted(s)) {
     int64_t now = tx_mono_ns();
     if (now >= gt.end) break;
     sleep_until(now + 100000000 < gt.end ? now + 100000000 : gt.end);

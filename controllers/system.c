@@ -264,7 +264,15 @@ int tx_system_run(tx_system* s, const tx_run_options* o, tx_run_result* r, char*
   if (!tx_system_prepare_stats(s, o->duration_s)) return snprintf(err, n, "out of memory for statistics"), -1;
   s->record_dir = o->record_dir;
   s->out_dir = o->out_dir;
+  atomic_store(&s->halt, false);
+  atomic_store(&s->halt_claim, 0);
+  s->halt_reason[0] = 0;
   int rc = o->lockstep ? tx_run_lockstep(s, o, r, err, n) : tx_run_realtime(s, o, r, err, n);
+  if (tx_system_halted(s)) {
+    r->halted = true;
+    snprintf(r->halt_reason, sizeof r->halt_reason, "%s", s->halt_reason);
+    r->halt_t_s = (double)s->halt_sim_ns * 1e-9;
+  }
   return rc;
 }
 

@@ -63,6 +63,9 @@ typedef struct tx_run_result {
   bool pinned;            // every thread was pinned
   int awake_cpus;         // CPUs kept awake by spinners
   double steal_s;         // CPU time the hypervisor took during the run (all CPUs), -1 if unknown
+  bool halted;            // a controller stopped the run (tx_stop_run)
+  char halt_reason[512];  // "INSTANCE: reason", when halted
+  double halt_t_s;        // simulation time of that request, s
 } tx_run_result;
 
 // "an object", "a string", ... for messages about a JSON value of the wrong type

@@ -82,7 +82,14 @@ struct tx_system {
   bool tracing;        // lockstep: hash every publish
   FILE* trace;         // and write it here, if not NULL
   uint64_t trace_hash; // tx_hash over every publish, in order
+  _Atomic int halt_claim;  // 0 until a controller asks to stop the run
+  _Atomic bool halt;       // set once halt_reason is written
+  char halt_reason[512];   // the first tx_stop_run reason
+  int64_t halt_sim_ns;     // simulation time of that request
 };
+
+// true once a controller asked to stop the run (tx_stop_run)
+static inline bool tx_system_halted(tx_system* s) { return atomic_load_explicit(&s->halt, memory_order_acquire); }
 
 // nominal start of tick k of a group, ns from the run's start
 int64_t tx_tick_ns(double rate_hz, uint64_t k);

@@ -97,6 +97,10 @@ double tx_rate(const tx_ctx* c);                     // Hz
 void tx_warn(tx_ctx* c, tx_warning w);               // count one occurrence, lock-free
 const char* tx_record_dir(const tx_ctx* c);          // where this run keeps recordings, or NULL
 void tx_set_result(tx_ctx* c, tx_result r, double value); // the last value set is reported (set it in finish)
+// end the run at once for a fault the controller cannot recover from (a full
+// disk, a lost file); every thread stops at its next tick, finish still runs,
+// and the report names the first reason given. Lock-free; callable from any thread.
+void tx_stop_run(tx_ctx* c, const char* reason);
 
 #ifdef __cplusplus
 }

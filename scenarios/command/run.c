@@ -84,6 +84,7 @@ int tx_run_scenario(tx_scenario* sc, const tx_run_config* cfg, json_t** report_o
   }
   if (report_out) *report_out = report;
   else json_decref(report);
+  if (r.halted) return fprintf(stderr, "tactus: run %s stopped at t = %.3f s: %s\n", sc->name, r.halt_t_s, r.halt_reason), 1;
   return 0;
 }
 

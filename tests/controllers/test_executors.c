@@ -215,6 +215,34 @@ static void bad_durations_are_refused(void** state) {
   tx_system_destroy(s);
 }
 
+// a controller's tx_stop_run ends the run at once, in either executor, with its reason
+static void a_controller_can_stop_the_run(void** state) {
+  (void)state;
+  for (int lock = 1; lock >= 0; lock--) {
+    tx_system* s = tx_system_create();
+    tx_fault f;
+    json_t* p = json_loads("{\"write\":\"a\",\"stop_at\":20}", 0, NULL);
+    assert_int_equal(tx_system_add(s, "stopper", "test.counter", 1000, p, &f), 0);
+    json_decref(p);
+    p = json_loads("{\"write\":\"b\"}", 0, NULL);
+    assert_int_equal(tx_system_add(s, "other", "test.counter", 100, p, &f), 0);
+    json_decref(p);
+    assert_int_equal(tx_system_finalize(s, &f), 0);
+    tx_run_options o = {.duration_s = 5, .lockstep = lock};
+    tx_run_result r;
+    char err[256];
+    int64_t t0 = tx_mono_ns();
+    assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+    assert_true(r.halted);
+    assert_string_equal(r.halt_reason, "stopper: disk full");
+    assert_true(fabs(r.halt_t_s - 0.020) < 1e-9);
+    // the stopper steps once more at most (the check is at the top of the loop)
+    assert_true(tx_system_stats(s, 0).steps <= 21);
+    if (!lock) assert_true(tx_mono_ns() - t0 < 2000000000); // not the whole 5 s
+    tx_system_destroy(s);
+  }
+}
+
 int main(void) {
   register_test_classes();
   const struct CMUnitTest tests[] = {
@@ -226,6 +254,7 @@ int main(void) {
       cmocka_unit_test(a_tick_whose_period_is_over_is_skipped),
       cmocka_unit_test(a_failing_init_stops_the_run_cleanly),
       cmocka_unit_test(bad_durations_are_refused),
+      cmocka_unit_test(a_controller_can_stop_the_run),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

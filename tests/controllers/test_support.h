@@ -12,13 +12,15 @@ typedef struct counter {
   tx_port out, in;
   double gain;
   double seen; // last value read from "in"
+  int64_t stop_at; // step index at which to stop the run (tx_stop_run), -1: never
 } counter;
 
-// params: "write" (component), "read" (component, optional), "gain"
+// params: "write" (component), "read" (component, optional), "gain", "stop_at"
 static int counter_configure(tx_setup* s, void** self) {
   counter* c = calloc(1, sizeof *c);
   *self = c;
   c->gain = tx_param_num(s, "gain", 1, -1e6, 1e6);
+  c->stop_at = tx_param_int(s, "stop_at", -1, -1, 1000000000);
   const char* out = tx_param_str(s, "write", NULL);
   const char* in = tx_param_str(s, "read", NULL);
   if (out) c->out = tx_setup_write(s, &(tx_component_def){out, TX_F64, 1, 2, "1"});
@@ -28,6 +30,7 @@ static int counter_configure(tx_setup* s, void** self) {
 
 static void counter_step(tx_ctx* x, void* self) {
   counter* c = self;
+  if (c->stop_at >= 0 && tx_step_index(x) == (uint64_t)c->stop_at) tx_stop_run(x, "disk full");
   if (c->in.id) {
     tx_snapshot s = tx_read(x, c->in);
     c->seen = ((const double*)s.data)[0];
