@@ -9,6 +9,7 @@ cd "$(dirname "$0")"
 jobs=$(nproc 2>/dev/null || echo 2)
 default_scenario=suturing-skin
 fuzz_seconds=${TX_FUZZ_SECONDS:-60}
+soak_seconds=${TX_SOAK_SECONDS:-600}
 
 say() { printf '\n== %s\n' "$*" >&2; }
 
@@ -46,14 +47,14 @@ case "$target" in
   quick)
     tools/install-deps.sh
     build_variant build -DCMAKE_BUILD_TYPE=Release
-    test_variant build
+    test_variant build -LE soak
     ;;
   test)
     tools/install-deps.sh
     start=$(date +%s)
     say "Release: build and test"
-    build_variant build -DCMAKE_BUILD_TYPE=Release
-    test_variant build
+    build_variant build -DCMAKE_BUILD_TYPE=Release -DTX_SOAK_SECONDS="$soak_seconds"
+    test_variant build -LE soak
 
     say "Debug + AddressSanitizer + UndefinedBehaviorSanitizer: build and test"
     build_variant build-asan -DCMAKE_BUILD_TYPE=Debug -DTX_SANITIZE=address,undefined
@@ -73,6 +74,9 @@ case "$target" in
     CC=clang build_variant build-fuzz -DCMAKE_BUILD_TYPE=Debug -DTX_FUZZ=ON -DTX_SANITIZE=address,undefined \
       -DTX_FUZZ_SECONDS="$fuzz_seconds"
     test_variant build-fuzz -R fuzz
+
+    say "soak: suturing-skin in real time for ${soak_seconds} s, alone; memory must stay flat"
+    ctest --test-dir build --output-on-failure -L soak
 
     say "all variants passed in $(( $(date +%s) - start )) s"
     ;;

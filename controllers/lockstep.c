@@ -31,8 +31,8 @@ int tx_run_lockstep(tx_system* s, const tx_run_options* o, tx_run_result* r, cha
       instance* in = s->inst[s->groups[g].members[m]];
       if (in->steps == 0) in->first_start_ns = t;
       in->last_start_ns = t;
-      tx_samples_add(&in->step_time, tx_instance_step(s, in, t));
-      tx_samples_add(&in->jitter, 0);
+      tx_hist_add(&in->step_time, tx_instance_step(s, in, t));
+      tx_hist_add(&in->jitter, 0);
     }
     next[g]++;
     if (o->progress && t - last_progress >= 100000000) {

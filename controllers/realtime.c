@@ -88,9 +88,9 @@ static void* worker_main(void* arg) {
     for (int m = 0; m < g->count; m++) {
       instance* in = s->inst[g->members[m]];
       if (in->steps == 0) in->first_start_ns = start;
-      else tx_samples_add(&in->jitter, jitter < 0 ? -jitter : jitter);
+      else tx_hist_add(&in->jitter, jitter < 0 ? -jitter : jitter);
       in->last_start_ns = start;
-      tx_samples_add(&in->step_time, tx_instance_step(s, in, release - t0));
+      tx_hist_add(&in->step_time, tx_instance_step(s, in, release - t0));
     }
     prev_start = start;
     prev_k = k;

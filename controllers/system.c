@@ -29,8 +29,6 @@ void tx_system_destroy(tx_system* s) {
     json_decref(in->params);
     json_decref(in->used);
     json_decref(in->strings);
-    tx_samples_free(&in->jitter);
-    tx_samples_free(&in->step_time);
     free(in);
   }
   for (int g = 0; g < s->ngroups; g++) free(s->groups[g].members);
@@ -242,13 +240,11 @@ int tx_system_finalize(tx_system* s, tx_fault* f) {
 int64_t tx_tick_ns(double rate_hz, uint64_t k) { return (int64_t)llround((double)k * 1e9 / rate_hz); }
 
 bool tx_system_prepare_stats(tx_system* s, double duration_s) {
+  (void)duration_s; // the histograms hold a run of any length
   for (int i = 0; i < s->count; i++) {
     instance* in = s->inst[i];
-    double want = ceil(duration_s * in->rate_hz) + 8;
-    uint64_t cap = want > (double)(1u << 22) ? (1u << 22) : (uint64_t)want;
-    tx_samples_free(&in->jitter);
-    tx_samples_free(&in->step_time);
-    if (!tx_samples_init(&in->jitter, cap) || !tx_samples_init(&in->step_time, cap)) return false;
+    tx_hist_clear(&in->jitter);
+    tx_hist_clear(&in->step_time);
     in->steps = in->missed = 0;
     in->first_start_ns = in->last_start_ns = 0;
   }
@@ -301,8 +297,8 @@ tx_port_info tx_system_port(const tx_system* s, int i, int p) {
 
 tx_controller_stats tx_system_stats(const tx_system* s, int i) {
   const instance* in = s->inst[i];
-  tx_controller_stats st = {in->steps, in->missed, 0, tx_samples_percentiles(&in->jitter),
-                            tx_samples_percentiles(&in->step_time)};
+  tx_controller_stats st = {in->steps, in->missed, 0, tx_hist_percentiles(&in->jitter),
+                            tx_hist_percentiles(&in->step_time)};
   int64_t span = in->last_start_ns - in->first_start_ns;
   if (in->steps > 1 && span > 0) st.achieved_hz = (double)(in->steps - 1) * 1e9 / (double)span;
   return st;

@@ -50,7 +50,7 @@ struct instance {
   int group;
   tx_setup setup;
   tx_ctx ctx;
-  tx_samples jitter, step_time;
+  tx_hist jitter, step_time; // whole-run statistics in fixed memory
   uint64_t steps, missed;
   int64_t first_start_ns, last_start_ns;
 };
