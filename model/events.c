@@ -1,0 +1,103 @@
+// Event streams: a single-writer ring with one tail per reader.
+//
+// The writer fills slot head % capacity, then publishes head + 1 with a release
+// store; a reader acquires head, copies its slot, then releases its own tail.
+// The writer acquires every tail before it reuses a slot, so a slot is never
+// written while a reader may still copy it. Head and each tail sit on their
+// own cache line, so readers never contend with each other.
+#include "error.h"
+
+#include <tactus/events.h>
+
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define CACHE_LINE 64
+
+typedef struct tail {
+  _Alignas(CACHE_LINE) _Atomic uint64_t next; // next event this reader takes
+  uint64_t last_seq;                          // reader-private: seq of its last event
+  uint64_t lost;                              // reader-private, read after the run
+} tail;
+
+struct tx_stream {
+  char name[TX_NAME_MAX];
+  uint32_t mask;    // capacity - 1
+  tx_event* ring;   // capacity
+  tail* tails;      // TX_STREAM_READERS_MAX
+  int readers;
+  _Alignas(CACHE_LINE) _Atomic uint64_t head; // events published
+  _Alignas(CACHE_LINE) uint64_t seq;          // writer-private: the last seq handed out
+  _Atomic uint64_t overflows;
+};
+
+tx_stream* tx_stream_create(const char* name, uint32_t capacity) {
+  if (!name || !*name || strlen(name) >= TX_NAME_MAX) return tx_set_error("stream name: empty or too long"), NULL;
+  if (capacity < 2 || capacity > TX_STREAM_CAPACITY_MAX || (capacity & (capacity - 1)))
+    return tx_set_error("%s: capacity %u is not a power of two in [2, %u]", name, capacity, TX_STREAM_CAPACITY_MAX), NULL;
+  tx_stream* s = aligned_alloc(CACHE_LINE, sizeof *s);
+  tx_event* ring = aligned_alloc(CACHE_LINE, (size_t)capacity * sizeof *ring);
+  tail* tails = aligned_alloc(CACHE_LINE, TX_STREAM_READERS_MAX * sizeof *tails);
+  if (!s || !ring || !tails) {
+    free(s), free(ring), free(tails);
+    return tx_set_error("%s: out of memory", name), NULL;
+  }
+  memset(s, 0, sizeof *s);
+  memset(ring, 0, (size_t)capacity * sizeof *ring); // touched now, not in a 1 kHz push
+  memset(tails, 0, TX_STREAM_READERS_MAX * sizeof *tails);
+  strcpy(s->name, name);
+  s->mask = capacity - 1;
+  s->ring = ring;
+  s->tails = tails;
+  return s;
+}
+
+void tx_stream_destroy(tx_stream* s) {
+  if (!s) return;
+  free(s->ring);
+  free(s->tails);
+  free(s);
+}
+
+const char* tx_stream_name(const tx_stream* s) { return s->name; }
+
+int tx_stream_add_reader(tx_stream* s) {
+  if (atomic_load(&s->head) || s->seq) return tx_set_error("%s: a reader must be added before the first push", s->name), -1;
+  if (s->readers == TX_STREAM_READERS_MAX)
+    return tx_set_error("%s: more than %d readers", s->name, TX_STREAM_READERS_MAX), -1;
+  return s->readers++;
+}
+
+uint64_t tx_stream_push(tx_stream* s, const tx_event* e) {
+  uint64_t head = atomic_load_explicit(&s->head, memory_order_relaxed); // only this thread stores it
+  uint64_t seq = ++s->seq;
+  for (int r = 0; r < s->readers; r++)
+    if (head - atomic_load_explicit(&s->tails[r].next, memory_order_acquire) > s->mask) {
+      atomic_fetch_add_explicit(&s->overflows, 1, memory_order_relaxed);
+      return 0;
+    }
+  tx_event* slot = &s->ring[head & s->mask];
+  *slot = *e;
+  slot->seq = seq;
+  atomic_store_explicit(&s->head, head + 1, memory_order_release);
+  return seq;
+}
+
+bool tx_stream_next(tx_stream* s, int reader, tx_event* out) {
+  if (reader < 0 || reader >= s->readers) return false;
+  tail* t = &s->tails[reader];
+  uint64_t next = atomic_load_explicit(&t->next, memory_order_relaxed); // only this reader stores it
+  if (next == atomic_load_explicit(&s->head, memory_order_acquire)) return false;
+  *out = s->ring[next & s->mask];
+  atomic_store_explicit(&t->next, next + 1, memory_order_release);
+  t->lost += out->seq - t->last_seq - 1; // dropped pushes used their seq numbers
+  t->last_seq = out->seq;
+  return true;
+}
+
+uint64_t tx_stream_pushed(const tx_stream* s) { return s->seq; }
+uint64_t tx_stream_overflows(const tx_stream* s) { return atomic_load(&((tx_stream*)s)->overflows); }
+uint64_t tx_stream_lost(const tx_stream* s, int reader) {
+  return reader >= 0 && reader < s->readers ? s->tails[reader].lost : 0;
+}
