@@ -235,10 +235,12 @@ static void a_controller_can_stop_the_run(void** state) {
     assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
     assert_true(r.halted);
     assert_string_equal(r.halt_reason, "stopper: disk full");
-    assert_true(fabs(r.halt_t_s - 0.020) < 1e-9);
-    // the stopper steps once more at most (the check is at the top of the loop)
-    assert_true(tx_system_stats(s, 0).steps <= 21);
-    if (!lock) assert_true(tx_mono_ns() - t0 < 2000000000); // not the whole 5 s
+    // lockstep: exactly at step 20 (t = 20 ms), and no step after it. In real
+    // time a late tick may be skipped, so step 20 may come at a later tick
+    if (lock) assert_true(fabs(r.halt_t_s - 0.020) < 1e-9);
+    else assert_true(r.halt_t_s >= 0.020 - 1e-9 && r.halt_t_s < 2);
+    assert_int_equal(tx_system_stats(s, 0).steps, 21);
+    if (!lock) assert_true(tx_mono_ns() - t0 < 3000000000); // not the whole 5 s
     tx_system_destroy(s);
   }
 }
