@@ -1,8 +1,9 @@
 // haptics: one device, rendered every tick from the published force model.
 //
-// Each tick: read the device; render F = F0 + K (x - x0) from the latest force
-// model (or hold F0, the papers' sample-and-hold); let the passivity
-// controller add damping if asked; pass the safety chain; write the force.
+// Each tick: read the device; observe the energy of the force sent last tick;
+// render F = F0 + K (x - x0) from the latest force model (or hold F0, the
+// papers' sample-and-hold); let the passivity controller add damping if
+// asked; pass the safety chain; write the force.
 // It publishes what the rest of the model needs from the device, and counts
 // every safety event as a warning of the run.
 #include "haptics_controller.h"
