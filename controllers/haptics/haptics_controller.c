@@ -86,7 +86,7 @@ static int configure(tx_setup* s, void** self) {
   if (bad) return tx_setup_fail(s, NULL, "safety limits: %s", bad);
   tx_safety_init(&h->safety);
 
-  if (*model) h->model = tx_setup_read_as(s, model, TX_F64, 15); // F0, x0, K
+  if (*model) h->model = tx_setup_read_expect(s, model, TX_F64, TX_FORCE_MODEL_COLS, TX_FORCE_MODEL_UNITS); // F0, x0, K
   if (*tool) h->tool = tx_setup_read_as(s, tool, TX_F64, 7);     // a pose: x y z, qw qx qy qz
   char name[TX_NAME_MAX];
   snprintf(name, sizeof name, "device%d.pose", hand);

@@ -337,6 +337,27 @@ static void a_model_that_stops_is_still_caught(void** state) {
   tx_scenario_free(s);
 }
 
+// a force model in centimetres is refused at load, naming both controllers and both units
+static int cm_configure(tx_setup* s, void** self) {
+  *self = NULL;
+  tx_setup_write(s, &(tx_component_def){"tool0.force_model", TX_F64, 1, 15, "N, cm, N/cm"});
+  return 0;
+}
+
+static void a_force_model_in_other_units_is_refused(void** state) {
+  (void)state;
+  static const tx_controller_class cm = {.type = "test.cm", .configure = cm_configure, .step = huge_step};
+  if (!tx_find_controller(cm.type)) assert_int_equal(tx_register_controller(&cm), 0);
+  const char* text = "{\"name\":\"t\",\"controllers\":["
+                     "{\"name\":\"cm\",\"type\":\"test.cm\",\"rate_hz\":100},"
+                     "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{"
+                     "\"device\":\"sim\",\"force_model\":\"tool0.force_model\"}}]}";
+  char err[512] = "";
+  assert_null(tx_scenario_load_text("test", text, strlen(text), NULL, err, sizeof err));
+  if (!strstr(err, "haptics reads 'tool0.force_model' in units \"N, m, N/m\", but cm writes it in \"N, cm, N/cm\""))
+    fail_msg("%s", err);
+}
+
 int main(void) {
   tx_register_builtin();
   const struct CMUnitTest tests[] = {
@@ -351,6 +372,7 @@ int main(void) {
       cmocka_unit_test(the_observer_sums_the_force_sent),
       cmocka_unit_test(a_huge_force_gives_a_bounded_energy),
       cmocka_unit_test(a_model_that_stops_is_still_caught),
+      cmocka_unit_test(a_force_model_in_other_units_is_refused),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
