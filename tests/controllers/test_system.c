@@ -272,7 +272,8 @@ static void misused_writes_stop_the_run(void** state) {
       assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
       assert_true(r.halted);
       assert_string_equal(r.halt_reason, want[how]);
-      assert_true(fabs(r.halt_t_s - 0.03) < 1e-9);
+      // step 3 is at 30 ms; in real time a late tick may be skipped, never an early one taken
+      assert_true(lock ? fabs(r.halt_t_s - 0.03) < 1e-9 : r.halt_t_s > 0.03 - 1e-9);
       uint64_t bad = 0, clamped = 0;
       for (int w = 0; w < tx_system_warnings(s); w++) {
         if (strcmp(tx_system_warning_key(s, w), "plugin.bad_port") == 0) bad = tx_system_warning_count(s, w);
