@@ -10,28 +10,53 @@ static port* port_of(tx_ctx* c, tx_port p, bool write) {
   return pt->write == write ? pt : NULL;
 }
 
+// a write to a port the instance never declared: a bug in the controller.
+// Counted and the run stopped with the reason, never a silent NULL; no
+// allocation here (snprintf into the stack), so the haptic path stays safe.
+static port* write_port(tx_ctx* c, tx_port p, const char* call) {
+  port* pt = port_of(c, p, true);
+  if (pt) return pt;
+  tx_warn(c, c->in->bad_port);
+  char why[TX_NAME_MAX + 160];
+  if (p.id >= 1 && p.id <= c->in->nports)
+    snprintf(why, sizeof why, "%s on port %u ('%s'), which it declared as a read, not a write", call, p.id,
+             c->in->ports[p.id - 1].name);
+  else
+    snprintf(why, sizeof why, "%s on port %u, which it never declared (it has %d ports)", call, p.id, c->in->nports);
+  tx_stop_run(c, why);
+  return NULL;
+}
+
 tx_snapshot tx_read(tx_ctx* c, tx_port p) {
   port* pt = port_of(c, p, false);
   return pt ? tx_model_acquire(c->sys->model, pt->reader) : (tx_snapshot){0};
 }
 
 void* tx_write(tx_ctx* c, tx_port p) {
-  port* pt = port_of(c, p, true);
+  port* pt = write_port(c, p, "tx_write");
   if (!pt) return NULL;
   pt->dirty = true;
   return tx_model_back(c->sys->model, pt->comp);
 }
 
 void* tx_write_copy(tx_ctx* c, tx_port p) {
-  port* pt = port_of(c, p, true);
+  port* pt = write_port(c, p, "tx_write_copy");
   if (!pt) return NULL;
   pt->dirty = true;
   return tx_model_back_copy(c->sys->model, pt->comp);
 }
 
 void tx_write_rows(tx_ctx* c, tx_port p, uint32_t rows) {
-  port* pt = port_of(c, p, true);
-  if (pt) tx_model_set_rows(c->sys->model, pt->comp, rows);
+  port* pt = write_port(c, p, "tx_write_rows");
+  if (!pt) return;
+  if (rows > pt->def.rows) { // the rest would be lost without a word
+    tx_warn(c, c->in->rows_clamped);
+    char why[TX_NAME_MAX + 160];
+    snprintf(why, sizeof why, "tx_write_rows(%u) on '%s', beyond its capacity of %u rows", rows, pt->name,
+             pt->def.rows);
+    tx_stop_run(c, why);
+  }
+  tx_model_set_rows(c->sys->model, pt->comp, rows); // still clamped, so no reader looks past the buffer
 }
 
 int64_t tx_sim_ns(const tx_ctx* c) { return c->sim_ns; }

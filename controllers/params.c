@@ -135,10 +135,17 @@ tx_port tx_setup_write(tx_setup* s, const tx_component_def* def) {
 tx_port tx_setup_read(tx_setup* s, const char* component) { return tx_setup_read_as(s, component, (tx_type)0, 0); }
 
 tx_port tx_setup_read_as(tx_setup* s, const char* component, tx_type type, uint32_t cols) {
+  return tx_setup_read_expect(s, component, type, cols, NULL);
+}
+
+tx_port tx_setup_read_expect(tx_setup* s, const char* component, tx_type type, uint32_t cols, const char* units) {
+  if (units && strlen(units) >= TX_UNITS_MAX)
+    return tx_setup_fail(s, NULL, "%s: units '%s' too long", component ? component : "", units), (tx_port){0};
   port* p = new_port(s, component, false);
   if (!p) return (tx_port){0};
   p->want_type = type;
   p->want_cols = cols;
+  if (units) strcpy(p->want_units, units);
   return (tx_port){(uint16_t)s->in->nports};
 }
 

@@ -203,17 +203,29 @@ int tx_system_finalize(tx_system* s, tx_fault* f) {
     for (int p = 0; p < in->nports; p++) {
       const port* pt = &in->ports[p];
       if (pt->write) continue;
-      const tx_component_def* d = writer_def(s, pt->name, NULL);
+      int w = -1;
+      const tx_component_def* d = writer_def(s, pt->name, &w);
       if ((pt->want_type && d->type != pt->want_type) || (pt->want_cols && d->cols != pt->want_cols))
         return fault(f, in->name, "reads '%s' as %s x %u, but it is written as %s %ux%u", pt->name,
                      pt->want_type ? tx_type_name(pt->want_type) : "any", pt->want_cols, tx_type_name(d->type), d->rows,
                      d->cols);
+      if (*pt->want_units && strcmp(d->units, pt->want_units) != 0)
+        return fault(f, in->name, "%s reads '%s' in units \"%s\", but %s writes it in \"%s\"", in->name, pt->name,
+                     pt->want_units, s->inst[w]->name, d->units);
     }
   }
   // declared components need a writer too, or nothing could ever fill them
   for (int d = 0; d < s->ndeclared; d++)
     if (!writer_def(s, s->declared[d].name, NULL))
       return fault(f, "", "model component '%s' has no writer", s->declared[d].name);
+
+  // every instance may misuse tx_write or tx_write_rows at run time: counted (context.c)
+  for (int i = 0; i < s->count; i++) {
+    instance* in = s->inst[i];
+    in->bad_port = tx_setup_warning(&in->setup, "bad_port");
+    in->rows_clamped = tx_setup_warning(&in->setup, "rows_clamped");
+    if (in->failed) return *f = in->fault, -1;
+  }
 
   s->model = tx_model_create();
   if (!s->model) return fault(f, "", "out of memory");

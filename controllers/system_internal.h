@@ -17,6 +17,7 @@ typedef struct port {
   tx_reader reader;     // reads: this instance's hazard slot
   tx_type want_type;    // reads: the element type needed, 0 for any
   uint32_t want_cols;   // reads: values per row needed, 0 for any
+  char want_units[TX_UNITS_MAX]; // reads: units needed, "" for any
   bool dirty;           // written during the current step
 } port;
 
@@ -50,6 +51,7 @@ struct instance {
   int group;
   tx_setup setup;
   tx_ctx ctx;
+  tx_warning bad_port, rows_clamped; // misuse of tx_write / tx_write_rows (context.c)
   tx_hist jitter, step_time; // whole-run statistics in fixed memory
   uint64_t steps, missed;
   int64_t first_start_ns, last_start_ns;

@@ -1,8 +1,9 @@
 // haptics: one device, rendered every tick from the published force model.
 //
-// Each tick: read the device; render F = F0 + K (x - x0) from the latest force
-// model (or hold F0, the papers' sample-and-hold); let the passivity
-// controller add damping if asked; pass the safety chain; write the force.
+// Each tick: read the device; observe the energy of the force sent last tick;
+// render F = F0 + K (x - x0) from the latest force model (or hold F0, the
+// papers' sample-and-hold); let the passivity controller add damping if
+// asked; pass the safety chain; write the force.
 // It publishes what the rest of the model needs from the device, and counts
 // every safety event as a warning of the run.
 #include "haptics_controller.h"
@@ -34,7 +35,9 @@ typedef struct haptics {
   tx_warning warn[W_COUNT];
   tx_result energy_result, dissipated_result, min_energy_result;
   tx_device_state state;         // last sample
-  double held[3];                // N, the environment force rendered last tick, held since
+  double held[3];                // N, the force sent last tick, held since
+  double damping;                // N s/m, the passivity controller's damping in last tick's force
+  double damped_vel[3];          // m/s, the velocity that damping was computed for
   double silent_s;               // since the last sample
   int hand;
   bool record;                   // when the run keeps recordings
@@ -83,7 +86,7 @@ static int configure(tx_setup* s, void** self) {
   if (bad) return tx_setup_fail(s, NULL, "safety limits: %s", bad);
   tx_safety_init(&h->safety);
 
-  if (*model) h->model = tx_setup_read_as(s, model, TX_F64, 15); // F0, x0, K
+  if (*model) h->model = tx_setup_read_expect(s, model, TX_F64, TX_FORCE_MODEL_COLS, TX_FORCE_MODEL_UNITS); // F0, x0, K
   if (*tool) h->tool = tx_setup_read_as(s, tool, TX_F64, 7);     // a pose: x y z, qw qx qy qz
   char name[TX_NAME_MAX];
   snprintf(name, sizeof name, "device%d.pose", hand);
@@ -160,32 +163,44 @@ static void step(tx_ctx* c, void* self) {
     memcpy(fm.f0, m, sizeof fm.f0);
     memcpy(fm.x0, m + 3, sizeof fm.x0);
     memcpy(fm.k, m + 6, sizeof fm.k);
-    tx_render_force(&fm, h->mode, h->state.pos, f);
     memcpy(h->rec.force_model, m, sizeof h->rec.force_model);
-    model_age = snap.seq ? (double)(tx_sim_ns(c) - snap.sim_ns) * 1e-9 : INFINITY; // no model yet: no force
+    // seq 0: never published yet (the first tick runs before collision), so
+    // there is nothing to render and nothing stale to warn about
+    if (snap.seq) {
+      tx_render_force(&fm, h->mode, h->state.pos, f);
+      model_age = (double)(tx_sim_ns(c) - snap.sim_ns) * 1e-9;
+    }
   } else if (h->tool.id) {
     // virtual coupling: a spring-damper pulls the device toward the simulated
     // tool, which the physics moves; the tool's pose is x y z (then orientation)
     tx_snapshot snap = tx_read(c, h->tool);
     const double still[3] = {0, 0, 0};
-    tx_render_coupling(h->coupling_k, h->coupling_b, snap.data, still, h->state.pos, h->state.vel, f);
-    model_age = snap.seq ? (double)(tx_sim_ns(c) - snap.sim_ns) * 1e-9 : INFINITY;
+    if (snap.seq) {
+      tx_render_coupling(h->coupling_k, h->coupling_b, snap.data, still, h->state.pos, h->state.vel, f);
+      model_age = (double)(tx_sim_ns(c) - snap.sim_ns) * 1e-9;
+    }
   }
   // the observer pairs the velocity of the period just measured with the
-  // force held over it (this tick's force would make a sampled spring look
-  // passive); the controller then damps the force about to be rendered
-  double held[3] = {h->held[0], h->held[1], h->held[2]};
-  bool finite = true; // a broken sample must not poison the energy for the rest of the run
-  for (int i = 0; i < 3; i++) finite = finite && isfinite(held[i]) && isfinite(h->state.vel[i]) && isfinite(f[i]);
-  double alpha = finite ? tx_passivity_tick(&h->passivity, held, h->state.vel, dt, h->passivity_control) : 0;
+  // force sent and held over it, after every safety stage (this tick's force
+  // would make a sampled spring look passive; the force before the safety
+  // chain is not what the hand felt)
+  const double* v = h->state.vel;
+  tx_passivity_observe(&h->passivity, h->held, v, dt);
+  double v_dot = h->damped_vel[0] * v[0] + h->damped_vel[1] * v[1] + h->damped_vel[2] * v[2];
+  if (isfinite(v_dot)) h->passivity.dissipated += h->damping * v_dot * dt; // last tick's damping, over this period
+  // the controller damps the force about to be rendered; the safety chain
+  // after it still bounds what is sent, and the observer measures that
+  double alpha = h->passivity_control ? tx_passivity_damping(&h->passivity, v, dt, h->limits.max_force) : 0;
   for (int i = 0; i < 3; i++) {
-    h->held[i] = f[i];
-    f[i] -= alpha * h->state.vel[i];
+    f[i] -= alpha * v[i];
+    h->damped_vel[i] = alpha ? v[i] : 0;
   }
+  h->damping = alpha;
   tx_safety_counts before = h->safety.counts;
   double out[3];
   tx_safety_apply(&h->safety, &h->limits, dt, f, h->state.pos, model_age, h->silent_s, out);
   warn_new(c, h, &before);
+  memcpy(h->held, out, sizeof h->held);
   h->device.backend->write(h->device.device, out);
   publish(c, h, out);
   if (h->recorder) {

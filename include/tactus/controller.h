@@ -72,6 +72,9 @@ tx_port tx_setup_read(tx_setup* s, const char* component);
 // a read that needs this element type and this many values per row (0: any);
 // the loader rejects a writer of another schema
 tx_port tx_setup_read_as(tx_setup* s, const char* component, tx_type type, uint32_t cols);
+// the same, and in these units (as the writer spells them, e.g. "N, m, N/m";
+// NULL for any): the loader rejects a writer of other units, naming both
+tx_port tx_setup_read_expect(tx_setup* s, const char* component, tx_type type, uint32_t cols, const char* units);
 tx_warning tx_setup_warning(tx_setup* s, const char* key); // reported as "INSTANCE.key"
 tx_result tx_setup_result(tx_setup* s, const char* key);   // reported as "INSTANCE.key"; put the units in the key
 
@@ -88,6 +91,10 @@ int tx_setup_fail(tx_setup* s, const char* key, const char* fmt, ...)
 
 // run time, from init and step
 tx_snapshot tx_read(tx_ctx* c, tx_port p);           // latest publish; held until the next tx_read
+// tx_write and tx_write_copy return NULL for a port this instance did not
+// declare with tx_setup_write; tx_write_rows keeps at most the declared rows.
+// Either misuse counts the warning "INSTANCE.bad_port" or
+// "INSTANCE.rows_clamped" and stops the run, naming the instance and the port.
 void* tx_write(tx_ctx* c, tx_port p);                // back buffer, published after step
 void* tx_write_copy(tx_ctx* c, tx_port p);           // same, starting from the latest publish
 void tx_write_rows(tx_ctx* c, tx_port p, uint32_t rows); // rows in use for this publish

@@ -32,12 +32,22 @@ typedef struct tx_device_info {
   double workspace_max[3]; // m
 } tx_device_info;
 
-// F = f0 + k (x - x0): published by collision, rendered by haptics
+// F = f0 + k (x - x0): published by collision, rendered by haptics. The
+// component is f64, 1 x TX_FORCE_MODEL_COLS, in units TX_FORCE_MODEL_UNITS;
+// the haptics controller reads it with tx_setup_read_expect, so a writer of
+// another layout or other units is refused when the scenario is loaded.
 typedef struct tx_force_model {
   double f0[3]; // N, the force at x0
   double x0[3]; // m, where f0 was computed
   double k[9];  // N/m, row-major dF/dx; a spring wall with normal n is -k n n^T
 } tx_force_model;
+#define TX_FORCE_MODEL_COLS 15
+#define TX_FORCE_MODEL_UNITS "N, m, N/m"
+#ifdef __cplusplus
+static_assert(sizeof(tx_force_model) == TX_FORCE_MODEL_COLS * sizeof(double), "tx_force_model is 15 doubles");
+#else
+_Static_assert(sizeof(tx_force_model) == TX_FORCE_MODEL_COLS * sizeof(double), "tx_force_model is 15 doubles");
+#endif
 
 #ifdef __cplusplus
 }

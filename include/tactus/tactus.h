@@ -3,11 +3,14 @@
 // tactus is an extended Model-View-Controller framework for haptic surgical
 // simulation. The model (tactus/model.h) is a set of double-buffered
 // components; controllers (tactus/controller.h) change it, each on a thread
-// at its own rate; views only read it. See docs/architecture.md.
+// at its own rate; views only read it (tactus/haptics.h: the force model a
+// controller publishes for the haptics controller to render on a device).
+// See docs/architecture.md.
 #ifndef TACTUS_H
 #define TACTUS_H
 
 #include <tactus/controller.h>
+#include <tactus/haptics.h>
 #include <tactus/model.h>
 
 #define TX_VERSION "0.1.0"

@@ -181,6 +181,114 @@ static void groups_follow_rates_fastest_first(void** state) {
   tx_system_destroy(s);
 }
 
+// a reader that expects units: a writer of other units is refused at load,
+// and the message names both controllers and both units
+static int units_configure(tx_setup* s, void** self) {
+  *self = NULL;
+  tx_setup_read_expect(s, "x", TX_F64, 2, tx_param_str(s, "units", "m"));
+  return 0;
+}
+
+static void reads_get_the_units_they_expect(void** state) {
+  (void)state;
+  static const tx_controller_class cls = {.type = "test.units", .configure = units_configure, .step = picky_step};
+  if (!tx_find_controller(cls.type)) assert_int_equal(tx_register_controller(&cls), 0);
+  tx_system* s = tx_system_create();
+  int rc;
+  add(s, "writer", 10, "{\"write\":\"x\"}", &rc); // the counter writes x in "1"
+  tx_fault f;
+  assert_int_equal(tx_system_add(s, "reader", "test.units", 10, NULL, &f), 0);
+  assert_int_equal(tx_system_finalize(s, &f), -1);
+  assert_string_equal(f.key, "reader");
+  assert_string_equal(f.message, "reader reads 'x' in units \"m\", but writer writes it in \"1\"");
+  tx_system_destroy(s);
+
+  // the same units pass
+  s = tx_system_create();
+  add(s, "writer", 10, "{\"write\":\"x\"}", &rc);
+  json_t* p = params("{\"units\":\"1\"}");
+  assert_int_equal(tx_system_add(s, "reader", "test.units", 10, p, &f), 0);
+  json_decref(p);
+  assert_int_equal(tx_system_finalize(s, &f), 0);
+  tx_system_destroy(s);
+}
+
+// a controller that misuses the write calls, as a plugin might: "how" picks the mistake
+typedef struct misuse {
+  tx_port out, in;
+  int how;
+} misuse;
+
+static int misuse_configure(tx_setup* s, void** self) {
+  misuse* m = calloc(1, sizeof *m);
+  *self = m;
+  m->how = (int)tx_param_int(s, "how", 0, 0, 3);
+  m->out = tx_setup_write(s, &(tx_component_def){"rows", TX_F64, 4, 1, "1"});
+  m->in = tx_setup_read(s, "x");
+  return 0;
+}
+
+static void misuse_step(tx_ctx* c, void* self) {
+  misuse* m = self;
+  if (tx_step_index(c) < 3) return; // fine at first
+  double* p = NULL;
+  switch (m->how) {
+  case 0: p = tx_write(c, m->in); break;             // its read port
+  case 1: p = tx_write(c, (tx_port){42}); break;     // never declared
+  case 2: p = tx_write_copy(c, (tx_port){0}); break; // the invalid port
+  case 3: tx_write(c, m->out), tx_write_rows(c, m->out, 5); return; // one row beyond the four it declared
+  }
+  if (p) p[0] = 1; // never: a bad port gives NULL
+}
+
+static void misuse_fini(void* self) { free(self); }
+
+static void misused_writes_stop_the_run(void** state) {
+  (void)state;
+  static const tx_controller_class cls = {.type = "test.misuse", .configure = misuse_configure, .step = misuse_step,
+                                          .fini = misuse_fini};
+  if (!tx_find_controller(cls.type)) assert_int_equal(tx_register_controller(&cls), 0);
+  const char* want[] = {
+      "plugin: tx_write on port 2 ('x'), which it declared as a read, not a write",
+      "plugin: tx_write on port 42, which it never declared (it has 2 ports)",
+      "plugin: tx_write_copy on port 0, which it never declared (it has 2 ports)",
+      "plugin: tx_write_rows(5) on 'rows', beyond its capacity of 4 rows",
+  };
+  for (int how = 0; how < 4; how++) {
+    for (int lock = 1; lock >= 0; lock--) {
+      tx_system* s = tx_system_create();
+      int rc;
+      add(s, "writer", 100, "{\"write\":\"x\"}", &rc);
+      char text[32];
+      snprintf(text, sizeof text, "{\"how\":%d}", how);
+      json_t* p = params(text);
+      tx_fault f;
+      assert_int_equal(tx_system_add(s, "plugin", "test.misuse", 100, p, &f), 0);
+      json_decref(p);
+      assert_int_equal(tx_system_finalize(s, &f), 0);
+      tx_run_options o = {.duration_s = 2, .lockstep = lock};
+      tx_run_result r;
+      char err[256];
+      assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+      assert_true(r.halted);
+      assert_string_equal(r.halt_reason, want[how]);
+      // step 3 is at 30 ms; in real time a late tick may be skipped, never an early one taken
+      assert_true(lock ? fabs(r.halt_t_s - 0.03) < 1e-9 : r.halt_t_s > 0.03 - 1e-9);
+      uint64_t bad = 0, clamped = 0;
+      for (int w = 0; w < tx_system_warnings(s); w++) {
+        if (strcmp(tx_system_warning_key(s, w), "plugin.bad_port") == 0) bad = tx_system_warning_count(s, w);
+        if (strcmp(tx_system_warning_key(s, w), "plugin.rows_clamped") == 0) clamped = tx_system_warning_count(s, w);
+      }
+      assert_true(how == 3 ? (bad == 0 && clamped >= 1) : (bad >= 1 && clamped == 0));
+      if (how == 3) { // still clamped, so no reader looks past the buffer
+        tx_model* m = tx_system_model(s);
+        assert_int_equal(tx_model_latest(m, tx_model_find(m, "rows")).rows, 4);
+      }
+      tx_system_destroy(s);
+    }
+  }
+}
+
 int main(void) {
   register_test_classes();
   const struct CMUnitTest tests[] = {
@@ -189,6 +297,8 @@ int main(void) {
       cmocka_unit_test(unknown_and_unwritten_reads_are_rejected),
       cmocka_unit_test(declared_schema_must_match),
       cmocka_unit_test(reads_get_the_schema_they_need),
+      cmocka_unit_test(reads_get_the_units_they_expect),
+      cmocka_unit_test(misused_writes_stop_the_run),
       cmocka_unit_test(parameters_are_checked),
       cmocka_unit_test(names_and_types_are_checked),
       cmocka_unit_test(registry_rejects_bad_classes),
