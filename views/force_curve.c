@@ -106,7 +106,7 @@ static void finish(tx_ctx* ctx, void* self) {
     return;
   }
   if (!c->png) return;
-  // the papers' plot: force along the axis (N) against the position along it (cm)
+  // the papers' plot: force along the axis (N) against the position along it, in the plots' length unit
   double* xs = malloc(sizeof(double) * c->n);
   double* ys = malloc(sizeof(double) * c->n);
   if (!xs || !ys) {
@@ -114,11 +114,11 @@ static void finish(tx_ctx* ctx, void* self) {
     return;
   }
   for (uint64_t i = 0; i < c->n; i++) {
-    xs[i] = 100.0 * c->rows[COLS * i + 1 + c->axis];
+    xs[i] = tx_plot_length(c->rows[COLS * i + 1 + c->axis]);
     ys[i] = c->rows[COLS * i + 4 + c->axis];
   }
   char xl[64], yl[64];
-  snprintf(xl, sizeof xl, "HIP %c (cm)", 'x' + c->axis);
+  snprintf(xl, sizeof xl, "HIP %c (" TX_PLOT_LENGTH_UNIT ")", 'x' + c->axis);
   snprintf(yl, sizeof yl, "force F%c on the device (N)", 'x' + c->axis);
   tx_plot_series s = {"force", xs, ys, (int)(c->n > 2147483647u ? 2147483647u : c->n), false, 1};
   tx_plot p = {"force against displacement", xl, yl, false, false, &s, 1};

@@ -5,12 +5,13 @@
 // (skin.torn); it writes nothing. When the run ends it leaves, in the run's
 // folder, NAME.csv (t_s, x y z m, fx fy fz N, contacts, pierced, torn,
 // skin_t_s: the time of the skin publish the force was computed on) and
-// NAME.png, the force along `axis` against the position along it in cm (the
-// suturing papers' plots). Parameters: pose, force, state ("" for none),
-// torn ("" for none), axis (x, y or z), file (default force_displacement),
-// max_samples (the recording stops, with a warning, when it is full), png
-// (false: the CSV only; the PNG goes through PLplot and cairo, whose font
-// threads ThreadSanitizer cannot see into).
+// NAME.png, the force along `axis` against the position along it in mm, the
+// length unit of every plot (the suturing papers' plots, which use cm).
+// Parameters: pose, force, state ("" for none), torn ("" for none), axis (x, y
+// or z), file (default force_displacement), max_samples (the recording stops,
+// with a warning, when it is full), png (false: the CSV only; the PNG goes
+// through PLplot and cairo, whose font threads ThreadSanitizer cannot see
+// into).
 #ifndef TX_VIEWS_FORCE_CURVE_H
 #define TX_VIEWS_FORCE_CURVE_H
 

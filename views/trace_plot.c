@@ -106,13 +106,13 @@ int tx_trace_plot_png(const char* csv, const char* png, char* err, size_t n) {
   for (int i = 0; i < t.n; i++) {
     mag[i] = sqrt(t.f[0][i] * t.f[0][i] + t.f[1][i] * t.f[1][i] + t.f[2][i] * t.f[2][i]);
     for (int k = 0; k < 3; k++) {
-      mm[k][i] = t.p[k][i] * 1e3;
+      mm[k][i] = tx_plot_length(t.p[k][i]);
       reach[k] = fmax(reach[k], fabs(t.p[k][i] - t.p[k][0]));
     }
   }
   for (int k = 1; k < 3; k++)
     if (reach[k] > reach[axis]) axis = k;
-  for (int i = 0; i < t.n; i++) disp[i] = (t.p[axis][i] - t.p[axis][0]) * 1e3;
+  for (int i = 0; i < t.n; i++) disp[i] = tx_plot_length(t.p[axis][i] - t.p[axis][0]);
   static const char* const xyz[3] = {"x", "y", "z"};
   tx_plot_series force[] = {{"F_x", t.t, t.f[0], t.n, false, 1}, {"F_y", t.t, t.f[1], t.n, false, 2},
                             {"F_z", t.t, t.f[2], t.n, false, 3}, {"|F|", t.t, mag, t.n, false, 15}};
@@ -121,12 +121,12 @@ int tx_trace_plot_png(const char* csv, const char* png, char* err, size_t n) {
   char flabel[32], dlabel[64], ftitle[64];
   snprintf(flabel, sizeof flabel, "F_%s", xyz[axis]);
   tx_plot_series fd[] = {{flabel, disp, t.f[axis], t.n, false, 4}};
-  snprintf(dlabel, sizeof dlabel, "tool displacement along %s (mm)", xyz[axis]);
+  snprintf(dlabel, sizeof dlabel, "tool displacement along %s (" TX_PLOT_LENGTH_UNIT ")", xyz[axis]);
   snprintf(ftitle, sizeof ftitle, "(c) force against displacement");
   char ylabel[32];
   snprintf(ylabel, sizeof ylabel, "force F_%s (N)", xyz[axis]);
   tx_plot panels[3] = {{"(a) force sent to the device", "time t (s)", "force (N)", false, false, force, 4},
-                       {"(b) tool position", "time t (s)", "position (mm)", false, false, pos, 3},
+                       {"(b) tool position", "time t (s)", "position (" TX_PLOT_LENGTH_UNIT ")", false, false, pos, 3},
                        {ftitle, dlabel, ylabel, false, false, fd, 1}};
   rc = tx_plot_png_panels(png, panels, 3, 3, err, n);
 done:

@@ -197,7 +197,7 @@ static int write_plot(const char* dir, const row* rows, char* err, size_t en) {
   }
   char path[4200];
   snprintf(path, sizeof path, "%s/skin-accuracy.png", dir);
-  tx_plot p = {"Skin force error vs run time (pierce-down; ref. 0.1 cm, 20 it, 120 Hz)",
+  tx_plot p = {"Skin force error vs run time (pierce-down; ref. spacing 1 mm, 20 it, 120 Hz)",
                "run time (CPU s per simulated s)", "RMS force error (% of the reference peak)",
                true, true, s, ns};
   return tx_plot_png(path, &p, err, en);

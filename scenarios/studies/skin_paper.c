@@ -172,6 +172,23 @@ static int run_case(const tx_study_args* a, const char* motions_dir, const skin_
   return 0;
 }
 
+// a case's label for a plot: its lengths ("radius 0.05 cm") in the plots' unit
+static void label_in_plot_unit(const char* in, char* out, size_t n) {
+  size_t o = 0;
+  while (*in && o + 1 < n) {
+    char* end;
+    double v = strtod(in, &end);
+    if (end != in && (in[0] == '.' || (in[0] >= '0' && in[0] <= '9')) && strncmp(end, " cm", 3) == 0) {
+      int w = snprintf(out + o, n - o, "%g " TX_PLOT_LENGTH_UNIT, tx_plot_length(v / 100));
+      if (w < 0 || (size_t)w >= n - o) break;
+      o += (size_t)w;
+      in = end + 3;
+    } else
+      out[o++] = *in++;
+  }
+  out[o] = 0;
+}
+
 // EXPERIMENT.csv and EXPERIMENT.png from the cases [first, last)
 static int write_experiment(const char* dir, const char* name, run_data** runs, int first, int last, char* err,
                             size_t en) {
@@ -188,23 +205,53 @@ static int write_experiment(const char* dir, const char* name, run_data** runs, 
               d->pos[1][i], d->pos[2][i], d->f[0][i], d->f[1][i], d->f[2][i], d->contacts[i], d->pierced[i], d->torn[i]);
   }
   if (fclose(f) != 0 || rename(tmp, path) != 0) return remove(tmp), snprintf(err, en, "%.900s: cannot be written", path), -1;
-  // force against position in cm: along y for piercing; for sliding the tangential force along the slide
+  // force against position: along y for piercing; for sliding the tangential force along the slide
   tx_plot_series s[8];
   static double xs[8][TICKS_MAX];
+  static char labels[8][96];
+  bool slide[8];
   int ns = 0;
-  bool slide = runs[first]->slide_axis >= 0;
   for (int c = first; c < last && ns < 8; c++, ns++) {
     const run_data* d = runs[c];
     int ax = d->slide_axis >= 0 ? d->slide_axis : 1;
-    for (int i = 0; i < d->n; i++) xs[ns][i] = 100 * d->pos[ax][i];
-    s[ns] = (tx_plot_series){cases[c].label, xs[ns], d->f[ax], d->n, false, 1 + ns};
+    for (int i = 0; i < d->n; i++) xs[ns][i] = tx_plot_length(d->pos[ax][i]);
+    label_in_plot_unit(cases[c].label, labels[ns], sizeof labels[ns]);
+    s[ns] = (tx_plot_series){labels[ns], xs[ns], d->f[ax], d->n, false, 1 + ns};
+    slide[ns] = d->slide_axis >= 0;
   }
-  char title[128];
-  snprintf(title, sizeof title, "skin-paper: %s", name);
-  tx_plot p = {title, slide ? "HIP position along the slide (cm)" : "HIP y (cm)",
-               slide ? "tangential force on the device (N)" : "force Fy on the device (N)", false, false, s, ns};
+  // piercing and sliding have different x axes: a panel each. Curves that
+  // coincide (the four slides are symmetric) would hide one another: then
+  // each case of that kind gets a panel of its own, which says so.
+  tx_plot panels[8];
+  static char titles[8][160];
+  int np = 0;
+  for (int kind = 0; kind < 2; kind++) {
+    int members[8], nm = 0;
+    bool coincide = false;
+    for (int i = 0; i < ns; i++)
+      if (slide[i] == (kind == 1)) {
+        for (int k = 0; k < nm; k++) coincide |= tx_plot_series_coincide(&s[members[k]], &s[i]);
+        members[nm++] = i;
+      }
+    if (!nm) continue;
+    const char* xl = kind ? "HIP position along the slide (" TX_PLOT_LENGTH_UNIT ")" : "HIP y (" TX_PLOT_LENGTH_UNIT ")";
+    const char* yl = kind ? "tangential force on the device (N)" : "force Fy on the device (N)";
+    for (int k = 0; k < (coincide ? nm : 1); k++) {
+      panels[np] = (tx_plot){titles[np], xl, yl, false, false, coincide ? &s[members[k]] : &s[members[0]], coincide ? 1 : nm};
+      int same = -1;
+      for (int j = 0; coincide && j < k && same < 0; j++)
+        if (tx_plot_series_coincide(&s[members[j]], &s[members[k]])) same = members[j];
+      snprintf(titles[np], sizeof titles[np], "%s: %s%s%s%s", name, coincide ? s[members[k]].label : kind ? "sliding" : "piercing",
+               same >= 0 ? " (the same curve as " : "", same >= 0 ? s[same].label : "", same >= 0 ? ")" : "");
+      np++;
+    }
+  }
   snprintf(path, sizeof path, "%s/%s.png", dir, name);
-  return tx_plot_png(path, &p, err, en);
+  if (np == 1) {
+    snprintf(titles[0], sizeof titles[0], "skin-paper: %s", name);
+    return tx_plot_png(path, &panels[0], err, en);
+  }
+  return tx_plot_png_panels(path, panels, np, 2, err, en);
 }
 
 static bool check(const char* what, bool ok, const char* fmt, ...) __attribute__((format(printf, 3, 4)));

@@ -84,7 +84,7 @@ static void on_key(GLFWwindow* w, int key, int scancode, int action, int mods) {
   publish(t);
 }
 
-static GLFWwindow* make(int width, int height, bool quad) {
+static GLFWwindow* make(int width, int height, bool quad, bool visible) {
   glfwDefaultWindowHints();
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
@@ -92,7 +92,20 @@ static GLFWwindow* make(int width, int height, bool quad) {
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
   glfwWindowHint(GLFW_STEREO, quad ? GLFW_TRUE : GLFW_FALSE);
   glfwWindowHint(GLFW_RESIZABLE, GLFW_TRUE);
+  glfwWindowHint(GLFW_VISIBLE, visible ? GLFW_TRUE : GLFW_FALSE);
   return glfwCreateWindow(width, height, "tactus", NULL, NULL);
+}
+
+tx_window_lack tx_window_probe(bool need_quad, char* err, size_t n) {
+  glfwSetErrorCallback(on_error);
+  glfw_error[0] = 0;
+  if (!glfwInit()) return snprintf(err, n, "cannot open the display (GLFW: %s)", glfw_error), TX_WINDOW_NO_DISPLAY;
+  if (!need_quad) return TX_WINDOW_OK;
+  // a hidden window with quad buffers, made and closed at once: the answer is the driver's
+  GLFWwindow* w = make(16, 16, true, false);
+  if (!w) return snprintf(err, n, "the display's GL has no quad-buffered stereo (GLFW: %s)", glfw_error), TX_WINDOW_NO_QUAD;
+  glfwDestroyWindow(w);
+  return TX_WINDOW_OK;
 }
 
 tx_window* tx_window_open(int width, int height, bool want_quad, char* err, size_t n) {
@@ -101,8 +114,8 @@ tx_window* tx_window_open(int width, int height, bool want_quad, char* err, size
   tx_window* t = calloc(1, sizeof *t);
   if (!t) return snprintf(err, n, "out of memory"), NULL;
   // quad buffers where the driver has them; otherwise the chosen mode in a plain window
-  if (want_quad && (t->w = make(width, height, true))) t->quad = true;
-  else t->w = make(width, height, false);
+  if (want_quad && (t->w = make(width, height, true, true))) t->quad = true;
+  else t->w = make(width, height, false, true);
   if (!t->w) {
     free(t);
     return snprintf(err, n, "no window: GLFW: %s", glfw_error), NULL;

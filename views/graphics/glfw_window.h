@@ -6,7 +6,7 @@
 //   arrow keys, W A S D         x and z in steps
 //   space                       button 0 (held)
 //   Esc or closing the window   ends the run (as Ctrl-C does)
-// GLFW is used from the view's rendering thread only.
+// GLFW is used from the view's rendering thread, after the probe at load.
 #ifndef TX_VIEWS_GRAPHICS_GLFW_WINDOW_H
 #define TX_VIEWS_GRAPHICS_GLFW_WINDOW_H
 
@@ -17,6 +17,11 @@
 
 typedef struct tx_window tx_window;
 
+typedef enum tx_window_lack { TX_WINDOW_OK, TX_WINDOW_NO_DISPLAY, TX_WINDOW_NO_QUAD } tx_window_lack;
+// at load time, before the run writes anything: whether the display opens and,
+// with need_quad, offers a quad-buffered GL context; a message when not.
+// GLFW stays initialised, as after tx_window_open.
+tx_window_lack tx_window_probe(bool need_quad, char* err, size_t n);
 // NULL and a one-line message when no window can be made
 tx_window* tx_window_open(int width, int height, bool want_quad, char* err, size_t n);
 void tx_window_close(tx_window* w);

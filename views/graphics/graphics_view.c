@@ -123,6 +123,17 @@ static int configure(tx_setup* s, void** self) {
 #endif
 #if !TX_WITH_GLFW
   if (v->target == TARGET_WINDOW) return tx_setup_fail(s, "target", "this build has no GLFW (TX_WITH_GLFW=OFF)");
+#else
+  // a display that cannot be opened, or lr without quad buffers (a window shows one
+  // image; lr's two need GL_BACK_LEFT and GL_BACK_RIGHT), is bad input found at load,
+  // before the run has made a folder or a recording
+  if (v->target == TARGET_WINDOW) {
+    char why[300];
+    tx_window_lack lack = tx_window_probe(v->stereo == TX_STEREO_LR, why, sizeof why);
+    if (lack == TX_WINDOW_NO_DISPLAY) return tx_setup_fail(s, "target", "--view window: %s", why);
+    if (lack == TX_WINDOW_NO_QUAD)
+      return tx_setup_fail(s, "stereo_mode", "--stereo lr in a window: %s; use sbs, tb or anaglyph, or --view png for lr files", why);
+  }
 #endif
   (void)threads;
   // every component an item draws, with the schema it must have
@@ -258,6 +269,9 @@ static void write_frame(view* v, render_state* rs, uint64_t index) {
 }
 
 #if TX_WITH_GLFW
+// the overlay over one eye's image of w x h px, repeated in the other eye where
+// the eyes tile the frame (sbs, tb); quad's GL_BACK and anaglyph's one image
+// already give it to both
 static void draw_overlay(view* v, render_state* rs, int w, int h) {
   // publishes per second of each drawn component, over the last half second
   int64_t now = tx_mono_ns();
@@ -296,7 +310,11 @@ static void draw_overlay(view* v, render_state* rs, int w, int h) {
       y += 9;
     }
   }
-  tx_overlay_flush(rs->overlay, w, h);
+  // GL counts rows from the bottom: tb's left eye is the upper half
+  tx_overlay_draw(rs->overlay, 0, v->stereo == TX_STEREO_TB ? h : 0, w, h);
+  if (v->stereo == TX_STEREO_SBS) tx_overlay_draw(rs->overlay, w, 0, w, h);
+  if (v->stereo == TX_STEREO_TB) tx_overlay_draw(rs->overlay, 0, 0, w, h);
+  tx_overlay_clear(rs->overlay);
 }
 #endif
 
@@ -315,6 +333,8 @@ static int setup_target(view* v, render_state* rs, char* err, size_t n) {
       tx_stereo_image_size(v->stereo, v->def.width, v->def.height, &rs->img_w, &rs->img_h);
       tx_window_resize(rs->win, rs->img_w, rs->img_h);
     }
+    if (v->stereo == TX_STEREO_LR) // the probe at load found quad buffers: this window must have them too
+      return snprintf(err, n, "--stereo lr in a window: the window has no quad-buffered stereo"), -1;
     if (!(rs->r = tx_renderer_create(tx_window_proc, err, n))) return -1;
     rs->overlay = tx_overlay_create(tx_renderer_gl(rs->r));
 #endif
@@ -370,7 +390,7 @@ static void render_frame(view* v, render_state* rs) {
   rs->last_written = false;
 #if TX_WITH_GLFW
   if (rs->win) {
-    draw_overlay(v, rs, w * (v->stereo == TX_STEREO_SBS ? 2 : 1), h * (v->stereo == TX_STEREO_TB ? 2 : 1));
+    draw_overlay(v, rs, w, h);
     if (!tx_window_present(rs->win)) kill(getpid(), SIGINT); // closing the window ends the run, report and all
     record_time(v, (double)(tx_mono_ns() - t0) * 1e-6, (double)(thread_cpu_ns() - c0) * 1e-6);
     return;
@@ -397,7 +417,7 @@ static void finish_frames(view* v, render_state* rs) {
     uint8_t* px = malloc((size_t)fw * fh * 4);
     if (px && w > 0 && h > 0) {
       tx_stereo_draw(rs->r, &v->def, &v->def.camera, v->stereo, 0, w, h);
-      draw_overlay(v, rs, fw, fh);
+      draw_overlay(v, rs, w, h);
       gl->ReadBuffer(v->stereo == TX_STEREO_QUAD ? GL_BACK_LEFT : GL_BACK);
       gl->PixelStorei(GL_PACK_ALIGNMENT, 1);
       gl->ReadPixels(0, 0, fw, fh, GL_RGBA, GL_UNSIGNED_BYTE, px);

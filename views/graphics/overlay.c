@@ -127,9 +127,18 @@ void tx_overlay_text(tx_overlay* o, int x, int y, int scale, const char* text, c
 }
 
 void tx_overlay_flush(tx_overlay* o, int width, int height) {
+  tx_overlay_draw(o, 0, 0, width, height);
+  tx_overlay_clear(o);
+}
+
+void tx_overlay_clear(tx_overlay* o) {
+  if (o) o->nrects = 0;
+}
+
+void tx_overlay_draw(tx_overlay* o, int x, int y, int width, int height) {
   if (!o || !o->nrects) return;
   const tx_gl* gl = o->gl;
-  gl->Viewport(0, 0, width, height);
+  gl->Viewport(x, y, width, height);
   gl->Disable(GL_DEPTH_TEST);
   gl->UseProgram(o->prog);
   const float size[2] = {(float)width, (float)height};
@@ -141,5 +150,4 @@ void tx_overlay_flush(tx_overlay* o, int width, int height) {
   gl->DrawArrays(GL_TRIANGLES, 0, 6 * o->nrects);
   gl->BindVertexArray(0);
   gl->Enable(GL_DEPTH_TEST);
-  o->nrects = 0;
 }

@@ -15,6 +15,11 @@ void tx_overlay_text(tx_overlay* o, int x, int y, int scale, const char* text, c
 void tx_overlay_rect(tx_overlay* o, int x, int y, int w, int h, const float rgb[3]);
 // draw what was queued over a viewport of width x height px and empty the queue
 void tx_overlay_flush(tx_overlay* o, int width, int height);
+// draw what was queued over the viewport at (x, y) (GL's lower-left origin) and
+// keep it queued: each eye of a tiled stereo frame gets the same overlay
+void tx_overlay_draw(tx_overlay* o, int x, int y, int width, int height);
+// empty the queue
+void tx_overlay_clear(tx_overlay* o);
 // font pixels of a character: 7 rows of 5 bits (bit 4 is the left column); NULL when not in the font
 const unsigned char* tx_overlay_glyph(char c);
 
