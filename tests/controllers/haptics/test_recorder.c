@@ -8,6 +8,7 @@
 #include <cmocka.h>
 
 #include "controllers/haptics/recorder.h"
+#include "scenarios/loader.h"
 #include "views/trace_plot.h"
 
 #include <errno.h>
@@ -352,6 +353,39 @@ static void a_failed_write_is_seen_at_once(void** state) {
   assert_non_null(strstr(err, "device0.bin: File too large"));
 }
 
+// the haptics controller sees the failed write at its next step and stops the
+// run with the reason, long before its duration (600 s; lockstep runs far
+// faster than real time, so the bound is loose)
+static void a_failed_write_stops_the_run(void** state) {
+  (void)state;
+  static const char text[] =
+      "{\"name\":\"t\",\"controllers\":["
+      "{\"name\":\"wall\",\"type\":\"collision.wall\",\"rate_hz\":60,\"params\":{\"stiffness\":300}},"
+      "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":"
+      "\"sim:hand_stiffness=200,hand=pierce-down\",\"force_model\":\"tool0.force_model\"}}]}";
+  char err[512];
+  tx_scenario* sc = tx_scenario_load_text("test", text, strlen(text), NULL, err, sizeof err);
+  if (!sc) fail_msg("%s", err);
+  struct rlimit old;
+  assert_int_equal(getrlimit(RLIMIT_FSIZE, &old), 0);
+  void (*was)(int) = signal(SIGXFSZ, SIG_IGN);
+  struct rlimit small = {20000, old.rlim_max};
+  assert_int_equal(setrlimit(RLIMIT_FSIZE, &small), 0);
+  tx_run_options o = {.duration_s = 600, .lockstep = true, .record_dir = dir};
+  tx_run_result r;
+  int rc = tx_system_run(sc->system, &o, &r, err, sizeof err);
+  assert_int_equal(setrlimit(RLIMIT_FSIZE, &old), 0);
+  signal(SIGXFSZ, was);
+  if (rc) fail_msg("%s", err);
+  print_message("  %s at t = %.3f s of 600 s\n", r.halt_reason, r.halt_t_s);
+  assert_true(r.halted);
+  char want[256];
+  snprintf(want, sizeof want, "haptics: %s: File too large", bin_path());
+  assert_string_equal(r.halt_reason, want);
+  assert_true(r.halt_t_s > 0 && r.halt_t_s < 300);
+  tx_scenario_free(sc);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test_setup_teardown(records_read_back_bit_for_bit, make_dir, remove_dir),
@@ -362,6 +396,7 @@ int main(void) {
       cmocka_unit_test_setup_teardown(the_csv_reads_back_bit_for_bit, make_dir, remove_dir),
       cmocka_unit_test_setup_teardown(version_1_files_still_read, make_dir, remove_dir),
       cmocka_unit_test_setup_teardown(a_failed_write_is_seen_at_once, make_dir, remove_dir),
+      cmocka_unit_test_setup_teardown(a_failed_write_stops_the_run, make_dir, remove_dir),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
