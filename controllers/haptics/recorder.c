@@ -194,7 +194,7 @@ int tx_record_load(const char* path, tx_record_header* h, tx_record** records, s
 
 // NULL when the device's limits are finite and sane
 static const char* device_problem(const tx_device_info* d) {
-  if (!(isfinite(d->max_force) && d->max_force > 0 && d->max_force <= 1e4)) return "its max_force is not in (0, 10000] N";
+  if (!(d->max_force >= 1e-6 && d->max_force <= 1e4)) return "its max_force is not in [1e-6, 1e4] N";
   if (!(isfinite(d->max_stiffness) && d->max_stiffness >= 0 && d->max_stiffness <= 1e9)) return "its max_stiffness is not in [0, 1e9] N/m";
   if (!(isfinite(d->damping) && d->damping >= 0 && d->damping <= 1e6)) return "its damping is not in [0, 1e6] N s/m";
   for (int i = 0; i < 3; i++)
@@ -221,8 +221,8 @@ static const char* record_problem(const tx_record* r, const tx_record* prev, con
   if (!all_finite(r->vel, 3, 1000)) return "a velocity is not finite or beyond 1000 m/s";
   if (!(fabs(r->grip) <= 100)) return "the grip is not finite or beyond 100 rad";
   if (!(r->buttons >= 0 && r->buttons <= 4294967295.0 && r->buttons == floor(r->buttons))) return "the buttons are not a 32-bit field";
-  double f2 = r->force[0] * r->force[0] + r->force[1] * r->force[1] + r->force[2] * r->force[2];
-  if (!(sqrt(f2) <= h->device.max_force * (1 + 1e-9))) return "the force sent is not finite or above the device's max_force";
+  double f = hypot(hypot(r->force[0], r->force[1]), r->force[2]); // no square to underflow or overflow
+  if (!(f <= h->device.max_force * (1 + 1e-9))) return "the force sent is not finite or above the device's max_force";
   return NULL;
 }
 
