@@ -64,5 +64,14 @@ for cmd in "run haptics-wall --lockstep --device replay:$work/bad.bin --out $wor
 done
 [ -e "$work/bad.csv" ] && fail "export of a corrupt recording left bad.csv"
 
+# 5. bad input to export: one line, exit 2, nothing written
+for args in "" "$work/none.bin" "$work/rec/device0.bin --out" "$work/rec/device0.bin --bogus" "$work/rec/device0.csv"; do
+  # shellcheck disable=SC2086
+  "$tactus" export $args >/dev/null 2>"$work/err"
+  rc=$?
+  [ $rc -eq 2 ] && [ "$(grep -c '' "$work/err")" -eq 1 ] || fail "tactus export $args: exit $rc, $(grep -c '' "$work/err") lines"
+done
+[ -e "$work/none.csv" ] && fail "export of a missing recording left none.csv"
+
 [ $failures -eq 0 ] || exit 1
 echo "recordings: killed, cut short, replayed to their end, corrupt: all as expected"
