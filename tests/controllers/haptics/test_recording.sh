@@ -6,6 +6,8 @@
 # Usage: test_recording.sh TACTUS
 set -u
 tactus=$1
+# stderr lines are counted: under LeakSanitizer, no report of the suppressions used
+export LSAN_OPTIONS="${LSAN_OPTIONS:+$LSAN_OPTIONS:}print_suppressions=0"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 failures=0
