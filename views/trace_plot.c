@@ -59,10 +59,15 @@ int tx_trace_load(const char* csv, tx_trace* t, char* err, size_t n) {
       char* end;
       for (int k = 0; k < 7; k++)
         if (col[k] == c) {
-          errno = 0;
+          // strtod reads back every double that %.17g wrote; its ERANGE on a
+          // subnormal is no error, only an overflow (not finite) is
           v[k] = strtod(p, &end);
-          if (end == p || errno || (*end != ',' && *end != '\n' && *end != '\r' && *end)) {
+          if (end == p || (*end != ',' && *end != '\n' && *end != '\r' && *end)) {
             snprintf(err, n, "%s:%ld: column %s: not a number", csv, lineno, names[k]);
+            goto done;
+          }
+          if (!isfinite(v[k])) {
+            snprintf(err, n, "%s:%ld: column %s: not a finite number", csv, lineno, names[k]);
             goto done;
           }
           got++;

@@ -1,7 +1,10 @@
 // replay: a device that plays back a recording (deviceN.bin), one recorded
 // tick per haptics tick, with the recorded device's limits. Run in lockstep,
-// the same scenario then renders the recorded forces bit for bit. After the
-// last record the device falls silent, and the watchdog fades the force out.
+// the same scenario then renders the recorded forces bit for bit. `tactus run`
+// without --duration ends the run with the recording; given a longer one, the
+// device falls silent after the last record and the watchdog fades the force
+// out. A recording cut short (a killed run) replays its whole blocks, with one
+// warning; a corrupt or implausible one is refused.
 #include "device.h"
 #include "recorder.h"
 
@@ -18,7 +21,8 @@ struct tx_device {
 static tx_device* open_replay(const char* path, double period_s, char* err, size_t n) {
   tx_device* d = calloc(1, sizeof *d);
   if (!d) return snprintf(err, n, "out of memory"), NULL;
-  if (tx_record_load(path, &d->header, &d->records, &d->count, err, n)) return free(d), NULL;
+  char warn[512];
+  if (tx_record_load(path, &d->header, &d->records, &d->count, warn, sizeof warn, err, n)) return free(d), NULL;
   double rate = 1.0 / period_s;
   if (fabs(d->header.rate_hz - rate) > 1e-9 * rate) {
     snprintf(err, n, "%s: recorded at %g Hz, replayed at %g Hz: set the haptics rate_hz to match", path,
@@ -27,6 +31,7 @@ static tx_device* open_replay(const char* path, double period_s, char* err, size
     free(d);
     return NULL;
   }
+  if (*warn) fprintf(stderr, "tactus: warning: %s\n", warn); // only once the recording is taken
   return d;
 }
 

@@ -8,6 +8,7 @@
 // last row the device holds still. Lines starting with '#' and a first line
 // of column names are skipped. Forces written to it are ignored.
 #include "device.h"
+#include "device_scripted.h"
 
 #include <errno.h>
 #include <math.h>
@@ -86,9 +87,12 @@ static const char* parse_row(char* line, waypoint* w) {
   if (n != 4 && n != 5 && n != 8 && n != 9) return "expected 4, 5, 8 or 9 columns: t, x, y, z [, qw, qx, qy, qz] [, grip]";
   *w = (waypoint){v[0], {v[1], v[2], v[3]}, {1, 0, 0, 0}, 0};
   if (n >= 8) {
-    double q = sqrt(v[4] * v[4] + v[5] * v[5] + v[6] * v[6] + v[7] * v[7]);
-    if (!(q > 1e-9)) return "the quaternion is zero";
-    for (int i = 0; i < 4; i++) w->quat[i] = v[4 + i] / q;
+    // scaled by the largest component first, so that a huge one cannot overflow the norm
+    double m = fmax(fmax(fabs(v[4]), fabs(v[5])), fmax(fabs(v[6]), fabs(v[7])));
+    if (!(m > 1e-9)) return "the quaternion is zero";
+    double q = 0;
+    for (int i = 0; i < 4; i++) q += (v[4 + i] / m) * (v[4 + i] / m);
+    for (int i = 0; i < 4; i++) w->quat[i] = v[4 + i] / m / sqrt(q);
   }
   if (n == 5 || n == 9) w->grip = v[n - 1];
   for (int i = 0; i < 3; i++)
@@ -96,9 +100,7 @@ static const char* parse_row(char* line, waypoint* w) {
   return NULL;
 }
 
-static tx_device* from_file(const char* path, char* err, size_t n) {
-  FILE* f = fopen(path, "r");
-  if (!f) return snprintf(err, n, "%s: %s", path, strerror(errno)), NULL;
+tx_device* tx_scripted_read_csv(FILE* f, const char* path, char* err, size_t n) {
   size_t cap = 256, count = 0;
   tx_device* d = with_rows(cap);
   char line[1024];
@@ -121,11 +123,12 @@ static tx_device* from_file(const char* path, char* err, size_t n) {
       }
       problem = parse_row(line, &d->w[count]);
       if (!problem && d->w[count].t < 0) problem = "time must not be negative";
-      if (!problem && count && d->w[count].t <= d->w[count - 1].t) problem = "time must increase from row to row";
+      // rows closer than 1 us would make the velocity between them overflow
+      if (!problem && count && !(d->w[count].t - d->w[count - 1].t >= 1e-6))
+        problem = "time must increase by at least 1 us from row to row";
       count++;
     }
   }
-  fclose(f);
   if (!problem && d && count == 0) problem = "no waypoints", lineno = 0;
   if (problem || !d) {
     if (lineno) snprintf(err, n, "%s:%d: %s", path, lineno, problem ? problem : "out of memory");
@@ -143,7 +146,13 @@ static tx_device* open_scripted(const char* arg, double period_s, char* err, siz
   for (size_t i = 0; i < sizeof motions / sizeof motions[0]; i++)
     if (strcmp(arg, motions[i].name) == 0) return from_motion(&motions[i]);
   size_t len = strlen(arg);
-  if (len > 4 && strcmp(arg + len - 4, ".csv") == 0) return from_file(arg, err, n);
+  if (len > 4 && strcmp(arg + len - 4, ".csv") == 0) {
+    FILE* f = fopen(arg, "r");
+    if (!f) return snprintf(err, n, "%s: %s", arg, strerror(errno)), NULL;
+    tx_device* d = tx_scripted_read_csv(f, arg, err, n);
+    fclose(f);
+    return d;
+  }
   snprintf(err, n, "device 'scripted:%s': expected a .csv file or one of pierce-down, pierce-up, slide-x-over, "
                    "slide-x-under, slide-z-over, slide-z-under, insert", arg);
   return NULL;

@@ -42,6 +42,7 @@ typedef struct haptics {
   int hand;
   bool record;                   // when the run keeps recordings
   tx_recorder* recorder;
+  bool record_failed;            // the recording broke (a full disk): the run was told to stop
   tx_record rec;                 // this tick's record, filled as the tick goes
 } haptics;
 
@@ -196,6 +197,18 @@ static void step(tx_ctx* c, void* self) {
     h->damped_vel[i] = alpha ? v[i] : 0;
   }
   h->damping = alpha;
+  // a broken recording stops the run at once; until it ends, the force ramps to zero
+  if (h->recorder && !h->record_failed) {
+    const char* file;
+    int e = tx_recorder_error(h->recorder, &file);
+    if (e) {
+      char reason[4200];
+      snprintf(reason, sizeof reason, "%s: %s", file, strerror(e));
+      tx_stop_run(c, reason);
+      h->record_failed = true;
+    }
+  }
+  if (h->record_failed) f[0] = f[1] = f[2] = 0; // the rate limit makes it a ramp
   tx_safety_counts before = h->safety.counts;
   double out[3];
   tx_safety_apply(&h->safety, &h->limits, dt, f, h->state.pos, model_age, h->silent_s, out);
@@ -223,7 +236,8 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, h->min_energy_result, h->passivity.min_energy);
   tx_set_result(c, h->dissipated_result, h->passivity.dissipated);
   char err[512];
-  if (tx_recorder_stop(h->recorder, err, sizeof err)) fprintf(stderr, "tactus: recording: %s\n", err);
+  if (tx_recorder_stop(h->recorder, err, sizeof err) && !h->record_failed) // else the run's stop reason says it
+    fprintf(stderr, "tactus: recording: %s\n", err);
   h->recorder = NULL;
 }
 

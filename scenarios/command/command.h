@@ -14,6 +14,10 @@ int tx_cmd_describe(int argc, char** argv);
 int tx_cmd_run(int argc, char** argv);
 int tx_cmd_bench(int argc, char** argv);
 int tx_cmd_study(int argc, char** argv);
+int tx_cmd_export(int argc, char** argv);
+// a run replaying recordings ends with the longest of them (s); 0 when no
+// device replays or a --set gives duration_s
+double tx_replay_duration(const char* const* devices, int ndevices, const char* const* sets, int nsets);
 
 // the program name that starts every error line: "tactus" or "tactus-device"
 extern const char* tx_program;

@@ -15,6 +15,7 @@ static const char usage[] =
     "  run SCENARIO [OPTIONS]     run it; writes OUT/report.json (tactus run --help)\n"
     "  bench NAME [--out DIR]     a benchmark table (tactus bench lists them)\n"
     "  study NAME [--out DIR]     a study with plots (tactus study lists them)\n"
+    "  export FILE.bin [--out F]  the CSV of a device recording (one a killed run left)\n"
     "  version                    version and the optional parts built in\n"
     "\n"
     "SCENARIO is a name from `tactus list` or a path to a .json file.\n"
@@ -93,5 +94,6 @@ int main(int argc, char** argv) {
   if (!strcmp(cmd, "run")) return tx_cmd_run(argc - 1, argv + 1);
   if (!strcmp(cmd, "bench")) return tx_cmd_bench(argc - 1, argv + 1);
   if (!strcmp(cmd, "study")) return tx_cmd_study(argc - 1, argv + 1);
+  if (!strcmp(cmd, "export")) return tx_cmd_export(argc - 1, argv + 1);
   return tx_bad_input("unknown command '%s' (tactus --help lists them)", cmd);
 }

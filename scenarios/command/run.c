@@ -140,6 +140,7 @@ int tx_cmd_run(int argc, char** argv) {
       return tx_bad_input("run: unknown or incomplete option '%s' (tactus run --help)", argv[optind - 1]);
     }
   }
+  if (cfg.duration_s == 0) cfg.duration_s = tx_replay_duration(devices, ndevices, sets, nsets); // ends with the recording
   if (optind < argc) cfg.scenario = argv[optind++];
   if (optind < argc) return tx_bad_input("run: unexpected argument '%s'", argv[optind]);
   if (!cfg.scenario) return tx_bad_input("run: expected a SCENARIO (tactus list shows them)");

@@ -4,6 +4,7 @@
 
 #include <tactus/config.h>
 
+#include <float.h>
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -78,7 +79,38 @@ static void bad_files_name_the_line(void** state) {
   assert_non_null(strstr(err, "/nonexistent/device0.csv: "));
 }
 
+// every finite double that the recorder's %.17g writes reads back to the same
+// bits: subnormals (strtod's ERANGE on them is no error), -0, the extremes
+static void every_finite_double_reads_back(void** state) {
+  (void)state;
+  const double v[] = {4.1e-312, -4.1e-312, 0x1p-1074, DBL_MIN, -0.0, DBL_MAX, -DBL_MAX, 0.1, 1.0 / 3, nextafter(1, 2)};
+  const int nv = (int)(sizeof v / sizeof v[0]);
+  char path[] = "/tmp/tx_trace_XXXXXX";
+  close(mkstemp(path));
+  FILE* f = fopen(path, "w");
+  assert_non_null(f);
+  fprintf(f, "t_s,px_m,py_m,pz_m,fx_n,fy_n,fz_n\n");
+  for (int i = 0; i < nv; i++) // each value in every column, rotated from row to row
+    for (int c = 0; c < 7; c++) fprintf(f, "%.17g%s", v[(i + c) % nv], c < 6 ? "," : "\n");
+  fclose(f);
+  tx_trace t;
+  char err[256];
+  if (tx_trace_load(path, &t, err, sizeof err)) fail_msg("%s", err);
+  assert_int_equal(t.n, nv);
+  for (int i = 0; i < nv; i++) {
+    double* got[7] = {&t.t[i], &t.p[0][i], &t.p[1][i], &t.p[2][i], &t.f[0][i], &t.f[1][i], &t.f[2][i]};
+    for (int c = 0; c < 7; c++)
+      if (memcmp(got[c], &v[(i + c) % nv], sizeof(double)) != 0) fail_msg("row %d column %d: %a, wrote %a", i, c, *got[c], v[(i + c) % nv]);
+  }
+  tx_trace_free(&t);
+  remove(path);
+  // what no finite double prints as
+  expect_bad("t_s,px_m,py_m,pz_m,fx_n,fy_n,fz_n\n0,0,0,0,0,0,0\n0,0,1e999,0,0,0,0\n", ":3: column py_m: not a finite number");
+  expect_bad("t_s,px_m,py_m,pz_m,fx_n,fy_n,fz_n\n0,0,0,0,nan,0,0\n", ":2: column fx_n: not a finite number");
+}
+
 int main(void) {
-  const struct CMUnitTest tests[] = {cmocka_unit_test(loads_columns_by_name), cmocka_unit_test(bad_files_name_the_line)};
+  const struct CMUnitTest tests[] = {cmocka_unit_test(loads_columns_by_name), cmocka_unit_test(bad_files_name_the_line),
+                                     cmocka_unit_test(every_finite_double_reads_back)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

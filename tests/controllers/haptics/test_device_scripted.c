@@ -99,6 +99,7 @@ static void bad_files_name_the_line(void** state) {
   } bad[] = {
       {"0,0,0,0\n1,0,0\n", ":2: expected 4, 5, 8 or 9 columns"},
       {"0,0,0,0\n0,1,0,0\n", ":2: time must increase"},
+      {"0,0,0,0\n1e-300,1,0,0\n", ":2: time must increase by at least 1 us"}, // else an infinite velocity
       {"0,0,0,0\n1,nan,0,0\n", ":2: expected a finite number"},
       {"0,0,0,0\n1;0;0;0\n", ":2: expected ','"},
       {"0,0,0,0\n1,0,0,0,0,0,0,0\n", ":2: the quaternion is zero"},
