@@ -187,14 +187,26 @@ tx_scenario* tx_load_for_command_view(const char* name, const char* const* sets,
 }
 
 static volatile sig_atomic_t stop_requested; // the signal, 0 for none
+static volatile int64_t stop_first_ns;        // when it came
 
-static void on_stop(int sig) { stop_requested = sig; }
-
+// The first signal stops the run cleanly. One more, a second or more later,
+// ends the process at once, should a step never return; sooner it is the same
+// request again (timeout(1) sends it to the child and to the process group).
+static void on_stop(int sig) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  int64_t now = (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+  if (!stop_requested) {
+    stop_first_ns = now;
+    stop_requested = sig;
+  } else if (now - stop_first_ns > 1000000000) {
+    signal(sig, SIG_DFL);
+    raise(sig);
+  }
+}
 
 void tx_catch_stop_signals(void) {
-  // the first signal stops the run cleanly; SA_RESETHAND lets a second one end
-  // the process at once, should a step never return
-  struct sigaction sa = {.sa_handler = on_stop, .sa_flags = SA_RESETHAND};
+  struct sigaction sa = {.sa_handler = on_stop};
   sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, NULL);
   sigaction(SIGTERM, &sa, NULL);

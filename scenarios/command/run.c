@@ -32,7 +32,7 @@ static const char run_usage[] =
     "Writes OUT/report.json: per controller achieved rate, missed deadlines, period jitter and step time,\n"
     "and OUT/device0.png (force and position traces) when a haptics device was recorded.\n"
     "Ctrl-C (SIGINT) or SIGTERM stops the run early, still writes the report and exits 130 or 143;\n"
-    "a second signal ends it at once. A run that fails before its first step exits 2 and keeps nothing.\n";
+    "another, a second later, ends it at once. A run that fails before its first step exits 2 and keeps nothing.\n";
 
 static bool one_of(const char* s, const char* const* options) {
   for (; *options; options++)
@@ -85,6 +85,9 @@ int tx_run_scenario(tx_scenario* sc, const tx_run_config* cfg, json_t** report_o
   if (isatty(2)) fprintf(stderr, "\r%40s\r", "");
   if (rc) { // before the first step: nothing of this run is kept
     if (trace) fclose(trace);
+    // fini first, so that no controller writes into the folder after it is cleared
+    tx_system_destroy(sc->system);
+    sc->system = NULL;
     tx_out_discard(&out);
     return tx_bad_input("run %s: %s", sc->name, err);
   }
