@@ -237,7 +237,9 @@ static void a_controller_can_stop_the_run(void** state) {
     assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
     assert_true(r.halted);
     assert_string_equal(r.halt_reason, "stopper: disk full");
-    assert_true(fabs(r.halt_t_s - 0.020) < 1e-9);
+    // step 20 is at 20 ms; in real time a loaded machine may have skipped ticks before it
+    if (lock) assert_true(fabs(r.halt_t_s - 0.020) < 1e-9);
+    else assert_true(r.halt_t_s > 0.020 - 1e-9 && r.halt_t_s < 2.0);
     // the stopper steps once more at most (the check is at the top of the loop)
     assert_true(tx_system_stats(s, 0).steps <= 21);
     if (!lock) assert_true(tx_mono_ns() - t0 < 2000000000); // not the whole 5 s
