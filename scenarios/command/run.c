@@ -93,7 +93,7 @@ int tx_run_scenario(tx_scenario* sc, const tx_run_config* cfg, json_t** report_o
   }
   tx_out_close(&out);
   // the trace is whole, or gone with the reason
-  char trace_err[1200] = "";
+  char trace_err[4400] = "";
   if (trace) {
     errno = 0;
     bool bad = ferror(trace) != 0;
