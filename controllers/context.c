@@ -1,6 +1,7 @@
 // Run-time API of a controller, and one step of an instance with its publishes.
 #include "system_internal.h"
 
+#include <errno.h>
 #include <inttypes.h>
 #include <string.h>
 
@@ -75,14 +76,16 @@ void tx_warn(tx_ctx* c, tx_warning w) {
     atomic_fetch_add_explicit(&c->sys->warning_counts[w.id - 1], 1, memory_order_relaxed);
 }
 
-void tx_stop_run(tx_ctx* c, const char* reason) {
-  tx_system* s = c->sys;
+// the first reason wins; who gives it is the prefix ("INSTANCE" or the file)
+static void stop_run(tx_system* s, int64_t sim_ns, const char* who, const char* reason) {
   int expected = 0;
-  if (!atomic_compare_exchange_strong(&s->halt_claim, &expected, 1)) return; // the first reason wins
-  snprintf(s->halt_reason, sizeof s->halt_reason, "%s: %s", c->in->name, reason ? reason : "stopped");
-  s->halt_sim_ns = c->sim_ns;
+  if (!atomic_compare_exchange_strong(&s->halt_claim, &expected, 1)) return;
+  snprintf(s->halt_reason, sizeof s->halt_reason, "%s: %s", who, reason ? reason : "stopped");
+  s->halt_sim_ns = sim_ns;
   atomic_store_explicit(&s->halt, true, memory_order_release);
 }
+
+void tx_stop_run(tx_ctx* c, const char* reason) { stop_run(c->sys, c->sim_ns, c->in->name, reason); }
 
 static void trace_publish(tx_system* s, const instance* in, const port* pt) {
   tx_snapshot snap = tx_model_latest(s->model, pt->comp);
@@ -90,9 +93,12 @@ static void trace_publish(tx_system* s, const instance* in, const port* pt) {
   uint64_t h = tx_hash(TX_HASH_SEED, snap.data, (size_t)snap.rows * def->cols * tx_type_size(def->type));
   uint64_t stamp[3] = {(uint64_t)snap.sim_ns, snap.seq, h};
   s->trace_hash = tx_hash(s->trace_hash, stamp, sizeof stamp);
-  if (s->trace)
-    fprintf(s->trace, "%" PRId64 ",%s,%s,%" PRIu64 ",%u,%016" PRIx64 "\n", snap.sim_ns, in->name, pt->name, snap.seq,
-            snap.rows, h);
+  // a write error (a full disk) stops the run now, not after the whole duration
+  if (s->trace && fprintf(s->trace, "%" PRId64 ",%s,%s,%" PRIu64 ",%u,%016" PRIx64 "\n", snap.sim_ns, in->name,
+                          pt->name, snap.seq, snap.rows, h) < 0) {
+    stop_run(s, snap.sim_ns, s->trace_name ? s->trace_name : "trace", strerror(errno ? errno : EIO));
+    s->trace = NULL;
+  }
 }
 
 // the swap-buffer step: publish every component the instance wrote
@@ -124,7 +130,11 @@ int tx_instance_init(tx_system* s, instance* in, char* err, size_t n) {
   in->ctx.sim_ns = 0;
   in->ctx.step = 0;
   if (!in->cls->init) return 0;
-  if (in->cls->init(&in->ctx, in->self) != 0) return snprintf(err, n, "controller '%s' failed to initialise", in->name), -1;
+  if (in->cls->init(&in->ctx, in->self) != 0) {
+    // a reason given with tx_stop_run is the one to report
+    if (tx_system_halted(s)) return snprintf(err, n, "%s", s->halt_reason), -1;
+    return snprintf(err, n, "controller '%s' failed to initialise", in->name), -1;
+  }
   publish_written(s, in, 0); // what init wrote is the first publish, at time 0
   return 0;
 }

@@ -2,8 +2,10 @@
 //
 // The next step is always the earliest pending tick. At equal times the slower
 // group goes first, so that a fast consumer sees what a slow producer (physics)
-// published at the same instant; within a group, scenario order. Nothing here
-// depends on wall time, so two runs give bit-identical traces.
+// published at the same instant; within a group, scenario order. Nothing the
+// controllers see depends on wall time, so two runs give bit-identical traces;
+// wall time only paces the progress calls, so that a stop request is never kept
+// waiting by a slow step or a clock that hardly moves.
 #include "system_internal.h"
 
 #include <stdlib.h>
@@ -11,6 +13,7 @@
 int tx_run_lockstep(tx_system* s, const tx_run_options* o, tx_run_result* r, char* err, size_t n) {
   s->tracing = true;
   s->trace = o->trace;
+  s->trace_name = o->trace_name;
   s->trace_hash = TX_HASH_SEED;
   int rc = 0;
   for (int i = 0; i < s->count && rc == 0; i++) rc = tx_instance_init(s, s->inst[i], err, n);
@@ -18,7 +21,7 @@ int tx_run_lockstep(tx_system* s, const tx_run_options* o, tx_run_result* r, cha
   uint64_t* next = calloc(s->ngroups, sizeof *next);
   if (!next && rc == 0) rc = -1, snprintf(err, n, "out of memory");
   const int64_t end_ns = (int64_t)(o->duration_s * 1e9);
-  int64_t last_progress = 0;
+  int64_t last_progress = 0, last_wall = tx_mono_ns(), reached = end_ns;
   while (rc == 0) {
     int g = -1;
     int64_t t = 0;
@@ -26,7 +29,10 @@ int tx_run_lockstep(tx_system* s, const tx_run_options* o, tx_run_result* r, cha
       int64_t tk = tx_tick_ns(s->groups[k].rate_hz, next[k]);
       if (g < 0 || tk < t) g = k, t = tk;
     }
-    if (t >= end_ns || tx_system_halted(s)) break;
+    if (t >= end_ns || tx_system_halted(s)) {
+      if (t < end_ns) reached = t;
+      break;
+    }
     for (int m = 0; m < s->groups[g].count; m++) {
       instance* in = s->inst[s->groups[g].members[m]];
       if (in->steps == 0) in->first_start_ns = t;
@@ -35,17 +41,23 @@ int tx_run_lockstep(tx_system* s, const tx_run_options* o, tx_run_result* r, cha
       tx_hist_add(&in->jitter, 0);
     }
     next[g]++;
-    if (o->progress && t - last_progress >= 100000000) {
+    // every 100 ms of simulated time, or of wall time: a slow step, or a clock
+    // that hardly moves, must not keep a stop request waiting
+    if (!o->progress) continue;
+    int64_t now = tx_mono_ns(); // cheap beside a step, which reads it twice
+    if (t - last_progress >= 100000000 || now - last_wall >= 100000000) {
       last_progress = t;
+      last_wall = now;
       if (!o->progress((double)t * 1e-9, o->progress_user)) {
         r->stopped_early = true;
+        reached = t;
         break;
       }
     }
   }
   free(next);
   for (int i = 0; i < s->count && rc == 0; i++) tx_instance_finish(s->inst[i]);
-  r->duration_s = o->duration_s;
+  r->duration_s = (double)reached * 1e-9; // simulated time reached: all of it, unless stopped
   r->trace_hash = s->trace_hash;
   snprintf(r->scheduler, sizeof r->scheduler, "lockstep: one thread, virtual clock");
   s->tracing = false;

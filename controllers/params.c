@@ -104,11 +104,35 @@ int tx_param_strs(tx_setup* s, const char* key, const char** out, int max) {
   return (int)json_array_size(v);
 }
 
+// the model's rule for component names (model/model.c)
+static bool valid_component_name(const char* s) {
+  if (!s || !*s || strlen(s) >= TX_NAME_MAX) return false;
+  for (; *s; s++)
+    if (!((*s >= 'a' && *s <= 'z') || (*s >= '0' && *s <= '9') || *s == '_' || *s == '.')) return false;
+  return true;
+}
+
+// the parameter that gave this component name (a string, or a string in a
+// list), so that the error names it and the --set behind it; NULL if none
+static const char* param_naming(const instance* in, const char* name) {
+  const char* key;
+  json_t* v;
+  if (name && in->params) json_object_foreach(in->params, key, v) {
+    if (json_is_string(v) && strcmp(json_string_value(v), name) == 0) return key;
+    size_t i;
+    json_t* e;
+    if (json_is_array(v)) json_array_foreach(v, i, e)
+      if (json_is_string(e) && strcmp(json_string_value(e), name) == 0) return key;
+  }
+  return NULL;
+}
+
 static port* new_port(tx_setup* s, const char* name, bool write) {
   instance* in = s->in;
   if (in->failed) return NULL;
-  if (!name || !*name || strlen(name) >= TX_NAME_MAX)
-    return tx_setup_fail(s, NULL, "component name '%s' is empty or too long", name ? name : ""), NULL;
+  if (!valid_component_name(name))
+    return tx_setup_fail(s, param_naming(in, name), "bad component name '%s': expected 1-%d characters of a-z 0-9 _ .",
+                         name ? name : "", TX_NAME_MAX - 1), NULL;
   for (int i = 0; i < in->nports; i++)
     if (strcmp(in->ports[i].name, name) == 0)
       return tx_setup_fail(s, NULL, "component '%s' is declared twice by this controller", name), NULL;

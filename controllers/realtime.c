@@ -24,6 +24,7 @@ typedef struct gate {
   pthread_cond_t cond;
   int ready;   // workers that finished init
   bool open;   // t0 and end are set
+  bool failed; // an init failed: no step and no finish, as in lockstep
   int64_t t0;  // release of tick 0, monotonic ns
   int64_t end; // no release at or after this
 } gate;
@@ -74,13 +75,16 @@ static void* worker_main(void* arg) {
   pthread_cond_broadcast(&w->gate->cond);
   while (!w->gate->open) pthread_cond_wait(&w->gate->cond, &w->gate->mutex);
   const int64_t t0 = w->gate->t0, end = w->gate->end;
+  const bool failed = w->gate->failed;
   pthread_mutex_unlock(&w->gate->mutex);
+  if (failed) return NULL;
 
   int64_t prev_start = 0;
   uint64_t prev_k = 0;
   for (uint64_t k = 0; !atomic_load_explicit(w->stop, memory_order_relaxed) && !tx_system_halted(s);) {
-    int64_t release = t0 + tx_tick_ns(g->rate_hz, k);
-    if (release >= end) break;
+    int64_t tick = tx_tick_ns(g->rate_hz, k);
+    if (tick >= end - t0) break; // compared before adding: a saturated tick must not wrap
+    int64_t release = t0 + tick;
     sleep_until(release);
     int64_t start = tx_mono_ns();
     int64_t expected = tx_tick_ns(g->rate_hz, k) - tx_tick_ns(g->rate_hz, prev_k);
@@ -99,8 +103,8 @@ static void* worker_main(void* arg) {
     // over is skipped, and counts as missed too
     int64_t done = tx_mono_ns();
     uint64_t next = k + 1;
-    uint64_t missed = done > t0 + tx_tick_ns(g->rate_hz, next);
-    while (t0 + tx_tick_ns(g->rate_hz, next + 1) <= done) next++, missed++;
+    uint64_t missed = done - t0 > tx_tick_ns(g->rate_hz, next);
+    while (tx_tick_ns(g->rate_hz, next + 1) <= done - t0) next++, missed++;
     for (int m = 0; m < g->count && missed; m++) s->inst[g->members[m]]->missed += missed;
     k = next;
   }
@@ -222,7 +226,7 @@ int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r, cha
   while (gt.ready < started) pthread_cond_wait(&gt.cond, &gt.mutex);
   for (int g = 0; g < started && rc == 0; g++)
     if (w[g].init_rc) rc = -1, snprintf(err, n, "%s", w[g].init_err);
-  if (rc) atomic_store(&stop, true);
+  if (rc) atomic_store(&stop, true), gt.failed = true;
   // every first release lies in the future; spun-up CPUs get time to be
   // running on the host before the first tick
   gt.t0 = tx_mono_ns() + (nspin ? 100000000 : 2000000);

@@ -81,8 +81,8 @@ int tx_system_add(tx_system* s, const char* name, const char* type, double rate_
     if (strcmp(s->inst[i]->name, name) == 0) return fault(f, "name", "a controller named '%s' already exists", name);
   const tx_controller_class* cls = tx_find_controller(type);
   if (!cls) return fault(f, "type", "unknown controller type '%s'", type ? type : "");
-  if (!(rate_hz > 0 && rate_hz <= TX_RATE_MAX_HZ))
-    return fault(f, "rate_hz", "%g Hz is out of range (0, %g]", rate_hz, TX_RATE_MAX_HZ);
+  if (!(rate_hz >= TX_RATE_MIN_HZ && rate_hz <= TX_RATE_MAX_HZ))
+    return fault(f, "rate_hz", "%g Hz is out of range [%g, %g]", rate_hz, TX_RATE_MIN_HZ, TX_RATE_MAX_HZ);
   if (params && !json_is_object(params)) return fault(f, "params", "expected an object");
 
   instance** grown = realloc(s->inst, (s->count + 1) * sizeof *grown);
@@ -249,7 +249,31 @@ int tx_system_finalize(tx_system* s, tx_fault* f) {
   return 0;
 }
 
-int64_t tx_tick_ns(double rate_hz, uint64_t k) { return (int64_t)llround((double)k * 1e9 / rate_hz); }
+// saturates at INT64_MAX ("never"), so a clock past its range ends a run rather than wrapping
+int64_t tx_tick_ns(double rate_hz, uint64_t k) {
+  double ns = (double)k * 1e9 / rate_hz;
+  return ns < 9.2e18 ? (int64_t)llround(ns) : INT64_MAX;
+}
+
+static double digits(double v) { return v < 10 ? 1 : floor(log10(v)) + 1; }
+
+double tx_system_trace_bytes(const tx_system* s, double duration_s) {
+  // one line per publish: "sim_ns,instance,component,seq,rows,hash16\n", each
+  // write published at most once per tick and once by init
+  double total = 64; // the header
+  for (int i = 0; i < s->count; i++) {
+    const instance* in = s->inst[i];
+    double ticks = ceil(duration_s * in->rate_hz) + 1;
+    for (int p = 0; p < in->nports; p++) {
+      const port* pt = &in->ports[p];
+      if (!pt->write) continue;
+      double line = digits(duration_s * 1e9) + strlen(in->name) + strlen(pt->name) + digits(ticks) +
+                    digits(pt->def.rows) + 16 + 6;
+      total += ticks * line;
+    }
+  }
+  return total;
+}
 
 bool tx_system_prepare_stats(tx_system* s, double duration_s) {
   (void)duration_s; // the histograms hold a run of any length
@@ -268,7 +292,8 @@ bool tx_system_prepare_stats(tx_system* s, double duration_s) {
 int tx_system_run(tx_system* s, const tx_run_options* o, tx_run_result* r, char* err, size_t n) {
   *r = (tx_run_result){0};
   if (!s->model) return snprintf(err, n, "the system is not finalized"), -1;
-  if (!(o->duration_s > 0 && o->duration_s <= 86400)) return snprintf(err, n, "duration %g s is out of range (0, 86400]", o->duration_s), -1;
+  if (!(o->duration_s >= TX_DURATION_MIN_S && o->duration_s <= TX_DURATION_MAX_S))
+    return snprintf(err, n, "duration %g s is out of range [%g, %g]", o->duration_s, TX_DURATION_MIN_S, TX_DURATION_MAX_S), -1;
   if (!tx_system_prepare_stats(s, o->duration_s)) return snprintf(err, n, "out of memory for statistics"), -1;
   s->record_dir = o->record_dir;
   s->out_dir = o->out_dir;

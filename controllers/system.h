@@ -15,6 +15,11 @@
 #include <stdio.h>
 
 #define TX_WARNINGS_MAX 256
+// the run lengths the clocks hold (with TX_RATE_MIN_HZ, every tick fits in int64 ns)
+#define TX_DURATION_MIN_S 1e-6
+#define TX_DURATION_MAX_S 86400.0
+// a lockstep trace (tx_run_options.trace) may grow to this; a longer run is refused before it starts
+#define TX_TRACE_MAX_BYTES (1024.0 * 1024 * 1024)
 #define TX_WARNING_KEY_MAX (2 * TX_NAME_MAX)
 
 typedef struct tx_system tx_system;
@@ -43,7 +48,8 @@ typedef struct tx_controller_stats {
 typedef struct tx_run_options {
   double duration_s;   // > 0
   bool lockstep;       // one thread, virtual clock
-  FILE* trace;         // lockstep: one line per publish, or NULL
+  FILE* trace;         // lockstep: one line per publish, or NULL; a write error stops the run
+  const char* trace_name; // the trace's file, named in that error
   bool realtime_priority; // try SCHED_FIFO
   bool pin_threads;       // try CPU pinning
   bool keep_cpus_awake;   // a SCHED_IDLE spinner per CPU, so no CPU halts between ticks
@@ -99,6 +105,8 @@ int tx_system_ports(const tx_system* s, int i);
 tx_port_info tx_system_port(const tx_system* s, int i, int p);
 tx_controller_stats tx_system_stats(const tx_system* s, int i);
 tx_model* tx_system_model(tx_system* s);
+// the most bytes a lockstep trace of a run this long can take (every write published every tick)
+double tx_system_trace_bytes(const tx_system* s, double duration_s);
 int tx_system_warnings(const tx_system* s);
 const char* tx_system_warning_key(const tx_system* s, int w);
 uint64_t tx_system_warning_count(const tx_system* s, int w);

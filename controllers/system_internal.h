@@ -83,6 +83,7 @@ struct tx_system {
   const char* out_dir;    // of the current run, or NULL
   bool tracing;        // lockstep: hash every publish
   FILE* trace;         // and write it here, if not NULL
+  const char* trace_name; // that file, for a write error
   uint64_t trace_hash; // tx_hash over every publish, in order
   _Atomic int halt_claim;  // 0 until a controller asks to stop the run
   _Atomic bool halt;       // set once halt_reason is written

@@ -77,6 +77,9 @@ static int apply_sets(const char* file, json_t* root, const tx_load_options* o, 
     key[eq - text] = 0;
     json_error_t je;
     json_t* value = json_loads(eq + 1, JSON_DECODE_ANY, &je);
+    // a number past a double's range is not a bare word
+    if (!value && strstr(je.text, "real number overflow"))
+      return fail(err, n, "--set %s: the number is out of range (beyond +-1.8e308)", text);
     if (!value) value = json_string(eq + 1); // bare words are strings
     if (!value) return fail(err, n, "--set %s: value is not valid UTF-8", text);
 
@@ -87,9 +90,9 @@ static int apply_sets(const char* file, json_t* root, const tx_load_options* o, 
         return fail(err, n, "--set %s: unknown key '%s' (use duration_s or CONTROLLER.PARAM)", text, key);
       }
       // checked here, so that a bad value names the --set rather than the file
-      if (!json_is_number(value) || !(json_number_value(value) > 0 && json_number_value(value) <= 86400)) {
+      if (!json_is_number(value) || !(json_number_value(value) >= TX_DURATION_MIN_S && json_number_value(value) <= TX_DURATION_MAX_S)) {
         json_decref(value);
-        return fail(err, n, "--set %s: expected a number in (0, 86400]", text);
+        return fail(err, n, "--set %s: expected a number in [%g, %g]", text, TX_DURATION_MIN_S, TX_DURATION_MAX_S);
       }
       json_object_set_new(root, key, value);
       continue;
@@ -261,6 +264,10 @@ static int add_view(const char* file, tx_system* sys, json_t* view, const tx_loa
   char key[128] = "", msg[300];
   if (view && tx_view_def_from_json(view, &d, key, sizeof key, msg, sizeof msg))
     return fail(err, n, "%s: view%s%s: %s", file, *key ? "." : "", key, msg);
+  // the clocks' lower bound, checked even when nothing draws
+  json_t* vr = view ? json_object_get(view, "rate_hz") : NULL;
+  if (json_is_number(vr) && json_number_value(vr) < TX_RATE_MIN_HZ)
+    return fail(err, n, "%s: view.rate_hz: %g Hz is below the least rate, %g Hz", file, json_number_value(vr), TX_RATE_MIN_HZ);
   if (!o || !o->view || strcmp(o->view, "none") == 0) return 0;
   json_t* rate = view ? json_object_get(view, "rate_hz") : NULL;
   json_t* params = json_object();
@@ -308,8 +315,8 @@ static tx_scenario* load_root(const char* file, const char* dir, json_t* root, c
   double seconds = 10;
   if (duration) {
     seconds = json_number_value(duration);
-    if (!json_is_number(duration) || !(seconds > 0 && seconds <= 86400))
-      return fail(err, n, "%s: duration_s: expected a number in (0, 86400]", file), NULL;
+    if (!json_is_number(duration) || !(seconds >= TX_DURATION_MIN_S && seconds <= TX_DURATION_MAX_S))
+      return fail(err, n, "%s: duration_s: expected a number in [%g, %g]", file, TX_DURATION_MIN_S, TX_DURATION_MAX_S), NULL;
   }
   if (load_plugins(file, dir, json_object_get(root, "plugins"), o, err, n)) return NULL;
 
@@ -408,6 +415,18 @@ int tx_scenario_locate(const char* name, char* path, size_t size, char* err, siz
     if (access(path, R_OK) == 0) return 0;
   }
   return fail(err, n, "%s: unknown scenario (tactus list shows them; a file needs a .json ending)", name);
+}
+
+int tx_asset_locate(const char* given, char* path, size_t size) {
+  if (access(given, R_OK) == 0 || given[0] == '/') return snprintf(path, size, "%s", given), access(given, R_OK);
+  // the source tree holds scenarios/ and assets/ side by side
+  const char* prefixes[] = {TX_SCENARIO_DIR "/..", TX_SCENARIO_DIR "/../assets"};
+  for (size_t i = 0; i < sizeof prefixes / sizeof prefixes[0]; i++) {
+    if (snprintf(path, size, "%s/%s", prefixes[i], given) >= (int)size) continue;
+    if (access(path, R_OK) == 0) return 0;
+  }
+  snprintf(path, size, "%s", given);
+  return -1;
 }
 
 void tx_scenario_list(tx_scenario_visit visit, void* user) {

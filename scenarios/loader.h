@@ -37,6 +37,11 @@ tx_scenario* tx_scenario_load_text(const char* label, const char* text, size_t l
                                    size_t n);
 void tx_scenario_free(tx_scenario* s);
 
+// a file a scenario or study names (assets/needle/x.csv): as given when it is
+// there, else a relative name in the source tree or its assets/ folder, so that
+// tactus finds its own assets from any working folder; -1 if nowhere (path = given)
+int tx_asset_locate(const char* given, char* path, size_t size);
+
 // every scenario on the search path: $TACTUS_SCENARIO_PATH (':'-separated), then the source tree
 typedef void (*tx_scenario_visit)(const char* name, const char* path, const char* description, void* user);
 void tx_scenario_list(tx_scenario_visit visit, void* user);

@@ -2,6 +2,8 @@
 #include "report.h"
 
 #include <errno.h>
+#include <fcntl.h>
+#include <stdlib.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -28,6 +30,15 @@ json_t* tx_report_json(const tx_report* r) {
   json_t* warnings = json_object();
   for (int w = 0; w < tx_system_warnings(s); w++)
     json_object_set_new(warnings, tx_system_warning_key(s, w), json_integer((json_int_t)tx_system_warning_count(s, w)));
+  // a haptics controller that misses a deadline is a stall the hand feels: a
+  // warning, not only a number in the table
+  for (int i = 0; i < tx_system_count(s); i++) {
+    tx_controller_stats st = tx_system_stats(s, i);
+    if (strncmp(tx_system_class(s, i)->type, "haptics", 7) != 0 || st.missed == 0) continue;
+    char key[TX_WARNING_KEY_MAX + 32];
+    snprintf(key, sizeof key, "%s.missed_deadlines", tx_system_name(s, i));
+    json_object_set_new(warnings, key, json_integer((json_int_t)st.missed));
+  }
   if (!r->lockstep && !r->result->fifo) json_object_set_new(warnings, "scheduler.no_sched_fifo", json_integer(1));
   if (!r->lockstep && !r->result->pinned) json_object_set_new(warnings, "scheduler.not_pinned", json_integer(1));
 
@@ -50,12 +61,50 @@ json_t* tx_report_json(const tx_report* r) {
   return report;
 }
 
+// room for a report of this system: a few hundred bytes per controller, key and value
+static long report_bytes(tx_system* s) {
+  return 8192 + 1024L * tx_system_count(s) + 160L * (tx_system_warnings(s) + tx_system_results(s));
+}
+
+int tx_report_reserve(tx_system* s, const char* dir, const char* name, char* err, size_t n) {
+  char tmp[4200];
+  snprintf(tmp, sizeof tmp, "%s/%s.tmp", dir, name);
+  FILE* f = fopen(tmp, "w");
+  int rc = f ? posix_fallocate(fileno(f), 0, report_bytes(s)) : errno;
+  if (f && fclose(f) != 0 && !rc) rc = errno;
+  if (rc == EOPNOTSUPP || rc == ENOSYS || rc == EINVAL) rc = 0; // a file system without it: no reservation, no fault
+  if (rc) {
+    snprintf(err, n, "%s: %s", tmp, strerror(rc));
+    remove(tmp);
+    return -1;
+  }
+  return 0;
+}
+
+void tx_report_unreserve(const char* dir, const char* name) {
+  char tmp[4200];
+  snprintf(tmp, sizeof tmp, "%s/%s.tmp", dir, name);
+  remove(tmp);
+}
+
 int tx_report_save(const json_t* json, const char* dir, const char* name, char* err, size_t n) {
   char path[4096], tmp[4200];
   snprintf(path, sizeof path, "%s/%s", dir, name);
   snprintf(tmp, sizeof tmp, "%s.tmp", path);
-  if (json_dump_file(json, tmp, JSON_INDENT(2) | JSON_REAL_PRECISION(10)) != 0 || rename(tmp, path) != 0) {
-    snprintf(err, n, "%s: %s", path, strerror(errno ? errno : EIO));
+  char* text = json_dumps(json, JSON_INDENT(2) | JSON_REAL_PRECISION(10));
+  if (!text) return snprintf(err, n, "%s: out of memory", path), -1;
+  size_t len = strlen(text);
+  // into the space tx_report_reserve set aside, if any: a full disk still takes the report
+  FILE* f = fopen(tmp, "r+");
+  if (!f) f = fopen(tmp, "w");
+  errno = 0;
+  bool ok = f && fwrite(text, 1, len, f) == len && fflush(f) == 0 && ftruncate(fileno(f), (off_t)len) == 0;
+  int e = errno;
+  if (f && fclose(f) != 0 && ok) ok = false, e = errno;
+  free(text);
+  if (!ok || rename(tmp, path) != 0) {
+    if (ok) e = errno;
+    snprintf(err, n, "%s: %s", path, strerror(e ? e : EIO));
     remove(tmp);
     return -1;
   }

@@ -38,6 +38,9 @@ extern "C" {
 
 #define TX_API_VERSION 1
 #define TX_RATE_MAX_HZ 100000.0 // no controller runs faster
+// no controller runs slower: one period is 1000 s, so every tick of the longest
+// run (86400 s) is a few 1e13 ns, far inside the int64 ns of the clocks
+#define TX_RATE_MIN_HZ 0.001
 #define TX_PLUGIN_ENTRY tx_plugin_register // int tx_plugin_register(int api_version)
 
 typedef struct tx_setup tx_setup; // configure-time view of one instance

@@ -295,12 +295,15 @@ static const struct {
 
 int tx_cmd_bench(int argc, char** argv) {
   static const struct option longs[] = {
-      {"out", required_argument, 0, 'o'}, {"duration", required_argument, 0, 'd'}, {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
+      {"out", required_argument, 0, 'o'}, {"duration", required_argument, 0, 'd'}, {"help", no_argument, 0, 'h'},
+      {"force", no_argument, 0, 'F'},     {0, 0, 0, 0}};
   bench_args a = {0};
+  bool force = false;
   optind = 1;
   opterr = 0;
   for (int c; (c = getopt_long(argc, argv, "", longs, NULL)) != -1;) {
     if (c == 'o') a.out = optarg;
+    else if (c == 'F') force = true;
     else if (c == 'd') {
       if (!tx_parse_num(optarg, 0.1, 3600, &a.duration_s)) return tx_bad_input("--duration %s: expected seconds in [0.1, 3600]", optarg);
     } else if (c == 'h') {
@@ -311,12 +314,15 @@ int tx_cmd_bench(int argc, char** argv) {
     else return tx_bad_input("bench: unknown or incomplete option '%s'", argv[optind - 1]);
   }
   if (optind != argc - 1) {
-    printf("usage: tactus bench NAME [--out DIR] [--duration S]\n\n");
+    printf("usage: tactus bench NAME [--out DIR [--force]] [--duration S]\n\n");
     for (size_t i = 0; i < sizeof benches / sizeof benches[0]; i++) printf("  %-10s %s\n", benches[i].name, benches[i].what);
     if (optind == argc + 1) return 0; // --help
     return tx_bad_input("bench: expected one NAME from the list above");
   }
-  for (size_t i = 0; i < sizeof benches / sizeof benches[0]; i++)
-    if (strcmp(argv[optind], benches[i].name) == 0) return benches[i].run(&a);
+  for (size_t i = 0; i < sizeof benches / sizeof benches[0]; i++) {
+    if (strcmp(argv[optind], benches[i].name) != 0) continue;
+    if (tx_out_check(a.out, force)) return TX_EXIT_BAD_INPUT; // a used --out is refused, as by run
+    return benches[i].run(&a);
+  }
   return tx_bad_input("bench %s: unknown benchmark (tactus bench lists them)", argv[optind]);
 }

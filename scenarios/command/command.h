@@ -27,6 +27,25 @@ int tx_bad_input(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 bool tx_parse_num(const char* s, double min, double max, double* out);
 // make the output folder (given, or out/STEM-TIMESTAMP) and check that it takes files
 int tx_out_dir(const char* given, const char* stem, char* dir, size_t n, char* err, size_t en);
+// a given --out that already holds files is refused (status 2, one line) unless force
+int tx_out_check(const char* given, bool force);
+
+// an output folder and what it held before this run, so that a failed run can
+// take back what it wrote
+typedef struct tx_out {
+  char dir[4096];  // the folder
+  char made[4096]; // the outermost folder made for it, "" when it existed
+  char** had;      // names it held before (with --force)
+  int nhad;
+} tx_out;
+// tx_out_dir, remembering; on failure nothing made is left
+int tx_out_open(tx_out* o, const char* given, const char* stem, char* err, size_t en);
+// true when nothing was added since tx_out_open
+bool tx_out_empty(const tx_out* o);
+// remove all that was added since tx_out_open (the folder too, if it was made), then close
+void tx_out_discard(tx_out* o);
+// keep what was written
+void tx_out_close(tx_out* o);
 // load a scenario by name or path; prints the error and returns NULL on failure
 tx_scenario* tx_load_for_command(const char* name, const char* const* sets, int nsets, const char* const* devices,
                                  int ndevices);
@@ -36,5 +55,7 @@ tx_scenario* tx_load_for_command_view(const char* name, const char* const* sets,
 // stop requests (SIGINT, SIGTERM) end a run cleanly; the progress callback of a run
 void tx_catch_stop_signals(void);
 bool tx_progress(double elapsed_s, void* total_s);
+// the stop signal caught since tx_catch_stop_signals (SIGINT, SIGTERM), or 0
+int tx_stop_signal(void);
 
 #endif

@@ -1,7 +1,9 @@
 // What the subcommands share: errors, numbers, output folders, progress.
 #include "command.h"
 
+#include <dirent.h>
 #include <errno.h>
+#include <ftw.h>
 #include <math.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -36,41 +38,136 @@ bool tx_parse_num(const char* s, double min, double max, double* out) {
   return true;
 }
 
-// mkdir -p
-static int make_dirs(const char* path) {
+// mkdir -p; made receives the outermost folder it made ("" if none)
+static int make_dirs(const char* path, char* made, size_t mn) {
   char p[4096];
-  if (snprintf(p, sizeof p, "%s", path) >= (int)sizeof p) return errno = ENAMETOOLONG, -1;
-  for (char* c = *p ? p + 1 : p; *c; c++) { // an empty path has nothing past its NUL
-    if (*c != '/') continue;
+  *made = 0;
+  if (snprintf(p, sizeof p, "%s", path) >= (int)sizeof p || strlen(path) >= mn) return errno = ENAMETOOLONG, -1;
+  for (char* c = *p ? p + 1 : p;; c++) { // an empty path has nothing past its NUL
+    if (*c != '/' && *c) continue;
+    char end = *c;
     *c = 0;
-    if (mkdir(p, 0755) != 0 && errno != EEXIST) return -1;
-    *c = '/';
+    if (mkdir(p, 0755) == 0) {
+      if (!*made) snprintf(made, mn, "%s", p);
+    } else if (errno != EEXIST) {
+      return -1;
+    }
+    *c = end;
+    if (!end) break;
   }
-  if (mkdir(p, 0755) != 0 && errno != EEXIST) return -1;
   struct stat st;
   if (stat(p, &st) != 0) return -1;
   if (!S_ISDIR(st.st_mode)) return errno = ENOTDIR, -1;
   return 0;
 }
 
-int tx_out_dir(const char* given, const char* stem, char* dir, size_t n, char* err, size_t en) {
+static int remove_one(const char* path, const struct stat* st, int flag, struct FTW* ftw) {
+  (void)st, (void)flag, (void)ftw;
+  remove(path);
+  return 0;
+}
+
+// rm -r, never following links out of the folder
+static void remove_tree(const char* path) { nftw(path, remove_one, 16, FTW_DEPTH | FTW_PHYS); }
+
+static int no_dots(const struct dirent* e) { return strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0; }
+
+int tx_out_check(const char* given, bool force) {
+  if (!given || force) return 0;
+  struct dirent** entries = NULL;
+  int n = scandir(given, &entries, no_dots, alphasort);
+  if (n <= 0) return free(entries), 0; // missing (made later) or empty; other faults are named when it is made
+  char first[256];
+  snprintf(first, sizeof first, "%s", entries[0]->d_name);
+  for (int i = 0; i < n; i++) free(entries[i]);
+  free(entries);
+  return tx_bad_input("--out %s: not empty (it holds %s%s); choose a new folder, or add --force to write into it", given,
+                      first, n > 1 ? ", ..." : "");
+}
+
+int tx_out_open(tx_out* o, const char* given, const char* stem, char* err, size_t en) {
+  *o = (tx_out){0};
   if (given) {
-    snprintf(dir, n, "%s", given);
+    snprintf(o->dir, sizeof o->dir, "%s", given);
   } else {
     char stamp[32];
     time_t now = time(NULL);
     strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", localtime(&now));
-    snprintf(dir, n, "out/%s-%s", stem, stamp);
-    for (int k = 2; access(dir, F_OK) == 0 && k < 100; k++) snprintf(dir, n, "out/%s-%s-%d", stem, stamp, k);
+    snprintf(o->dir, sizeof o->dir, "out/%s-%s", stem, stamp);
+    for (int k = 2; access(o->dir, F_OK) == 0 && k < 100; k++) snprintf(o->dir, sizeof o->dir, "out/%s-%s-%d", stem, stamp, k);
   }
-  if (make_dirs(dir) != 0) return snprintf(err, en, "--out %s: %s", dir, strerror(errno)), -1;
+  if (make_dirs(o->dir, o->made, sizeof o->made) != 0) {
+    snprintf(err, en, "--out %s: %s", o->dir, strerror(errno));
+    return tx_out_discard(o), -1;
+  }
+  // what it held before (with --force): a failed run removes only what it added
+  struct dirent** entries = NULL;
+  int n = *o->made ? 0 : scandir(o->dir, &entries, no_dots, alphasort);
+  if (n > 0 && (o->had = calloc(n, sizeof *o->had))) {
+    for (int i = 0; i < n; i++) o->had[o->nhad++] = strdup(entries[i]->d_name);
+  }
+  for (int i = 0; i < n; i++) free(entries[i]);
+  free(entries);
   // prove the folder takes files before any work is done
   char probe[4200];
-  snprintf(probe, sizeof probe, "%s/.tactus-probe", dir);
+  snprintf(probe, sizeof probe, "%s/.tactus-probe", o->dir);
   FILE* f = fopen(probe, "w");
-  if (!f) return snprintf(err, en, "--out %s: %s", dir, strerror(errno)), -1;
+  if (!f) {
+    snprintf(err, en, "--out %s: %s", o->dir, strerror(errno));
+    return tx_out_discard(o), -1;
+  }
   fclose(f);
   remove(probe);
+  return 0;
+}
+
+static bool had(const tx_out* o, const char* name) {
+  for (int i = 0; i < o->nhad; i++)
+    if (o->had[i] && strcmp(o->had[i], name) == 0) return true;
+  return false;
+}
+
+void tx_out_discard(tx_out* o) {
+  if (*o->made) {
+    remove_tree(o->made);
+  } else if (*o->dir) {
+    struct dirent** entries = NULL;
+    int n = scandir(o->dir, &entries, no_dots, alphasort);
+    for (int i = 0; i < n; i++) {
+      char path[4400];
+      snprintf(path, sizeof path, "%s/%s", o->dir, entries[i]->d_name);
+      if (!had(o, entries[i]->d_name)) remove_tree(path);
+      free(entries[i]);
+    }
+    free(entries);
+  }
+  tx_out_close(o);
+}
+
+void tx_out_close(tx_out* o) {
+  for (int i = 0; i < o->nhad; i++) free(o->had[i]);
+  free(o->had);
+  o->had = NULL;
+  o->nhad = 0;
+  *o->made = 0;
+}
+
+bool tx_out_empty(const tx_out* o) {
+  struct dirent** entries = NULL;
+  int n = scandir(o->dir, &entries, no_dots, alphasort), added = 0;
+  for (int i = 0; i < n; i++) {
+    added += !had(o, entries[i]->d_name);
+    free(entries[i]);
+  }
+  free(entries);
+  return added == 0;
+}
+
+int tx_out_dir(const char* given, const char* stem, char* dir, size_t n, char* err, size_t en) {
+  tx_out o;
+  if (tx_out_open(&o, given, stem, err, en)) return -1;
+  snprintf(dir, n, "%s", o.dir);
+  tx_out_close(&o);
   return 0;
 }
 
@@ -89,19 +186,33 @@ tx_scenario* tx_load_for_command_view(const char* name, const char* const* sets,
   return s;
 }
 
-static volatile sig_atomic_t stop_requested;
+static volatile sig_atomic_t stop_requested; // the signal, 0 for none
+static volatile int64_t stop_first_ns;        // when it came
 
+// The first signal stops the run cleanly. One more, a second or more later,
+// ends the process at once, should a step never return; sooner it is the same
+// request again (timeout(1) sends it to the child and to the process group).
 static void on_stop(int sig) {
-  (void)sig;
-  stop_requested = 1;
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  int64_t now = (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+  if (!stop_requested) {
+    stop_first_ns = now;
+    stop_requested = sig;
+  } else if (now - stop_first_ns > 1000000000) {
+    signal(sig, SIG_DFL);
+    raise(sig);
+  }
 }
 
 void tx_catch_stop_signals(void) {
-  struct sigaction sa = {0};
-  sa.sa_handler = on_stop;
+  struct sigaction sa = {.sa_handler = on_stop};
+  sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, NULL);
   sigaction(SIGTERM, &sa, NULL);
 }
+
+int tx_stop_signal(void) { return stop_requested; }
 
 bool tx_progress(double elapsed_s, void* total_s) {
   if (isatty(STDERR_FILENO)) fprintf(stderr, "\r  %.1f / %.1f s ", elapsed_s, *(double*)total_s);

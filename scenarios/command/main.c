@@ -5,16 +5,19 @@
 #include <tactus/tactus.h>
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static const char usage[] =
     "usage: tactus COMMAND [ARGS]\n"
     "\n"
-    "  list                       the scenarios on the search path\n"
+    "  list                       the scenarios on the search path, with their files; (shadowed) marks a\n"
+    "                             name an earlier folder already gives\n"
     "  describe SCENARIO          controllers, rates, threads, reads and writes\n"
     "  run SCENARIO [OPTIONS]     run it; writes OUT/report.json (tactus run --help)\n"
     "  bench NAME [--out DIR]     a benchmark table (tactus bench lists them)\n"
     "  study NAME [--out DIR]     a study with plots (tactus study lists them)\n"
+    "                             (--out refuses a folder that holds files, unless --force)\n"
     "  export FILE.bin [--out F]  the CSV of a device recording (one a killed run left)\n"
     "  version                    version and the optional parts built in\n"
     "\n"
@@ -22,16 +25,35 @@ static const char usage[] =
     "Scenarios are searched in $TACTUS_SCENARIO_PATH (':'-separated), then " TX_SCENARIO_DIR ".\n"
     "Bad input exits with status 2 and one line naming the file and key.\n";
 
+// the names already listed: the first on the search path wins (tx_scenario_locate)
+typedef struct listing {
+  char (*names)[TX_NAME_MAX + 192];
+  int count, cap;
+} listing;
+
 static void print_scenario(const char* name, const char* path, const char* description, void* user) {
-  (void)path;
-  (void)user;
-  printf("%-20s %s\n", name, description);
+  listing* l = user;
+  bool shadowed = false;
+  for (int i = 0; i < l->count && !shadowed; i++) shadowed = strcmp(l->names[i], name) == 0;
+  if (!shadowed && l->count == l->cap) {
+    int cap = l->cap ? 2 * l->cap : 32;
+    void* grown = realloc(l->names, cap * sizeof *l->names);
+    if (grown) l->names = grown, l->cap = cap;
+  }
+  if (!shadowed && l->count < l->cap) snprintf(l->names[l->count++], sizeof l->names[0], "%s", name);
+  char label[TX_NAME_MAX + 16];
+  snprintf(label, sizeof label, "%s%s", name, shadowed ? " (shadowed)" : "");
+  printf("%-24s %s\n%-24s %s\n", label, path, "", description);
 }
 
 int tx_cmd_list(int argc, char** argv) {
   (void)argv;
   if (argc > 1) return tx_bad_input("list: takes no arguments");
-  tx_scenario_list(print_scenario, NULL);
+  listing l = {0};
+  tx_scenario_list(print_scenario, &l);
+  free(l.names);
+  printf("\nNames are looked up in this order: where two scenarios share a name, the first is run and a later one is\n"
+         "(shadowed).\n");
   return 0;
 }
 

@@ -16,7 +16,10 @@ typedef struct tx_run_config {
 } tx_run_config;
 
 // run and report; *report receives the report (caller frees) when not NULL.
-// Returns 0, TX_EXIT_BAD_INPUT for a bad --out, or 1 if the run failed.
+// Returns 0; TX_EXIT_BAD_INPUT for a bad --out or a run that failed before its
+// first step (then nothing of it is kept in the folder, and sc->system is
+// already destroyed: only tx_scenario_free may follow); 1 if the run failed
+// later (the report is written); 130 or 143 when SIGINT or SIGTERM stopped it.
 int tx_run_scenario(tx_scenario* sc, const tx_run_config* cfg, json_t** report);
 
 #endif

@@ -3,7 +3,10 @@
 
 #include "../studies/studies.h"
 
+#include <tactus/config.h>
+
 #include <getopt.h>
+#include <limits.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -34,8 +37,10 @@ static bool takes_file(const char* name) {
 
 int tx_cmd_study(int argc, char** argv) {
   static const struct option longs[] = {
-      {"out", required_argument, 0, 'o'}, {"set", required_argument, 0, 's'}, {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
+      {"out", required_argument, 0, 'o'}, {"set", required_argument, 0, 's'}, {"help", no_argument, 0, 'h'},
+      {"force", no_argument, 0, 'F'},     {0, 0, 0, 0}};
   const char* out = NULL;
+  bool force = false;
   const char* sets[64];
   int nsets = 0;
   bool help = false;
@@ -47,10 +52,13 @@ int tx_cmd_study(int argc, char** argv) {
       if (nsets == 64) return tx_bad_input("--set: at most 64");
       sets[nsets++] = optarg;
     } else if (c == 'h') help = true;
+    else if (c == 'F') force = true;
     else return tx_bad_input("study: unknown or incomplete option '%s'", argv[optind - 1]);
   }
   if (help || optind < argc - 2 || optind > argc - 1) {
-    printf("usage: tactus study NAME [FILE] [--out DIR] [--set KEY=VALUE]...\n\n");
+    printf("usage: tactus study NAME [FILE] [--out DIR [--force]] [--set KEY=VALUE]...\n\n"
+           "A --out that holds files is refused unless --force. A relative FILE not found here is looked for\n"
+           "in the source tree and its assets/ folder (" TX_SCENARIO_DIR "/..).\n\n");
     for (size_t i = 0; i < sizeof studies / sizeof studies[0]; i++) printf("  %-18s %s\n", studies[i].name, studies[i].what);
     return help ? 0 : tx_bad_input("study: expected one NAME from the list above");
   }
@@ -59,10 +67,17 @@ int tx_cmd_study(int argc, char** argv) {
     const char* file = optind == argc - 2 ? argv[optind + 1] : NULL;
     if (takes_file(studies[i].name) && !file) return tx_bad_input("study %s: expected a FILE after the name", studies[i].name);
     if (!takes_file(studies[i].name) && file) return tx_bad_input("study %s: unexpected argument '%s'", studies[i].name, file);
-    char dir[4096], err[1024];
-    if (tx_out_dir(out, studies[i].name, dir, sizeof dir, err, sizeof err)) return tx_bad_input("%s", err);
-    tx_study_args a = {dir, sets, nsets, file};
-    return studies[i].run(&a);
+    char path[PATH_MAX], err[1024];
+    if (file && tx_asset_locate(file, path, sizeof path) == 0) file = path;
+    if (tx_out_check(out, force)) return TX_EXIT_BAD_INPUT;
+    tx_out o;
+    if (tx_out_open(&o, out, studies[i].name, err, sizeof err)) return tx_bad_input("%s", err);
+    tx_study_args a = {o.dir, sets, nsets, file};
+    int rc = studies[i].run(&a);
+    // bad input keeps nothing; a failed study keeps what it wrote, but never an empty folder
+    if (rc == TX_EXIT_BAD_INPUT || (rc != 0 && tx_out_empty(&o))) tx_out_discard(&o);
+    else tx_out_close(&o);
+    return rc;
   }
   return tx_bad_input("study %s: unknown study (tactus study lists them)", argv[optind]);
 }

@@ -6,8 +6,10 @@
 #include <cmocka.h>
 
 #include "controllers/system.h"
+#include "controllers/system_internal.h"
 #include "test_support.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <time.h>
@@ -205,7 +207,7 @@ static void a_failing_init_stops_the_run_cleanly(void** state) {
 static void bad_durations_are_refused(void** state) {
   (void)state;
   tx_system* s = chain();
-  const double bad[] = {0, -1, 86401, NAN};
+  const double bad[] = {0, -1, 86401, NAN, 1e-9, INFINITY};
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     tx_run_options o = {.duration_s = bad[i], .lockstep = true};
     tx_run_result r;
@@ -245,6 +247,133 @@ static void a_controller_can_stop_the_run(void** state) {
   }
 }
 
+// a period past the int64 ns clocks saturates ("never") instead of wrapping to
+// INT64_MIN, which made a 1e-10 Hz run spin forever; the slowest allowed rate
+// holds every tick of the longest run with a wide margin
+static void ticks_saturate_and_the_limits_fit(void** state) {
+  (void)state;
+  assert_true(tx_tick_ns(1e-10, 1) == INT64_MAX);
+  assert_true(tx_tick_ns(1e-10, UINT64_MAX) == INT64_MAX);
+  assert_true(tx_tick_ns(1, UINT64_MAX) == INT64_MAX);
+  assert_true(tx_tick_ns(1e-10, 0) == 0);
+  uint64_t last = (uint64_t)ceil(TX_DURATION_MAX_S * TX_RATE_MIN_HZ) + 1;
+  assert_true(tx_tick_ns(TX_RATE_MIN_HZ, last) > 0 && tx_tick_ns(TX_RATE_MIN_HZ, last) < INT64_MAX / 1000);
+  assert_true(tx_tick_ns(TX_RATE_MAX_HZ, (uint64_t)(TX_DURATION_MAX_S * TX_RATE_MAX_HZ)) == (int64_t)(TX_DURATION_MAX_S * 1e9));
+  // the longest run at the slowest rate: one tick each 1000 s, 0 to 86000 s
+  tx_system* s = tx_system_create();
+  tx_fault f;
+  json_t* p = json_loads("{\"write\":\"a\"}", 0, NULL);
+  assert_int_equal(tx_system_add(s, "slow", "test.counter", TX_RATE_MIN_HZ, p, &f), 0);
+  json_decref(p);
+  assert_int_equal(tx_system_finalize(s, &f), 0);
+  tx_run_options o = {.duration_s = TX_DURATION_MAX_S, .lockstep = true};
+  tx_run_result r;
+  char err[256];
+  assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+  assert_int_equal(tx_system_stats(s, 0).steps, 87);
+  tx_system_destroy(s);
+  // and one below it is refused
+  s = tx_system_create();
+  assert_int_equal(tx_system_add(s, "slower", "test.counter", TX_RATE_MIN_HZ / 2, NULL, &f), -1);
+  assert_string_equal(f.key, "rate_hz");
+  tx_system_destroy(s);
+}
+
+// every step sleeps 20 ms
+static void slow_step(tx_ctx* c, void* self) {
+  (void)c, (void)self;
+  struct timespec ts = {0, 20000000};
+  nanosleep(&ts, NULL);
+}
+
+static int progress_calls;
+static bool stop_at_once(double elapsed_s, void* user) {
+  (void)elapsed_s, (void)user;
+  progress_calls++;
+  return false;
+}
+
+// a stop request is heard within about 100 ms of wall time, however slowly the
+// virtual clock moves: 100 ms of simulated time here is 2 s of steps
+static void lockstep_hears_a_stop_on_wall_time(void** state) {
+  (void)state;
+  static tx_controller_class cls = {.type = "test.slow", .summary = "sleeps 20 ms a step", .configure = sleeper_configure,
+                                    .step = slow_step, .fini = counter_fini};
+  if (!tx_find_controller(cls.type)) assert_int_equal(tx_register_controller(&cls), 0);
+  tx_system* s = tx_system_create();
+  tx_fault f;
+  assert_int_equal(tx_system_add(s, "slow", "test.slow", 1000, NULL, &f), 0);
+  assert_int_equal(tx_system_finalize(s, &f), 0);
+  tx_run_options o = {.duration_s = 10, .lockstep = true, .progress = stop_at_once};
+  tx_run_result r;
+  char err[256];
+  progress_calls = 0;
+  assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+  assert_true(r.stopped_early);
+  assert_int_equal(progress_calls, 1);
+  uint64_t steps = tx_system_stats(s, 0).steps;
+  print_message("  stopped after %llu steps, at t = %g s\n", (unsigned long long)steps, r.duration_s);
+  assert_true(steps >= 1 && steps <= 20); // about 5; 100 if only simulated time counted
+  // the report's duration is the simulated time reached, not the whole run
+  assert_true(fabs(r.duration_s - (double)(steps - 1) * 1e-3) < 1e-9);
+  tx_system_destroy(s);
+}
+
+// a trace that cannot be written (a full disk) stops a lockstep run at once,
+// naming the file and the reason, rather than after the whole duration
+static void a_trace_write_error_stops_the_run(void** state) {
+  (void)state;
+  FILE* full = fopen("/dev/full", "w");
+  if (!full) skip();
+  tx_system* s = chain();
+  tx_run_options o = {.duration_s = 10, .lockstep = true, .trace = full, .trace_name = "out/trace.csv"};
+  tx_run_result r;
+  char err[256];
+  assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+  assert_true(r.halted);
+  char want[256];
+  snprintf(want, sizeof want, "out/trace.csv: %s", strerror(ENOSPC));
+  assert_string_equal(r.halt_reason, want);
+  print_message("  halted at t = %g s: %s\n", r.halt_t_s, r.halt_reason);
+  assert_true(r.halt_t_s < 0.5);
+  assert_true(tx_system_stats(s, 1).steps < 2000); // collision, 4 kHz: not the 40000 of 10 s
+  fclose(full);
+  tx_system_destroy(s);
+}
+
+static int finishes;
+static void count_finish(tx_ctx* c, void* self) {
+  (void)c, (void)self;
+  finishes++;
+}
+
+// a run whose init failed never started: no controller's finish runs (it would
+// flush an empty recording), in either executor
+static void no_finish_after_a_failed_init(void** state) {
+  (void)state;
+  static tx_controller_class fin = {.type = "test.finisher", .summary = "counts finish", .configure = counter_configure,
+                                    .step = counter_step, .finish = count_finish, .fini = counter_fini};
+  static tx_controller_class bad = {.type = "test.badinit2", .summary = "fails init", .configure = counter_configure,
+                                    .init = failing_init, .step = counter_step, .fini = counter_fini};
+  if (!tx_find_controller(fin.type)) assert_int_equal(tx_register_controller(&fin), 0);
+  if (!tx_find_controller(bad.type)) assert_int_equal(tx_register_controller(&bad), 0);
+  for (int lock = 0; lock < 2; lock++) {
+    tx_system* s = tx_system_create();
+    tx_fault f;
+    assert_int_equal(tx_system_add(s, "good", "test.finisher", 1000, NULL, &f), 0);
+    assert_int_equal(tx_system_add(s, "bad", "test.badinit2", 50, NULL, &f), 0);
+    assert_int_equal(tx_system_finalize(s, &f), 0);
+    tx_run_options o = {.duration_s = 0.2, .lockstep = lock};
+    tx_run_result r;
+    char err[256];
+    finishes = 0;
+    assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), -1);
+    assert_int_equal(finishes, 0);
+    assert_int_equal(tx_system_stats(s, 0).steps, 0);
+    tx_system_destroy(s);
+  }
+}
+
 int main(void) {
   register_test_classes();
   const struct CMUnitTest tests[] = {
@@ -257,6 +386,10 @@ int main(void) {
       cmocka_unit_test(a_failing_init_stops_the_run_cleanly),
       cmocka_unit_test(bad_durations_are_refused),
       cmocka_unit_test(a_controller_can_stop_the_run),
+      cmocka_unit_test(ticks_saturate_and_the_limits_fit),
+      cmocka_unit_test(lockstep_hears_a_stop_on_wall_time),
+      cmocka_unit_test(a_trace_write_error_stops_the_run),
+      cmocka_unit_test(no_finish_after_a_failed_init),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -203,13 +203,21 @@ static void rate_hz_of_the_wrong_type(void** state) {
 
 static void rate_hz_out_of_range(void** state) {
   (void)state;
-  static const char* const rates[] = {"0", "-5", "100001", "100000.5", "1e300"};
+  // below TX_RATE_MIN_HZ a period no longer fits the int64 ns clocks (1e-10 Hz: 1e19 ns)
+  static const char* const rates[] = {"0", "-5", "100001", "100000.5", "1e300", "1e-10", "0.0009", "5e-324"};
   for (size_t i = 0; i < sizeof rates / sizeof rates[0]; i++) {
     char text[256];
     snprintf(text, sizeof text, "{\"name\":\"t\",\"controllers\":[{\"name\":\"a\"," WORKER ",\"rate_hz\":%s}]}",
              rates[i]);
-    expect_text_error(text, LABEL ": controllers[0].rate_hz: ", "out of range (0, 100000]");
+    expect_text_error(text, LABEL ": controllers[0].rate_hz: ", "out of range [0.001, 100000]");
   }
+}
+
+// the view's rate is checked against the clocks even when nothing draws
+static void view_rate_below_the_least(void** state) {
+  (void)state;
+  expect_text_error("{\"name\":\"t\",\"view\":{\"rate_hz\":1e-10},\"controllers\":[{\"name\":\"a\"," WORKER ",\"rate_hz\":1}]}",
+                    LABEL ": view.rate_hz: ", "below the least rate");
 }
 
 static void two_writers_of_one_component(void** state) {
@@ -277,9 +285,11 @@ static void parameter_out_of_range_or_of_the_wrong_type(void** state) {
 static void duration_out_of_range(void** state) {
   (void)state;
   expect_text_error("{\"name\":\"t\",\"duration_s\":0,\"controllers\":[{\"name\":\"a\"," WORKER ",\"rate_hz\":1}]}",
-                    LABEL ": duration_s: ", "(0, 86400]");
+                    LABEL ": duration_s: ", "[1e-06, 86400]");
   expect_text_error("{\"name\":\"t\",\"duration_s\":\"long\",\"controllers\":[{\"name\":\"a\"," WORKER ",\"rate_hz\":1}]}",
-                    LABEL ": duration_s: ", "(0, 86400]");
+                    LABEL ": duration_s: ", "[1e-06, 86400]");
+  expect_text_error("{\"name\":\"t\",\"duration_s\":1e-300,\"controllers\":[{\"name\":\"a\"," WORKER ",\"rate_hz\":1}]}",
+                    LABEL ": duration_s: ", "[1e-06, 86400]");
 }
 
 static void plugins_rejected_when_not_allowed(void** state) {
@@ -364,12 +374,23 @@ static void set_of_an_unknown_parameter(void** state) {
 
 static void set_out_of_range(void** state) {
   (void)state;
-  expect_set_error(one_worker, "a.rate_hz=0", "--set a.rate_hz=0: ", "out of range (0, 100000]");
+  expect_set_error(one_worker, "a.rate_hz=0", "--set a.rate_hz=0: ", "out of range [0.001, 100000]");
+  expect_set_error(one_worker, "a.rate_hz=1e-10", "--set a.rate_hz=1e-10: ", "out of range [0.001, 100000]");
   expect_set_error(one_worker, "a.rate_hz=100001", "--set a.rate_hz=100001: ", "out of range");
   expect_set_error(one_worker, "a.rate_hz=fast", "--set a.rate_hz=fast: ", "expected a number");
   expect_set_error(one_worker, "a.work_us=-1", "--set a.work_us=-1: ", "out of range");
-  expect_set_error(one_worker, "duration_s=0", "--set duration_s=0: ", "(0, 86400]");
-  expect_set_error(one_worker, "duration_s=abc", "--set duration_s=abc: ", "(0, 86400]");
+  expect_set_error(one_worker, "duration_s=0", "--set duration_s=0: ", "[1e-06, 86400]");
+  expect_set_error(one_worker, "duration_s=abc", "--set duration_s=abc: ", "[1e-06, 86400]");
+  // a number past a double's range is named as such, not as "a string"
+  expect_set_error(one_worker, "a.work_us=1e999", "--set a.work_us=1e999: ", "out of range");
+  expect_set_error(one_worker, "a.work_us=-1e400", "--set a.work_us=-1e400: ", "out of range");
+}
+
+// a bad component name is named, with the --set that gave it, not blamed on a reader
+static void set_of_a_bad_component_name(void** state) {
+  (void)state;
+  expect_set_error(one_worker, "a.write=Bad Name!", "--set a.write=Bad Name!: ", "bad component name 'Bad Name!'");
+  expect_set_error(one_worker, "a.reads=[\"ok.x\", \"UP\"]", "--set a.reads=[\"ok.x\", \"UP\"]: ", "bad component name 'UP'");
 }
 
 static void set_malformed(void** state) {
@@ -518,6 +539,8 @@ int main(void) {
       cmocka_unit_test(set_of_an_unknown_controller),
       cmocka_unit_test(set_of_an_unknown_parameter),
       cmocka_unit_test(set_out_of_range),
+      cmocka_unit_test(set_of_a_bad_component_name),
+      cmocka_unit_test(view_rate_below_the_least),
       cmocka_unit_test(set_malformed),
       cmocka_unit_test(set_names_only_the_controller_it_changed),
       cmocka_unit_test_setup_teardown(files_load_and_errors_name_the_path, make_dir, remove_dir),

@@ -1,0 +1,75 @@
+// The run report: a haptics controller's missed deadlines are a warning (a
+// stall the hand feels), on the summary's warnings line and in report.json;
+// another controller's stay in the table only.
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include "views/report.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+// step 1 sleeps 300 ms: at 5 Hz (ticks 200 ms apart) that is one missed deadline
+static int configure(tx_setup* s, void** self) {
+  (void)s;
+  *self = NULL;
+  return 0;
+}
+static void step(tx_ctx* c, void* self) {
+  (void)self;
+  if (tx_step_index(c) != 1) return;
+  struct timespec ts = {0, 300000000};
+  nanosleep(&ts, NULL);
+}
+static const tx_controller_class stall_haptics = {.type = "haptics.test_stall", .summary = "stalls once",
+                                                  .configure = configure, .step = step};
+static const tx_controller_class stall_other = {.type = "test.stall", .summary = "stalls once",
+                                                .configure = configure, .step = step};
+
+static void haptic_stalls_are_warnings(void** state) {
+  (void)state;
+  if (!tx_find_controller(stall_haptics.type)) assert_int_equal(tx_register_controller(&stall_haptics), 0);
+  if (!tx_find_controller(stall_other.type)) assert_int_equal(tx_register_controller(&stall_other), 0);
+  tx_system* s = tx_system_create();
+  tx_fault f;
+  assert_int_equal(tx_system_add(s, "hand", "haptics.test_stall", 5, NULL, &f), 0);
+  assert_int_equal(tx_system_add(s, "physics", "test.stall", 4, NULL, &f), 0);
+  assert_int_equal(tx_system_finalize(s, &f), 0);
+  tx_run_options o = {.duration_s = 1.0};
+  tx_run_result r;
+  char err[256];
+  assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+  uint64_t missed = tx_system_stats(s, 0).missed;
+  assert_true(missed >= 1);
+  assert_true(tx_system_stats(s, 1).missed >= 1);
+
+  json_t* report = tx_report_json(&(tx_report){"t", false, &r, s});
+  json_t* warnings = json_object_get(report, "warnings");
+  assert_int_equal(json_integer_value(json_object_get(warnings, "hand.missed_deadlines")), (json_int_t)missed);
+  assert_null(json_object_get(warnings, "physics.missed_deadlines"));
+
+  char* text = NULL;
+  size_t len = 0;
+  FILE* f2 = open_memstream(&text, &len);
+  tx_report_print(f2, report);
+  fclose(f2);
+  char want[64];
+  snprintf(want, sizeof want, "hand.missed_deadlines=%llu", (unsigned long long)missed);
+  const char* line = strstr(text, "\nwarnings:");
+  assert_non_null(line);
+  const char* end = strchr(line + 1, '\n');
+  assert_non_null(strstr(line, want));
+  assert_true(strstr(line, want) < end);
+  free(text);
+  json_decref(report);
+  tx_system_destroy(s);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {cmocka_unit_test(haptic_stalls_are_warnings)};
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
