@@ -1,6 +1,8 @@
 // Full-rate device recording through a lock-free ring and a writer thread.
 #include "recorder.h"
 
+#include "../../model/prefault.h"
+
 #include "device_protocol.h" // tx_dp_crc32: the CRC-32 of zlib, already in the library
 
 #include <errno.h>
@@ -93,6 +95,7 @@ tx_recorder* tx_recorder_start(const char* dir, int hand, double rate_hz, const 
                                size_t n) {
   tx_recorder* r = calloc(1, sizeof *r);
   if (!r) return snprintf(err, n, "out of memory for the recorder"), NULL;
+  tx_prefault(r->ring, sizeof r->ring); // calloc maps its pages lazily
   snprintf(r->bin, sizeof r->bin, "%s/device%d.bin", dir, hand);
   snprintf(r->csv, sizeof r->csv, "%s/device%d.csv", dir, hand);
   r->file = fopen(r->bin, "wb");
