@@ -89,6 +89,26 @@ printf 'not a recording\n' >"$WORK/text.bin"
 expect_bad "replay of a text file" "$WORK/text.bin" -- "replay:$WORK/text.bin"
 expect_bad "replay of a missing file" "$WORK/none.bin" "No such file" -- "replay:$WORK/none.bin"
 expect_bad "a udp device served again" "udp:127.0.0.1:9" -- udp:127.0.0.1:9
+# issue 11, rows 13 and 14: a sim value that would make the integration NaN, a key given twice, the mouse
+expect_bad "sim: a mass of 1e-300 kg" "sim:mass=1e-300" "mass = 1e-300 kg" -- sim:mass=1e-300
+expect_bad "sim: a key twice" "sim:mass=0.1,mass=0.2" "mass: given twice" -- sim:mass=0.1,mass=0.2
+expect_bad "the mouse served" "mouse" "window" -- mouse
+# a replay served at another rate names the flag and the recording's rate; without --rate it is served at its own
+if timeout -k 5 60 "$RUNNER" run haptics-wall --device sim --lockstep --duration 0.2 --out "$WORK/rec" --quiet \
+  >/dev/null 2>"$WORK/rec.err"; then
+  expect_bad "a 1 kHz replay at --rate 500" "--rate 500" "recorded at 1000 Hz" "--rate 1000" -- \
+    "replay:$WORK/rec/device0.bin" --rate 500
+  cases=$((cases + 1))
+  timeout -k 5 20 "$DEVICE" "replay:$WORK/rec/device0.bin" --listen 127.0.0.1:0 --duration 0.1 >"$WORK/rep.out" 2>&1 &
+  rep=$!
+  pids+=($rep)
+  rport=$(port_of "$WORK/rep.out")
+  grep -q "at 1000 Hz" "$WORK/rep.out" || fail "a replay without --rate: not served at its 1000 Hz: $(head -n 1 "$WORK/rep.out")"
+  [ -n "$rport" ] && kill -INT "$rep" 2>/dev/null
+  wait "$rep" || fail "a replay without --rate: exit status $?"
+else
+  fail "recording for the replay cases: $(head -n 1 "$WORK/rec.err")"
+fi
 # a port already taken: the second server says so
 timeout -k 5 20 "$DEVICE" scripted:pierce-down --listen 127.0.0.1:0 >"$WORK/taken.out" 2>&1 &
 pids+=($!)
@@ -104,6 +124,12 @@ TACTUS=$RUNNER
 expect_bad "run: --device udp: without an address" "--device udp:bogus" "HOST:PORT" -- run haptics-wall --device udp:bogus
 expect_bad "run: --device udp: port 0" "--device udp:127.0.0.1:0" -- run haptics-wall --device udp:127.0.0.1:0
 expect_bad "run: --device udp: off loopback" "--device udp:10.1.2.3:5000" "bind=" -- run haptics-wall --device udp:10.1.2.3:5000
+expect_bad "run: --device sim: a mass of 1e-300 kg" "--device sim:mass=1e-300" "mass = 1e-300 kg" -- \
+  run haptics-wall --device sim:mass=1e-300 --lockstep --duration 0.1
+expect_bad "run: --device sim: a key twice" "--device sim:mass=0.1,mass=0.2" "mass: given twice" -- \
+  run haptics-wall --device sim:mass=0.1,mass=0.2 --lockstep --duration 0.1
+expect_bad "run: --device sim: a hand that is no motion" "--device sim:hand=wiggle" "hand:" -- \
+  run haptics-wall --device sim:hand=wiggle --lockstep --duration 0.1
 # nobody serving: refused quickly, named, within the 2 s wait
 expect_bad "run: --device udp: nobody there" "--device udp:127.0.0.1:9" "no hello" -- run haptics-wall --device udp:127.0.0.1:9
 
