@@ -34,7 +34,9 @@ static const char usage[] =
     "ADDR is an IPv4 address or localhost. It listens on loopback unless --listen says otherwise,\n"
     "and takes packets only from its peer. The first line on stdout names the address it serves on.\n"
     "At the end it prints the packets counted and the round trip (state out, force back) p50/p99.\n"
-    "Ctrl-C stops it; the device is left with zero force. Bad input exits with status 2.\n"
+    "A client not heard from for 1 s is let go, and the next to say hello is served; each client's\n"
+    "forces ramp from zero over 5 ms. Ctrl-C stops it; the device is left with zero force.\n"
+    "Bad input exits with status 2.\n"
     "\n"
     "  tactus-device scripted:pierce-down --listen 127.0.0.1:47100 &\n"
     "  tactus run haptics-wall --device udp:127.0.0.1:47100\n";
@@ -53,6 +55,8 @@ static void print_stats(const tx_device_server_stats* s) {
          (unsigned long long)s->stale, (unsigned long long)s->malformed, (unsigned long long)s->foreign,
          (unsigned long long)s->other_session, (unsigned long long)s->unexpected, (unsigned long long)s->send_errors,
          (unsigned long long)s->force_timeouts, (unsigned long long)s->late_ticks);
+  printf("clients: %llu served, %llu let go after falling silent; %llu forces ramped from zero after a hello\n",
+         (unsigned long long)s->clients, (unsigned long long)s->clients_gone, (unsigned long long)s->ramped);
   if (s->round_trips)
     printf("round trip (%llu): link p50 %.1f us p99 %.1f us max %.1f us; with the simulator's tick wait p50 %.1f us "
            "p99 %.1f us\n",
@@ -135,9 +139,11 @@ int main(int argc, char** argv) {
   sa.sa_handler = on_stop; // no SA_RESTART: a signal wakes the wait at once
   sigaction(SIGINT, &sa, NULL);
   sigaction(SIGTERM, &sa, NULL);
-  char ip[64] = "?";
-  inet_ntop(AF_INET, &def.listen.sin_addr, ip, sizeof ip);
-  printf("tactus-device: serving %s on %s:%u at %g Hz\n", def.spec, ip, tx_device_server_port(s), def.rate_hz);
+  struct sockaddr_in bound = def.listen;
+  bound.sin_port = htons(tx_device_server_port(s));
+  char where[64];
+  printf("tactus-device: serving %s on %s at %g Hz\n", def.spec, tx_dp_addr_text(&bound, where, sizeof where),
+         def.rate_hz);
 
   int rc = tx_device_server_run(s, &stop_requested, err, sizeof err);
   if (rc) fprintf(stderr, "tactus-device: %s\n", err);

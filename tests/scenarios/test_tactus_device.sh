@@ -8,6 +8,9 @@
 #     garbage, replays, forged packets): no crash, stale and foreign packets
 #     dropped, the force still within the clamp and zero after the stream stops
 #   - Ctrl-C stops the server cleanly
+#   - issue 11: one server serves two successive runs (row 7); a server stopped during a
+#     run and started again is lost and rejoined, with one line each (row 8); bad sim
+#     specs, the mouse and a replay at another --rate are refused (rows 13, 14)
 #
 #   test_tactus_device.sh TACTUS_DEVICE TACTUS UDP_SHIM
 set -u
@@ -209,6 +212,85 @@ else
       n=$(echo "$stats" | sed -n "s/.* \([0-9][0-9]*\) $what.*/\1/p")
       [ -n "$n" ] && [ "$n" -gt 0 ] || fail "lossy: the device counted no $what packets: $stats"
     done
+  fi
+fi
+
+# --- issue 11, row 7: one server, two successive runs ----------------------------------------
+# the first run's client goes quiet at its end; the server lets it go and serves the second
+cases=$((cases + 1))
+timeout -k 5 60 "$DEVICE" scripted:pierce-down --listen 127.0.0.1:0 >"$WORK/dev4.out" 2>"$WORK/dev4.err" &
+dev=$!
+pids+=($dev)
+port=$(port_of "$WORK/dev4.out")
+if [ -z "$port" ]; then
+  fail "two runs: the server printed no port"
+else
+  for r in 1 2; do
+    timeout -k 5 60 "$RUNNER" run haptics-wall --device "udp:127.0.0.1:$port" --duration 1 --out "$WORK/two$r" --quiet \
+      >"$WORK/two$r.stdout" 2>"$WORK/two$r.stderr"
+    rc=$?
+    [ "$rc" -eq 0 ] || fail "two runs: run $r exit status $rc: $(head -n 1 "$WORK/two$r.stderr")"
+  done
+  kill -INT "$dev"
+  wait "$dev" || fail "two runs: tactus-device exit status $?"
+  # each run's first forces ramp from zero: 5 ms of 1 kHz forces each
+  grep -Eq '^clients: 2 served, [0-9]+ let go after falling silent; ([89]|[1-9][0-9]+) forces ramped' "$WORK/dev4.out" ||
+    fail "two runs: not two clients served, each with its ramp: $(grep '^clients' "$WORK/dev4.out")"
+  sed -n 's/^/two runs: tactus-device: /p' "$WORK/dev4.out" | grep -E 'packets|clients'
+fi
+
+# --- issue 11, row 8: the server is stopped 3 s into an 8 s run, then started again ----------
+# the run says when the device is lost and when it is back, the force is zero within 10 ticks
+# of the last state before the outage, and once the server's motion reaches the wall again
+# there is force again
+cases=$((cases + 1))
+timeout -k 5 60 "$DEVICE" scripted:pierce-down --listen 127.0.0.1:0 >"$WORK/dev5.out" 2>"$WORK/dev5.err" &
+dev=$!
+pids+=($dev)
+port=$(port_of "$WORK/dev5.out")
+if [ -z "$port" ]; then
+  fail "restart: the server printed no port"
+else
+  timeout -k 5 60 "$RUNNER" run haptics-wall --device "udp:127.0.0.1:$port" --duration 8 --out "$WORK/restart" --quiet \
+    --set haptics.device_timeout_s=0.004 --set haptics.ramp_s=0.005 >"$WORK/restart.stdout" 2>"$WORK/restart.stderr" &
+  run=$!
+  pids+=($run)
+  sleep 3
+  kill -TERM "$dev"
+  wait "$dev"
+  sleep 1
+  timeout -k 5 60 "$DEVICE" scripted:pierce-down --listen "127.0.0.1:$port" >"$WORK/dev6.out" 2>"$WORK/dev6.err" &
+  dev=$!
+  pids+=($dev)
+  wait "$run"
+  rc=$?
+  kill -INT "$dev"
+  wait "$dev"
+  [ "$rc" -eq 0 ] || fail "restart: tactus run exit status $rc: $(head -n 1 "$WORK/restart.stderr")"
+  sed -n 's/^/restart: /p' "$WORK/restart.stderr"
+  [ "$(grep -c "device udp:127.0.0.1:$port lost at t = " "$WORK/restart.stderr")" -eq 1 ] ||
+    fail "restart: not one 'lost' line: $(cat "$WORK/restart.stderr")"
+  [ "$(grep -c "device udp:127.0.0.1:$port back at t = .*restarted server" "$WORK/restart.stderr")" -eq 1 ] ||
+    fail "restart: not one 'back' line: $(cat "$WORK/restart.stderr")"
+  if [ -s "$WORK/restart/device0.csv" ]; then
+    # the outage is the longest run of ticks without a new state; zero within 10 ticks of its
+    # start; force again (>= 0.5 N) in the last 0.5 s
+    msg=$(awk -F, 'NR > 1 {
+        t[NR] = $1; f[NR] = sqrt($5 * $5 + $6 * $6 + $7 * $7)
+        if (NR > 2 && ($2 != px || $3 != py || $4 != pz)) { if (NR - last > gap) { gap = NR - last; from = last } last = NR }
+        if (NR == 2) last = NR
+        px = $2; py = $3; pz = $4; end = $1
+      }
+      END {
+        for (i = from; i <= NR && f[i] != 0; i++);
+        late = 0
+        for (j = 2; j <= NR; j++) if (t[j] > end - 0.5 && f[j] > late) late = f[j]
+        printf "outage from %.3f s for %.3f s; zero %d ticks after its start; |F| up to %.3f N in the last 0.5 s\n", t[from], t[from + gap] - t[from], i - from, late
+        exit !(gap * 0.001 >= 0.5 && i - from <= 10 && late >= 0.5)
+      }' "$WORK/restart/device0.csv") || fail "restart: $msg"
+    echo "restart: $msg"
+  else
+    fail "restart: no device0.csv"
   fi
 fi
 
