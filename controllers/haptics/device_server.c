@@ -259,7 +259,6 @@ int tx_device_server_run(tx_device_server* s, const atomic_int* stop, char* err,
   while (!atomic_load(stop)) {
     int64_t now = tx_dp_now_ns();
     if (s->first_ns && duration && now - s->first_ns >= duration) break;
-    if (s->streaming && now - s->arrival_ns > client_timeout) let_go(s);
     if (s->streaming && now >= s->next_ns) tick(s, now, period);
     if (s->forcing && now - s->last_force_ns > force_timeout) { // the simulator went quiet
       zero_device(s);
@@ -278,6 +277,8 @@ int tx_device_server_run(tx_device_server* s, const atomic_int* stop, char* err,
       rc = -1;
       break;
     }
+    // after the drain: what waited in the socket while this thread was held up still counts
+    if (s->streaming && tx_dp_now_ns() - s->arrival_ns > client_timeout) let_go(s);
   }
   zero_device(s);
   return rc;
