@@ -42,6 +42,7 @@ struct tx_device {
   int64_t echo_ns;            // send_ns of the newest packet accepted
   int64_t arrival_ns;         // when it arrived here, monotonic
   int64_t last_state_ns;      // when the newest state was taken, monotonic
+  int64_t sent_ns;            // when the newest packet left, monotonic
   bool lost;                  // no state for TX_DEVICE_UDP_LOST_S
   int64_t lost_ns;            // since when, monotonic
   int64_t next_hello_ns;      // while lost: when to say hello again
@@ -147,6 +148,7 @@ static bool drain(tx_device* d) {
 static void send_packet(tx_device* d, tx_dp_packet* p) {
   uint8_t buf[TX_DP_MAX_SIZE];
   size_t n = tx_dp_stamp_encode(p, d->session, &d->seq, d->echo_ns, d->arrival_ns, buf, sizeof buf);
+  d->sent_ns = p->send_ns;
   if (n == 0 || send(d->fd, buf, n, MSG_DONTWAIT | MSG_NOSIGNAL) != (ssize_t)n) d->counts.send_errors++;
 }
 
@@ -286,6 +288,11 @@ static bool read_udp(tx_device* d, double t, tx_device_state* s) {
   if (d->lost && now >= d->next_hello_ns) { // a restarted server knows no client until it hears a hello
     send_hello(d);
     d->next_hello_ns = now + (int64_t)(TX_DEVICE_UDP_REJOIN_S * 1e9);
+  } else if (now - d->sent_ns > (int64_t)(TX_DEVICE_UDP_LOST_S * 1e9)) {
+    // nothing sent for a while (the run's setup between the open and its first
+    // tick, a stalled machine): the server may have let this client go, so say
+    // hello at once rather than be lost first
+    send_hello(d);
   }
   *s = d->state;
   return fresh;
