@@ -102,7 +102,9 @@ if timeout -k 5 60 "$RUNNER" run haptics-wall --device sim --lockstep --duration
   expect_bad "a 1 kHz replay at --rate 500" "--rate 500" "recorded at 1000 Hz" "--rate 1000" -- \
     "replay:$WORK/rec/device0.bin" --rate 500
   cases=$((cases + 1))
-  timeout -k 5 20 "$DEVICE" "replay:$WORK/rec/device0.bin" --listen 127.0.0.1:0 --duration 0.1 >"$WORK/rep.out" 2>&1 &
+  # stopped by a signal: no leak check at exit (see Ctrl-C below)
+  ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" \
+    timeout -k 5 20 "$DEVICE" "replay:$WORK/rec/device0.bin" --listen 127.0.0.1:0 --duration 0.1 >"$WORK/rep.out" 2>&1 &
   rep=$!
   pids+=($rep)
   rport=$(port_of "$WORK/rep.out")
@@ -218,7 +220,8 @@ fi
 # --- issue 11, row 7: one server, two successive runs ----------------------------------------
 # the first run's client goes quiet at its end; the server lets it go and serves the second
 cases=$((cases + 1))
-timeout -k 5 60 "$DEVICE" scripted:pierce-down --listen 127.0.0.1:0 >"$WORK/dev4.out" 2>"$WORK/dev4.err" &
+ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" \
+  timeout -k 5 60 "$DEVICE" scripted:pierce-down --listen 127.0.0.1:0 >"$WORK/dev4.out" 2>"$WORK/dev4.err" &
 dev=$!
 pids+=($dev)
 port=$(port_of "$WORK/dev4.out")
@@ -244,7 +247,8 @@ fi
 # of the last state before the outage, and once the server's motion reaches the wall again
 # there is force again
 cases=$((cases + 1))
-timeout -k 5 60 "$DEVICE" scripted:pierce-down --listen 127.0.0.1:0 >"$WORK/dev5.out" 2>"$WORK/dev5.err" &
+ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" \
+  timeout -k 5 60 "$DEVICE" scripted:pierce-down --listen 127.0.0.1:0 >"$WORK/dev5.out" 2>"$WORK/dev5.err" &
 dev=$!
 pids+=($dev)
 port=$(port_of "$WORK/dev5.out")
@@ -259,7 +263,8 @@ else
   kill -TERM "$dev"
   wait "$dev"
   sleep 1
-  timeout -k 5 60 "$DEVICE" scripted:pierce-down --listen "127.0.0.1:$port" >"$WORK/dev6.out" 2>"$WORK/dev6.err" &
+  ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" \
+    timeout -k 5 60 "$DEVICE" scripted:pierce-down --listen "127.0.0.1:$port" >"$WORK/dev6.out" 2>"$WORK/dev6.err" &
   dev=$!
   pids+=($dev)
   wait "$run"
@@ -275,8 +280,9 @@ else
   rejoined=$(grep -c "device udp:127.0.0.1:$port back at t = .*(a restarted server, rejoined)" "$WORK/restart.stderr")
   [ "$lost" -ge 1 ] && [ "$lost" -eq "$back" ] && [ "$rejoined" -eq 1 ] ||
     fail "restart: expected lost and back lines in pairs, one of them a rejoin: $(cat "$WORK/restart.stderr")"
-  [ "$(grep -vc "device udp:127.0.0.1:$port \(lost\|back\) at t = " "$WORK/restart.stderr")" -eq 0 ] ||
-    fail "restart: other lines on stderr: $(grep -v " at t = " "$WORK/restart.stderr")"
+  # (a sanitizer build adds its own summary at exit, which is not the run's)
+  [ "$(grep '^tactus' "$WORK/restart.stderr" | grep -vc "device udp:127.0.0.1:$port \(lost\|back\) at t = ")" -eq 0 ] ||
+    fail "restart: other lines on stderr: $(grep '^tactus' "$WORK/restart.stderr" | grep -v " at t = ")"
   if [ -s "$WORK/restart/device0.csv" ]; then
     # the outage is the longest run of ticks without a new state; zero within 10 ticks of its
     # start; force again (>= 0.5 N) in the last 0.5 s
