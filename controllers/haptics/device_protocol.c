@@ -220,6 +220,17 @@ bool tx_dp_parse_addr(const char* s, bool any_port, struct sockaddr_in* out, con
   return true;
 }
 
+bool tx_dp_same_addr(const struct sockaddr_in* a, const struct sockaddr_in* b) {
+  return a->sin_family == b->sin_family && a->sin_addr.s_addr == b->sin_addr.s_addr && a->sin_port == b->sin_port;
+}
+
+const char* tx_dp_addr_text(const struct sockaddr_in* a, char* buf, size_t n) {
+  char ip[INET_ADDRSTRLEN] = "?";
+  inet_ntop(AF_INET, &a->sin_addr, ip, sizeof ip);
+  snprintf(buf, n, "%s:%u", ip, ntohs(a->sin_port));
+  return buf;
+}
+
 int64_t tx_dp_now_ns(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);

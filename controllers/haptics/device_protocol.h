@@ -122,6 +122,10 @@ tx_dp_verdict tx_dp_peer_accept(tx_dp_peer* peer, const tx_dp_packet* p, bool re
 // "A.B.C.D:PORT" or "localhost:PORT" into an IPv4 address; port 0 only if
 // any_port; false with a reason when it is not one
 bool tx_dp_parse_addr(const char* s, bool any_port, struct sockaddr_in* out, const char** why);
+// the same IPv4 address and port
+bool tx_dp_same_addr(const struct sockaddr_in* a, const struct sockaddr_in* b);
+// "A.B.C.D:PORT" into buf, which it returns
+const char* tx_dp_addr_text(const struct sockaddr_in* a, char* buf, size_t n);
 // the monotonic clock, ns
 int64_t tx_dp_now_ns(void);
 

@@ -31,10 +31,14 @@ struct tx_device_server {
   bool locked;                // the peer is known
   struct sockaddr_in peer;    // then, the only source accepted
   tx_dp_peer from;            // the peer's session and newest sequence
+  uint32_t client;            // the session of the client served last, 0 before the first
   int64_t echo_ns;            // send_ns of the newest packet accepted
   int64_t arrival_ns;         // when it arrived, monotonic
-  bool streaming;             // a hello has come: states flow
-  int64_t t0_ns;              // when the stream started: device time 0
+  bool streaming;             // a client said hello and has not gone: states flow
+  int64_t first_ns;           // the first hello, for the duration
+  int64_t t0_ns;              // when this client's stream started: device time 0
+  bool ramp_pending;          // a client said hello: its next force starts the ramp
+  int64_t ramp_from_ns;       // the force the ramp started from
   int64_t next_ns;            // the next state tick
   int64_t last_force_ns;      // arrival of the newest force
   bool forcing;               // a force from the peer is on the device
@@ -43,24 +47,14 @@ struct tx_device_server {
   tx_device_server_stats stats;
 };
 
-static bool same_addr(const struct sockaddr_in* a, const struct sockaddr_in* b) {
-  return a->sin_addr.s_addr == b->sin_addr.s_addr && a->sin_port == b->sin_port;
-}
-
 tx_device_server_def tx_device_server_def_default(void) {
-  tx_device_server_def d = {.rate_hz = 1000, .force_timeout_s = 0.02, .align_s = 120e-6};
+  tx_device_server_def d = {
+      .rate_hz = 1000, .force_timeout_s = 0.02, .client_timeout_s = 1, .ramp_s = 0.005, .align_s = 120e-6};
   d.listen.sin_family = AF_INET;
   d.listen.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   d.listen.sin_port = htons(TX_DEVICE_SERVER_PORT);
   d.peer.sin_family = AF_INET;
   return d;
-}
-
-static const char* addr_text(const struct sockaddr_in* a, char* buf, size_t n) {
-  char ip[INET_ADDRSTRLEN] = "?";
-  inet_ntop(AF_INET, &a->sin_addr, ip, sizeof ip);
-  snprintf(buf, n, "%s:%u", ip, ntohs(a->sin_port));
-  return buf;
 }
 
 tx_device_server* tx_device_server_open(const tx_device_server_def* def, char* err, size_t n) {
@@ -70,6 +64,9 @@ tx_device_server* tx_device_server_open(const tx_device_server_def* def, char* e
   if (!(def->duration_s >= 0 && def->duration_s <= 1e7)) return snprintf(err, n, "duration: out of range"), NULL;
   if (!(def->force_timeout_s > 0 && def->force_timeout_s <= 10))
     return snprintf(err, n, "force timeout: expected (0, 10] s"), NULL;
+  if (!(def->client_timeout_s > 0 && def->client_timeout_s <= 60))
+    return snprintf(err, n, "client timeout: expected (0, 60] s"), NULL;
+  if (!(def->ramp_s >= 0 && def->ramp_s <= 1)) return snprintf(err, n, "ramp: expected [0, 1] s"), NULL;
   tx_device_server* s = calloc(1, sizeof *s);
   if (!s) return snprintf(err, n, "out of memory"), NULL;
   s->def = *def;
@@ -89,7 +86,7 @@ tx_device_server* tx_device_server_open(const tx_device_server_def* def, char* e
   int on = 1;
   if (s->fd >= 0) setsockopt(s->fd, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on);
   if (s->fd < 0 || bind(s->fd, (const struct sockaddr*)&def->listen, sizeof def->listen) != 0) {
-    snprintf(err, n, "--listen %s: %s", addr_text(&def->listen, where, sizeof where), strerror(errno));
+    snprintf(err, n, "--listen %s: %s", tx_dp_addr_text(&def->listen, where, sizeof where), strerror(errno));
     tx_device_server_close(s);
     return NULL;
   }
@@ -137,9 +134,40 @@ static void align(tx_device_server* s, uint32_t hold_ns) {
   s->next_ns += error / 4;
 }
 
+// a client's hello was accepted: a new client (or a new run of the
+// same one) starts the device's time again; any client starting or coming
+// back after it was let go has its forces ramp from zero
+static void hello_accepted(tx_device_server* s, const tx_dp_packet* p) {
+  bool new_client = p->session != s->client;
+  if (new_client) { // the forces and round trips of the one before no longer count
+    if (s->forcing) zero_device(s);
+    s->last_echo_measured = 0;
+    s->client = p->session;
+    s->stats.clients++;
+  }
+  if (new_client || !s->streaming) {
+    s->ramp_pending = true;
+    int64_t now = tx_dp_now_ns();
+    if (!s->first_ns) s->first_ns = now;
+    if (new_client) s->t0_ns = now;
+    if (!s->streaming) s->next_ns = now;
+    s->streaming = true;
+  }
+}
+
+// the client fell silent: stop streaming to it, and without a fixed peer let
+// the next client that says hello take its place
+static void let_go(tx_device_server* s) {
+  if (s->forcing) zero_device(s);
+  s->streaming = false;
+  if (!s->def.peer.sin_port) s->locked = false;
+  s->from = (tx_dp_peer){0}; // whoever comes next opens a session of its own clock
+  s->stats.clients_gone++;
+}
+
 static void consider(tx_device_server* s, const uint8_t* buf, size_t n, const struct sockaddr_in* from,
                      int64_t arrival) {
-  if (s->locked && !same_addr(from, &s->peer)) {
+  if (s->locked && !tx_dp_same_addr(from, &s->peer)) {
     s->stats.foreign++;
     return;
   }
@@ -148,7 +176,7 @@ static void consider(tx_device_server* s, const uint8_t* buf, size_t n, const st
     s->stats.malformed++;
     return;
   }
-  if (!s->locked) { // the first valid hello picks the peer for good
+  if (!s->locked) { // the first valid hello picks the peer, until it is gone
     if (p.type != TX_DP_HELLO) {
       s->stats.other_session++;
       return;
@@ -164,19 +192,19 @@ static void consider(tx_device_server* s, const uint8_t* buf, size_t n, const st
   s->echo_ns = p.send_ns;
   s->arrival_ns = arrival;
   if (p.type == TX_DP_HELLO) {
-    if (v == TX_DP_NEW_SESSION) { // forces and round trips of an older session no longer count
-      if (s->forcing) zero_device(s);
-      s->last_echo_measured = 0;
-    }
+    hello_accepted(s, &p);
     tx_dp_packet hello = {.type = TX_DP_HELLO, .hello = {s->def.rate_hz, s->info}};
     send_packet(s, &hello);
     s->stats.hellos++;
-    if (!s->streaming) {
-      s->streaming = true;
-      s->t0_ns = s->next_ns = tx_dp_now_ns();
-    }
-  } else if (p.type == TX_DP_FORCE) {
-    s->dev.backend->write(s->dev.device, p.force);
+  } else if (p.type == TX_DP_FORCE && s->streaming) {
+    // the safety ramp: a client's forces after its hello are scaled from zero
+    // (its first) up over ramp_s, so a switch of clients never steps the force
+    if (s->ramp_pending) s->ramp_from_ns = arrival, s->ramp_pending = false;
+    double ramp = (double)(arrival - s->ramp_from_ns) * 1e-9, force[3];
+    double gain = s->def.ramp_s > 0 && ramp < s->def.ramp_s ? fmax(0, ramp / s->def.ramp_s) : 1;
+    if (gain < 1) s->stats.ramped++;
+    for (int i = 0; i < 3; i++) force[i] = gain * p.force[i];
+    s->dev.backend->write(s->dev.device, force);
     s->stats.forces++;
     s->last_force_ns = arrival;
     s->forcing = true;
@@ -189,7 +217,7 @@ static void consider(tx_device_server* s, const uint8_t* buf, size_t n, const st
       s->stats.round_trips++;
       align(s, p.echo_hold_ns);
     }
-  } else {
+  } else if (p.type != TX_DP_FORCE) {
     s->stats.unexpected++;
   }
 }
@@ -226,10 +254,11 @@ static void tick(tx_device_server* s, int64_t now, int64_t period) {
 int tx_device_server_run(tx_device_server* s, const atomic_int* stop, char* err, size_t n) {
   const int64_t period = (int64_t)llround(1e9 / s->def.rate_hz);
   const int64_t duration = (int64_t)llround(s->def.duration_s * 1e9), force_timeout = (int64_t)llround(s->def.force_timeout_s * 1e9);
+  const int64_t client_timeout = (int64_t)llround(s->def.client_timeout_s * 1e9);
   int rc = 0;
   while (!atomic_load(stop)) {
     int64_t now = tx_dp_now_ns();
-    if (s->streaming && duration && now - s->t0_ns >= duration) break;
+    if (s->first_ns && duration && now - s->first_ns >= duration) break;
     if (s->streaming && now >= s->next_ns) tick(s, now, period);
     if (s->forcing && now - s->last_force_ns > force_timeout) { // the simulator went quiet
       zero_device(s);
@@ -248,6 +277,8 @@ int tx_device_server_run(tx_device_server* s, const atomic_int* stop, char* err,
       rc = -1;
       break;
     }
+    // after the drain: what waited in the socket while this thread was held up still counts
+    if (s->streaming && tx_dp_now_ns() - s->arrival_ns > client_timeout) let_go(s);
   }
   zero_device(s);
   return rc;

@@ -5,7 +5,10 @@
 // (the one given, or else the first valid hello), answers it with the
 // device's limits, then sends a state packet every 1/rate_hz seconds and
 // applies each new force packet to the device. Forces that stop coming for
-// force_timeout_s zero the device; so does stopping.
+// force_timeout_s zero the device; so does stopping. A client not heard from for
+// client_timeout_s is gone: the server stops streaming and, without a fixed
+// peer, takes the next client that says hello. Each client's forces (a new
+// one, or one back after it was gone) ramp from zero over ramp_s.
 //
 //     tx_device_server_def def = tx_device_server_def_default();
 //     def.spec = "scripted:pierce-down";
@@ -32,6 +35,8 @@ typedef struct tx_device_server_def {
   double rate_hz;            // state packets per second, (0, 100000]; 1000
   double duration_s;         // stop this long after the first hello; 0: until stopped
   double force_timeout_s;    // no new force for this long zeroes the device; 0.02
+  double client_timeout_s;   // nothing from the client for this long: it is gone; 1 (below the client's 2 s wait for a hello), (0, 60]
+  double ramp_s;             // a client's forces ramp from zero (its first after a hello) over this long; 0.005, [0, 1]
   double align_s;            // aim for each state to wait this long at the client before its
                              // tick reads it, by shifting when states are sent; 0: free-running;
                              // 120e-6: enough for the link and the client's wake-up jitter
@@ -48,6 +53,9 @@ typedef struct tx_device_server_stats {
   uint64_t unexpected;     // of a type a simulator does not send: dropped
   uint64_t send_errors;    // packets the socket refused
   uint64_t force_timeouts; // times the device was zeroed for want of forces
+  uint64_t clients;        // client sessions served: the first, and each new one after
+  uint64_t clients_gone;   // times a client fell silent for client_timeout_s and was let go
+  uint64_t ramped;         // forces scaled down by the ramp after a client's hello
   uint64_t late_ticks;     // state ticks more than one period late
   uint64_t round_trips;    // forces that answered a state for the first time
   tx_percentiles loop;     // ns: a state leaves -> the first force computed from it arrives (with the client's tick wait)

@@ -7,7 +7,10 @@
 #include "../../model/error.h"
 
 #include <math.h>
+#include <ctype.h>
+#include <errno.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 tx_sim_device_def tx_sim_device_def_default(void) {
@@ -32,8 +35,10 @@ static const char* range(const char* name, double v, double lo, bool open_lo, do
 
 const char* tx_sim_device_def_check(const tx_sim_device_def* d) {
   const char* e;
-  // the ranges span every device of this kind, from a fingertip to an arm
-  if ((e = range("mass", d->mass, 0, true, 100, "kg"))) return e;
+  // the ranges span every device of this kind, from a fingertip to an arm; a
+  // mass below a gram would make k T / m and b T / m so large that the
+  // transition over one period under- and overflows
+  if ((e = range("mass", d->mass, 1e-3, false, 100, "kg"))) return e;
   if ((e = range("damping", d->damping, 0, false, 1e3, "N s/m"))) return e;
   if ((e = range("period", d->period, 1e-5, false, 0.1, "s"))) return e;
   if ((e = range("quantum", d->quantum, 0, false, 1e-3, "m"))) return e;
@@ -49,6 +54,74 @@ const char* tx_sim_device_def_check(const tx_sim_device_def* d) {
                            d->workspace_min[i], i, d->workspace_max[i]);
   }
   return NULL;
+}
+
+// at most cap - 1 bytes of s into out, each control byte as '?': a message stays one line
+static const char* shown(const char* s, size_t len, char* out, size_t cap) {
+  if (len >= cap) len = cap - 1;
+  for (size_t i = 0; i < len; i++) out[i] = iscntrl((unsigned char)s[i]) ? '?' : s[i];
+  out[len] = 0;
+  return out;
+}
+
+bool tx_sim_device_parse(const char* spec, tx_sim_device_def* d, char* hand, size_t hand_size, char* err, size_t n) {
+  struct {
+    const char* key;
+    double* field;
+  } const keys[] = {{"mass", &d->mass},
+                    {"damping", &d->damping},
+                    {"quantum", &d->quantum},
+                    {"max_force", &d->max_force},
+                    {"hand_stiffness", &d->hand_stiffness},
+                    {"hand_damping", &d->hand_damping},
+                    {"hand", NULL}};
+  enum { KEYS = sizeof keys / sizeof keys[0] };
+  bool seen[KEYS] = {false};
+  for (const char* kv = spec; *kv;) {
+    size_t len = strcspn(kv, ","), klen = strcspn(kv, "=");
+    if (klen > len) klen = len;
+    const char* next = kv[len] ? kv + len + 1 : kv + len;
+    if (len == 0) { // "a,,b" or a trailing comma: nothing to set
+      kv = next;
+      continue;
+    }
+    char key[65]; // as written, for the message
+    shown(kv, klen, key, sizeof key);
+    if (klen == len) return snprintf(err, n, "%s: expected key=value", key), false;
+    size_t k = 0;
+    while (k < KEYS && !(strlen(keys[k].key) == klen && strncmp(kv, keys[k].key, klen) == 0)) k++;
+    if (k == KEYS)
+      return snprintf(err, n, "%s: unknown key (known: mass, damping, quantum, max_force, hand_stiffness, "
+                              "hand_damping, hand)", key), false;
+    // the second of two values would silently win
+    if (seen[k]) return snprintf(err, n, "%s: given twice", keys[k].key), false;
+    seen[k] = true;
+    const char* value = kv + klen + 1;
+    size_t vlen = len - klen - 1;
+    if (!keys[k].field) {
+      if (vlen == 0) return snprintf(err, n, "hand: expected a scripted motion or a .csv file"), false;
+      if (vlen >= hand_size) return snprintf(err, n, "hand: too long"), false;
+      memcpy(hand, value, vlen);
+      hand[vlen] = 0;
+    } else {
+      char num[64], text[64];
+      if (vlen == 0 || vlen >= sizeof num) return snprintf(err, n, "%s: expected a number", keys[k].key), false;
+      memcpy(num, value, vlen);
+      num[vlen] = 0;
+      shown(num, vlen, text, sizeof text);
+      char* end;
+      errno = 0;
+      double v = strtod(num, &end);
+      if (*end || end == num || isspace((unsigned char)num[0]))
+        return snprintf(err, n, "%s: expected a number, got '%s'", keys[k].key, text), false;
+      if (errno == ERANGE) return snprintf(err, n, "%s: %s is out of range", keys[k].key, text), false;
+      *keys[k].field = v;
+    }
+    kv = next;
+  }
+  const char* bad = tx_sim_device_def_check(d);
+  if (bad) return snprintf(err, n, "%s", bad), false;
+  return true;
 }
 
 static void mat3_mul(const double a[9], const double b[9], double out[9]) {
@@ -88,13 +161,24 @@ bool tx_sim_device_init(tx_sim_device* dev, const tx_sim_device_def* def) {
     tx_set_error("%s", e);
     return false;
   }
-  *dev = (tx_sim_device){.def = *def};
   // state (x, v, u) with u the held input F + kh xt + bh vt; exp of the
   // augmented matrix gives the transition and the input response at once
   double m = def->mass, T = def->period;
   double a[9] = {0, T, 0, -def->hand_stiffness / m * T, -(def->damping + def->hand_damping) / m * T, T / m, 0, 0, 0};
   double e3[9];
   mat3_exp(a, e3);
+  // a passive system's transition has both eigenvalues within the unit circle
+  // (Jury: |det| <= 1 and |trace| <= 1 + det); the ranges of the check keep
+  // it so, and this makes sure no corner of them steps toward infinity
+  double tr = e3[0] + e3[4], det = e3[0] * e3[4] - e3[1] * e3[3];
+  bool finite = isfinite(tr) && isfinite(det) && isfinite(e3[2]) && isfinite(e3[5]);
+  if (!finite || fabs(det) > 1 + 1e-9 || fabs(tr) > 1 + det + 1e-9) {
+    tx_set_error("sim device: mass = %g kg, damping = %g N s/m, hand_stiffness = %g N/m and hand_damping = %g N s/m "
+                 "at a period of %g s cannot be integrated stably: raise mass or lower the others",
+                 m, def->damping, def->hand_stiffness, def->hand_damping, T);
+    return false;
+  }
+  *dev = (tx_sim_device){.def = *def};
   dev->phi[0] = e3[0], dev->phi[1] = e3[1], dev->phi[2] = e3[3], dev->phi[3] = e3[4];
   dev->gam[0] = e3[2], dev->gam[1] = e3[5];
   tx_sim_device_reset(dev, NULL, NULL);

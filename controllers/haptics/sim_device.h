@@ -30,12 +30,13 @@
 #define TX_CONTROLLERS_HAPTICS_SIM_DEVICE_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "tactus/haptics.h"
 
 typedef struct tx_sim_device_def {
-  double mass;              // kg, apparent mass at the tool point, each axis; 0.045: the tip inertia of this class
+  double mass;              // kg, apparent mass at the tool point, each axis, [0.001, 100]; 0.045: the tip inertia of this class
   double damping;           // N s/m, physical viscous damping b; 0.3: makes 2b/T = 600 N/m at 1 kHz, just above the nominal stiffness
   double period;            // s, servo period T; 1e-3: the 1 kHz servo loop of these devices
   double quantum;           // m, encoder resolution at the tip, 0 = ideal; 2.3e-5: about 1100 dpi
@@ -70,6 +71,14 @@ tx_sim_device_def tx_sim_device_def_default(void);
 // NULL when every field is finite and in range; otherwise one line naming the
 // field, its value and the allowed range (valid until the next call on this thread)
 const char* tx_sim_device_def_check(const tx_sim_device_def* def);
+
+// the keys of a "sim:" device spec, "key=value,...", over def (the part after
+// "sim:"; "" keeps def): mass, damping, quantum, max_force, hand_stiffness,
+// hand_damping (numbers in the units above) and hand (the scripted motion the
+// hand follows, copied into hand). Each key at most once, and the result must
+// pass tx_sim_device_def_check. false with one line naming the key; def and
+// hand are then unspecified. Nothing here opens a file.
+bool tx_sim_device_parse(const char* spec, tx_sim_device_def* def, char* hand, size_t hand_size, char* err, size_t n);
 
 // checks def and sets the device at rest at the origin, hand target there too;
 // on bad input returns false, leaves dev unchanged and sets tx_error()

@@ -8,6 +8,9 @@
 #     garbage, replays, forged packets): no crash, stale and foreign packets
 #     dropped, the force still within the clamp and zero after the stream stops
 #   - Ctrl-C stops the server cleanly
+#   - issue 11: one server serves two successive runs (row 7); a server stopped during a
+#     run and started again is lost and rejoined, with one line each (row 8); bad sim
+#     specs, the mouse and a replay at another --rate are refused (rows 13, 14)
 #
 #   test_tactus_device.sh TACTUS_DEVICE TACTUS UDP_SHIM
 set -u
@@ -89,6 +92,28 @@ printf 'not a recording\n' >"$WORK/text.bin"
 expect_bad "replay of a text file" "$WORK/text.bin" -- "replay:$WORK/text.bin"
 expect_bad "replay of a missing file" "$WORK/none.bin" "No such file" -- "replay:$WORK/none.bin"
 expect_bad "a udp device served again" "udp:127.0.0.1:9" -- udp:127.0.0.1:9
+# issue 11, rows 13 and 14: a sim value that would make the integration NaN, a key given twice, the mouse
+expect_bad "sim: a mass of 1e-300 kg" "sim:mass=1e-300" "mass = 1e-300 kg" -- sim:mass=1e-300
+expect_bad "sim: a key twice" "sim:mass=0.1,mass=0.2" "mass: given twice" -- sim:mass=0.1,mass=0.2
+expect_bad "the mouse served" "mouse" "window" -- mouse
+# a replay served at another rate names the flag and the recording's rate; without --rate it is served at its own
+if timeout -k 5 60 "$RUNNER" run haptics-wall --device sim --lockstep --duration 0.2 --out "$WORK/rec" --quiet \
+  >/dev/null 2>"$WORK/rec.err"; then
+  expect_bad "a 1 kHz replay at --rate 500" "--rate 500" "recorded at 1000 Hz" "--rate 1000" -- \
+    "replay:$WORK/rec/device0.bin" --rate 500
+  cases=$((cases + 1))
+  # stopped by a signal: no leak check at exit (see Ctrl-C below)
+  ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" \
+    timeout -k 5 20 "$DEVICE" "replay:$WORK/rec/device0.bin" --listen 127.0.0.1:0 --duration 0.1 >"$WORK/rep.out" 2>&1 &
+  rep=$!
+  pids+=($rep)
+  rport=$(port_of "$WORK/rep.out")
+  grep -q "at 1000 Hz" "$WORK/rep.out" || fail "a replay without --rate: not served at its 1000 Hz: $(head -n 1 "$WORK/rep.out")"
+  [ -n "$rport" ] && kill -INT "$rep" 2>/dev/null
+  wait "$rep" || fail "a replay without --rate: exit status $?"
+else
+  fail "recording for the replay cases: $(head -n 1 "$WORK/rec.err")"
+fi
 # a port already taken: the second server says so
 timeout -k 5 20 "$DEVICE" scripted:pierce-down --listen 127.0.0.1:0 >"$WORK/taken.out" 2>&1 &
 pids+=($!)
@@ -104,6 +129,12 @@ TACTUS=$RUNNER
 expect_bad "run: --device udp: without an address" "--device udp:bogus" "HOST:PORT" -- run haptics-wall --device udp:bogus
 expect_bad "run: --device udp: port 0" "--device udp:127.0.0.1:0" -- run haptics-wall --device udp:127.0.0.1:0
 expect_bad "run: --device udp: off loopback" "--device udp:10.1.2.3:5000" "bind=" -- run haptics-wall --device udp:10.1.2.3:5000
+expect_bad "run: --device sim: a mass of 1e-300 kg" "--device sim:mass=1e-300" "mass = 1e-300 kg" -- \
+  run haptics-wall --device sim:mass=1e-300 --lockstep --duration 0.1
+expect_bad "run: --device sim: a key twice" "--device sim:mass=0.1,mass=0.2" "mass: given twice" -- \
+  run haptics-wall --device sim:mass=0.1,mass=0.2 --lockstep --duration 0.1
+expect_bad "run: --device sim: a hand that is no motion" "--device sim:hand=wiggle" "hand:" -- \
+  run haptics-wall --device sim:hand=wiggle --lockstep --duration 0.1
 # nobody serving: refused quickly, named, within the 2 s wait
 expect_bad "run: --device udp: nobody there" "--device udp:127.0.0.1:9" "no hello" -- run haptics-wall --device udp:127.0.0.1:9
 
@@ -183,6 +214,94 @@ else
       n=$(echo "$stats" | sed -n "s/.* \([0-9][0-9]*\) $what.*/\1/p")
       [ -n "$n" ] && [ "$n" -gt 0 ] || fail "lossy: the device counted no $what packets: $stats"
     done
+  fi
+fi
+
+# --- issue 11, row 7: one server, two successive runs ----------------------------------------
+# the first run's client goes quiet at its end; the server lets it go and serves the second
+cases=$((cases + 1))
+ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" \
+  timeout -k 5 60 "$DEVICE" scripted:pierce-down --listen 127.0.0.1:0 >"$WORK/dev4.out" 2>"$WORK/dev4.err" &
+dev=$!
+pids+=($dev)
+port=$(port_of "$WORK/dev4.out")
+if [ -z "$port" ]; then
+  fail "two runs: the server printed no port"
+else
+  for r in 1 2; do
+    timeout -k 5 60 "$RUNNER" run haptics-wall --device "udp:127.0.0.1:$port" --duration 1 --out "$WORK/two$r" --quiet \
+      >"$WORK/two$r.stdout" 2>"$WORK/two$r.stderr"
+    rc=$?
+    [ "$rc" -eq 0 ] || fail "two runs: run $r exit status $rc: $(head -n 1 "$WORK/two$r.stderr")"
+  done
+  kill -INT "$dev"
+  wait "$dev" || fail "two runs: tactus-device exit status $?"
+  # each run's first forces ramp from zero: 5 ms of 1 kHz forces each
+  grep -Eq '^clients: 2 served, [0-9]+ let go after falling silent; ([89]|[1-9][0-9]+) forces ramped' "$WORK/dev4.out" ||
+    fail "two runs: not two clients served, each with its ramp: $(grep '^clients' "$WORK/dev4.out")"
+  sed -n 's/^/two runs: tactus-device: /p' "$WORK/dev4.out" | grep -E 'packets|clients'
+fi
+
+# --- issue 11, row 8: the server is stopped 3 s into an 8 s run, then started again ----------
+# the run says when the device is lost and when it is back, the force is zero within 10 ticks
+# of the last state before the outage, and once the server's motion reaches the wall again
+# there is force again
+cases=$((cases + 1))
+ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" \
+  timeout -k 5 60 "$DEVICE" scripted:pierce-down --listen 127.0.0.1:0 >"$WORK/dev5.out" 2>"$WORK/dev5.err" &
+dev=$!
+pids+=($dev)
+port=$(port_of "$WORK/dev5.out")
+if [ -z "$port" ]; then
+  fail "restart: the server printed no port"
+else
+  timeout -k 5 60 "$RUNNER" run haptics-wall --device "udp:127.0.0.1:$port" --duration 8 --out "$WORK/restart" --quiet \
+    --set haptics.device_timeout_s=0.004 --set haptics.ramp_s=0.005 >"$WORK/restart.stdout" 2>"$WORK/restart.stderr" &
+  run=$!
+  pids+=($run)
+  sleep 3
+  kill -TERM "$dev"
+  wait "$dev"
+  sleep 1
+  ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" \
+    timeout -k 5 60 "$DEVICE" scripted:pierce-down --listen "127.0.0.1:$port" >"$WORK/dev6.out" 2>"$WORK/dev6.err" &
+  dev=$!
+  pids+=($dev)
+  wait "$run"
+  rc=$?
+  kill -INT "$dev"
+  wait "$dev"
+  [ "$rc" -eq 0 ] || fail "restart: tactus run exit status $rc: $(head -n 1 "$WORK/restart.stderr")"
+  sed -n 's/^/restart: /p' "$WORK/restart.stderr"
+  # one 'lost' line and one 'back' line for the outage; a machine that holds up the stream for
+  # 100 ms elsewhere in the run adds a pair of its own, which is right, so pairs are counted
+  lost=$(grep -c "device udp:127.0.0.1:$port lost at t = " "$WORK/restart.stderr")
+  back=$(grep -c "device udp:127.0.0.1:$port back at t = " "$WORK/restart.stderr")
+  rejoined=$(grep -c "device udp:127.0.0.1:$port back at t = .*(a restarted server, rejoined)" "$WORK/restart.stderr")
+  [ "$lost" -ge 1 ] && [ "$lost" -eq "$back" ] && [ "$rejoined" -eq 1 ] ||
+    fail "restart: expected lost and back lines in pairs, one of them a rejoin: $(cat "$WORK/restart.stderr")"
+  # (a sanitizer build adds its own summary at exit, which is not the run's)
+  [ "$(grep '^tactus' "$WORK/restart.stderr" | grep -vc "device udp:127.0.0.1:$port \(lost\|back\) at t = ")" -eq 0 ] ||
+    fail "restart: other lines on stderr: $(grep '^tactus' "$WORK/restart.stderr" | grep -v " at t = ")"
+  if [ -s "$WORK/restart/device0.csv" ]; then
+    # the outage is the longest run of ticks without a new state; zero within 10 ticks of its
+    # start; force again (>= 0.5 N) in the last 0.5 s
+    msg=$(awk -F, 'NR > 1 {
+        t[NR] = $1; f[NR] = sqrt($5 * $5 + $6 * $6 + $7 * $7)
+        if (NR > 2 && ($2 != px || $3 != py || $4 != pz)) { if (NR - last > gap) { gap = NR - last; from = last } last = NR }
+        if (NR == 2) last = NR
+        px = $2; py = $3; pz = $4; end = $1
+      }
+      END {
+        for (i = from; i <= NR && f[i] != 0; i++);
+        late = 0
+        for (j = 2; j <= NR; j++) if (t[j] > end - 0.5 && f[j] > late) late = f[j]
+        printf "outage from %.3f s for %.3f s; zero %d ticks after its start; |F| up to %.3f N in the last 0.5 s\n", t[from], t[from + gap] - t[from], i - from, late
+        exit !(gap * 0.001 >= 0.5 && i - from <= 10 && late >= 0.5)
+      }' "$WORK/restart/device0.csv") || fail "restart: $msg"
+    echo "restart: $msg"
+  else
+    fail "restart: no device0.csv"
   fi
 fi
 

@@ -36,11 +36,14 @@ static void* serve(void* arg) {
   return NULL;
 }
 
-// a device server on 127.0.0.1, any free port; peer_port 0 = whoever says hello first
-static uint16_t start_server(server_thread* st, const char* spec, uint16_t peer_port) {
+// a device server on 127.0.0.1 at listen_port (0: any free port), letting a
+// client go after client_timeout_s; peer_port 0 = whoever says hello first
+static uint16_t start_server_at(server_thread* st, const char* spec, uint16_t peer_port, uint16_t listen_port,
+                                double client_timeout_s) {
   tx_device_server_def def = tx_device_server_def_default();
   def.spec = spec;
-  def.listen.sin_port = 0;
+  def.listen.sin_port = htons(listen_port);
+  def.client_timeout_s = client_timeout_s;
   if (peer_port) {
     def.peer.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
     def.peer.sin_port = htons(peer_port);
@@ -51,6 +54,10 @@ static uint16_t start_server(server_thread* st, const char* spec, uint16_t peer_
   atomic_init(&st->stop, 0);
   assert_int_equal(pthread_create(&st->thread, NULL, serve, st), 0);
   return tx_device_server_port(st->s);
+}
+
+static uint16_t start_server(server_thread* st, const char* spec, uint16_t peer_port) {
+  return start_server_at(st, spec, peer_port, 0, tx_device_server_def_default().client_timeout_s);
 }
 
 static tx_device_server_stats stop_server(server_thread* st) {
@@ -313,6 +320,45 @@ static void bad_specs_fail_with_one_message(void** unused) {
   close(quiet);
 }
 
+// a device opened in another thread, while this one ticks
+typedef struct opener {
+  uint16_t port;
+  tx_device_handle h;
+  int rc;
+  atomic_int done;
+  pthread_t thread;
+} opener;
+
+static void* open_in_thread(void* arg) {
+  opener* o = arg;
+  char spec[64], err[512];
+  snprintf(spec, sizeof spec, "udp:127.0.0.1:%u", o->port);
+  o->rc = tx_device_open(spec, 1e-3, &o->h, err, sizeof err);
+  atomic_store(&o->done, 1);
+  return NULL;
+}
+
+// tick h at 1 kHz, a force of 1 N each tick, for at least seconds and until o
+// (if any) has opened or failed, then join o; the ticks that had a new state
+static int tick_until_opened(tx_device_handle* h, opener* o, double seconds) {
+  struct timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  int64_t end = tx_dp_now_ns() + (int64_t)(seconds * 1e9);
+  int fresh = 0;
+  while (tx_dp_now_ns() < end || (o && !atomic_load(&o->done))) {
+    tx_device_state s;
+    fresh += h->backend->read(h->device, 0, &s);
+    const double f[3] = {0, 1, 0};
+    h->backend->write(h->device, f);
+    next_tick(&t);
+  }
+  if (o) {
+    pthread_join(o->thread, NULL);
+    if (o->rc == 0) tx_device_close(&o->h);
+  }
+  return fresh;
+}
+
 // a server answers its one peer: the --peer it was given, or else the first hello
 static void a_server_answers_only_its_peer(void** unused) {
   (void)unused;
@@ -327,16 +373,85 @@ static void a_server_answers_only_its_peer(void** unused) {
   assert_true(ss.foreign > 0 && ss.hellos == 0 && ss.states == 0);
   close(other);
 
+  // without --peer: the first to say hello, while it lives (it ticks here all the
+  // while the other one waits its 2 s)
   port = start_server(&st, "scripted:pierce-down", 0);
-  tx_device_handle first, second;
+  tx_device_handle first;
   open_udp(&first, port);
-  snprintf(spec, sizeof spec, "udp:127.0.0.1:%u", port);
-  assert_int_equal(tx_device_open(spec, 1e-3, &second, err, sizeof err), -1); // another port: not the peer
-  tx_device_state s;
-  first.backend->read(first.device, 0, &s);
+  opener second = {.port = port};
+  assert_int_equal(pthread_create(&second.thread, NULL, open_in_thread, &second), 0);
+  tick_until_opened(&first, &second, 1.0);
+  assert_int_equal(second.rc, -1); // another port: not the peer
   tx_device_close(&first);
   ss = stop_server(&st);
-  assert_true(ss.foreign > 0 && ss.hellos >= 1);
+  assert_true(ss.foreign > 0 && ss.hellos >= 1 && ss.clients == 1);
+}
+
+// issue 11, row 7: once a client is gone (nothing heard for the client
+// timeout), the next one that says hello is served, and its forces ramp from
+// zero; the first, gone quiet without a word, could not hold the device
+static void a_new_client_is_served_once_the_old_one_is_gone(void** unused) {
+  (void)unused;
+  server_thread st;
+  const double timeout = 0.3;
+  uint16_t port = start_server_at(&st, "scripted:pierce-down", 0, 0, timeout);
+  tx_device_handle first, second;
+  open_udp(&first, port);
+  tick_until_opened(&first, NULL, 0.3); // forces of 1 N
+  tx_device_close(&first);
+  int64_t t0 = tx_dp_now_ns();
+  open_udp(&second, port); // waits out the client timeout within its 2 s
+  double waited = (double)(tx_dp_now_ns() - t0) * 1e-9;
+  tick_until_opened(&second, NULL, 0.3);
+  tx_device_udp_counts c;
+  tx_device_udp_counts_get(second.device, &c);
+  tx_device_close(&second);
+  tx_device_server_stats ss = stop_server(&st);
+  print_message("  second client served %.3f s after the first left; server: %llu clients, %llu let go, %llu forces "
+                "ramped\n",
+                waited, (unsigned long long)ss.clients, (unsigned long long)ss.clients_gone,
+                (unsigned long long)ss.ramped);
+  assert_true(waited >= timeout * 0.5 && waited < TX_DEVICE_UDP_WAIT_S);
+  assert_true(c.states >= 100);
+  assert_true(ss.clients == 2 && ss.clients_gone >= 1);
+  // each client's first forces after its hello are scaled down: 5 ms of a 1 kHz stream, less the handshake
+  assert_true(ss.ramped >= 4 && ss.ramped <= 20);
+}
+
+// issue 11, row 8: a server that stops is lost, one that comes back in its
+// place is rejoined (the client says hello again while it waits); one that
+// comes back with other limits is not
+static void a_lost_device_is_rejoined(void** unused) {
+  (void)unused;
+  server_thread st;
+  uint16_t port = start_server(&st, "scripted:pierce-down", 0);
+  tx_device_handle h;
+  open_udp(&h, port);
+  tx_device_udp_counts c;
+  tick_until_opened(&h, NULL, 0.3);
+  stop_server(&st);
+  tick_until_opened(&h, NULL, 0.3);
+  tx_device_udp_counts_get(h.device, &c);
+  assert_true(c.losses == 1 && c.returns == 0);
+  // a server of another device on the same port: not taken on
+  start_server_at(&st, "sim", 0, port, 1);
+  int fresh = tick_until_opened(&h, NULL, 0.3);
+  tx_device_udp_counts_get(h.device, &c);
+  stop_server(&st);
+  assert_int_equal(fresh, 0);
+  assert_true(c.other_device >= 1 && c.returns == 0 && c.rejoins == 0);
+  // the same device again: rejoined, and states flow
+  start_server_at(&st, "scripted:pierce-down", 0, port, 1);
+  int64_t t0 = tx_dp_now_ns();
+  fresh = tick_until_opened(&h, NULL, 0.5);
+  tx_device_udp_counts_get(h.device, &c);
+  tx_device_close(&h);
+  tx_device_server_stats ss = stop_server(&st);
+  print_message("  rejoined: %d fresh ticks in the 0.5 s after the restart (%.3f s); %llu losses, %llu returns\n", fresh,
+                (double)(tx_dp_now_ns() - t0) * 1e-9, (unsigned long long)c.losses, (unsigned long long)c.returns);
+  assert_true(c.losses == 1 && c.returns == 1 && c.rejoins == 1);
+  assert_true(fresh >= 100);
+  assert_true(ss.clients == 1 && ss.forces >= 200);
 }
 
 int main(void) {
@@ -347,6 +462,8 @@ int main(void) {
       cmocka_unit_test(server_drops_what_is_not_from_its_peer),
       cmocka_unit_test(bad_specs_fail_with_one_message),
       cmocka_unit_test(a_server_answers_only_its_peer),
+      cmocka_unit_test(a_new_client_is_served_once_the_old_one_is_gone),
+      cmocka_unit_test(a_lost_device_is_rejoined),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -252,6 +252,61 @@ static void runs_are_deterministic(void** state) {
   assert_true(h[0] == h[1]);
 }
 
+// the "sim:" spec: every key set, each at most once, every value in a range
+// that keeps the integration finite; a refusal is one line naming the key
+static void the_spec_is_parsed_and_checked(void** state) {
+  (void)state;
+  tx_sim_device_def d = tx_sim_device_def_default();
+  char hand[32] = "pierce-down", err[256];
+  assert_true(tx_sim_device_parse("", &d, hand, sizeof hand, err, sizeof err));
+  tx_sim_device_def defaults = tx_sim_device_def_default();
+  assert_memory_equal(&d, &defaults, sizeof d);
+  assert_true(tx_sim_device_parse("mass=0.1,damping=0.5,quantum=0,max_force=7,hand_stiffness=300,hand_damping=3,"
+                                  "hand=slide-x-over",
+                                  &d, hand, sizeof hand, err, sizeof err));
+  assert_true(d.mass == 0.1 && d.damping == 0.5 && d.quantum == 0 && d.max_force == 7 && d.hand_stiffness == 300 &&
+              d.hand_damping == 3);
+  assert_string_equal(hand, "slide-x-over");
+  const struct {
+    const char* spec;
+    const char* names; // in the message
+  } bad[] = {
+      {"mass=1e-300", "mass = 1e-300 kg"}, // NaN poses for the whole run before
+      {"mass=0.0009", "mass"},
+      {"mass=0.1,mass=0.2", "mass: given twice"},
+      {"hand=pierce-up,hand=pierce-down", "hand: given twice"},
+      {"damping=1,quantum=0,damping=1", "damping: given twice"},
+      {"mass=1e999", "mass"},
+      {"mass=nan", "mass"},
+      {"max_force=-1", "max_force"},
+      {"hand_stiffness=1e7", "hand_stiffness"},
+      {"hand_damping=abc", "hand_damping: expected a number"},
+      {"quantum= 1e-5", "quantum: expected a number"},
+      {"damping=", "damping: expected a number"},
+      {"mass", "mass: expected key=value"},
+      {"weight=1", "weight: unknown key"},
+      {"hand=", "hand: expected"},
+      {"hand=a-motion-name-longer-than-the-buffer-holds", "hand: too long"},
+      {"ma\nss=1", "ma?ss: unknown key"},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    d = tx_sim_device_def_default();
+    err[0] = 0;
+    if (tx_sim_device_parse(bad[i].spec, &d, hand, sizeof hand, err, sizeof err)) fail_msg("'%s' accepted", bad[i].spec);
+    if (!strstr(err, bad[i].names) || strchr(err, '\n')) fail_msg("'%s': %s", bad[i].spec, err);
+  }
+  // the lightest device the check takes, with the stiffest hand and no damping, at the longest
+  // period, integrates stably: the state stays bounded under a bounded force
+  d = tx_sim_device_def_default();
+  assert_true(tx_sim_device_parse("mass=0.001,damping=0,hand_damping=0,hand_stiffness=1e6", &d, hand, sizeof hand, err,
+                                  sizeof err));
+  d.period = 0.1;
+  tx_sim_device dev;
+  assert_true(tx_sim_device_init(&dev, &d));
+  for (int k = 0; k < 100000; k++) tx_sim_device_step(&dev, (double[3]){3.3, -3.3, k % 2 ? 3.3 : -3.3}, NULL);
+  for (int i = 0; i < 3; i++) assert_true(isfinite(dev.x[i]) && fabs(dev.x[i]) < 1 && isfinite(dev.v[i]));
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(defaults_are_of_the_class),
@@ -263,6 +318,7 @@ int main(void) {
       cmocka_unit_test(the_encoder_quantizes),
       cmocka_unit_test(the_hand_settles_the_device),
       cmocka_unit_test(runs_are_deterministic),
+      cmocka_unit_test(the_spec_is_parsed_and_checked),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
