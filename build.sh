@@ -70,7 +70,7 @@ case "$target" in
       -DTX_WITH_OSMESA=OFF -DTX_WITH_GLFW=OFF -DTX_WITH_DDS=OFF -DTX_WITH_PLPLOT=OFF
     test_variant build-core
 
-    say "libFuzzer: the scenario loader and the device packet decoder, ${fuzz_seconds} s each"
+    say "libFuzzer: the scenario loader, the device packet decoder, the recording and waypoint readers and the sim spec, ${fuzz_seconds} s each"
     CC=clang build_variant build-fuzz -DCMAKE_BUILD_TYPE=Debug -DTX_FUZZ=ON -DTX_SANITIZE=address,undefined \
       -DTX_FUZZ_SECONDS="$fuzz_seconds"
     test_variant build-fuzz -R fuzz
