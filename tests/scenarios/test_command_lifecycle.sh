@@ -58,7 +58,8 @@ signal_case() { # SIGNAL STATUS ARGS...
   wait "$pid"
   local rc=$? ms=$((($(date +%s%N) - start) / 1000000))
   [ "$rc" -eq "$want" ] || fail "SIG$sig: exit status $rc, expected $want: $(head -n 1 "$WORK/sig.stderr")"
-  [ "$ms" -lt 3000 ] || fail "SIG$sig: took $ms ms to stop"
+  # the runs last 30 s and 3000 s: 10 s leaves room for a sanitizer build on a loaded machine
+  [ "$ms" -lt 10000 ] || fail "SIG$sig: took $ms ms to stop"
   grep -Eq "^tactus: run rates stopped early at t = [0-9.]+ s by SIG$sig" "$WORK/sig.stderr" ||
     fail "SIG$sig: no 'stopped early at t = ...' line: $(head -n 1 "$WORK/sig.stderr")"
   [ "$(grep -c '' "$WORK/sig.stderr")" -eq 1 ] || fail "SIG$sig: more than one line on stderr"
