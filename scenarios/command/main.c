@@ -60,10 +60,14 @@ int tx_cmd_list(int argc, char** argv) {
   return 0;
 }
 
-// a number as the docs write it: %g without the "+" and leading zeros of the exponent
+// a number as the docs write it: the shortest %g that reads back, without the
+// "+" and leading zeros of the exponent
 static const char* num_text(double x, char* buf, size_t n) {
   char raw[64];
-  snprintf(raw, sizeof raw, "%g", x);
+  for (int digits = 6; digits <= 17; digits++) { // the shortest text that reads back as x
+    snprintf(raw, sizeof raw, "%.*g", digits, x);
+    if (strtod(raw, NULL) == x) break;
+  }
   size_t o = 0;
   for (const char* p = raw; *p && o + 1 < n; p++) {
     buf[o++] = *p;
@@ -89,8 +93,8 @@ static const char* kind_text(tx_param_kind k) {
   return "?";
 }
 
-// the default as the table gives it
-static const char* default_text(const tx_param_def* d, char* buf, size_t n) {
+// the default as the table gives it; md: strings as Markdown code
+static const char* default_text(const tx_param_def* d, bool md, char* buf, size_t n) {
   switch (d->kind) {
   case TX_PARAM_NUM: case TX_PARAM_INT:
     if (d->def_str) return snprintf(buf, n, "%s", d->def_str), buf;
@@ -98,7 +102,7 @@ static const char* default_text(const tx_param_def* d, char* buf, size_t n) {
   case TX_PARAM_BOOL: return d->def_num != 0 ? "true" : "false";
   case TX_PARAM_STR:
     if (!d->def_str) return "none";
-    return snprintf(buf, n, "\"%s\"", d->def_str), buf;
+    return snprintf(buf, n, md ? "`%s`" : "\"%s\"", *d->def_str || !md ? d->def_str : "\"\""), buf;
   case TX_PARAM_STRS: return "[]";
   case TX_PARAM_JSON: return "none";
   }
@@ -123,7 +127,7 @@ static int describe_class(const char* type) {
   for (int k = 0; k < cls->nparams; k++) {
     const tx_param_def* d = &cls->params[k];
     char def[128], range[96];
-    printf("| `%s` | %s | %s | %s | %s | %s |\n", d->key, kind_text(d->kind), default_text(d, def, sizeof def),
+    printf("| `%s` | %s | %s | %s | %s | %s |\n", d->key, kind_text(d->kind), default_text(d, true, def, sizeof def),
            d->units ? d->units : "-", range_text(d, range, sizeof range), d->meaning);
   }
   return 0;
@@ -148,7 +152,7 @@ static void describe_params(tx_system* s, int i) {
       else snprintf(value, sizeof value, "%s", text ? text : "?");
       free(text);
     } else {
-      snprintf(value, sizeof value, "%s (default)", default_text(d, def, sizeof def));
+      snprintf(value, sizeof value, "%s (default)", default_text(d, false, def, sizeof def));
     }
     printf("  %-20s %-30s %-8s %-22s %s\n", d->key, value, d->units ? d->units : "-", range_text(d, range, sizeof range),
            d->meaning);
