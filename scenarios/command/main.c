@@ -145,7 +145,9 @@ static void describe_params(tx_system* s, int i) {
     const tx_param_def* d = &cls->params[k];
     json_t* v = given ? json_object_get(given, d->key) : NULL;
     char value[64], def[128], range[96];
-    if (v) {
+    if (v && json_is_number(v)) {
+      num_text(json_number_value(v), value, sizeof value);
+    } else if (v) {
       char* text = json_dumps(v, JSON_COMPACT | JSON_ENCODE_ANY);
       // a long value (the view object) is cut: describe shows, the scenario holds
       if (text && strlen(text) > 30) snprintf(value, sizeof value, "%.27s...", text);

@@ -49,6 +49,9 @@ for key in work_us reads write rows cols units; do
 done
 expect_out "describe shows the value of the scenario" describe haptics-wall -- \
   "wall (collision.wall):" "stiffness" "N/m" "max_force" "the device's (default)"
+# numbers as the file writes them, not 17 digits
+expect_out "describe shows numbers as written" describe needle-voxel -- \
+  "  damage_shrink        0.5238394913 " "  skin_m               0.0002 "
 expect_out "describe --class prints the Markdown table" describe --class collision.wall -- \
   "| key | kind | default | units | range | meaning |" "| \`stiffness\` | number | 300 | N/m | [0, 1e6] |"
 expect_out "describe --classes lists the built-in types" describe --classes -- rates.worker collision.wall haptics
