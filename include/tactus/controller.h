@@ -45,7 +45,9 @@
 extern "C" {
 #endif
 
-#define TX_API_VERSION 1
+// 2: tx_controller_class gained its parameter table (params, nparams), so a
+// plugin built against version 1 would be read past its end: it must refuse
+#define TX_API_VERSION 2
 #define TX_RATE_MAX_HZ 100000.0 // no controller runs faster
 // no controller runs slower: one period is 1000 s, so every tick of the longest
 // run (86400 s) is a few 1e13 ns, far inside the int64 ns of the clocks
