@@ -33,6 +33,11 @@ static const char* table_error(const tx_controller_class* cls, char* why, size_t
     for (int j = 0; j < i; j++)
       if (strcmp(cls->params[j].key, k) == 0) return snprintf(why, n, "params[%d]: key '%s' appears twice", i, k), why;
     if (!d->meaning || !*d->meaning) return snprintf(why, n, "params[%d] %s: no meaning given", i, k), why;
+    // one line each, and a cell of the docs' Markdown tables
+    const char* texts[3] = {d->meaning, d->units, d->def_str};
+    for (int t = 0; t < 3; t++)
+      if (texts[t] && strpbrk(texts[t], "|\n\r"))
+        return snprintf(why, n, "params[%d] %s: meaning, units and default hold no '|' or line break", i, k), why;
     switch (d->kind) {
     case TX_PARAM_NUM:
     case TX_PARAM_INT:

@@ -210,6 +210,8 @@ static void untrustworthy_tables_are_refused_at_registration(void** state) {
       {{{"a", TX_PARAM_STRS, NULL, 0, 0, 0, NULL, "x"}}, 1, "a list needs max in [1, 65536]"},
       {{{"a", (tx_param_kind)99, NULL, 0, 0, 0, NULL, "x"}}, 1, "unknown kind 99"},
       {{{"a", TX_PARAM_STR, NULL, 0, 0, 0, NULL, ""}}, 1, "params[0] a: no meaning given"},
+      {{{"a", TX_PARAM_STR, NULL, 0, 0, 0, NULL, "x | y"}}, 1, "hold no '|' or line break"},
+      {{{"a", TX_PARAM_STR, NULL, 0, 0, 0, "two\nlines", "x"}}, 1, "hold no '|' or line break"},
       {{{"Bad-Key", TX_PARAM_STR, NULL, 0, 0, 0, NULL, "x"}}, 1, "key 'Bad-Key' must be 1-63 characters"},
       {{{NULL, TX_PARAM_STR, NULL, 0, 0, 0, NULL, "x"}}, 1, "params[0]: key '' must be"},
       {{{"a", TX_PARAM_STR, NULL, 0, 0, 0, NULL, "x"}, {"a", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "y"}}, 2,
