@@ -34,7 +34,52 @@ static json_t* param(tx_setup* s, const char* key) {
   return s->in->params ? json_object_get(s->in->params, key) : NULL;
 }
 
-json_t* tx_param_json(tx_setup* s, const char* key) { return param(s, key); }
+const tx_param_def* tx_param_find(const tx_controller_class* cls, const char* key) {
+  for (int i = 0; cls && cls->params && key && i < cls->nparams; i++)
+    if (strcmp(cls->params[i].key, key) == 0) return &cls->params[i];
+  return NULL;
+}
+
+static const char* kind_name(tx_param_kind k) {
+  static const char* const names[] = {"?", "a number", "an integer", "a boolean", "a string", "a list of strings", "JSON"};
+  return k >= TX_PARAM_NUM && k <= TX_PARAM_JSON ? names[k] : names[0];
+}
+
+// In a class with a table: the entry for key, which must be of this kind.
+// NULL without a table, or after an error (a table that lacks the key is a
+// programming error, so that the table cannot drift from configure).
+static const tx_param_def* entry(tx_setup* s, const char* key, tx_param_kind kind) {
+  const tx_controller_class* cls = s->in->cls;
+  if (!cls->params || s->in->failed) return NULL;
+  const tx_param_def* d = tx_param_find(cls, key);
+  if (!d)
+    return tx_setup_fail(s, key, "programming error: %s reads a parameter its table lacks", cls->type), NULL;
+  if (d->kind != kind)
+    return tx_setup_fail(s, key, "programming error: %s reads it as %s, its table says %s", cls->type, kind_name(kind),
+                         kind_name(d->kind)), NULL;
+  return d;
+}
+
+// a tx_table_* call in a class without a table
+static bool no_table(tx_setup* s, const char* key) {
+  if (s->in->cls->params) return false;
+  tx_setup_fail(s, key, "programming error: %s has no parameter table, read it with tx_param_*", s->in->cls->type);
+  return true;
+}
+
+// a tx_param_* call whose default or range differs from the class's table
+static bool drifted(tx_setup* s, const char* key, bool same, const char* code, const char* table) {
+  if (same) return false;
+  tx_setup_fail(s, key, "programming error: %s reads it with %s, its table says %s", s->in->cls->type, code, table);
+  return true;
+}
+
+static bool same_num(double a, double b) { return a == b || (isnan(a) && isnan(b)); }
+
+json_t* tx_param_json(tx_setup* s, const char* key) {
+  if (s->in->cls->params && !entry(s, key, TX_PARAM_JSON)) return NULL;
+  return param(s, key);
+}
 
 const char* tx_json_kind(const json_t* v) {
   switch (json_typeof(v)) {
@@ -48,7 +93,7 @@ const char* tx_json_kind(const json_t* v) {
   return "?";
 }
 
-double tx_param_num(tx_setup* s, const char* key, double def, double min, double max) {
+static double read_num(tx_setup* s, const char* key, double def, double min, double max) {
   json_t* v = param(s, key);
   if (!v) return def;
   if (!json_is_number(v)) return tx_setup_fail(s, key, "expected a number, got %s", tx_json_kind(v)), def;
@@ -58,7 +103,7 @@ double tx_param_num(tx_setup* s, const char* key, double def, double min, double
   return x;
 }
 
-int64_t tx_param_int(tx_setup* s, const char* key, int64_t def, int64_t min, int64_t max) {
+static int64_t read_int(tx_setup* s, const char* key, int64_t def, int64_t min, int64_t max) {
   json_t* v = param(s, key);
   if (!v) return def;
   if (!json_is_integer(v)) return tx_setup_fail(s, key, "expected an integer, got %s", tx_json_kind(v)), def;
@@ -68,7 +113,7 @@ int64_t tx_param_int(tx_setup* s, const char* key, int64_t def, int64_t min, int
   return x;
 }
 
-bool tx_param_bool(tx_setup* s, const char* key, bool def) {
+static bool read_bool(tx_setup* s, const char* key, bool def) {
   json_t* v = param(s, key);
   if (!v) return def;
   if (!json_is_boolean(v)) return tx_setup_fail(s, key, "expected true or false, got %s", tx_json_kind(v)), def;
@@ -82,14 +127,14 @@ static const char* keep(tx_setup* s, const char* str) {
   return json_string_value(copy);
 }
 
-const char* tx_param_str(tx_setup* s, const char* key, const char* def) {
+static const char* read_str(tx_setup* s, const char* key, const char* def) {
   json_t* v = param(s, key);
   if (!v) return def;
   if (!json_is_string(v)) return tx_setup_fail(s, key, "expected a string, got %s", tx_json_kind(v)), def;
   return keep(s, json_string_value(v));
 }
 
-int tx_param_strs(tx_setup* s, const char* key, const char** out, int max) {
+static int read_strs(tx_setup* s, const char* key, const char** out, int max) {
   json_t* v = param(s, key);
   if (!v) return 0;
   if (!json_is_array(v)) return tx_setup_fail(s, key, "expected an array of strings, got %s", tx_json_kind(v)), 0;
@@ -102,6 +147,99 @@ int tx_param_strs(tx_setup* s, const char* key, const char** out, int max) {
     out[i] = keep(s, json_string_value(e));
   }
   return (int)json_array_size(v);
+}
+
+double tx_table_num(tx_setup* s, const char* key) {
+  if (no_table(s, key)) return NAN;
+  const tx_param_def* d = entry(s, key, TX_PARAM_NUM);
+  if (!d) return NAN;
+  return read_num(s, key, d->def_str ? NAN : d->def_num, d->min, d->max);
+}
+
+int64_t tx_table_int(tx_setup* s, const char* key) {
+  if (no_table(s, key)) return 0;
+  const tx_param_def* d = entry(s, key, TX_PARAM_INT);
+  if (!d) return 0;
+  return read_int(s, key, (int64_t)d->def_num, (int64_t)d->min, (int64_t)d->max);
+}
+
+bool tx_table_bool(tx_setup* s, const char* key) {
+  if (no_table(s, key)) return false;
+  const tx_param_def* d = entry(s, key, TX_PARAM_BOOL);
+  if (!d) return false;
+  return read_bool(s, key, d->def_num != 0);
+}
+
+const char* tx_table_str(tx_setup* s, const char* key) {
+  if (no_table(s, key)) return NULL;
+  const tx_param_def* d = entry(s, key, TX_PARAM_STR);
+  if (!d) return NULL;
+  return read_str(s, key, d->def_str);
+}
+
+int tx_table_strs(tx_setup* s, const char* key, const char** out, int max) {
+  if (no_table(s, key)) return 0;
+  const tx_param_def* d = entry(s, key, TX_PARAM_STRS);
+  if (!d) return 0;
+  if (d->max > max)
+    return tx_setup_fail(s, key, "programming error: %s keeps %d entries, its table allows %g", s->in->cls->type, max,
+                         d->max), 0;
+  return read_strs(s, key, out, (int)d->max);
+}
+
+double tx_param_num(tx_setup* s, const char* key, double def, double min, double max) {
+  const tx_param_def* d = entry(s, key, TX_PARAM_NUM);
+  char code[96], table[96];
+  if (d) {
+    snprintf(code, sizeof code, "default %g in [%g, %g]", def, min, max);
+    snprintf(table, sizeof table, "default %g in [%g, %g]", d->def_str ? NAN : d->def_num, d->min, d->max);
+    if (drifted(s, key, same_num(def, d->def_str ? NAN : d->def_num) && min == d->min && max == d->max, code, table))
+      return def;
+  }
+  return read_num(s, key, def, min, max);
+}
+
+int64_t tx_param_int(tx_setup* s, const char* key, int64_t def, int64_t min, int64_t max) {
+  const tx_param_def* d = entry(s, key, TX_PARAM_INT);
+  char code[96], table[96];
+  if (d) {
+    snprintf(code, sizeof code, "default %lld in [%lld, %lld]", (long long)def, (long long)min, (long long)max);
+    snprintf(table, sizeof table, "default %g in [%g, %g]", d->def_num, d->min, d->max);
+    if (drifted(s, key, (double)def == d->def_num && (double)min == d->min && (double)max == d->max, code, table))
+      return def;
+  }
+  return read_int(s, key, def, min, max);
+}
+
+bool tx_param_bool(tx_setup* s, const char* key, bool def) {
+  const tx_param_def* d = entry(s, key, TX_PARAM_BOOL);
+  if (d && drifted(s, key, def == (d->def_num != 0), def ? "default true" : "default false",
+                   d->def_num != 0 ? "default true" : "default false"))
+    return def;
+  return read_bool(s, key, def);
+}
+
+const char* tx_param_str(tx_setup* s, const char* key, const char* def) {
+  const tx_param_def* d = entry(s, key, TX_PARAM_STR);
+  char code[128], table[128];
+  if (d) {
+    snprintf(code, sizeof code, "default \"%s\"", def ? def : "(none)");
+    snprintf(table, sizeof table, "default \"%s\"", d->def_str ? d->def_str : "(none)");
+    if (drifted(s, key, (!def && !d->def_str) || (def && d->def_str && strcmp(def, d->def_str) == 0), code, table))
+      return def;
+  }
+  return read_str(s, key, def);
+}
+
+int tx_param_strs(tx_setup* s, const char* key, const char** out, int max) {
+  const tx_param_def* d = entry(s, key, TX_PARAM_STRS);
+  char code[64], table[64];
+  if (d) {
+    snprintf(code, sizeof code, "at most %d entries", max);
+    snprintf(table, sizeof table, "at most %g entries", d->max);
+    if (drifted(s, key, (double)max == d->max, code, table)) return 0;
+  }
+  return read_strs(s, key, out, max);
 }
 
 // the model's rule for component names (model/model.c)

@@ -101,14 +101,26 @@ int tx_system_add(tx_system* s, const char* name, const char* type, double rate_
   in->ctx = (tx_ctx){s, in, 0, 0};
   if (!in->used || !in->strings) return fault(f, "", "out of memory");
 
+  const char* key;
+  json_t* value;
+  // with a table, a key it lacks is refused before configure runs, naming the valid keys
+  if (cls->params && params) json_object_foreach(params, key, value) {
+    if (tx_param_find(cls, key)) continue;
+    char known[640] = "", where[128];
+    for (int k = 0; k < cls->nparams; k++) {
+      size_t len = strlen(known);
+      snprintf(known + len, sizeof known - len, "%s%s", k ? ", " : "", cls->params[k].key);
+    }
+    snprintf(where, sizeof where, "params.%s", key);
+    return fault(f, where, "unknown parameter for %s (valid: %s)", type, cls->nparams ? known : "none");
+  }
+
   int rc = cls->configure(&in->setup, &in->self);
   in->configured = true; // fini frees whatever configure made, even on failure
   if (in->failed) return *f = in->fault, -1;
   if (rc != 0) return fault(f, "", "controller '%s' (%s) failed to configure", name, type);
-  // every parameter in the scenario must be one configure asked for
-  const char* key;
-  json_t* value;
-  if (params) json_object_foreach(params, key, value) {
+  // without a table, every parameter in the scenario must be one configure asked for
+  if (params && !cls->params) json_object_foreach(params, key, value) {
     if (json_object_get(in->used, key)) continue;
     char known[256] = "";
     const char* k;
@@ -325,6 +337,7 @@ double tx_system_result(const tx_system* s, int k) { return s->result_values[k];
 uint64_t tx_system_warning_count(const tx_system* s, int w) {
   return atomic_load(&((tx_system*)s)->warning_counts[w]);
 }
+json_t* tx_system_params(const tx_system* s, int i) { return s->inst[i]->params; }
 
 tx_port_info tx_system_port(const tx_system* s, int i, int p) {
   const port* pt = &s->inst[i]->ports[p];

@@ -28,7 +28,7 @@ typedef struct tx_system tx_system;
 // ("params.work_us", "rate_hz", "" for the instance as a whole) and a message
 typedef struct tx_fault {
   char key[128];
-  char message[400];
+  char message[768]; // room for the valid keys of a large table
 } tx_fault;
 
 typedef struct tx_port_info {
@@ -89,6 +89,9 @@ int tx_system_finalize(tx_system* s, tx_fault* f);
 // run; on failure (an init failed) returns -1 with a message in err
 int tx_system_run(tx_system* s, const tx_run_options* o, tx_run_result* r, char* err, size_t n);
 
+// the registered classes in order of registration; NULL past the last
+const tx_controller_class* tx_controller_class_at(int i);
+
 // for built-in classes only: params.KEY as JSON (borrowed, marked as used), or NULL
 json_t* tx_param_json(tx_setup* s, const char* key);
 // the run's output folder (tx_run_options.out_dir), or NULL
@@ -98,6 +101,7 @@ const char* tx_output_dir(const tx_ctx* c);
 int tx_system_count(const tx_system* s);
 const char* tx_system_name(const tx_system* s, int i);
 const tx_controller_class* tx_system_class(const tx_system* s, int i);
+json_t* tx_system_params(const tx_system* s, int i); // as the scenario gave them (borrowed), may be NULL
 double tx_system_rate(const tx_system* s, int i);
 int tx_system_thread(const tx_system* s, int i); // rate group, 0 = fastest
 int tx_system_threads(const tx_system* s);

@@ -25,18 +25,29 @@ typedef struct curve {
   tx_result r_samples;
 } curve;
 
+static const tx_param_def params[] = {
+    {"pose", TX_PARAM_STR, NULL, 0, 0, 0, "device0.pose", "the tool pose read (f64 1 x 7)"},
+    {"force", TX_PARAM_STR, NULL, 0, 0, 0, "device0.force", "the force read (f64 1 x 3)"},
+    {"state", TX_PARAM_STR, NULL, 0, 0, 0, "hip0.state", "the HIP state read (f64 1 x 8)"},
+    {"torn", TX_PARAM_STR, NULL, 0, 0, 0, "skin.torn", "the torn-link count read (i32 1 x 1)"},
+    {"axis", TX_PARAM_STR, NULL, 0, 0, 0, "y", "the axis plotted: x, y or z"},
+    {"file", TX_PARAM_STR, NULL, 0, 0, 0, "force_displacement", "base name of OUT/FILE.csv and OUT/FILE.png"},
+    {"max_samples", TX_PARAM_INT, "1", 1, 10000000, 600000, NULL, "rows kept, allocated at configure"},
+    {"png", TX_PARAM_BOOL, NULL, 0, 0, 1, NULL, "also plot OUT/FILE.png"},
+};
+
 static int configure(tx_setup* s, void** self) {
   curve* c = calloc(1, sizeof *c);
   if (!c) return -1;
   *self = c;
-  const char* pose = tx_param_str(s, "pose", "device0.pose");
-  const char* force = tx_param_str(s, "force", "device0.force");
-  const char* state = tx_param_str(s, "state", "hip0.state");
-  const char* torn = tx_param_str(s, "torn", "skin.torn");
-  const char* axis = tx_param_str(s, "axis", "y");
-  const char* file = tx_param_str(s, "file", "force_displacement");
-  c->cap = (uint64_t)tx_param_int(s, "max_samples", 600000, 1, 10000000);
-  c->png = tx_param_bool(s, "png", true);
+  const char* pose = tx_table_str(s, "pose");
+  const char* force = tx_table_str(s, "force");
+  const char* state = tx_table_str(s, "state");
+  const char* torn = tx_table_str(s, "torn");
+  const char* axis = tx_table_str(s, "axis");
+  const char* file = tx_table_str(s, "file");
+  c->cap = (uint64_t)tx_table_int(s, "max_samples");
+  c->png = tx_table_bool(s, "png");
   if (!pose || !force || !state || !torn || !axis || !file) return -1;
   if (strlen(axis) != 1 || axis[0] < 'x' || axis[0] > 'z') return tx_setup_fail(s, "axis", "expected x, y or z, got \"%s\"", axis);
   c->axis = axis[0] - 'x';
@@ -144,4 +155,6 @@ const tx_controller_class tx_view_force_curve = {
     .step = step,
     .finish = finish,
     .fini = fini,
+    .params = params,
+    .nparams = TX_PARAMS_COUNT(params),
 };

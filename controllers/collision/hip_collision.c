@@ -43,19 +43,36 @@ typedef struct hip_ctl {
   bool was_pierced;
 } hip_ctl;
 
+// defaults are tx_hip_def_default()'s (tests/controllers/test_param_tables.c checks)
+static const tx_param_def params[] = {
+    {"radius_m", TX_PARAM_NUM, "m", 1e-5, 0.05, 0.0005, NULL, "the HIP sphere's radius (the papers' 0.05 cm)"},
+    {"rays", TX_PARAM_INT, "1", 26, 98, 26, NULL, "rays cast from the HIP: 26 or 98"},
+    {"alpha", TX_PARAM_NUM, "N/m", 0, 1e6, 20, NULL, "force per metre of mean ray depth, F = -alpha sum(R_n)/N (0.2 N/cm)"},
+    {"k", TX_PARAM_NUM, "1", 0, 0.999, 0.3, NULL, "eq. 8 factor: how far P_in follows the surface per update"},
+    {"slide_max_m", TX_PARAM_NUM, "m", 1e-6, 1, 0.003, NULL, "how far the HIP slides before P_in moves (0.3 cm)"},
+    {"pierce_range_m", TX_PARAM_NUM, "m", 1e-5, 1, 0.01, NULL, "how far a pierced HIP may go from its entry point"},
+    {"hold_m", TX_PARAM_NUM, "m", 0, 0.01, 5e-4, NULL, "how far the skin may lead the HIP over one physics period"},
+    {"join", TX_PARAM_STR, NULL, 0, 0, 0, "anchor", "\"anchor\" or \"own\": where a pierced HIP joins the surface"},
+    {"pose", TX_PARAM_STR, NULL, 0, 0, 0, "device0.pose", "the tool pose read (f64 1 x 7)"},
+    {"skin", TX_PARAM_STR, NULL, 0, 0, 0, "skin", "the mesh read: SKIN.x, SKIN.tri, SKIN.thickness"},
+    {"force_model", TX_PARAM_STR, NULL, 0, 0, 0, "tool0.force_model", "the force model written (f64 1 x 15)"},
+    {"state", TX_PARAM_STR, NULL, 0, 0, 0, "hip0.state", "the HIP state written (f64 1 x 8)"},
+    {"spheres", TX_PARAM_STR, NULL, 0, 0, 0, "hip0.spheres", "the HIP for views, written"},
+};
+
 static int configure(tx_setup* s, void** self) {
   hip_ctl* h = calloc(1, sizeof *h);
   if (!h) return -1;
   *self = h;
   tx_hip_def def = tx_hip_def_default();
-  def.radius = tx_param_num(s, "radius_m", def.radius, 1e-5, 0.05);
-  def.rays = (int)tx_param_int(s, "rays", def.rays, 26, 98);
-  def.alpha = tx_param_num(s, "alpha", def.alpha, 0, 1e6);
-  def.k = tx_param_num(s, "k", def.k, 0, 0.999);
-  def.slide_max = tx_param_num(s, "slide_max_m", def.slide_max, 1e-6, 1);
-  def.pierce_range = tx_param_num(s, "pierce_range_m", def.pierce_range, 1e-5, 1);
-  def.hold = tx_param_num(s, "hold_m", def.hold, 0, 0.01);
-  const char* join = tx_param_str(s, "join", "anchor");
+  def.radius = tx_table_num(s, "radius_m");
+  def.rays = (int)tx_table_int(s, "rays");
+  def.alpha = tx_table_num(s, "alpha");
+  def.k = tx_table_num(s, "k");
+  def.slide_max = tx_table_num(s, "slide_max_m");
+  def.pierce_range = tx_table_num(s, "pierce_range_m");
+  def.hold = tx_table_num(s, "hold_m");
+  const char* join = tx_table_str(s, "join");
   if (!join) return -1;
   if (strcmp(join, "anchor") && strcmp(join, "own")) return tx_setup_fail(s, "join", "expected \"anchor\" or \"own\", got \"%s\"", join);
   def.join_anchor = strcmp(join, "anchor") == 0;
@@ -63,11 +80,11 @@ static int configure(tx_setup* s, void** self) {
   const char* err = tx_hip_def_check(&def);
   if (err) return tx_setup_fail(s, NULL, "%s", err);
   tx_hip_init(&h->hip, &def);
-  const char* pose = tx_param_str(s, "pose", "device0.pose");
-  const char* skin = tx_param_str(s, "skin", "skin");
-  const char* model = tx_param_str(s, "force_model", "tool0.force_model");
-  const char* state = tx_param_str(s, "state", "hip0.state");
-  const char* spheres = tx_param_str(s, "spheres", "hip0.spheres");
+  const char* pose = tx_table_str(s, "pose");
+  const char* skin = tx_table_str(s, "skin");
+  const char* model = tx_table_str(s, "force_model");
+  const char* state = tx_table_str(s, "state");
+  const char* spheres = tx_table_str(s, "spheres");
   if (!pose || !skin || !model || !state || !spheres) return -1;
   char name[3][TX_NAME_MAX];
   if (snprintf(name[0], TX_NAME_MAX, "%s.x", skin) >= TX_NAME_MAX) return tx_setup_fail(s, "skin", "name too long");
@@ -262,4 +279,6 @@ const tx_controller_class tx_collision_hip = {
     .step = step,
     .finish = finish,
     .fini = fini,
+    .params = params,
+    .nparams = TX_PARAMS_COUNT(params),
 };

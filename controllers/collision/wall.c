@@ -15,14 +15,21 @@ typedef struct wall {
   tx_port model;    // the force model written
 } wall;
 
+static const tx_param_def params[] = {
+    {"stiffness", TX_PARAM_NUM, "N/m", 0, 1e6, 300, NULL, "the wall's spring: F = stiffness x depth"},
+    {"height_m", TX_PARAM_NUM, "m", -10, 10, 0, NULL, "the plane y = height_m; the wall fills y below it"},
+    {"pose", TX_PARAM_STR, NULL, 0, 0, 0, "device0.pose", "the tool pose read (f64 1 x 7)"},
+    {"force_model", TX_PARAM_STR, NULL, 0, 0, 0, "tool0.force_model", "the force model written (f64 1 x 15)"},
+};
+
 static int configure(tx_setup* s, void** self) {
   wall* w = calloc(1, sizeof *w);
   if (!w) return -1;
   *self = w;
-  w->stiffness = tx_param_num(s, "stiffness", 300, 0, 1e6);
-  w->height = tx_param_num(s, "height_m", 0, -10, 10);
-  const char* pose = tx_param_str(s, "pose", "device0.pose");
-  const char* model = tx_param_str(s, "force_model", "tool0.force_model");
+  w->stiffness = tx_table_num(s, "stiffness");
+  w->height = tx_table_num(s, "height_m");
+  const char* pose = tx_table_str(s, "pose");
+  const char* model = tx_table_str(s, "force_model");
   if (!pose || !model) return -1;
   w->pose = tx_setup_read_as(s, pose, TX_F64, 7); // x y z, qw qx qy qz
   w->model = tx_setup_write(s, &(tx_component_def){model, TX_F64, 1, 15, "N, m, N/m"});
@@ -50,4 +57,6 @@ const tx_controller_class tx_collision_wall = {
     .configure = configure,
     .step = step,
     .fini = fini,
+    .params = params,
+    .nparams = TX_PARAMS_COUNT(params),
 };

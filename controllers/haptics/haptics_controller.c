@@ -47,8 +47,30 @@ typedef struct haptics {
 } haptics;
 
 static double lowered(tx_setup* s, const char* key, double device_value) {
-  return tx_param_num(s, key, device_value, 1e-9, device_value); // can only lower
+  double v = tx_table_num(s, key); // NaN: not given
+  if (isnan(v)) return device_value;
+  if (v > device_value)
+    return tx_setup_fail(s, key, "%g is above the device's %g: a limit can only be lowered", v, device_value), device_value;
+  return v;
 }
+
+#define DEVICE_S "the device's" // the safety limits default to the device's own
+static const tx_param_def params[] = {
+    {"device", TX_PARAM_STR, NULL, 0, 0, 0, "scripted:pierce-down", "the device spec (docs/haptics.md#devices); --device sets it"},
+    {"hand", TX_PARAM_INT, "1", 0, 1, 0, NULL, "0 or 1: names its components device0.* or device1.*"},
+    {"record", TX_PARAM_BOOL, NULL, 0, 0, 1, NULL, "keep OUT/deviceN.bin and OUT/deviceN.csv"},
+    {"mode", TX_PARAM_STR, NULL, 0, 0, 0, "local", "local: F = F0 + K (x - x0) every tick; sample_hold: F0 until the next model"},
+    {"force_model", TX_PARAM_STR, NULL, 0, 0, 0, "", "the force model rendered (f64 1 x 15, \"N, m, N/m\"); \"\": none"},
+    {"passivity_control", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "add damping whenever the observed energy would go negative"},
+    {"coupling_tool", TX_PARAM_STR, NULL, 0, 0, 0, "", "instead of a force model, a simulated tool's pose (f64 1 x 7) to couple to"},
+    {"coupling_stiffness", TX_PARAM_NUM, "N/m", 0, 1e5, 200, NULL, "the virtual coupling's spring"},
+    {"coupling_damping", TX_PARAM_NUM, "N s/m", 0, 1e3, 1, NULL, "the virtual coupling's damper"},
+    {"max_force", TX_PARAM_NUM, "N", 1e-9, 1e6, 0, DEVICE_S, "largest force sent; can only lower the device's"},
+    {"max_force_rate", TX_PARAM_NUM, "N/s", 1e-9, 1e12, 0, DEVICE_S, "largest change of force per second; can only lower the device's"},
+    {"model_timeout_s", TX_PARAM_NUM, "s", 1e-9, 3600, 0, DEVICE_S, "a force model older than this ramps the force down"},
+    {"device_timeout_s", TX_PARAM_NUM, "s", 1e-9, 3600, 0, DEVICE_S, "a device silent this long is lost"},
+    {"ramp_s", TX_PARAM_NUM, "s", 1e-9, 3600, 0, DEVICE_S, "time to ramp the force up at start and down on a fault"},
+};
 
 static int configure(tx_setup* s, void** self) {
   haptics* h = calloc(1, sizeof *h);
@@ -56,15 +78,15 @@ static int configure(tx_setup* s, void** self) {
   *self = h;
   const double period = 1.0 / tx_setup_rate(s);
   if (tx_setup_rate(s) > 10000) return tx_setup_fail(s, NULL, "haptics runs at most at 10000 Hz, not %g", tx_setup_rate(s));
-  const char* spec = tx_param_str(s, "device", "scripted:pierce-down");
-  int hand = h->hand = (int)tx_param_int(s, "hand", 0, 0, 1);
-  h->record = tx_param_bool(s, "record", true);
-  const char* mode = tx_param_str(s, "mode", "local");
-  const char* model = tx_param_str(s, "force_model", "");
-  h->passivity_control = tx_param_bool(s, "passivity_control", false);
-  const char* tool = tx_param_str(s, "coupling_tool", "");
-  h->coupling_k = tx_param_num(s, "coupling_stiffness", 200, 0, 1e5);
-  h->coupling_b = tx_param_num(s, "coupling_damping", 1, 0, 1e3);
+  const char* spec = tx_table_str(s, "device");
+  int hand = h->hand = (int)tx_table_int(s, "hand");
+  h->record = tx_table_bool(s, "record");
+  const char* mode = tx_table_str(s, "mode");
+  const char* model = tx_table_str(s, "force_model");
+  h->passivity_control = tx_table_bool(s, "passivity_control");
+  const char* tool = tx_table_str(s, "coupling_tool");
+  h->coupling_k = tx_table_num(s, "coupling_stiffness");
+  h->coupling_b = tx_table_num(s, "coupling_damping");
   if (!tool) return -1;
   if (*tool && *model) return tx_setup_fail(s, "coupling_tool", "renders either a force model or a coupling, not both");
   if (!spec || !mode || !model) return -1; // a parameter error is already recorded
@@ -258,4 +280,6 @@ const tx_controller_class tx_haptics_controller = {
     .step = step,
     .fini = fini,
     .finish = finish,
+    .params = params,
+    .nparams = TX_PARAMS_COUNT(params),
 };

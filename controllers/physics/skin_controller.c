@@ -21,6 +21,25 @@ typedef struct skin {
   tx_result torn_result, fault_result;
 } skin;
 
+// defaults are tx_cloth_def_default()'s (tests/controllers/test_param_tables.c checks)
+static const tx_param_def params[] = {
+    {"size_m", TX_PARAM_NUM, "m", 0.01, 1, 0.1, NULL, "the patch's side (10 cm); the edge is size_m + spacing_m"},
+    {"spacing_m", TX_PARAM_NUM, "m", 0.0005, 0.05, 0.0025, NULL, "particle spacing, dividing size_m; 0.001 is the papers' high density"},
+    {"thickness_m", TX_PARAM_NUM, "m", 0, 0.02, 0.004, NULL, "the skin's thickness; only the contact uses it"},
+    {"mass_kg", TX_PARAM_NUM, "kg", 1e-6, 100, 0.044, NULL, "the whole patch (10 x 10 x 0.4 cm at 1100 kg/m^3)"},
+    {"stretch_stiffness", TX_PARAM_NUM, "N/m", 1e-6, 1e9, 2000, NULL, "k of eq. 1 for stretch and shear links"},
+    {"bend_stiffness", TX_PARAM_NUM, "N/m", 0, 1e9, 20, NULL, "k of the bending links"},
+    {"damping", TX_PARAM_NUM, "1/s", 0, 1e4, 5, NULL, "decay rate of particle velocities"},
+    {"gravity", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "9.81 m/s^2 along -y"},
+    {"fixed_border", TX_PARAM_BOOL, NULL, 0, 0, 1, NULL, "the outer ring of particles does not move"},
+    {"rupture_strain", TX_PARAM_NUM, "1", 0, 100, 0.6, NULL, "a link breaks above this strain; 0: never"},
+    {"iterations", TX_PARAM_INT, "1", 1, 200, 10, NULL, "Bullet position iterations per substep"},
+    {"max_substep_s", TX_PARAM_NUM, "s", 1e-5, 0.1, 1.0 / 60, NULL, "a step is split into substeps of at most this"},
+    {"max_speed", TX_PARAM_NUM, "m/s", 1e-3, 1e4, 100, NULL, "a faster particle is a blow-up"},
+    {"hip_radius_m", TX_PARAM_NUM, "m", 0, 0.01, 0.0005, NULL, "the HIP sphere (0.05 cm); 0: no HIP"},
+    {"pose", TX_PARAM_STR, NULL, 0, 0, 0, "device0.pose", "the pose the HIP follows (f64 1 x 7)"},
+};
+
 static int configure(tx_setup* s, void** self) {
   skin* k = calloc(1, sizeof *k);
   if (!k) return -1;
@@ -33,21 +52,21 @@ static int configure(tx_setup* s, void** self) {
 
   // the patch, in metres (the papers' centimetres / 100)
   tx_cloth_def d = tx_cloth_def_default();
-  double size = tx_param_num(s, "size_m", 0.1, 0.01, 1);
-  double spacing = tx_param_num(s, "spacing_m", 0.0025, 0.0005, 0.05);
-  d.thickness = tx_param_num(s, "thickness_m", d.thickness, 0, 0.02);
-  d.mass = tx_param_num(s, "mass_kg", d.mass, 1e-6, 100);
-  d.stretch_stiffness = tx_param_num(s, "stretch_stiffness", d.stretch_stiffness, 1e-6, 1e9);
-  d.bend_stiffness = tx_param_num(s, "bend_stiffness", d.bend_stiffness, 0, 1e9);
-  d.damping = tx_param_num(s, "damping", d.damping, 0, 1e4);
-  d.gravity = tx_param_bool(s, "gravity", false) ? 9.81 : 0;
-  d.fixed_border = tx_param_bool(s, "fixed_border", d.fixed_border);
-  d.rupture_strain = tx_param_num(s, "rupture_strain", d.rupture_strain, 0, 100);
-  d.iterations = (int)tx_param_int(s, "iterations", d.iterations, 1, 200);
-  d.max_substep = tx_param_num(s, "max_substep_s", d.max_substep, 1e-5, 0.1);
-  d.max_speed = tx_param_num(s, "max_speed", d.max_speed, 1e-3, 1e4);
-  k->hip_radius = tx_param_num(s, "hip_radius_m", 0.0005, 0, 0.01);
-  const char* pose = tx_param_str(s, "pose", "device0.pose");
+  double size = tx_table_num(s, "size_m");
+  double spacing = tx_table_num(s, "spacing_m");
+  d.thickness = tx_table_num(s, "thickness_m");
+  d.mass = tx_table_num(s, "mass_kg");
+  d.stretch_stiffness = tx_table_num(s, "stretch_stiffness");
+  d.bend_stiffness = tx_table_num(s, "bend_stiffness");
+  d.damping = tx_table_num(s, "damping");
+  d.gravity = tx_table_bool(s, "gravity") ? 9.81 : 0;
+  d.fixed_border = tx_table_bool(s, "fixed_border");
+  d.rupture_strain = tx_table_num(s, "rupture_strain");
+  d.iterations = (int)tx_table_int(s, "iterations");
+  d.max_substep = tx_table_num(s, "max_substep_s");
+  d.max_speed = tx_table_num(s, "max_speed");
+  k->hip_radius = tx_table_num(s, "hip_radius_m");
+  const char* pose = tx_table_str(s, "pose");
   if (!pose) return -1;
 
   // the papers' counts: size / spacing + 1 cells a side (42 x 42 particles at
@@ -131,4 +150,6 @@ const tx_controller_class tx_physics_skin = {
     .step = step,
     .finish = finish,
     .fini = fini,
+    .params = params,
+    .nparams = TX_PARAMS_COUNT(params),
 };

@@ -40,6 +40,41 @@ typedef struct needle_ctl {
   double record_max_s;
 } needle_ctl;
 
+// tissue and needle defaults are tx_voxel_tissue_def_default()'s and
+// tx_voxel_needle_def_default()'s (tests/controllers/test_param_tables.c checks)
+static const tx_param_def params[] = {
+    {"count_x", TX_PARAM_INT, "1", 1, 1000, 10, NULL, "voxels along x (at most 10^7 in all)"},
+    {"count_y", TX_PARAM_INT, "1", 1, 1000, 10, NULL, "voxels along y"},
+    {"count_z", TX_PARAM_INT, "1", 1, 1000, 10, NULL, "voxels along z"},
+    {"block_x_m", TX_PARAM_NUM, "m", 1e-5, 1, 5e-3, NULL, "the block's edge along x, centred on x = 0"},
+    {"block_y_m", TX_PARAM_NUM, "m", 1e-5, 1, 5e-3, NULL, "the block's edge along y, below top_y_m"},
+    {"block_z_m", TX_PARAM_NUM, "m", 1e-5, 1, 5e-3, NULL, "the block's edge along z, centred on z = 0"},
+    {"top_y_m", TX_PARAM_NUM, "m", -10, 10, 0, NULL, "the y of the block's top face"},
+    {"mass_kg", TX_PARAM_NUM, "kg", 1e-15, 1, 1.25e-7, NULL, "each voxel's mass"},
+    {"elasticity", TX_PARAM_NUM, "1", 0, 1, 0.5, NULL, "e of eq. 5"},
+    {"spring_n_m", TX_PARAM_NUM, "N/m", 0, 1e9, 0.05, NULL, "each voxel's spring to its rest position"},
+    {"damper_n_s_m", TX_PARAM_NUM, "N s/m", 0, 1e9, 1e-4, NULL, "each voxel's damper to rest"},
+    {"radius_m", TX_PARAM_NUM, "m", 1e-7, 1, 0.25e-3, NULL, "each voxel's rest radius"},
+    {"damage_shrink", TX_PARAM_NUM, "1", 0, 0.99, 0.5, NULL, "the part of the radius lost at full damage"},
+    {"recovery_s", TX_PARAM_NUM, "s", 1e-3, 1e6, 0.5, NULL, "time for damage to heal"},
+    {"skin_m", TX_PARAM_NUM, "m", 1e-7, 1, 0.1e-3, NULL, "the neighbour lists' skin"},
+    {"gauge", TX_PARAM_INT, "1", 10, 34, 18, NULL, "the needle's gauge"},
+    {"tip", TX_PARAM_STR, NULL, 0, 0, 0, "conical", "the tip: conical, bevel or blunt"},
+    {"tip_angle_deg", TX_PARAM_NUM, "deg", 1, 89, 15, NULL, "the tip's half angle"},
+    {"length_m", TX_PARAM_NUM, "m", 1e-3, 1, 0.04, NULL, "the needle's length"},
+    {"friction", TX_PARAM_NUM, "1", 0, 10, 0.3, NULL, "the needle's friction coefficient"},
+    {"rupture_force_n", TX_PARAM_NUM, "N", 1e-9, 1e4, 0.2, NULL, "load on the tip that punctures the surface"},
+    {"cutting_force_n", TX_PARAM_NUM, "N", 1e-9, 1e4, 0.1, NULL, "load that cuts on inside the tissue"},
+    {"load_time_s", TX_PARAM_NUM, "s", 1e-5, 1, 0.005, NULL, "time over which the tip's load is averaged"},
+    {"max_stiffness_n_m", TX_PARAM_NUM, "N/m", 0, 1e5, 500, NULL, "cap on the published K"},
+    {"draw_every", TX_PARAM_INT, "1", 1, 100000, 16, NULL, "steps between publishes of the drawables"},
+    {"checkpoint_steps", TX_PARAM_INT, "1", 1, 100000, 100, NULL, "steps between the guard's checkpoints"},
+    {"record", TX_PARAM_BOOL, NULL, 0, 0, 1, NULL, "keep OUT/needle-recording.csv"},
+    {"record_max_s", TX_PARAM_NUM, "s", 1, 3600, 120, NULL, "the longest recording kept"},
+    {"pose", TX_PARAM_STR, NULL, 0, 0, 0, "device0.pose", "the tool pose read (f64 1 x 7)"},
+    {"force_model", TX_PARAM_STR, NULL, 0, 0, 0, "tool0.force_model", "the force model written (f64 1 x 15)"},
+};
+
 static int configure(tx_setup* s, void** self) {
   needle_ctl* c = calloc(1, sizeof *c);
   if (!c) return -1;
@@ -48,38 +83,38 @@ static int configure(tx_setup* s, void** self) {
   static const char* const size_keys[3] = {"block_x_m", "block_y_m", "block_z_m"};
   static const char* const count_keys[3] = {"count_x", "count_y", "count_z"};
   for (int a = 0; a < 3; a++) {
-    d.block_size[a] = tx_param_num(s, size_keys[a], 5e-3, 1e-5, 1);
-    d.count[a] = (int)tx_param_int(s, count_keys[a], 10, 1, 1000);
+    d.block_size[a] = tx_table_num(s, size_keys[a]);
+    d.count[a] = (int)tx_table_int(s, count_keys[a]);
   }
   // the block's top face at y = top_y_m, centred on x = z = 0
-  double top = tx_param_num(s, "top_y_m", 0, -10, 10);
+  double top = tx_table_num(s, "top_y_m");
   d.origin[0] = -0.5 * d.block_size[0];
   d.origin[1] = top - d.block_size[1];
   d.origin[2] = -0.5 * d.block_size[2];
-  d.mass = tx_param_num(s, "mass_kg", d.mass, 1e-15, 1);
-  d.elasticity = tx_param_num(s, "elasticity", d.elasticity, 0, 1);
-  d.spring = tx_param_num(s, "spring_n_m", d.spring, 0, 1e9);
-  d.damper = tx_param_num(s, "damper_n_s_m", d.damper, 0, 1e9);
-  d.radius = tx_param_num(s, "radius_m", d.radius, 1e-7, 1);
-  d.damage_shrink = tx_param_num(s, "damage_shrink", d.damage_shrink, 0, 0.99);
-  d.recovery_time = tx_param_num(s, "recovery_s", d.recovery_time, 1e-3, 1e6);
-  d.skin = tx_param_num(s, "skin_m", d.skin, 1e-7, 1);
+  d.mass = tx_table_num(s, "mass_kg");
+  d.elasticity = tx_table_num(s, "elasticity");
+  d.spring = tx_table_num(s, "spring_n_m");
+  d.damper = tx_table_num(s, "damper_n_s_m");
+  d.radius = tx_table_num(s, "radius_m");
+  d.damage_shrink = tx_table_num(s, "damage_shrink");
+  d.recovery_time = tx_table_num(s, "recovery_s");
+  d.skin = tx_table_num(s, "skin_m");
   tx_voxel_needle_def nd = tx_voxel_needle_def_default();
-  nd.gauge = (int)tx_param_int(s, "gauge", nd.gauge, 10, 34);
-  const char* tip = tx_param_str(s, "tip", "conical");
-  nd.tip_angle_deg = tx_param_num(s, "tip_angle_deg", nd.tip_angle_deg, 1, 89);
-  nd.length = tx_param_num(s, "length_m", nd.length, 1e-3, 1);
-  nd.friction = tx_param_num(s, "friction", nd.friction, 0, 10);
-  nd.rupture_force = tx_param_num(s, "rupture_force_n", nd.rupture_force, 1e-9, 1e4);
-  nd.cutting_force = tx_param_num(s, "cutting_force_n", nd.cutting_force, 1e-9, 1e4);
-  nd.load_time = tx_param_num(s, "load_time_s", nd.load_time, 1e-5, 1);
-  c->max_stiffness = tx_param_num(s, "max_stiffness_n_m", 500, 0, 1e5);
-  c->draw_every = (int)tx_param_int(s, "draw_every", 16, 1, 100000);
-  int every = (int)tx_param_int(s, "checkpoint_steps", 100, 1, 100000);
-  c->record = tx_param_bool(s, "record", true);
-  c->record_max_s = tx_param_num(s, "record_max_s", 120, 1, 3600);
-  const char* pose = tx_param_str(s, "pose", "device0.pose");
-  const char* model = tx_param_str(s, "force_model", "tool0.force_model");
+  nd.gauge = (int)tx_table_int(s, "gauge");
+  const char* tip = tx_table_str(s, "tip");
+  nd.tip_angle_deg = tx_table_num(s, "tip_angle_deg");
+  nd.length = tx_table_num(s, "length_m");
+  nd.friction = tx_table_num(s, "friction");
+  nd.rupture_force = tx_table_num(s, "rupture_force_n");
+  nd.cutting_force = tx_table_num(s, "cutting_force_n");
+  nd.load_time = tx_table_num(s, "load_time_s");
+  c->max_stiffness = tx_table_num(s, "max_stiffness_n_m");
+  c->draw_every = (int)tx_table_int(s, "draw_every");
+  int every = (int)tx_table_int(s, "checkpoint_steps");
+  c->record = tx_table_bool(s, "record");
+  c->record_max_s = tx_table_num(s, "record_max_s");
+  const char* pose = tx_table_str(s, "pose");
+  const char* model = tx_table_str(s, "force_model");
   if (!tip || !pose || !model) return -1;
   if (!tx_needle_tip_parse(tip, &nd.tip))
     return tx_setup_fail(s, "tip", "expected \"conical\", \"bevel\" or \"blunt\", got \"%s\"", tip);
@@ -222,4 +257,6 @@ const tx_controller_class tx_voxel_needle_controller = {
     .step = step,
     .finish = finish,
     .fini = fini,
+    .params = params,
+    .nparams = TX_PARAMS_COUNT(params),
 };

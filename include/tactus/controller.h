@@ -13,17 +13,26 @@
 //   fini       frees what configure and init made
 //
 // No step may allocate, lock or block: the haptic thread shares nothing that
-// waits. Parameter errors are sticky: tx_param_* return the default after the
-// first error, and the loader reports "params.KEY: message" for the first one.
-// A parameter in the scenario that configure never asked for is an error too.
+// waits. Parameters are declared in the class's table (key, kind, units,
+// range, default, meaning); configure reads them with tx_table_*, which take
+// the default and range from the table, so `tactus describe` and the docs
+// list them without running configure. Parameter errors are sticky: the
+// readers return the default after the first error, and the loader reports
+// "params.KEY: message" for the first one. A parameter in the scenario that
+// the table lacks is an error too, naming the valid keys.
 //
+//     static const tx_param_def params[] = {
+//       {"gain", TX_PARAM_NUM, "1", 0.0, 10.0, 1.0, NULL, "counts this much per step"},
+//     };
 //     static int configure(tx_setup* s, void** self) {
 //       counter* c = calloc(1, sizeof *c);
-//       c->gain = tx_param_num(s, "gain", 1.0, 0.0, 10.0);
+//       c->gain = tx_table_num(s, "gain");
 //       c->out = tx_setup_write(s, &(tx_component_def){"demo.count", TX_F64, 1, 1, "1"});
 //       *self = c;
 //       return 0;
 //     }
+//     const tx_controller_class demo = {.type = "demo.counter", .configure = configure, .step = step,
+//                                       .params = params, .nparams = TX_PARAMS_COUNT(params)};
 //
 // Plugins: a shared library named in a scenario's "plugins" exports
 // TX_PLUGIN_ENTRY, which calls tx_register_controller for each class.
@@ -36,7 +45,9 @@
 extern "C" {
 #endif
 
-#define TX_API_VERSION 1
+// 2: tx_controller_class gained its parameter table (params, nparams), so a
+// plugin built against version 1 would be read past its end: it must refuse
+#define TX_API_VERSION 2
 #define TX_RATE_MAX_HZ 100000.0 // no controller runs faster
 // no controller runs slower: one period is 1000 s, so every tick of the longest
 // run (86400 s) is a few 1e13 ns, far inside the int64 ns of the clocks
@@ -49,6 +60,30 @@ typedef struct tx_port { uint16_t id; } tx_port;       // a declared read or wri
 typedef struct tx_warning { uint16_t id; } tx_warning; // a counted warning; 0 is invalid
 typedef struct tx_result { uint16_t id; } tx_result;   // a number the run reports; 0 is invalid
 
+// One parameter of a controller class. Ranges are inclusive. A number whose
+// default configure works out (from the device, say) gives def_str as the text
+// that describes it and reads as NaN when the scenario leaves it out.
+typedef enum tx_param_kind {
+  TX_PARAM_NUM = 1, // double, in [min, max]
+  TX_PARAM_INT,     // integer, in [min, max]
+  TX_PARAM_BOOL,    // true or false; def_num 0 or 1
+  TX_PARAM_STR,     // a string; def_str (NULL: none)
+  TX_PARAM_STRS,    // a list of at most max strings; empty by default
+  TX_PARAM_JSON,    // any JSON, read by built-in classes (tx_param_json)
+} tx_param_kind;
+
+typedef struct tx_param_def {
+  const char* key;     // as in the scenario's "params"
+  tx_param_kind kind;
+  const char* units;   // e.g. "N/m", "1" for none; NULL for strings and booleans
+  double min, max;     // NUM and INT: the range; STRS: max is the most entries
+  double def_num;      // NUM, INT, BOOL: the default
+  const char* def_str; // STR: the default (NULL: none); NUM: text for a computed default
+  const char* meaning; // one line for `tactus describe` and the docs
+} tx_param_def;
+
+#define TX_PARAMS_COUNT(table) ((int)(sizeof(table) / sizeof((table)[0])))
+
 typedef struct tx_controller_class {
   const char* type;    // registry name, e.g. "rates.synthetic"
   const char* summary; // one line for `tactus describe`
@@ -57,9 +92,14 @@ typedef struct tx_controller_class {
   void (*step)(tx_ctx* c, void* self);
   void (*fini)(void* self);                   // optional
   void (*finish)(tx_ctx* c, void* self);      // optional
+  // the parameter table; a class without one (NULL) reads with tx_param_*
+  // alone, and `tactus describe` says it has no parameter table
+  const tx_param_def* params;
+  int nparams;
 } tx_controller_class;
 
-// registry; returns 0, or -1 for a bad class or a taken type name
+// registry; returns 0, or -1 for a bad class (a bad parameter table
+// included: see tx_error()) or a taken type name
 int tx_register_controller(const tx_controller_class* cls);
 const tx_controller_class* tx_find_controller(const char* type);
 
@@ -81,7 +121,21 @@ tx_port tx_setup_read_expect(tx_setup* s, const char* component, tx_type type, u
 tx_warning tx_setup_warning(tx_setup* s, const char* key); // reported as "INSTANCE.key"
 tx_result tx_setup_result(tx_setup* s, const char* key);   // reported as "INSTANCE.key"; put the units in the key
 
-// configure: parameters. Range checks are inclusive.
+// configure: parameters through the class's table: the default and range come
+// from there. Asking for a key the table lacks, or as another kind, is a
+// programming error reported at configure. tx_table_strs fills at most
+// the table's max entries of out.
+double tx_table_num(tx_setup* s, const char* key);
+int64_t tx_table_int(tx_setup* s, const char* key);
+bool tx_table_bool(tx_setup* s, const char* key);
+const char* tx_table_str(tx_setup* s, const char* key); // valid until fini
+int tx_table_strs(tx_setup* s, const char* key, const char** out, int max);
+// the entry for key in this class's table, or NULL
+const tx_param_def* tx_param_find(const tx_controller_class* cls, const char* key);
+
+// configure: parameters without a table (older classes). Range checks are
+// inclusive. In a class with a table the key must be there, and the default
+// and range given here must equal the table's.
 double tx_param_num(tx_setup* s, const char* key, double def, double min, double max);
 int64_t tx_param_int(tx_setup* s, const char* key, int64_t def, int64_t min, int64_t max);
 bool tx_param_bool(tx_setup* s, const char* key, bool def);

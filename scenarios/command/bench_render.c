@@ -23,13 +23,19 @@ typedef struct skin {
   int voxels;     // spheres in ball.spheres
 } skin;
 
+static const tx_param_def skin_params[] = {
+    {"side", TX_PARAM_INT, "1", 2, SIDE_MAX, 42, NULL, "particles along an edge"},
+    {"spacing_m", TX_PARAM_NUM, "m", 1e-4, 0.1, 0.0025, NULL, "distance between particles"},
+    {"voxels", TX_PARAM_INT, "1", 1, 100000, 1, NULL, "spheres in ball.spheres"},
+};
+
 static int skin_configure(tx_setup* s, void** self) {
   skin* k = calloc(1, sizeof *k);
   if (!k) return -1;
   *self = k;
-  k->side = (int)tx_param_int(s, "side", 42, 2, SIDE_MAX);
-  k->spacing = tx_param_num(s, "spacing_m", 0.0025, 1e-4, 0.1);
-  k->voxels = (int)tx_param_int(s, "voxels", 1, 1, 100000);
+  k->side = (int)tx_table_int(s, "side");
+  k->spacing = tx_table_num(s, "spacing_m");
+  k->voxels = (int)tx_table_int(s, "voxels");
   const uint32_t n = (uint32_t)(k->side * k->side), m = (uint32_t)(2 * (k->side - 1) * (k->side - 1));
   k->x = tx_setup_write(s, &(tx_component_def){"skin.x", TX_F32, n, 3, "m"});
   k->tri = tx_setup_write(s, &(tx_component_def){"skin.tri", TX_I32, m, 3, "1"});
@@ -82,7 +88,9 @@ static const tx_controller_class skin_class = {.type = "bench.skin",
                                                .summary = "a 10404-particle rippling mesh and a sphere",
                                                .configure = skin_configure,
                                                .step = skin_step,
-                                               .fini = skin_fini};
+                                               .fini = skin_fini,
+                                               .params = skin_params,
+                                               .nparams = TX_PARAMS_COUNT(skin_params)};
 
 typedef struct render_case {
   const char* name;

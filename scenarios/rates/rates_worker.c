@@ -52,18 +52,27 @@ void tx_rates_payload_fill(float* v, size_t values, double base) {
   memcpy(&v[values - 1], &sum, sizeof sum);
 }
 
+static const tx_param_def params[] = {
+    {"work_us", TX_PARAM_NUM, "us", 0, 1e6, 0, NULL, "busy computation per step"},
+    {"reads", TX_PARAM_STRS, NULL, 0, READS_MAX, 0, NULL, "f32 components read; each payload's checksum is checked"},
+    {"write", TX_PARAM_STR, NULL, 0, 0, 0, NULL, "the f32 component written with a checksummed payload; none by default"},
+    {"rows", TX_PARAM_INT, "1", 1, 1 << 24, 1, NULL, "rows of the component written"},
+    {"cols", TX_PARAM_INT, "1", 1, 64, 3, NULL, "values per row of the component written"},
+    {"units", TX_PARAM_STR, NULL, 0, 0, 0, "1", "units of the component written"},
+};
+
 static int configure(tx_setup* s, void** self) {
   worker* w = calloc(1, sizeof *w);
   if (!w) return -1;
   *self = w;
-  w->work_ns = 1e3 * tx_param_num(s, "work_us", 0, 0, 1e6);
+  w->work_ns = 1e3 * tx_table_num(s, "work_us");
   const char* reads[READS_MAX];
-  w->nreads = tx_param_strs(s, "reads", reads, READS_MAX);
+  w->nreads = tx_table_strs(s, "reads", reads, READS_MAX);
   for (int i = 0; i < w->nreads; i++) w->reads[i] = tx_setup_read_as(s, reads[i], TX_F32, 0);
-  const char* out = tx_param_str(s, "write", NULL);
-  int64_t rows = tx_param_int(s, "rows", 1, 1, 1 << 24);
-  int64_t cols = tx_param_int(s, "cols", 3, 1, 64);
-  const char* units = tx_param_str(s, "units", "1");
+  const char* out = tx_table_str(s, "write");
+  int64_t rows = tx_table_int(s, "rows");
+  int64_t cols = tx_table_int(s, "cols");
+  const char* units = tx_table_str(s, "units");
   if (out) {
     if (rows * cols < 2) return tx_setup_fail(s, "rows", "a payload needs at least 2 values (one is the checksum)");
     w->out = tx_setup_write(s, &(tx_component_def){out, TX_F32, (uint32_t)rows, (uint32_t)cols, units});
@@ -102,4 +111,6 @@ const tx_controller_class tx_rates_worker = {
     .init = init,
     .step = step,
     .fini = fini,
+    .params = params,
+    .nparams = TX_PARAMS_COUNT(params),
 };

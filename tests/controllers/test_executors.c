@@ -187,7 +187,8 @@ static int failing_init(tx_ctx* c, void* self) { return -1; }
 static void a_failing_init_stops_the_run_cleanly(void** state) {
   (void)state;
   static tx_controller_class bad = {.type = "test.badinit", .summary = "fails init", .configure = counter_configure,
-                                    .init = failing_init, .step = counter_step, .fini = counter_fini};
+                                    .init = failing_init, .step = counter_step, .fini = counter_fini,
+                                    .params = counter_params, .nparams = TX_PARAMS_COUNT(counter_params)};
   if (!tx_find_controller(bad.type)) assert_int_equal(tx_register_controller(&bad), 0);
   for (int lock = 0; lock < 2; lock++) {
     tx_system* s = tx_system_create();
@@ -352,9 +353,11 @@ static void count_finish(tx_ctx* c, void* self) {
 static void no_finish_after_a_failed_init(void** state) {
   (void)state;
   static tx_controller_class fin = {.type = "test.finisher", .summary = "counts finish", .configure = counter_configure,
-                                    .step = counter_step, .finish = count_finish, .fini = counter_fini};
+                                    .step = counter_step, .finish = count_finish, .fini = counter_fini,
+                                    .params = counter_params, .nparams = TX_PARAMS_COUNT(counter_params)};
   static tx_controller_class bad = {.type = "test.badinit2", .summary = "fails init", .configure = counter_configure,
-                                    .init = failing_init, .step = counter_step, .fini = counter_fini};
+                                    .init = failing_init, .step = counter_step, .fini = counter_fini,
+                                    .params = counter_params, .nparams = TX_PARAMS_COUNT(counter_params)};
   if (!tx_find_controller(fin.type)) assert_int_equal(tx_register_controller(&fin), 0);
   if (!tx_find_controller(bad.type)) assert_int_equal(tx_register_controller(&bad), 0);
   for (int lock = 0; lock < 2; lock++) {

@@ -15,14 +15,20 @@ typedef struct counter {
   int64_t stop_at; // step index at which to stop the run (tx_stop_run), -1: never
 } counter;
 
-// params: "write" (component), "read" (component, optional), "gain", "stop_at"
+static const tx_param_def counter_params[] = {
+    {"gain", TX_PARAM_NUM, "1", -1e6, 1e6, 1, NULL, "value written per step"},
+    {"stop_at", TX_PARAM_INT, "1", -1, 1000000000, -1, NULL, "step index at which to stop the run; -1: never"},
+    {"write", TX_PARAM_STR, NULL, 0, 0, 0, NULL, "the component written (f64 1 x 2); none by default"},
+    {"read", TX_PARAM_STR, NULL, 0, 0, 0, NULL, "a component read; none by default"},
+};
+
 static int counter_configure(tx_setup* s, void** self) {
   counter* c = calloc(1, sizeof *c);
   *self = c;
-  c->gain = tx_param_num(s, "gain", 1, -1e6, 1e6);
-  c->stop_at = tx_param_int(s, "stop_at", -1, -1, 1000000000);
-  const char* out = tx_param_str(s, "write", NULL);
-  const char* in = tx_param_str(s, "read", NULL);
+  c->gain = tx_table_num(s, "gain");
+  c->stop_at = tx_table_int(s, "stop_at");
+  const char* out = tx_table_str(s, "write");
+  const char* in = tx_table_str(s, "read");
   if (out) c->out = tx_setup_write(s, &(tx_component_def){out, TX_F64, 1, 2, "1"});
   if (in) c->in = tx_setup_read(s, in);
   return 0;
@@ -46,7 +52,8 @@ static void counter_fini(void* self) { free(self); }
 
 static const tx_controller_class test_counter = {.type = "test.counter", .summary = "counts steps",
                                                  .configure = counter_configure, .step = counter_step,
-                                                 .fini = counter_fini};
+                                                 .fini = counter_fini, .params = counter_params,
+                                                 .nparams = TX_PARAMS_COUNT(counter_params)};
 
 static inline void register_test_classes(void) {
   if (!tx_find_controller("test.counter")) tx_register_controller(&test_counter);

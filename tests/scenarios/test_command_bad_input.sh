@@ -153,7 +153,7 @@ expect_bad "--device sim with a bad hand" "scripted:nope" -- run haptics-wall --
 expect_bad "--device without a haptics controller" "--device scripted:pierce-up" "0 haptics controllers" -- run rates --device scripted:pierce-up
 expect_bad "--device more than the scenario has" "at most 1 --device" -- run haptics-wall --device scripted:pierce-up --device scripted:pierce-down
 expect_bad "--device three times" "at most two" -- run haptics-wall --device scripted:pierce-up --device scripted:pierce-up --device scripted:pierce-up
-expect_bad "haptics limit above the device's" "--set haptics.max_force=10" "out of range" -- run haptics-wall --lockstep --set haptics.max_force=10
+expect_bad "haptics limit above the device's" "--set haptics.max_force=10" "above the device's 3.3" -- run haptics-wall --lockstep --set haptics.max_force=10
 expect_bad "haptics mode unknown" "--set haptics.mode=fast" "sample_hold" -- run haptics-wall --lockstep --set haptics.mode=fast
 # --- views: --view, --stereo and a scenario's "view" (docs/views.md) ---------------
 expect_bad "--stereo without a view" "--stereo sbs" "--view png" -- run haptics-wall --lockstep --stereo sbs

@@ -90,18 +90,27 @@ static void schema_of(const tx_draw_item* it, const char* comp, tx_type* type, u
   }
 }
 
+static const tx_param_def params[] = {
+    {"view", TX_PARAM_JSON, NULL, 0, 0, 0, NULL, "the scenario's \"view\" object (docs/views.md); the loader passes it"},
+    {"target", TX_PARAM_STR, NULL, 0, 0, 0, "png", "png (OSMesa frames) or window (GLFW); --view sets it"},
+    {"stereo_mode", TX_PARAM_STR, NULL, 0, 0, 0, "mono", "mono, sbs, tb, anaglyph or lr; --stereo sets it"},
+    {"wait", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "lockstep: wait for the renderer instead of dropping a frame"},
+    {"render_threads", TX_PARAM_INT, "1", -1, 64, -1, NULL, "llvmpipe rasteriser threads (png only); -1: chosen from the CPUs"},
+    {"available", TX_PARAM_STRS, NULL, 0, 256, 0, NULL, "the components written in the scenario; the loader passes them"},
+};
+
 static int configure(tx_setup* s, void** self) {
   view* v = calloc(1, sizeof *v);
   if (!v) return -1;
   *self = v;
   v->def = tx_view_def_default();
   json_t* vj = tx_param_json(s, "view");
-  const char* target = tx_param_str(s, "target", "png");
-  const char* stereo = tx_param_str(s, "stereo_mode", "mono");
-  v->wait = tx_param_bool(s, "wait", false);
-  int threads = (int)tx_param_int(s, "render_threads", -1, -1, 64);
+  const char* target = tx_table_str(s, "target");
+  const char* stereo = tx_table_str(s, "stereo_mode");
+  v->wait = tx_table_bool(s, "wait");
+  int threads = (int)tx_table_int(s, "render_threads");
   const char* avail[256];
-  int navail = tx_param_strs(s, "available", avail, 256);
+  int navail = tx_table_strs(s, "available", avail, 256);
   if (!target || !stereo) return -1;
   if (strcmp(target, "png") == 0) v->target = TARGET_PNG;
   else if (strcmp(target, "window") == 0) v->target = TARGET_WINDOW;
@@ -591,4 +600,6 @@ const tx_controller_class tx_graphics_view = {
     .step = step,
     .fini = fini,
     .finish = finish,
+    .params = params,
+    .nparams = TX_PARAMS_COUNT(params),
 };
