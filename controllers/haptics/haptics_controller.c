@@ -25,6 +25,7 @@ enum { W_NON_FINITE, W_CLAMPED, W_RATE, W_WATCHDOG, W_WORKSPACE, W_SILENT, W_DRO
 typedef struct haptics {
   tx_device_handle device;
   tx_render_mode mode;
+  tx_safety_limits limits;       // as configured; the path keeps its copy
   tx_haptic_path path;           // passivity and safety: the force path the stability study measures
   tx_port model;                 // the force model read, 0 for none
   tx_port tool;                  // virtual coupling: the simulated tool's pose, 0 for none
@@ -79,15 +80,15 @@ static int configure(tx_setup* s, void** self) {
   tx_device_info info;
   h->device.backend->info(h->device.device, &info);
   tx_safety_limits d = tx_safety_limits_from_device(&info);
-  tx_safety_limits limits = d;
-  limits.max_force = lowered(s, "max_force", d.max_force);
-  limits.max_force_rate = lowered(s, "max_force_rate", d.max_force_rate);
-  limits.model_timeout_s = lowered(s, "model_timeout_s", d.model_timeout_s);
-  limits.device_timeout_s = lowered(s, "device_timeout_s", d.device_timeout_s);
-  limits.ramp_s = lowered(s, "ramp_s", d.ramp_s);
-  const char* bad = tx_safety_limits_check(&limits);
+  h->limits = d;
+  h->limits.max_force = lowered(s, "max_force", d.max_force);
+  h->limits.max_force_rate = lowered(s, "max_force_rate", d.max_force_rate);
+  h->limits.model_timeout_s = lowered(s, "model_timeout_s", d.model_timeout_s);
+  h->limits.device_timeout_s = lowered(s, "device_timeout_s", d.device_timeout_s);
+  h->limits.ramp_s = lowered(s, "ramp_s", d.ramp_s);
+  const char* bad = tx_safety_limits_check(&h->limits);
   if (bad) return tx_setup_fail(s, NULL, "safety limits: %s", bad);
-  tx_haptic_path_init(&h->path, &limits, control, ref);
+  tx_haptic_path_init(&h->path, &h->limits, control, ref);
 
   if (*model) h->model = tx_setup_read_expect(s, model, TX_F64, TX_FORCE_MODEL_COLS, TX_FORCE_MODEL_UNITS); // F0, x0, K
   if (*tool) h->tool = tx_setup_read_as(s, tool, TX_F64, 7);     // a pose: x y z, qw qx qy qz
