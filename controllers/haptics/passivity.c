@@ -74,8 +74,10 @@ double tx_spring_energy(const double k[9], const double f[3]) {
   return u / 2;
 }
 
-void tx_haptic_path_init(tx_haptic_path* p, const tx_safety_limits* limits, bool control, tx_passivity_ref reference) {
-  *p = (tx_haptic_path){.control = control, .reference = reference, .limits = *limits};
+void tx_haptic_path_init(tx_haptic_path* p, const tx_safety_limits* limits, bool control, tx_passivity_ref reference,
+                         double device_damping) {
+  *p = (tx_haptic_path){.control = control, .reference = reference, .limits = *limits,
+                        .device_damping = isfinite(device_damping) && device_damping > 0 ? device_damping : 0};
   tx_safety_init(&p->safety);
 }
 
@@ -83,9 +85,14 @@ void tx_haptic_tick(tx_haptic_path* p, double dt, const tx_haptic_input* in, con
                     double out[3]) {
   tx_passivity* o = &p->passivity;
   tx_passivity_observe(o, p->held, vel, dt);
-  // what the spring holds now is not energy the loop made
-  if (p->reference == TX_PASSIVITY_REF_SPRING && isfinite(in->stored)) p->stored = in->stored;
-  p->reference_energy = o->energy - (p->reference == TX_PASSIVITY_REF_SPRING ? p->stored : 0);
+  // what the spring holds now is not energy the loop made, and what the
+  // device's own damping took the port never saw
+  if (p->reference == TX_PASSIVITY_REF_SPRING) {
+    if (isfinite(in->stored)) p->stored = in->stored;
+    double v2 = vel[0] * vel[0] + vel[1] * vel[1] + vel[2] * vel[2];
+    if (isfinite(v2)) p->absorbed += p->device_damping * v2 * dt; // unseen at the port
+  }
+  p->reference_energy = o->energy - (p->reference == TX_PASSIVITY_REF_SPRING ? p->stored - p->absorbed : 0);
   if (p->reference_energy < p->reference_min) p->reference_min = p->reference_energy;
   double v_dot = p->damped_vel[0] * vel[0] + p->damped_vel[1] * vel[1] + p->damped_vel[2] * vel[2];
   if (isfinite(v_dot)) o->dissipated += p->damping * v_dot * dt; // last tick's damping, over this period

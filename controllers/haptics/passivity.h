@@ -15,8 +15,11 @@
 // - port: E as above. A spring pressed in and let go gives back what it
 //   stored, so a wall may spend that store on a vibration that never decays.
 // - spring: E less the energy U the rendered spring holds at the measured
-//   position (tx_spring_energy). What is left is the energy the sampling
-//   generates, and the controller removes it as it appears.
+//   position (tx_spring_energy), plus what the device's own damping b
+//   absorbed, b |v|^2 dt per period. Each sampled period of a spring makes
+//   k |dx|^2 / 2 that the port sees and b absorbs unseen while k < 2b/T
+//   (Colgate's condition); so this energy falls only where the sampling
+//   makes more than b takes, and the controller removes just that.
 #ifndef TX_CONTROLLERS_HAPTICS_PASSIVITY_H
 #define TX_CONTROLLERS_HAPTICS_PASSIVITY_H
 
@@ -69,10 +72,14 @@ typedef struct tx_haptic_path {
   double stored;               // J, spring reference: what the spring held at the last sample
   double reference_energy;     // J, what the controller acts on: passivity.energy, less stored for the spring
   double reference_min;        // J, its lowest
+  double device_damping;       // N s/m, spring reference: the device's own b (tx_device_info.damping)
+  double absorbed;             // J, spring reference: b |v|^2 dt summed so far
 } tx_haptic_path;
 
-// limits as checked by tx_safety_limits_check; everything else at rest
-void tx_haptic_path_init(tx_haptic_path* p, const tx_safety_limits* limits, bool control, tx_passivity_ref reference);
+// limits as checked by tx_safety_limits_check, the device's own damping
+// b >= 0 (N s/m); everything else at rest
+void tx_haptic_path_init(tx_haptic_path* p, const tx_safety_limits* limits, bool control, tx_passivity_ref reference,
+                         double device_damping);
 
 typedef struct tx_haptic_input {
   double force[3];     // N, what was rendered for this tick
@@ -86,7 +93,7 @@ typedef struct tx_haptic_input {
 // the force held over the period just measured (the force about to be
 // rendered would make a sampled spring look passive); the controller's
 // damping on the reference energy (with the spring reference, the port's
-// less what the spring holds now); the safety chain. out (N) is what to send; it is held for the
+// less what the spring holds now, plus what b absorbed); the safety chain. out (N) is what to send; it is held for the
 // next tick's observer. Allocates nothing.
 void tx_haptic_tick(tx_haptic_path* p, double dt, const tx_haptic_input* in, const double pos[3], const double vel[3],
                     double out[3]);

@@ -81,7 +81,8 @@ bool tx_wall_run(const tx_wall_case* c, tx_wall_result* out) {
   tx_safety_limits limits = tx_safety_limits_from_device(&info);
   tx_haptic_path path;
   tx_haptic_path_init(&path, &limits, c->passivity != TX_WALL_PC_OFF,
-                      c->passivity == TX_WALL_PC_SPRING ? TX_PASSIVITY_REF_SPRING : TX_PASSIVITY_REF_PORT);
+                      c->passivity == TX_WALL_PC_SPRING ? TX_PASSIVITY_REF_SPRING : TX_PASSIVITY_REF_PORT,
+                      info.damping);
   // as if the device had been pressed in from outside: the port has absorbed
   // the spring's store (the reading one period before the start gives it),
   // and the wall's force at the start was held over the period before

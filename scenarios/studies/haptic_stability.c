@@ -83,8 +83,8 @@ static int write_plot(const char* dir, const tx_wall_case* c, const row* rows, i
       {"Colgate bound 2(b-|B|)/T", tx, ty, DENSE, false, 1},
       {"exact boundary (eigenvalues)", tx, ex, DENSE, false, 3},
       {"measured, no passivity control", px, measured, n, true, 9},
-      {"passivity control, port reference (default)", px, port, n, true, 8},
-      {"passivity control, spring reference", px, spring, n, true, 10},
+      {"passivity control, spring reference (default)", px, spring, n, true, 10},
+      {"passivity control, port reference", px, port, n, true, 8},
   };
   char title[160], path[4200];
   snprintf(title, sizeof title, "Largest stable wall stiffness: m = %g kg, b = %g N s/m, B = %g N s/m",
@@ -105,7 +105,7 @@ int tx_study_haptic_stability(const tx_study_args* a) {
          "through the haptics controller's force path (passivity observer and controller, safety chain)\n",
          c.device.mass, c.device.damping, c.damping);
   printf("  %6s %10s %10s %10s %7s %7s %15s %6s %15s %6s\n", "T ms", "Colgate", "exact", "measured", "/Colg.",
-         "/exact", "PC port N/m", "gain", "PC spring N/m", "gain");
+         "/exact", "PC spring N/m", "gain", "PC port N/m", "gain");
   row rows[PERIODS_MAX];
   for (int i = 0; i < n; i++) {
     c.device.period = periods[i];
@@ -117,8 +117,8 @@ int tx_study_haptic_stability(const tx_study_args* a) {
     r->port_pc = largest(c, TX_WALL_PC_PORT);
     r->spring_pc = largest(c, TX_WALL_PC_SPRING);
     printf("  %6.3g %10.1f %10.1f %10.1f %7.3f %7.3f %15.1f %6.2f %15.1f %6.2f\n", periods[i] * 1e3, r->theory,
-           r->exact, r->measured, r->measured / r->theory, r->measured / r->exact, r->port_pc,
-           r->port_pc / r->measured, r->spring_pc, r->spring_pc / r->measured);
+           r->exact, r->measured, r->measured / r->theory, r->measured / r->exact, r->spring_pc,
+           r->spring_pc / r->measured, r->port_pc, r->port_pc / r->measured);
   }
   printf("\nwall damping B against the two bounds, no passivity control:\n  %6s %8s %10s %10s %10s %7s\n", "T ms",
          "B N s/m", "Colgate", "exact", "measured", "/exact");
@@ -145,11 +145,11 @@ int tx_study_haptic_stability(const tx_study_args* a) {
   FILE* csv = fopen(tmp, "w");
   if (!csv) return json_decref(cases), tx_bad_input("--out %s: cannot write haptic-stability.csv", a->out_dir);
   fprintf(csv, "period_s,k_max_theory_n_m,k_max_exact_n_m,k_max_measured_n_m,k_max_with_passivity_control_n_m,"
-               "k_max_with_spring_passivity_control_n_m\n");
+               "k_max_with_port_passivity_control_n_m\n");
   for (int i = 0; i < n; i++) {
     const row* r = &rows[i];
-    fprintf(csv, "%.9g,%.6g,%.6g,%.6g,%.6g,%.6g\n", r->period, r->theory, r->exact, r->measured, r->port_pc,
-            r->spring_pc);
+    fprintf(csv, "%.9g,%.6g,%.6g,%.6g,%.6g,%.6g\n", r->period, r->theory, r->exact, r->measured, r->spring_pc,
+            r->port_pc);
     json_t* damping = json_array();
     for (int j = 0; j < NB; j++)
       json_array_append_new(damping, json_pack("{s:f,s:f,s:f,s:f}", "wall_damping_n_s_m", r->b_damping[j],
@@ -159,9 +159,9 @@ int tx_study_haptic_stability(const tx_study_args* a) {
                                            "k_max_theory", r->theory, "k_max_exact", r->exact, "k_max_measured",
                                            r->measured, "measured_over_theory", r->measured / r->theory,
                                            "measured_over_exact", r->measured / r->exact,
-                                           "k_max_with_passivity_control", r->port_pc, "passivity_control_gain",
-                                           r->port_pc / r->measured, "k_max_with_spring_passivity_control",
-                                           r->spring_pc, "wall_damping", damping));
+                                           "k_max_with_passivity_control", r->spring_pc, "passivity_control_gain",
+                                           r->spring_pc / r->measured, "k_max_with_port_passivity_control",
+                                           r->port_pc, "wall_damping", damping));
   }
   char err[1024];
   if (fclose(csv) != 0 || rename(tmp, csv_path) != 0) return remove(tmp), fprintf(stderr, "tactus: %s: cannot write\n", csv_path), 1;
@@ -170,8 +170,8 @@ int tx_study_haptic_stability(const tx_study_args* a) {
                           "hand_stiffness_n_m", c.device.hand_stiffness, "wall_damping_n_s_m", c.damping, "units",
                           "stiffness in N/m, period in s", "passivity_control",
                           "the haptics controller's: k_max_with_passivity_control with its default reference, "
-                          "port (the energy at the device port); spring: that energy less what the wall's spring "
-                          "holds",
+                          "spring (the energy at the device port less what the wall's spring holds, plus what the "
+                          "device's damping absorbed); port: the energy at the device port",
                           "cases", cases);
   if (!doc || tx_report_save(doc, a->out_dir, "haptic-stability.json", err, sizeof err)) {
     json_decref(doc);
@@ -182,17 +182,21 @@ int tx_study_haptic_stability(const tx_study_args* a) {
   if (!plotted) fprintf(stderr, "tactus: %s\n", err);
 
   // the exact boundary is what the simulation must find; Colgate's bound is
-  // checked where it should hold, B = 0 (the first wall damping above)
+  // checked where it should hold, B = 0 (the first wall damping above); the
+  // shipped passivity control must not make the wall softer (but for the
+  // search's 1% tolerance, twice)
   printf("\ntargets:\n");
   bool all = true;
   for (int i = 0; i < n; i++) {
     double off = fabs(rows[i].b_measured[0] / rows[i].b_colgate[0] - 1) * 100;
     double worst = 0;
     for (int j = 0; j < NB; j++) worst = fmax(worst, fabs(rows[i].b_measured[j] / rows[i].b_exact[j] - 1) * 100);
+    double gain = rows[i].spring_pc / rows[i].measured;
     printf("  T = %-6.3g ms: B = 0 within 25%% of Colgate's bound: %5.1f%% off %-8s every B within 5%% of the exact "
-           "boundary: %5.1f%% off %s\n",
-           rows[i].period * 1e3, off, off <= 25 ? "met" : "MISSED", worst, worst <= 5 ? "met" : "MISSED");
-    all &= off <= 25 && worst <= 5;
+           "boundary: %5.1f%% off %-8s passivity control >= 0.98x: %5.2fx %s\n",
+           rows[i].period * 1e3, off, off <= 25 ? "met" : "MISSED", worst, worst <= 5 ? "met" : "MISSED", gain,
+           gain >= 0.98 ? "met" : "MISSED");
+    all &= off <= 25 && worst <= 5 && gain >= 0.98;
   }
   printf("%s\nwrote %s/haptic-stability.json, .csv%s\n", all ? "all targets met" : "some targets MISSED", a->out_dir,
          plotted ? " and .png" : "");

@@ -102,7 +102,7 @@ static int check_study(const json_t* r) {
     if (need_number(c, "period_s", where) || need_number(c, "k_max_theory", where) ||
         need_number(c, "k_max_exact", where) || need_number(c, "k_max_measured", where) ||
         need_number(c, "k_max_with_passivity_control", where) ||
-        need_number(c, "k_max_with_spring_passivity_control", where))
+        need_number(c, "k_max_with_port_passivity_control", where))
       return 1;
     double theory = json_number_value(json_object_get(c, "k_max_theory"));
     double exact = json_number_value(json_object_get(c, "k_max_exact"));
