@@ -59,10 +59,15 @@ static int apply(tx_wall_case* c, const tx_study_args* a, double* periods, int* 
   return 0;
 }
 
+// 0 when not even the lowest stiffness is stable (a wall damping below -b)
 static double largest(tx_wall_case c, tx_wall_pc pc) {
   c.passivity = pc;
-  return tx_wall_largest_stable(&c, 10, 1e6, 0.01).k;
+  tx_wall_search s = tx_wall_largest_stable(&c, 10, 1e6, 0.01);
+  return s.lo_unstable ? 0 : s.k;
 }
+
+// a JSON number, or null for a ratio to a bound of 0 (JSON has no infinity)
+static json_t* num(double v) { return isfinite(v) ? json_real(v) : json_null(); }
 
 static int write_plot(const char* dir, const tx_wall_case* c, const row* rows, int n, char* err, size_t en) {
   enum { DENSE = 64 };
@@ -155,12 +160,12 @@ int tx_study_haptic_stability(const tx_study_args* a) {
       json_array_append_new(damping, json_pack("{s:f,s:f,s:f,s:f}", "wall_damping_n_s_m", r->b_damping[j],
                                                "k_max_theory", r->b_colgate[j], "k_max_exact", r->b_exact[j],
                                                "k_max_measured", r->b_measured[j]));
-    json_array_append_new(cases, json_pack("{s:f,s:f,s:f,s:f,s:f,s:f,s:f,s:f,s:f,s:o}", "period_s", r->period,
+    json_array_append_new(cases, json_pack("{s:f,s:f,s:f,s:f,s:o,s:o,s:f,s:o,s:f,s:o}", "period_s", r->period,
                                            "k_max_theory", r->theory, "k_max_exact", r->exact, "k_max_measured",
-                                           r->measured, "measured_over_theory", r->measured / r->theory,
-                                           "measured_over_exact", r->measured / r->exact,
+                                           r->measured, "measured_over_theory", num(r->measured / r->theory),
+                                           "measured_over_exact", num(r->measured / r->exact),
                                            "k_max_with_passivity_control", r->spring_pc, "passivity_control_gain",
-                                           r->spring_pc / r->measured, "k_max_with_port_passivity_control",
+                                           num(r->spring_pc / r->measured), "k_max_with_port_passivity_control",
                                            r->port_pc, "wall_damping", damping));
   }
   char err[1024];
@@ -196,7 +201,7 @@ int tx_study_haptic_stability(const tx_study_args* a) {
            "boundary: %5.1f%% off %-8s passivity control >= 0.98x: %5.2fx %s\n",
            rows[i].period * 1e3, off, off <= 25 ? "met" : "MISSED", worst, worst <= 5 ? "met" : "MISSED", gain,
            gain >= 0.98 ? "met" : "MISSED");
-    all &= off <= 25 && worst <= 5 && gain >= 0.98;
+    all &= off <= 25 && worst <= 5 && (gain >= 0.98 || rows[i].measured == 0); // nothing to soften
   }
   printf("%s\nwrote %s/haptic-stability.json, .csv%s\n", all ? "all targets met" : "some targets MISSED", a->out_dir,
          plotted ? " and .png" : "");
