@@ -1,9 +1,10 @@
 // haptics: one device, rendered every tick from the published force model.
 //
-// Each tick: read the device; observe the energy of the force sent last tick;
-// render F = F0 + K (x - x0) from the latest force model (or hold F0, the
-// papers' sample-and-hold); let the passivity controller add damping if
-// asked; pass the safety chain; write the force.
+// Each tick: read the device; render F = F0 + K (x - x0) from the latest
+// force model (or hold F0, the papers' sample-and-hold); then the force path
+// that `tactus study haptic-stability` measures (tx_haptic_tick): observe the
+// energy of the force sent last tick, let the passivity controller add
+// damping if asked, pass the safety chain; write the force.
 // It publishes what the rest of the model needs from the device, and counts
 // every safety event as a warning of the run.
 #include "haptics_controller.h"
@@ -24,20 +25,15 @@ enum { W_NON_FINITE, W_CLAMPED, W_RATE, W_WATCHDOG, W_WORKSPACE, W_SILENT, W_DRO
 typedef struct haptics {
   tx_device_handle device;
   tx_render_mode mode;
-  bool passivity_control;
-  tx_safety_limits limits;
-  tx_safety safety;
-  tx_passivity passivity;
+  tx_safety_limits limits;       // as configured; the path keeps its copy
+  tx_haptic_path path;           // passivity and safety: the force path the stability study measures
   tx_port model;                 // the force model read, 0 for none
   tx_port tool;                  // virtual coupling: the simulated tool's pose, 0 for none
   double coupling_k, coupling_b; // N/m, N s/m
   tx_port pose, velocity, force, energy;
   tx_warning warn[W_COUNT];
-  tx_result energy_result, dissipated_result, min_energy_result;
+  tx_result energy_result, dissipated_result, min_energy_result, reference_result;
   tx_device_state state;         // last sample
-  double held[3];                // N, the force sent last tick, held since
-  double damping;                // N s/m, the passivity controller's damping in last tick's force
-  double damped_vel[3];          // m/s, the velocity that damping was computed for
   double silent_s;               // since the last sample
   int hand;
   bool record;                   // when the run keeps recordings
@@ -62,6 +58,7 @@ static const tx_param_def params[] = {
     {"mode", TX_PARAM_STR, NULL, 0, 0, 0, "local", "local: F = F0 + K (x - x0) every tick; sample_hold: F0 until the next model"},
     {"force_model", TX_PARAM_STR, NULL, 0, 0, 0, "", "the force model rendered (f64 1 x 15, \"N, m, N/m\"); \"\": none"},
     {"passivity_control", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "add damping whenever the observed energy would go negative"},
+    {"passivity_reference", TX_PARAM_STR, NULL, 0, 0, 0, "spring", "what that energy is measured against: spring (the port's energy less the force model's spring store, plus the device's own damping) or port (docs/haptics.md#passivity)"},
     {"coupling_tool", TX_PARAM_STR, NULL, 0, 0, 0, "", "instead of a force model, a simulated tool's pose (f64 1 x 7) to couple to"},
     {"coupling_stiffness", TX_PARAM_NUM, "N/m", 0, 1e5, 200, NULL, "the virtual coupling's spring"},
     {"coupling_damping", TX_PARAM_NUM, "N s/m", 0, 1e3, 1, NULL, "the virtual coupling's damper"},
@@ -83,13 +80,20 @@ static int configure(tx_setup* s, void** self) {
   h->record = tx_table_bool(s, "record");
   const char* mode = tx_table_str(s, "mode");
   const char* model = tx_table_str(s, "force_model");
-  h->passivity_control = tx_table_bool(s, "passivity_control");
+  bool control = tx_table_bool(s, "passivity_control");
+  const char* reference = tx_table_str(s, "passivity_reference");
   const char* tool = tx_table_str(s, "coupling_tool");
   h->coupling_k = tx_table_num(s, "coupling_stiffness");
   h->coupling_b = tx_table_num(s, "coupling_damping");
   if (!tool) return -1;
   if (*tool && *model) return tx_setup_fail(s, "coupling_tool", "renders either a force model or a coupling, not both");
-  if (!spec || !mode || !model) return -1; // a parameter error is already recorded
+  if (!spec || !mode || !model || !reference) return -1; // a parameter error is already recorded
+  // spring by default: through this very path the study finds it as good as
+  // port at 0.25 ms and better at 1 and 4 ms, where port is worse than none
+  tx_passivity_ref ref = TX_PASSIVITY_REF_SPRING;
+  if (strcmp(reference, "port") == 0) ref = TX_PASSIVITY_REF_PORT;
+  else if (strcmp(reference, "spring") != 0)
+    return tx_setup_fail(s, "passivity_reference", "expected \"port\" or \"spring\", got \"%s\"", reference);
   if (strcmp(mode, "local") == 0) h->mode = TX_RENDER_LOCAL_MODEL;
   else if (strcmp(mode, "sample_hold") == 0) h->mode = TX_RENDER_SAMPLE_HOLD;
   else return tx_setup_fail(s, "mode", "expected \"local\" or \"sample_hold\", got \"%s\"", mode);
@@ -107,7 +111,7 @@ static int configure(tx_setup* s, void** self) {
   h->limits.ramp_s = lowered(s, "ramp_s", d.ramp_s);
   const char* bad = tx_safety_limits_check(&h->limits);
   if (bad) return tx_setup_fail(s, NULL, "safety limits: %s", bad);
-  tx_safety_init(&h->safety);
+  tx_haptic_path_init(&h->path, &h->limits, control, ref, info.damping);
 
   if (*model) h->model = tx_setup_read_expect(s, model, TX_F64, TX_FORCE_MODEL_COLS, TX_FORCE_MODEL_UNITS); // F0, x0, K
   if (*tool) h->tool = tx_setup_read_as(s, tool, TX_F64, 7);     // a pose: x y z, qw qx qy qz
@@ -127,12 +131,13 @@ static int configure(tx_setup* s, void** self) {
   h->energy_result = tx_setup_result(s, "passivity_energy_j");
   h->min_energy_result = tx_setup_result(s, "passivity_min_energy_j");
   h->dissipated_result = tx_setup_result(s, "passivity_dissipated_j");
+  h->reference_result = tx_setup_result(s, "passivity_reference_energy_j");
   return 0;
 }
 
 // count the safety events of this tick as run warnings
 static void warn_new(tx_ctx* c, haptics* h, const tx_safety_counts* before) {
-  const tx_safety_counts* now = &h->safety.counts;
+  const tx_safety_counts* now = &h->path.safety.counts;
   if (now->non_finite > before->non_finite) tx_warn(c, h->warn[W_NON_FINITE]);
   if (now->clamped > before->clamped) tx_warn(c, h->warn[W_CLAMPED]);
   if (now->rate_limited > before->rate_limited) tx_warn(c, h->warn[W_RATE]);
@@ -148,8 +153,8 @@ static void publish(tx_ctx* c, haptics* h, const double force[3]) {
   memcpy(tx_write(c, h->velocity), h->state.vel, 3 * sizeof(double));
   memcpy(tx_write(c, h->force), force, 3 * sizeof(double));
   double* e = tx_write(c, h->energy);
-  e[0] = h->passivity.energy;
-  e[1] = h->passivity.dissipated;
+  e[0] = h->path.passivity.energy;
+  e[1] = h->path.passivity.dissipated;
 }
 
 // the device's first sample is published at time 0, so that the controllers
@@ -178,7 +183,7 @@ static void step(tx_ctx* c, void* self) {
   if (h->device.backend->read(h->device.device, t, &h->state)) h->silent_s = 0;
   else h->silent_s += dt, tx_warn(c, h->warn[W_SILENT]);
 
-  double f[3] = {0, 0, 0}, model_age = 0;
+  double f[3] = {0, 0, 0}, model_age = 0, stored = 0;
   if (h->model.id) {
     tx_snapshot snap = tx_read(c, h->model);
     const double* m = snap.data; // f0 (3), x0 (3), K (9)
@@ -191,6 +196,8 @@ static void step(tx_ctx* c, void* self) {
     // there is nothing to render and nothing stale to warn about
     if (snap.seq) {
       tx_render_force(&fm, h->mode, h->state.pos, f);
+      // what the rendered spring holds; held forces (sample_hold) follow no spring
+      if (h->mode == TX_RENDER_LOCAL_MODEL) stored = tx_spring_energy(fm.k, f);
       model_age = (double)(tx_sim_ns(c) - snap.sim_ns) * 1e-9;
     }
   } else if (h->tool.id) {
@@ -203,22 +210,6 @@ static void step(tx_ctx* c, void* self) {
       model_age = (double)(tx_sim_ns(c) - snap.sim_ns) * 1e-9;
     }
   }
-  // the observer pairs the velocity of the period just measured with the
-  // force sent and held over it, after every safety stage (this tick's force
-  // would make a sampled spring look passive; the force before the safety
-  // chain is not what the hand felt)
-  const double* v = h->state.vel;
-  tx_passivity_observe(&h->passivity, h->held, v, dt);
-  double v_dot = h->damped_vel[0] * v[0] + h->damped_vel[1] * v[1] + h->damped_vel[2] * v[2];
-  if (isfinite(v_dot)) h->passivity.dissipated += h->damping * v_dot * dt; // last tick's damping, over this period
-  // the controller damps the force about to be rendered; the safety chain
-  // after it still bounds what is sent, and the observer measures that
-  double alpha = h->passivity_control ? tx_passivity_damping(&h->passivity, v, dt, h->limits.max_force) : 0;
-  for (int i = 0; i < 3; i++) {
-    f[i] -= alpha * v[i];
-    h->damped_vel[i] = alpha ? v[i] : 0;
-  }
-  h->damping = alpha;
   // a broken recording stops the run at once; until it ends, the force ramps to zero
   if (h->recorder && !h->record_failed) {
     const char* file;
@@ -230,12 +221,13 @@ static void step(tx_ctx* c, void* self) {
       h->record_failed = true;
     }
   }
-  if (h->record_failed) f[0] = f[1] = f[2] = 0; // the rate limit makes it a ramp
-  tx_safety_counts before = h->safety.counts;
+  // the observer, the passivity controller and the safety chain: one call,
+  // the same the stability study measures
+  tx_haptic_input in = {{f[0], f[1], f[2]}, stored, h->record_failed, model_age, h->silent_s};
+  tx_safety_counts before = h->path.safety.counts;
   double out[3];
-  tx_safety_apply(&h->safety, &h->limits, dt, f, h->state.pos, model_age, h->silent_s, out);
+  tx_haptic_tick(&h->path, dt, &in, h->state.pos, h->state.vel, out);
   warn_new(c, h, &before);
-  memcpy(h->held, out, sizeof h->held);
   h->device.backend->write(h->device.device, out);
   publish(c, h, out);
   if (h->recorder) {
@@ -254,9 +246,10 @@ static void step(tx_ctx* c, void* self) {
 // the run is over: the recording is made whole (binary and CSV) before the report
 static void finish(tx_ctx* c, void* self) {
   haptics* h = self;
-  tx_set_result(c, h->energy_result, h->passivity.energy);
-  tx_set_result(c, h->min_energy_result, h->passivity.min_energy);
-  tx_set_result(c, h->dissipated_result, h->passivity.dissipated);
+  tx_set_result(c, h->energy_result, h->path.passivity.energy);
+  tx_set_result(c, h->min_energy_result, h->path.passivity.min_energy);
+  tx_set_result(c, h->dissipated_result, h->path.passivity.dissipated);
+  tx_set_result(c, h->reference_result, h->path.reference_energy);
   char err[512];
   if (tx_recorder_stop(h->recorder, err, sizeof err) && !h->record_failed) // else the run's stop reason says it
     fprintf(stderr, "tactus: recording: %s\n", err);

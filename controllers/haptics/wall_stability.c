@@ -2,6 +2,7 @@
 #include "wall_stability.h"
 
 #include "passivity.h"
+#include "safety.h"
 
 #include "../../model/error.h"
 
@@ -39,8 +40,8 @@ const char* tx_wall_case_check(const tx_wall_case* c) {
     name = "passivity", v = c->passivity, rule = "must be TX_WALL_PC_OFF, _PORT or _SPRING";
   else if (!(isfinite(c->stiffness) && c->stiffness > 0 && c->stiffness <= 1e7))
     name = "stiffness", v = c->stiffness, rule = "N/m, must be in (0, 1e7]";
-  else if (!(isfinite(c->damping) && c->damping >= 0 && c->damping <= 1e3))
-    name = "damping", v = c->damping, rule = "N s/m, must be in [0, 1e3]";
+  else if (!(isfinite(c->damping) && c->damping >= -1e3 && c->damping <= 1e3))
+    name = "damping", v = c->damping, rule = "N s/m, must be in [-1e3, 1e3]";
   else if (!(isfinite(c->push_force) && c->push_force > 0 && c->push_force < c->device.max_force))
     name = "push_force", v = c->push_force, rule = "N, must be in (0, device max_force)";
   else if (!(c->device.hand_stiffness > 0))
@@ -68,18 +69,29 @@ bool tx_wall_run(const tx_wall_case* c, tx_wall_result* out) {
   double x_eq = c->push_force / K;
   double v0 = c->kick * x_eq * sqrt(keff / m);
   double e0 = 0.5 * m * v0 * v0;
+  const double spring[9] = {-K, 0, 0, 0, 0, 0, 0, 0, 0}; // the wall as a force model publishes it: -K n n^T
 
   // start at rest depth moving inward; the hand's spring pushes with push_force there
   tx_sim_device_reset(&dev, (double[3]){x_eq, 0, 0}, (double[3]){v0, 0, 0});
   tx_sim_device_place_hand(&dev, (double[3]){x_eq + c->push_force / kh, 0, 0});
-  // port: the observer starts as if the device had been pressed in from
-  // outside, so the wall has absorbed its spring energy and may give it back.
-  // spring: that energy is subtracted as it is stored, leaving zero at rest.
-  double x_before = dev.state.pos[0] - dev.state.vel[0] * T; // the reading one period before the start
-  double stored_prev = x_before > 0 ? 0.5 * K * x_before * x_before : 0;
-  double e_obs0 = c->passivity == TX_WALL_PC_SPRING ? 0 : stored_prev;
-  tx_passivity obs = {.energy = e_obs0, .min_energy = e_obs0};
-  double f_env_prev[3] = {-K * dev.state.pos[0], 0, 0};
+  // the force path of the haptics controller, with the limits it would take
+  // from this device
+  tx_device_info info;
+  tx_sim_device_info(&dev, &info);
+  tx_safety_limits limits = tx_safety_limits_from_device(&info);
+  tx_haptic_path path;
+  tx_haptic_path_init(&path, &limits, c->passivity != TX_WALL_PC_OFF,
+                      c->passivity == TX_WALL_PC_SPRING ? TX_PASSIVITY_REF_SPRING : TX_PASSIVITY_REF_PORT,
+                      info.damping);
+  // as if the device had been pressed in from outside: the port has absorbed
+  // the spring's store (the reading one period before the start gives it),
+  // and the wall's force at the start was held over the period before
+  double x_before = dev.state.pos[0] - dev.state.vel[0] * T;
+  double stored0 = tx_spring_energy(spring, (double[3]){x_before > 0 ? -K * x_before : 0, 0, 0});
+  path.passivity.energy = path.passivity.min_energy = stored0;
+  path.stored = stored0;
+  path.reference_energy = path.reference_min = c->passivity == TX_WALL_PC_SPRING ? 0 : stored0;
+  path.held[0] = path.safety.last[0] = dev.state.pos[0] > 0 ? -K * dev.state.pos[0] : 0;
 
   uint64_t n = (uint64_t)llround(c->duration / T);
   uint64_t per_window = n / WINDOWS;
@@ -87,28 +99,16 @@ bool tx_wall_run(const tx_wall_case* c, tx_wall_result* out) {
   double depth_max = x_eq;
   uint64_t outside = 0;
   for (uint64_t k = 0; k < n; k++) {
-    // the wall, from what the encoder reports
+    // the wall, from what the encoder reports: F(k) = -K x(k) - B (x(k) - x(k-1)) / T
     const tx_device_state* s = &dev.state;
-    double f_env[3] = {0, 0, 0};
-    if (s->pos[0] > 0) f_env[0] = -K * s->pos[0] - B * s->vel[0];
-    // the observer is given the force that was held over the period just
-    // measured by vel, the energy the hold actually delivered (the force of
-    // this tick with the velocity of the last period would see a sampled
-    // spring as passive, E >= K x^2 / 2). Its controller damps the force
-    // about to be rendered.
-    if (c->passivity == TX_WALL_PC_SPRING) {
-      double xin = s->pos[0] > 0 ? s->pos[0] : 0;
-      double stored = 0.5 * K * xin * xin;
-      obs.energy -= stored - stored_prev;
-      stored_prev = stored;
+    tx_haptic_input in = {{0, 0, 0}, 0, false, 0, 0};
+    if (s->pos[0] > 0) {
+      double fs[3] = {-K * s->pos[0], 0, 0};
+      in.force[0] = fs[0] - B * s->vel[0];
+      in.stored = tx_spring_energy(spring, fs);
     }
-    double f_obs[3] = {f_env_prev[0], f_env_prev[1], f_env_prev[2]};
-    double alpha = tx_passivity_tick(&obs, f_obs, s->vel, T, c->passivity != TX_WALL_PC_OFF);
     double f[3];
-    for (int i = 0; i < 3; i++) {
-      f[i] = f_env[i] - alpha * s->vel[i];
-      f_env_prev[i] = f_env[i];
-    }
+    tx_haptic_tick(&path, T, &in, s->pos, s->vel, f);
     tx_sim_device_step(&dev, f, NULL);
 
     // the oscillation energy about the resting depth, from the true state
@@ -139,9 +139,10 @@ bool tx_wall_run(const tx_wall_case* c, tx_wall_result* out) {
       .depth_rest = x_eq,
       .depth_max = depth_max,
       .outside_s = (double)outside * T,
-      .observed_min = obs.min_energy,
-      .control_ticks = obs.activations,
-      .clamped_ticks = dev.clamped,
+      .observed_min = path.reference_min,
+      .control_ticks = path.passivity.activations,
+      .clamped_ticks = path.safety.counts.clamped + dev.clamped,
+      .rate_limited_ticks = path.safety.counts.rate_limited,
   };
   return true;
 }
@@ -195,6 +196,40 @@ tx_wall_search tx_wall_largest_stable(const tx_wall_case* c, double k_lo, double
   s.k = stable;
   s.k_unstable = unstable;
   return s;
+}
+
+// Jury's test for the monic cubic z^3 + a2 z^2 + a1 z + a0: every root
+// strictly inside the unit circle
+static bool jury3(double a2, double a1, double a0) {
+  return 1 + a2 + a1 + a0 > 0 && 1 - a2 + a1 - a0 > 0 && fabs(a0) < 1 && fabs(1 - a0 * a0) > fabs(a1 - a0 * a2);
+}
+
+bool tx_wall_exact_stable(const tx_sim_device* dev, double K, double B) {
+  const double *phi = dev->phi, *gam = dev->gam;
+  double T = dev->def.period, kb = K + B / T, bt = B / T;
+  // state (x(k), v(k), x(k-1)); F(k) = -K x(k) - B (x(k) - x(k-1)) / T, held over the period
+  double a[3][3] = {{phi[0] - gam[0] * kb, phi[1], gam[0] * bt}, {phi[2] - gam[1] * kb, phi[3], gam[1] * bt}, {1, 0, 0}};
+  double tr = a[0][0] + a[1][1] + a[2][2];
+  double minors = a[0][0] * a[1][1] - a[0][1] * a[1][0] + a[0][0] * a[2][2] - a[0][2] * a[2][0] + a[1][1] * a[2][2] -
+                  a[1][2] * a[2][1];
+  double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+               a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+  return jury3(-tr, minors, -det);
+}
+
+double tx_wall_exact_bound(const tx_sim_device_def* d, double B) {
+  tx_sim_device dev;
+  if (!isfinite(B) || !tx_sim_device_init(&dev, d)) return NAN;
+  // up in doublings from a stiffness far below any bound, then bisection
+  double lo = 0, hi = 1e-3;
+  while (hi <= 1e12 && tx_wall_exact_stable(&dev, hi, B)) lo = hi, hi *= 2;
+  if (lo == 0 || hi > 1e12) return lo;
+  while (hi - lo > 1e-12 * hi) {
+    double mid = 0.5 * (lo + hi);
+    if (tx_wall_exact_stable(&dev, mid, B)) lo = mid;
+    else hi = mid;
+  }
+  return lo;
 }
 
 double tx_wall_colgate_bound(double b, double B, double T) {

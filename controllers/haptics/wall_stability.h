@@ -4,11 +4,23 @@
 //
 //     F(k) = -K x(k) - B (x(k) - x(k-1)) / T   when x(k) > 0, else 0
 //
-// on the simulated device (sim_device.h), optionally through the passivity
-// controller (passivity.h). Colgate's passivity condition for this sampled
-// wall is b > K T / 2 + |B|: the zero-order hold delays the spring by about
-// T/2, which acts as a negative damping K T / 2 that the device's own damping
-// b must absorb. Hence the bound K_max = 2 (b - B) / T.
+// on the simulated device (sim_device.h), through the force path of the
+// `haptics` controller (tx_haptic_tick in passivity.h: passivity observer and
+// controller, then the safety chain with the limits the device gives), so
+// what is measured is what the controller ships. Colgate's passivity
+// condition for this sampled wall is b > K T / 2 + |B|: the zero-order hold
+// delays the spring by about T/2, which acts as a negative damping K T / 2
+// that the device's own damping b must absorb. Hence the bound
+// K_max = 2 (b - |B|) / T.
+//
+// That is a passivity bound: it holds against every passive hand. The exact
+// stability boundary of this loop (tx_wall_exact_bound) is where the
+// eigenvalues of its discretisation leave the unit circle: the device's exact
+// zero-order-hold transition over T (hand spring included), the wall
+// computed from the sample x(k) and held over the next period (no further
+// delay), the velocity a backward difference. The two agree near B = 0; with
+// B > 0 the boundary lies well above 2 (b - B) / T, near 2 (b + B) / T for
+// small B, since a damper that is one period late still mostly damps.
 //
 // One case: the hand presses the device into the wall with push_force and
 // holds it there; the device starts at the resting depth x_eq = push_force/K
@@ -28,14 +40,14 @@
 // the boundary the answer changes where the net damping of the loop changes
 // sign; the run length sets how close (10 s: to within about 1%).
 //
-// With the passivity controller, two references for its observer:
-// - port: the energy absorbed at the device port, the observer of
-//   passivity.h as it stands. It lets the wall give back the spring energy
-//   stored by the push, so above 2b/T the oscillation grows until it has
-//   spent that store and then stays: bounded (in contact up to a few times
-//   2b/T), but not decaying, so by the criterion above not stable.
-// - spring: the same energy less what an ideal continuous spring would hold
-//   at the measured depth. What is left is the energy the sampling
+// With the passivity controller, two references for it (passivity.h):
+// - port: the energy absorbed at the device port. It lets the wall give back
+//   the spring energy stored by the push, so above 2b/T the oscillation
+//   grows until it has spent that store and then stays: bounded, but not
+//   decaying, so by the criterion above not stable.
+// - spring: the same energy less what the wall's spring holds at the
+//   measured depth (tx_spring_energy, as the controller computes it from a
+//   published force model). What is left is the energy the sampling
 //   generates, and the controller removes it as it appears.
 //
 //     tx_wall_case c = tx_wall_case_default();
@@ -61,7 +73,7 @@ typedef enum tx_wall_pc {
 typedef struct tx_wall_case {
   tx_sim_device_def device; // m, b, T, quantum, max force; its hand fields are the operator (defaults below)
   double stiffness;         // N/m, wall stiffness K; 500: the device's nominal stiffness
-  double damping;           // N s/m, wall damping B; 0: the bound is then the device's own, 2b/T
+  double damping;           // N s/m, wall damping B in [-1e3, 1e3]; 0: the bound is then the device's own, 2b/T
   tx_wall_pc passivity;     // passivity control, off by default
   double push_force;        // N, how hard the hand presses at rest; 1: a firm touch, a third of max force
   double kick;              // initial amplitude as a fraction of x_eq, in (0, 1); 0.25: small, see above
@@ -78,7 +90,8 @@ typedef struct tx_wall_result {
   double outside_s;         // s the device spent outside the wall
   double observed_min;      // J, lowest energy the passivity observer saw (it runs with control off too)
   uint64_t control_ticks;   // ticks on which the passivity controller added damping
-  uint64_t clamped_ticks;   // ticks on which the device clamped the force
+  uint64_t clamped_ticks;   // ticks on which the safety chain (or the device) clamped the force
+  uint64_t rate_limited_ticks; // ticks on which the safety chain's impulse limit held the force back
 } tx_wall_result;
 
 typedef struct tx_wall_search {
@@ -109,6 +122,17 @@ bool tx_wall_run(const tx_wall_case* c, tx_wall_result* out);
 // rel_tol > 0, or a bad case) sets tx_error() and lo_unstable. The sweep, not bisection alone, because a
 // limit cycle can make a stiffer wall look stable again.
 tx_wall_search tx_wall_largest_stable(const tx_wall_case* c, double k_lo, double k_hi, double rel_tol);
+
+// whether the wall K (N/m), B (N s/m) in contact on this device (its exact
+// transition, dev->phi and dev->gam) is asymptotically stable: Jury's test on
+// the closed loop's characteristic cubic, in the state (x(k), v(k), x(k-1))
+bool tx_wall_exact_stable(const tx_sim_device* dev, double K, double B);
+
+// the exact stability boundary: the largest K (N/m) that tx_wall_exact_stable
+// accepts, to 1e-12 relative, for the device d (no quantisation: the encoder
+// is linearised away) and the wall's damping B (N s/m); 0 if even 1 mN/m is
+// unstable, NaN for a bad device (tx_error() set) or B
+double tx_wall_exact_bound(const tx_sim_device_def* d, double B);
 
 // Colgate's passivity bound K_max = 2 (b - B) / T, N/m, for the device's
 // damping b (N s/m), the wall's damping B (N s/m) and the period T (s);

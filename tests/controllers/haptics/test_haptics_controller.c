@@ -153,6 +153,8 @@ static void configuration_mistakes_are_refused(void** state) {
        "reads 'device0.velocity' as f64 x 7"},
       {"{\"name\":\"h\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"force_model\":\"a\",\"coupling_tool\":\"b\"}}",
        "not both"},
+      {"{\"name\":\"h\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"passivity_reference\":\"energy\"}}",
+       "passivity_reference: expected \"port\" or \"spring\", got \"energy\""},
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     char text[1024], err[512] = "";
@@ -240,8 +242,8 @@ static void energy_from_recording(const char* dir, double* energy, double* path,
 // controller on it reported +0.00059 J while the force sent gave -0.0051 J.
 static void the_observer_sums_the_force_sent(void** state) {
   (void)state;
-  const char* params[] = {"", "\"passivity_control\":true"};
-  for (int pc = 0; pc < 2; pc++) {
+  const char* params[] = {"", "\"passivity_control\":true", "\"passivity_control\":true,\"passivity_reference\":\"port\""};
+  for (int pc = 0; pc < 3; pc++) {
     tx_scenario* s = load(60, 5000, "sim", params[pc]);
     const char* dir = run_recorded(s, 5.0);
     double reported = result(s, "haptics.passivity_energy_j"), e, path, fmax_sent;
@@ -254,6 +256,49 @@ static void the_observer_sums_the_force_sent(void** state) {
     assert_true(fabs(reported - e) <= 1e-9 * fmax(1, fabs(e)));
     assert_true(fmax_sent <= 3.3);
     if (pc) assert_true(dissipated > 0 && dissipated < 1); // what the damping sent absorbed, not what it asked
+  }
+}
+
+// the spring reference is the port energy less what the published model's
+// spring holds at the device (for the wall, k d^2 / 2 at the last depth d),
+// plus what the device's damping b absorbed, b sum |v|^2 dt; both read back
+// from the recording. The port reference is the port energy.
+static double last_depth(const char* dir, double b, double* absorbed) {
+  char name[128], line[2048], last[2048] = "";
+  snprintf(name, sizeof name, "%s/device0.csv", dir);
+  FILE* f = fopen(name, "r");
+  assert_non_null(f);
+  assert_non_null(fgets(line, sizeof line, f)); // t_s,p (3),f (3),v (3),...
+  *absorbed = 0;
+  while (fgets(line, sizeof line, f)) {
+    double c[10];
+    assert_int_equal(sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &c[0], &c[1], &c[2], &c[3], &c[4], &c[5],
+                            &c[6], &c[7], &c[8], &c[9]), 10);
+    *absorbed += b * (c[7] * c[7] + c[8] * c[8] + c[9] * c[9]) * 1e-3;
+    memcpy(last, line, sizeof last);
+  }
+  fclose(f);
+  double t, x, y;
+  assert_int_equal(sscanf(last, "%lf,%lf,%lf", &t, &x, &y), 3);
+  return -y; // the wall fills y < 0
+}
+
+static void the_spring_reference_takes_off_the_models_store(void** state) {
+  (void)state;
+  const char* params[] = {"\"passivity_reference\":\"port\"", "\"passivity_reference\":\"spring\"", ""};
+  for (int i = 0; i < 3; i++) {
+    tx_scenario* s = load(60, 300, "sim", params[i]);
+    const char* dir = run_recorded(s, 3.0);
+    double port = result(s, "haptics.passivity_energy_j"), ref = result(s, "haptics.passivity_reference_energy_j");
+    tx_scenario_free(s);
+    double absorbed, d = last_depth(dir, 0.3, &absorbed), e, path, fmax_sent; // the sim device's b
+    energy_from_recording(dir, &e, &path, &fmax_sent); // removes dir
+    print_message("  %s: port %.6f J, reference %.6f J, depth %.4f mm, b absorbed %.6f J\n",
+                  *params[i] ? params[i] : "default", port, ref, d * 1e3, absorbed);
+    assert_true(d > 1e-3 && port > 0.9 * 0.5 * 300 * d * d); // pressed in: the port holds about the store
+    assert_true(absorbed > 0);
+    double want = i == 0 ? port : port - 0.5 * 300 * d * d + absorbed; // the default is spring
+    assert_true(fabs(ref - want) <= 1e-9 * fmax(1e-3, fabs(want)));
   }
 }
 
@@ -370,6 +415,7 @@ int main(void) {
       cmocka_unit_test(forces_above_the_device_are_clamped),
       cmocka_unit_test(a_stale_model_fades_out),
       cmocka_unit_test(the_observer_sums_the_force_sent),
+      cmocka_unit_test(the_spring_reference_takes_off_the_models_store),
       cmocka_unit_test(a_huge_force_gives_a_bounded_energy),
       cmocka_unit_test(a_model_that_stops_is_still_caught),
       cmocka_unit_test(a_force_model_in_other_units_is_refused),
