@@ -48,6 +48,7 @@ typedef struct tx_ctx tx_ctx;     // run-time view of one instance
 typedef struct tx_port { uint16_t id; } tx_port;       // a declared read or write; 0 is invalid
 typedef struct tx_warning { uint16_t id; } tx_warning; // a counted warning; 0 is invalid
 typedef struct tx_result { uint16_t id; } tx_result;   // a number the run reports; 0 is invalid
+typedef struct tx_event tx_event; // tactus/events.h, which a controller that sends or takes events includes
 
 typedef struct tx_controller_class {
   const char* type;    // registry name, e.g. "rates.synthetic"
@@ -57,6 +58,10 @@ typedef struct tx_controller_class {
   void (*step)(tx_ctx* c, void* self);
   void (*fini)(void* self);                   // optional
   void (*finish)(tx_ctx* c, void* self);      // optional
+  // runs on a thread of its own at the top priority, whatever the rates of the
+  // others (a device loop: no other step may delay it). Classes whose type
+  // starts with "haptics" always do.
+  bool own_thread;
 } tx_controller_class;
 
 // registry; returns 0, or -1 for a bad class or a taken type name
@@ -80,6 +85,14 @@ tx_port tx_setup_read_as(tx_setup* s, const char* component, tx_type type, uint3
 tx_port tx_setup_read_expect(tx_setup* s, const char* component, tx_type type, uint32_t cols, const char* units);
 tx_warning tx_setup_warning(tx_setup* s, const char* key); // reported as "INSTANCE.key"
 tx_result tx_setup_result(tx_setup* s, const char* key);   // reported as "INSTANCE.key"; put the units in the key
+
+// configure: event streams (tactus/events.h), for what must not be lost
+// between rates. A stream has one writer, which declares it with its capacity
+// (a power of two in [2, TX_STREAM_CAPACITY_MAX]); any number of instances
+// (at most TX_STREAM_READERS_MAX) listen, each seeing every event once and in
+// order. The loader rejects two writers, or a listen that no one emits.
+tx_port tx_setup_emit(tx_setup* s, const char* stream, uint32_t capacity);
+tx_port tx_setup_listen(tx_setup* s, const char* stream);
 
 // configure: parameters. Range checks are inclusive.
 double tx_param_num(tx_setup* s, const char* key, double def, double min, double max);
@@ -111,6 +124,12 @@ void tx_set_result(tx_ctx* c, tx_result r, double value); // the last value set 
 // disk, a lost file); every thread stops at its next tick, finish still runs,
 // and the report names the first reason given. Lock-free; callable from any thread.
 void tx_stop_run(tx_ctx* c, const char* reason);
+// send an event (its seq and sim_ns are set here); returns its seq, or 0 when
+// the slowest listener is a whole ring behind: then it is dropped and counted
+// in the report. Lock-free, no allocation: safe at 1 kHz.
+uint64_t tx_emit(tx_ctx* c, tx_port p, const tx_event* e);
+// take the next event of a listened stream; false when there is none
+bool tx_next_event(tx_ctx* c, tx_port p, tx_event* out);
 
 #ifdef __cplusplus
 }
