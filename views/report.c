@@ -18,16 +18,18 @@ json_t* tx_report_json(const tx_report* r) {
   json_t* controllers = json_array();
   for (int i = 0; i < tx_system_count(s); i++) {
     tx_controller_stats st = tx_system_stats(s, i);
-    char thread[48]; // "t2", or "t2 (tissue)" for a thread the scenario names
+    char thread[16];
     int t = tx_system_thread(s, i);
-    const char* tn = tx_system_thread_name(s, t);
-    snprintf(thread, sizeof thread, tn ? "t%d (%s)" : "t%d", t, tn);
+    snprintf(thread, sizeof thread, "t%d", t);
     json_array_append_new(controllers,
                           json_pack("{s:s,s:s,s:s,s:f,s:f,s:I,s:I,s:o,s:o}", "name", tx_system_name(s, i), "type",
                                     tx_system_class(s, i)->type, "thread", thread, "target_hz", tx_system_rate(s, i),
                                     "achieved_hz", st.achieved_hz, "steps", (json_int_t)st.steps, "missed",
                                     (json_int_t)st.missed, "jitter_us", percentiles_us(st.jitter_ns), "step_us",
                                     percentiles_us(st.step_ns)));
+    json_t* c = json_array_get(controllers, json_array_size(controllers) - 1);
+    if (tx_system_thread_name(s, t)) json_object_set_new(c, "thread_name", json_string(tx_system_thread_name(s, t)));
+    if (tx_system_thread_own(s, t)) json_object_set_new(c, "own_thread", json_true());
   }
   json_t* warnings = json_object();
   for (int w = 0; w < tx_system_warnings(s); w++)
