@@ -52,6 +52,11 @@ static void haptic_stalls_are_warnings(void** state) {
   json_t* warnings = json_object_get(report, "warnings");
   assert_int_equal(json_integer_value(json_object_get(warnings, "hand.missed_deadlines")), (json_int_t)missed);
   assert_null(json_object_get(warnings, "physics.missed_deadlines"));
+  // the haptics instance ran on a thread of its own, and the report says so
+  json_t* controllers = json_object_get(report, "controllers");
+  assert_true(json_is_true(json_object_get(json_array_get(controllers, 0), "own_thread")));
+  assert_null(json_object_get(json_array_get(controllers, 1), "own_thread"));
+  assert_string_equal(json_string_value(json_object_get(json_array_get(controllers, 0), "thread")), "t0");
 
   char* text = NULL;
   size_t len = 0;
