@@ -323,6 +323,9 @@ static void haptics_never_shares_a_thread(void** state) {
   assert_int_equal(tx_system_thread(s, 2), 4);
   assert_false(tx_system_thread_own(s, 3));
   assert_null(tx_system_thread_name(s, 3));
+  // priority below haptics ranks by rate: 1 kHz, then 60 Hz
+  assert_int_equal(s->threads[3].rank, 0);
+  assert_int_equal(s->threads[4].rank, 1);
   tx_system_destroy(s);
 }
 
@@ -364,6 +367,10 @@ static void named_threads(void** state) {
   assert_int_not_equal(tx_system_thread(s, 0), tx_system_thread(s, 2));
   assert_string_equal(tx_system_thread_name(s, tx_system_thread(s, 0)), "tissue");
   assert_null(tx_system_thread_name(s, tx_system_thread(s, 2)));
+  // threads of one rate share a priority; the 20 Hz one is next below
+  assert_int_equal(s->threads[tx_system_thread(s, 0)].rank, 0);
+  assert_int_equal(s->threads[tx_system_thread(s, 2)].rank, 0);
+  assert_int_equal(s->threads[tx_system_thread(s, 3)].rank, 1);
   tx_system_destroy(s);
 }
 
