@@ -48,7 +48,7 @@ typedef struct tx_ctx tx_ctx;     // run-time view of one instance
 typedef struct tx_port { uint16_t id; } tx_port;       // a declared read or write; 0 is invalid
 typedef struct tx_warning { uint16_t id; } tx_warning; // a counted warning; 0 is invalid
 typedef struct tx_result { uint16_t id; } tx_result;   // a number the run reports; 0 is invalid
-typedef struct tx_event tx_event; // tactus/events.h, which a controller that sends or takes events includes
+struct tx_event; // tactus/events.h, which a controller that sends or takes events includes
 
 typedef struct tx_controller_class {
   const char* type;    // registry name, e.g. "rates.synthetic"
@@ -127,9 +127,9 @@ void tx_stop_run(tx_ctx* c, const char* reason);
 // send an event (its seq and sim_ns are set here); returns its seq, or 0 when
 // the slowest listener is a whole ring behind: then it is dropped and counted
 // in the report. Lock-free, no allocation: safe at 1 kHz.
-uint64_t tx_emit(tx_ctx* c, tx_port p, const tx_event* e);
+uint64_t tx_emit(tx_ctx* c, tx_port p, const struct tx_event* e);
 // take the next event of a listened stream; false when there is none
-bool tx_next_event(tx_ctx* c, tx_port p, tx_event* out);
+bool tx_next_event(tx_ctx* c, tx_port p, struct tx_event* out);
 
 #ifdef __cplusplus
 }
