@@ -8,7 +8,7 @@
 static port* port_of(tx_ctx* c, tx_port p, bool write) {
   if (p.id < 1 || p.id > c->in->nports) return NULL;
   port* pt = &c->in->ports[p.id - 1];
-  return pt->write == write ? pt : NULL;
+  return pt->write == write && pt->kind == PORT_COMPONENT ? pt : NULL;
 }
 
 // a write to a port the instance never declared: a bug in the controller.
@@ -99,6 +99,43 @@ static void trace_publish(tx_system* s, const instance* in, const port* pt) {
     stop_run(s, snap.sim_ns, s->trace_name ? s->trace_name : "trace", strerror(errno ? errno : EIO));
     s->trace = NULL;
   }
+}
+
+// an event port of this kind, or NULL: a misuse is counted and stops the run, as for tx_write
+static port* event_port(tx_ctx* c, tx_port p, port_kind kind, const char* call) {
+  if (p.id >= 1 && p.id <= c->in->nports && c->in->ports[p.id - 1].kind == kind) return &c->in->ports[p.id - 1];
+  tx_warn(c, c->in->bad_port);
+  char why[TX_NAME_MAX + 160];
+  snprintf(why, sizeof why, "%s on port %u, which it did not declare with %s", call, p.id,
+           kind == PORT_EMIT ? "tx_setup_emit" : "tx_setup_listen");
+  tx_stop_run(c, why);
+  return NULL;
+}
+
+uint64_t tx_emit(tx_ctx* c, tx_port p, const tx_event* e) {
+  port* pt = event_port(c, p, PORT_EMIT, "tx_emit");
+  if (!pt || !e) return 0;
+  tx_system* s = c->sys;
+  tx_event ev = *e;
+  ev.sim_ns = c->sim_ns;
+  uint64_t seq = tx_stream_push(s->streams[pt->stream].stream, &ev);
+  if (s->tracing) { // lockstep: every event sent is part of the run's hash, a dropped one as seq 0
+    ev.seq = seq;
+    uint64_t h = tx_hash(TX_HASH_SEED, &ev, sizeof ev);
+    uint64_t stamp[3] = {(uint64_t)ev.sim_ns, seq, h};
+    s->trace_hash = tx_hash(s->trace_hash, stamp, sizeof stamp);
+    if (s->trace && fprintf(s->trace, "%" PRId64 ",%s,%s,%" PRIu64 ",event,%016" PRIx64 "\n", ev.sim_ns, c->in->name,
+                            pt->name, seq, h) < 0) {
+      stop_run(s, ev.sim_ns, s->trace_name ? s->trace_name : "trace", strerror(errno ? errno : EIO));
+      s->trace = NULL;
+    }
+  }
+  return seq;
+}
+
+bool tx_next_event(tx_ctx* c, tx_port p, tx_event* out) {
+  port* pt = event_port(c, p, PORT_LISTEN, "tx_next_event");
+  return pt && out && tx_stream_next(c->sys->streams[pt->stream].stream, pt->listener, out);
 }
 
 // the swap-buffer step: publish every component the instance wrote

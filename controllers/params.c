@@ -311,6 +311,24 @@ tx_port tx_setup_read_expect(tx_setup* s, const char* component, tx_type type, u
   return (tx_port){(uint16_t)s->in->nports};
 }
 
+tx_port tx_setup_emit(tx_setup* s, const char* stream, uint32_t capacity) {
+  if (capacity < 2 || capacity > TX_STREAM_CAPACITY_MAX || (capacity & (capacity - 1)))
+    return tx_setup_fail(s, NULL, "event stream '%s': capacity %u is not a power of two in [2, %u]", stream ? stream : "",
+                         capacity, TX_STREAM_CAPACITY_MAX), (tx_port){0};
+  port* p = new_port(s, stream, false);
+  if (!p) return (tx_port){0};
+  p->kind = PORT_EMIT;
+  p->capacity = capacity;
+  return (tx_port){(uint16_t)s->in->nports};
+}
+
+tx_port tx_setup_listen(tx_setup* s, const char* stream) {
+  port* p = new_port(s, stream, false);
+  if (!p) return (tx_port){0};
+  p->kind = PORT_LISTEN;
+  return (tx_port){(uint16_t)s->in->nports};
+}
+
 // "INSTANCE.key" in a run-wide table of keys (warnings or results): its id,
 // the same for the same key, or 0 after a configure error
 static uint16_t intern_key(tx_setup* s, char (*keys)[TX_WARNING_KEY_MAX], int* count, const char* key,

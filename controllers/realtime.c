@@ -1,11 +1,13 @@
-// Real-time executor: one thread per rate group, absolute deadlines.
+// Real-time executor: one thread per rate group, absolute deadlines. Each
+// haptics instance has a thread of its own at the top priority, and a
+// scenario may name a thread for instances of one rate (system.c builds them).
 //
 // Tick k of a group starts at t0 + k/rate (clock_nanosleep, TIMER_ABSTIME), so
 // errors never accumulate. A step that ends after the next tick's start is a
 // missed deadline; that next tick then runs at once, late, unless its whole
 // period is already over: such ticks are skipped, each counted as missed. Threads ask for
-// SCHED_FIFO by rate (faster = higher priority) and a CPU each, round-robin,
-// fastest on the last CPU; where either is refused they run without it and
+// SCHED_FIFO, haptics highest, the others by rate (faster = higher priority),
+// and a CPU each, round-robin, haptics then the fastest on the last CPU; where either is refused they run without it and
 // the result says so.
 #include "system_internal.h"
 
@@ -63,9 +65,10 @@ static void apply_scheduling(worker* w) {
 static void* worker_main(void* arg) {
   worker* w = arg;
   tx_system* s = w->sys;
-  group* g = &s->groups[w->group];
+  group* g = &s->threads[w->group];
   char tname[16];
-  snprintf(tname, sizeof tname, "tx-%.0fHz", g->rate_hz);
+  if (g->name) snprintf(tname, sizeof tname, "tx-%s", g->name);
+  else snprintf(tname, sizeof tname, "tx-%s%.0fHz", g->own ? "hap-" : "", g->rate_hz);
   pthread_setname_np(pthread_self(), tname);
   apply_scheduling(w);
   for (int m = 0; m < g->count && w->init_rc == 0; m++)
@@ -173,7 +176,7 @@ static void describe_scheduling(const worker* w, int n, tx_run_result* r) {
   char fifo[96], pin[96];
   if (!fifo_asked) snprintf(fifo, sizeof fifo, "SCHED_OTHER (SCHED_FIFO not asked for)");
   else if (fifo_err) snprintf(fifo, sizeof fifo, "SCHED_OTHER (SCHED_FIFO refused: %s)", strerror(fifo_err));
-  else snprintf(fifo, sizeof fifo, "SCHED_FIFO, priority by rate");
+  else snprintf(fifo, sizeof fifo, "SCHED_FIFO, haptics highest, then by rate");
   if (!pin_asked) snprintf(pin, sizeof pin, "not pinned");
   else if (pin_err) snprintf(pin, sizeof pin, "not pinned (refused: %s)", strerror(pin_err));
   else snprintf(pin, sizeof pin, "pinned round-robin");
@@ -183,7 +186,7 @@ static void describe_scheduling(const worker* w, int n, tx_run_result* r) {
 }
 
 int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r, char* err, size_t n) {
-  const int ng = s->ngroups;
+  const int ng = s->nthreads;
   worker* w = calloc(ng, sizeof *w);
   pthread_t* th = calloc(ng, sizeof *th);
   if (!w || !th) {
@@ -209,7 +212,8 @@ int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r, cha
 
   int rc = 0, started = 0;
   for (int g = 0; g < ng; g++) {
-    int prio = prio_max - 10 - 2 * g; // leave the top for the kernel's own threads
+    // leave the top for the kernel's own threads; haptics just below, alone
+    int prio = s->threads[g].own ? prio_max - 10 : prio_max - 12 - 2 * s->threads[g].rank;
     w[g] = (worker){.sys = s, .group = g, .gate = &gt, .stop = &stop,
                     .cpu = ncpu > 0 ? cpus[(ncpu - 1) - (g % ncpu)] : -1,
                     .priority = o->realtime_priority ? (prio < prio_min ? prio_min : prio) : 0};

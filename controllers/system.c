@@ -33,6 +33,10 @@ void tx_system_destroy(tx_system* s) {
   }
   for (int g = 0; g < s->ngroups; g++) free(s->groups[g].members);
   free(s->groups);
+  for (int t = 0; t < s->nthreads; t++) free(s->threads[t].members);
+  free(s->threads);
+  for (int k = 0; k < s->nstreams; k++) tx_stream_destroy(s->streams[k].stream);
+  free(s->streams);
   free(s->inst);
   free(s->declared);
   free(s->declared_names);
@@ -136,6 +140,33 @@ int tx_system_add(tx_system* s, const char* name, const char* type, double rate_
   return 0;
 }
 
+bool tx_class_own_thread(const tx_controller_class* cls) {
+  return cls->own_thread || strncmp(cls->type, "haptics", 7) == 0;
+}
+
+int tx_system_set_thread(tx_system* s, int i, const char* name, tx_fault* f) {
+  instance* in = s->inst[i];
+  if (!name || !*name || strlen(name) >= TX_THREAD_NAME_MAX) goto bad;
+  for (const char* c = name; *c; c++)
+    if (!((*c >= 'a' && *c <= 'z') || (*c >= '0' && *c <= '9') || *c == '_' || *c == '-')) goto bad;
+  for (int j = 0; j < s->count; j++) {
+    const instance* o = s->inst[j];
+    if (j == i || strcmp(o->thread_name, name) != 0) continue;
+    if (o->rate_hz != in->rate_hz)
+      return fault(f, "thread", "'%s' runs %s at %g Hz; %s at %g Hz cannot share it (one thread, one rate)", name,
+                   o->name, o->rate_hz, in->name, in->rate_hz);
+    if (tx_class_own_thread(o->cls) || tx_class_own_thread(in->cls))
+      return fault(f, "thread", "'%s' is the thread of %s (%s), which runs alone: %s cannot share it", name,
+                   tx_class_own_thread(o->cls) ? o->name : in->name,
+                   tx_class_own_thread(o->cls) ? o->cls->type : in->cls->type,
+                   tx_class_own_thread(o->cls) ? in->name : o->name);
+  }
+  snprintf(in->thread_name, sizeof in->thread_name, "%s", name);
+  return 0;
+bad:
+  return fault(f, "thread", "'%s' must be 1-%d characters of a-z 0-9 _ -", name ? name : "", TX_THREAD_NAME_MAX - 1);
+}
+
 static const tx_component_def* writer_def(const tx_system* s, const char* name, int* writer) {
   for (int i = 0; i < s->count; i++)
     for (int p = 0; p < s->inst[i]->nports; p++)
@@ -148,6 +179,58 @@ static const tx_component_def* writer_def(const tx_system* s, const char* name, 
 
 static bool same_schema(const tx_component_def* a, const tx_component_def* b) {
   return a->type == b->type && a->rows == b->rows && a->cols == b->cols && strcmp(a->units, b->units) == 0;
+}
+
+// event streams: one emitter each, and every listen has an emitter
+static int check_streams(tx_system* s, tx_fault* f) {
+  for (int i = 0; i < s->count; i++) {
+    instance* in = s->inst[i];
+    for (int p = 0; p < in->nports; p++) {
+      port* pt = &in->ports[p];
+      if (pt->kind == PORT_COMPONENT) continue;
+      int k = 0;
+      while (k < s->nstreams && strcmp(s->streams[k].name, pt->name) != 0) k++;
+      if (k == s->nstreams) {
+        sys_stream* grown = realloc(s->streams, (s->nstreams + 1) * sizeof *grown);
+        if (!grown) return fault(f, "", "out of memory");
+        s->streams = grown;
+        s->streams[s->nstreams++] = (sys_stream){.writer = -1};
+        strcpy(s->streams[k].name, pt->name);
+      }
+      sys_stream* st = &s->streams[k];
+      pt->stream = k;
+      if (pt->kind == PORT_EMIT) {
+        if (st->writer >= 0)
+          return fault(f, in->name, "event stream '%s' has two writers: %s and %s", pt->name, s->inst[st->writer]->name,
+                       in->name);
+        st->writer = i;
+        st->capacity = pt->capacity;
+      } else {
+        if (st->nreaders == TX_STREAM_READERS_MAX)
+          return fault(f, in->name, "event stream '%s' has more than %d listeners", pt->name, TX_STREAM_READERS_MAX);
+        pt->listener = st->nreaders;
+        st->readers[st->nreaders++] = i;
+      }
+    }
+  }
+  for (int k = 0; k < s->nstreams; k++)
+    if (s->streams[k].writer < 0)
+      return fault(f, s->inst[s->streams[k].readers[0]]->name, "listens to event stream '%s', which no controller emits",
+                   s->streams[k].name);
+  return 0;
+}
+
+// (re)make every stream with its readers: at finalize, and before a run after one that sent events
+static int make_streams(tx_system* s) {
+  for (int k = 0; k < s->nstreams; k++) {
+    sys_stream* st = &s->streams[k];
+    tx_stream_destroy(st->stream);
+    st->stream = tx_stream_create(st->name, st->capacity);
+    if (!st->stream) return -1;
+    for (int r = 0; r < st->nreaders; r++)
+      if (tx_stream_add_reader(st->stream) != r) return -1;
+  }
+  return 0;
 }
 
 static int cmp_rate_desc(const void* a, const void* b) {
@@ -172,6 +255,52 @@ static int build_groups(tx_system* s) {
         s->groups[g].members[s->groups[g].count++] = i;
         s->inst[i]->group = g;
       }
+  }
+  return 0;
+}
+
+// the key of an instance's real-time thread: its own, its scenario name, or its rate
+static bool same_thread(const instance* a, const instance* b) {
+  if (tx_class_own_thread(a->cls) || tx_class_own_thread(b->cls)) return a == b;
+  if (*a->thread_name || *b->thread_name) return strcmp(a->thread_name, b->thread_name) == 0;
+  return a->rate_hz == b->rate_hz;
+}
+
+static int cmp_thread(const void* a, const void* b) {
+  const group *x = a, *y = b;
+  if (x->own != y->own) return y->own - x->own; // own threads first
+  if (x->rate_hz != y->rate_hz) return (x->rate_hz < y->rate_hz) - (x->rate_hz > y->rate_hz);
+  return x->members[0] - y->members[0]; // then scenario order
+}
+
+// real-time threads: one per haptics instance, one per named thread, one per
+// rate for the rest; priority rank by rate among those that are not own
+static int build_threads(tx_system* s) {
+  s->threads = calloc(s->count, sizeof *s->threads);
+  if (!s->threads) return -1;
+  for (int i = 0; i < s->count; i++) {
+    int t = 0;
+    while (t < s->nthreads && !same_thread(s->inst[s->threads[t].members[0]], s->inst[i])) t++;
+    group* th = &s->threads[t];
+    if (t == s->nthreads) {
+      s->nthreads++;
+      th->members = malloc(s->count * sizeof(int));
+      if (!th->members) return -1;
+      th->rate_hz = s->inst[i]->rate_hz;
+      th->own = tx_class_own_thread(s->inst[i]->cls);
+      th->name = *s->inst[i]->thread_name ? s->inst[i]->thread_name : NULL;
+    }
+    th->members[th->count++] = i;
+  }
+  qsort(s->threads, s->nthreads, sizeof *s->threads, cmp_thread);
+  for (int t = 0; t < s->nthreads; t++) {
+    group* th = &s->threads[t];
+    th->rank = 0;
+    for (int u = 0; u < t; u++) // distinct faster rates before it
+      if (!s->threads[u].own && s->threads[u].rate_hz > th->rate_hz &&
+          (u == 0 || s->threads[u - 1].own || s->threads[u - 1].rate_hz != s->threads[u].rate_hz))
+        th->rank++;
+    for (int m = 0; m < th->count; m++) s->inst[th->members[m]]->thread = t;
   }
   return 0;
 }
@@ -204,7 +333,7 @@ int tx_system_finalize(tx_system* s, tx_fault* f) {
     instance* in = s->inst[i];
     for (int p = 0; p < in->nports; p++) {
       const char* name = in->ports[p].name;
-      if (in->ports[p].write || writer_def(s, name, NULL)) continue;
+      if (in->ports[p].kind != PORT_COMPONENT || in->ports[p].write || writer_def(s, name, NULL)) continue;
       if (declared(s, name)) return fault(f, in->name, "reads '%s', which no controller writes", name);
       return fault(f, in->name, "reads unknown component '%s'", name);
     }
@@ -214,7 +343,7 @@ int tx_system_finalize(tx_system* s, tx_fault* f) {
     instance* in = s->inst[i];
     for (int p = 0; p < in->nports; p++) {
       const port* pt = &in->ports[p];
-      if (pt->write) continue;
+      if (pt->write || pt->kind != PORT_COMPONENT) continue;
       int w = -1;
       const tx_component_def* d = writer_def(s, pt->name, &w);
       if ((pt->want_type && d->type != pt->want_type) || (pt->want_cols && d->cols != pt->want_cols))
@@ -226,6 +355,7 @@ int tx_system_finalize(tx_system* s, tx_fault* f) {
                      pt->want_units, s->inst[w]->name, d->units);
     }
   }
+  if (check_streams(s, f)) return -1;
   // declared components need a writer too, or nothing could ever fill them
   for (int d = 0; d < s->ndeclared; d++)
     if (!writer_def(s, s->declared[d].name, NULL))
@@ -251,13 +381,14 @@ int tx_system_finalize(tx_system* s, tx_fault* f) {
   for (int i = 0; i < s->count; i++)
     for (int p = 0; p < s->inst[i]->nports; p++) {
       port* pt = &s->inst[i]->ports[p];
-      if (pt->write) continue;
+      if (pt->write || pt->kind != PORT_COMPONENT) continue;
       pt->comp = tx_model_find(s->model, pt->name);
       pt->reader = tx_model_add_reader(s->model, pt->comp);
       if (!pt->reader.id) return fault(f, s->inst[i]->name, "%s", tx_error());
     }
   if (!tx_model_commit(s->model)) return fault(f, "", "%s", tx_error());
-  if (build_groups(s)) return fault(f, "", "out of memory");
+  if (build_groups(s) || build_threads(s)) return fault(f, "", "out of memory");
+  if (make_streams(s)) return fault(f, "", "%s", tx_error());
   return 0;
 }
 
@@ -297,6 +428,9 @@ bool tx_system_prepare_stats(tx_system* s, double duration_s) {
     in->first_start_ns = in->last_start_ns = 0;
   }
   for (int w = 0; w < s->nwarnings; w++) atomic_store(&s->warning_counts[w], 0);
+  bool used = false; // a stream holds the events of the last run: start empty
+  for (int k = 0; k < s->nstreams; k++) used |= tx_stream_pushed(s->streams[k].stream) > 0;
+  if (used && make_streams(s)) return false;
   for (int k = 0; k < s->nresults; k++) s->result_values[k] = NAN;
   return true;
 }
@@ -325,8 +459,22 @@ int tx_system_count(const tx_system* s) { return s->count; }
 const char* tx_system_name(const tx_system* s, int i) { return s->inst[i]->name; }
 const tx_controller_class* tx_system_class(const tx_system* s, int i) { return s->inst[i]->cls; }
 double tx_system_rate(const tx_system* s, int i) { return s->inst[i]->rate_hz; }
-int tx_system_thread(const tx_system* s, int i) { return s->inst[i]->group; }
-int tx_system_threads(const tx_system* s) { return s->ngroups; }
+int tx_system_thread(const tx_system* s, int i) { return s->inst[i]->thread; }
+int tx_system_threads(const tx_system* s) { return s->nthreads; }
+const char* tx_system_thread_name(const tx_system* s, int t) { return s->threads[t].name; }
+bool tx_system_thread_own(const tx_system* s, int t) { return s->threads[t].own; }
+int tx_system_streams(const tx_system* s) { return s->nstreams; }
+
+tx_stream_info tx_system_stream(const tx_system* s, int k) {
+  const sys_stream* st = &s->streams[k];
+  tx_stream_info info = {st->name, s->inst[st->writer]->name, st->capacity, tx_stream_pushed(st->stream),
+                         tx_stream_overflows(st->stream), st->nreaders, {0}, {0}};
+  for (int r = 0; r < st->nreaders; r++) {
+    info.readers[r] = s->inst[st->readers[r]]->name;
+    info.lost[r] = tx_stream_lost(st->stream, r);
+  }
+  return info;
+}
 int tx_system_ports(const tx_system* s, int i) { return s->inst[i]->nports; }
 tx_model* tx_system_model(tx_system* s) { return s->model; }
 int tx_system_warnings(const tx_system* s) { return s->nwarnings; }
@@ -342,7 +490,7 @@ json_t* tx_system_params(const tx_system* s, int i) { return s->inst[i]->params;
 tx_port_info tx_system_port(const tx_system* s, int i, int p) {
   const port* pt = &s->inst[i]->ports[p];
   const tx_component_def* def = pt->comp.id ? tx_model_def(s->model, pt->comp) : NULL;
-  return (tx_port_info){pt->write, pt->name, def};
+  return (tx_port_info){pt->write, pt->name, def, (int)pt->kind};
 }
 
 tx_controller_stats tx_system_stats(const tx_system* s, int i) {

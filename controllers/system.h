@@ -34,8 +34,22 @@ typedef struct tx_fault {
 typedef struct tx_port_info {
   bool write;
   const char* component;          // name
-  const tx_component_def* def;    // schema, after finalize
+  const tx_component_def* def;    // schema, after finalize; NULL for an event stream
+  int stream;                     // 0: a component; 1: emits the event stream; 2: listens to it
 } tx_port_info;
+
+#define TX_STREAM_INFO_READERS 16 // TX_STREAM_READERS_MAX, without tactus/events.h in every file
+
+typedef struct tx_stream_info {
+  const char* name;
+  const char* writer;       // instance that emits it
+  uint32_t capacity;        // events in its ring
+  uint64_t sent;            // events emitted, dropped ones included
+  uint64_t overflows;       // emits refused because a listener was a whole ring behind
+  int nreaders;
+  const char* readers[TX_STREAM_INFO_READERS]; // instances that listen
+  uint64_t lost[TX_STREAM_INFO_READERS];       // events each listener missed
+} tx_stream_info;
 
 typedef struct tx_controller_stats {
   uint64_t steps;      // steps run
@@ -84,6 +98,12 @@ void tx_system_destroy(tx_system* s); // runs fini for configured instances
 int tx_system_declare(tx_system* s, const tx_component_def* def, tx_fault* f);
 // add and configure one instance; params is borrowed and may be NULL
 int tx_system_add(tx_system* s, const char* name, const char* type, double rate_hz, json_t* params, tx_fault* f);
+// run instance i (the last added) on the scenario's thread NAME: 1-31
+// characters of a-z 0-9 _ -, shared only by instances of the same rate, and
+// never by a haptics instance; f->key is "thread"
+int tx_system_set_thread(tx_system* s, int i, const char* name, tx_fault* f);
+// a class that always runs on a thread of its own (own_thread, or a "haptics" type)
+bool tx_class_own_thread(const tx_controller_class* cls);
 // resolve reads, check writers, build and commit the model; f->key names the instance
 int tx_system_finalize(tx_system* s, tx_fault* f);
 // run; on failure (an init failed) returns -1 with a message in err
@@ -103,8 +123,13 @@ const char* tx_system_name(const tx_system* s, int i);
 const tx_controller_class* tx_system_class(const tx_system* s, int i);
 json_t* tx_system_params(const tx_system* s, int i); // as the scenario gave them (borrowed), may be NULL
 double tx_system_rate(const tx_system* s, int i);
-int tx_system_thread(const tx_system* s, int i); // rate group, 0 = fastest
+// real-time thread of instance i: haptics threads first, then the others fastest first
+int tx_system_thread(const tx_system* s, int i);
 int tx_system_threads(const tx_system* s);
+const char* tx_system_thread_name(const tx_system* s, int t); // the scenario's name, or NULL
+bool tx_system_thread_own(const tx_system* s, int t);         // a haptics thread, at the top priority
+int tx_system_streams(const tx_system* s);                    // event streams
+tx_stream_info tx_system_stream(const tx_system* s, int k);   // after a run: its counts
 int tx_system_ports(const tx_system* s, int i);
 tx_port_info tx_system_port(const tx_system* s, int i, int p);
 tx_controller_stats tx_system_stats(const tx_system* s, int i);

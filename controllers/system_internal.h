@@ -4,12 +4,18 @@
 
 #include "system.h"
 
+#include <tactus/events.h>
+
 #include <stdatomic.h>
+
+_Static_assert(TX_STREAM_INFO_READERS == TX_STREAM_READERS_MAX, "tx_stream_info holds every reader");
 
 #define TX_PORTS_MAX 64
 
+typedef enum port_kind { PORT_COMPONENT, PORT_EMIT, PORT_LISTEN } port_kind;
+
 typedef struct port {
-  bool write;
+  bool write;           // components only: an emit port is not a component write
   char name[TX_NAME_MAX];
   char units[TX_UNITS_MAX];
   tx_component_def def; // writes: the declared schema (name, units point above)
@@ -19,7 +25,23 @@ typedef struct port {
   uint32_t want_cols;   // reads: values per row needed, 0 for any
   char want_units[TX_UNITS_MAX]; // reads: units needed, "" for any
   bool dirty;           // written during the current step
+  port_kind kind;       // a component, or an event stream emitted or listened to
+  uint32_t capacity;    // emits: the ring's events
+  int stream;           // streams: index in tx_system.streams, after finalize
+  int listener;         // listens: this instance's reader of the stream
 } port;
+
+#define TX_THREAD_NAME_MAX 32 // a scenario's "thread": 1-31 characters of a-z 0-9 _ -
+
+// one event stream of the system, made at finalize
+typedef struct sys_stream {
+  char name[TX_NAME_MAX];
+  int writer;           // instance index
+  uint32_t capacity;
+  tx_stream* stream;
+  int nreaders;
+  int readers[TX_STREAM_READERS_MAX]; // instance index of each reader
+} sys_stream;
 
 typedef struct instance instance;
 
@@ -48,7 +70,9 @@ struct instance {
   bool configured;
   port ports[TX_PORTS_MAX];
   int nports;
-  int group;
+  int group;          // rate group (lockstep order)
+  int thread;         // real-time thread
+  char thread_name[TX_THREAD_NAME_MAX]; // from the scenario, "" for none
   tx_setup setup;
   tx_ctx ctx;
   tx_warning bad_port, rows_clamped; // misuse of tx_write / tx_write_rows (context.c)
@@ -61,6 +85,9 @@ typedef struct group {
   double rate_hz;
   int* members; // instance indices, in scenario order
   int count;
+  bool own;     // threads: a haptics thread, at the top priority
+  int rank;     // threads: 0 for the fastest rate among the threads that are not own
+  const char* name; // threads: the scenario's name, or NULL
 } group;
 
 struct tx_system {
@@ -71,8 +98,12 @@ struct tx_system {
   char (*declared_units)[TX_UNITS_MAX];
   int ndeclared;
   tx_model* model;
-  group* groups; // fastest first
+  group* groups; // instances of equal rate, fastest first: lockstep's order
   int ngroups;
+  group* threads; // real-time threads: own threads first, then fastest first
+  int nthreads;
+  sys_stream* streams;
+  int nstreams;
   char result_keys[TX_WARNINGS_MAX][TX_WARNING_KEY_MAX];
   double result_values[TX_WARNINGS_MAX]; // NaN until set
   int nresults;

@@ -233,7 +233,7 @@ static int add_controllers(const char* file, tx_system* sys, json_t* list, const
                            char* err, size_t n) {
   if (!json_is_array(list) || json_array_size(list) == 0)
     return fail(err, n, "%s: controllers: expected a non-empty array", file);
-  static const char* const keys[] = {"name", "type", "rate_hz", "params", NULL};
+  static const char* const keys[] = {"name", "type", "rate_hz", "params", "thread", NULL};
   size_t i;
   json_t* c;
   json_array_foreach(list, i, c) {
@@ -242,12 +242,16 @@ static int add_controllers(const char* file, tx_system* sys, json_t* list, const
     json_t *name = json_object_get(c, "name"), *type = json_object_get(c, "type"), *rate = json_object_get(c, "rate_hz");
     if (!json_is_string(name)) return fail(err, n, "%s: %s.name: expected a string", file, where);
     if (!json_is_string(type)) return fail(err, n, "%s: %s.type: expected a string", file, where);
+    json_t* thread = json_object_get(c, "thread");
+    if (thread && !json_is_string(thread))
+      return fail(err, n, "%s: %s.thread: expected a thread name (a string), got %s", file, where, tx_json_kind(thread));
     tx_fault f = {.key = "rate_hz"};
     if (!json_is_number(rate))
       snprintf(f.message, sizeof f.message, "expected a number in Hz, got %s", rate ? tx_json_kind(rate) : "nothing");
     else if (tx_system_add(sys, json_string_value(name), json_string_value(type), json_number_value(rate),
-                           json_object_get(c, "params"), &f) == 0)
-      continue;
+                           json_object_get(c, "params"), &f) == 0) {
+      if (!thread || tx_system_set_thread(sys, tx_system_count(sys) - 1, json_string_value(thread), &f) == 0) continue;
+    }
     for (int k = norigins - 1; k >= 0; k--) // the last --set of a key is the one in effect
       if (origins[k].controller == (int)i && strcmp(origins[k].key, f.key) == 0)
         return fail(err, n, "%s %s: %s", origins[k].flag, origins[k].text, f.message);

@@ -19,13 +19,17 @@ json_t* tx_report_json(const tx_report* r) {
   for (int i = 0; i < tx_system_count(s); i++) {
     tx_controller_stats st = tx_system_stats(s, i);
     char thread[16];
-    snprintf(thread, sizeof thread, "t%d", tx_system_thread(s, i));
+    int t = tx_system_thread(s, i);
+    snprintf(thread, sizeof thread, "t%d", t);
     json_array_append_new(controllers,
                           json_pack("{s:s,s:s,s:s,s:f,s:f,s:I,s:I,s:o,s:o}", "name", tx_system_name(s, i), "type",
                                     tx_system_class(s, i)->type, "thread", thread, "target_hz", tx_system_rate(s, i),
                                     "achieved_hz", st.achieved_hz, "steps", (json_int_t)st.steps, "missed",
                                     (json_int_t)st.missed, "jitter_us", percentiles_us(st.jitter_ns), "step_us",
                                     percentiles_us(st.step_ns)));
+    json_t* c = json_array_get(controllers, json_array_size(controllers) - 1);
+    if (tx_system_thread_name(s, t)) json_object_set_new(c, "thread_name", json_string(tx_system_thread_name(s, t)));
+    if (tx_system_thread_own(s, t)) json_object_set_new(c, "own_thread", json_true());
   }
   json_t* warnings = json_object();
   for (int w = 0; w < tx_system_warnings(s); w++)
@@ -39,6 +43,23 @@ json_t* tx_report_json(const tx_report* r) {
     snprintf(key, sizeof key, "%s.missed_deadlines", tx_system_name(s, i));
     json_object_set_new(warnings, key, json_integer((json_int_t)st.missed));
   }
+  // event streams: what was sent, and any loss, which is a warning
+  json_t* streams = json_object();
+  for (int k = 0; k < tx_system_streams(s); k++) {
+    tx_stream_info st = tx_system_stream(s, k);
+    json_t* lost = json_object();
+    char key[TX_WARNING_KEY_MAX + 64];
+    for (int rd = 0; rd < st.nreaders; rd++) {
+      json_object_set_new(lost, st.readers[rd], json_integer((json_int_t)st.lost[rd]));
+      snprintf(key, sizeof key, "%s.lost_by.%s", st.name, st.readers[rd]);
+      if (st.lost[rd]) json_object_set_new(warnings, key, json_integer((json_int_t)st.lost[rd]));
+    }
+    snprintf(key, sizeof key, "%s.overflows", st.name);
+    if (st.overflows) json_object_set_new(warnings, key, json_integer((json_int_t)st.overflows));
+    json_object_set_new(streams, st.name,
+                        json_pack("{s:s,s:I,s:I,s:I,s:o}", "writer", st.writer, "capacity", (json_int_t)st.capacity,
+                                  "sent", (json_int_t)st.sent, "overflows", (json_int_t)st.overflows, "lost", lost));
+  }
   if (!r->lockstep && !r->result->fifo) json_object_set_new(warnings, "scheduler.no_sched_fifo", json_integer(1));
   if (!r->lockstep && !r->result->pinned) json_object_set_new(warnings, "scheduler.not_pinned", json_integer(1));
 
@@ -51,6 +72,8 @@ json_t* tx_report_json(const tx_report* r) {
                              r->lockstep ? "lockstep" : "realtime", "duration_s", r->result->duration_s,
                              "controllers", controllers, "warnings", warnings, "results", results, "scheduler",
                              r->result->scheduler);
+  if (tx_system_streams(s)) json_object_set_new(report, "streams", streams);
+  else json_decref(streams);
   if (!r->lockstep) json_object_set_new(report, "host_steal_s", json_real(r->result->steal_s));
   if (r->lockstep) {
     char hash[17];
@@ -63,7 +86,10 @@ json_t* tx_report_json(const tx_report* r) {
 
 // room for a report of this system: a few hundred bytes per controller, key and value
 static long report_bytes(tx_system* s) {
-  return 8192 + 1024L * tx_system_count(s) + 160L * (tx_system_warnings(s) + tx_system_results(s));
+  int readers = 0;
+  for (int k = 0; k < tx_system_streams(s); k++) readers += tx_system_stream(s, k).nreaders;
+  return 8192 + 1024L * tx_system_count(s) + 160L * (tx_system_warnings(s) + tx_system_results(s)) +
+         512L * tx_system_streams(s) + 256L * readers;
 }
 
 int tx_report_reserve(tx_system* s, const char* dir, const char* name, char* err, size_t n) {

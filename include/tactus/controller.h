@@ -45,7 +45,8 @@
 extern "C" {
 #endif
 
-// 2: tx_controller_class gained its parameter table (params, nparams), so a
+// 2: tx_controller_class gained its parameter table (params, nparams) and
+// own_thread, so a
 // plugin built against version 1 would be read past its end: it must refuse
 #define TX_API_VERSION 2
 #define TX_RATE_MAX_HZ 100000.0 // no controller runs faster
@@ -59,6 +60,7 @@ typedef struct tx_ctx tx_ctx;     // run-time view of one instance
 typedef struct tx_port { uint16_t id; } tx_port;       // a declared read or write; 0 is invalid
 typedef struct tx_warning { uint16_t id; } tx_warning; // a counted warning; 0 is invalid
 typedef struct tx_result { uint16_t id; } tx_result;   // a number the run reports; 0 is invalid
+struct tx_event; // tactus/events.h, which a controller that sends or takes events includes
 
 // One parameter of a controller class. Ranges are inclusive. A number whose
 // default configure works out (from the device, say) gives def_str as the text
@@ -96,6 +98,10 @@ typedef struct tx_controller_class {
   // alone, and `tactus describe` says it has no parameter table
   const tx_param_def* params;
   int nparams;
+  // runs on a thread of its own at the top priority, whatever the rates of the
+  // others (a device loop: no other step may delay it). Classes whose type
+  // starts with "haptics" always do.
+  bool own_thread;
 } tx_controller_class;
 
 // registry; returns 0, or -1 for a bad class (a bad parameter table
@@ -120,6 +126,14 @@ tx_port tx_setup_read_as(tx_setup* s, const char* component, tx_type type, uint3
 tx_port tx_setup_read_expect(tx_setup* s, const char* component, tx_type type, uint32_t cols, const char* units);
 tx_warning tx_setup_warning(tx_setup* s, const char* key); // reported as "INSTANCE.key"
 tx_result tx_setup_result(tx_setup* s, const char* key);   // reported as "INSTANCE.key"; put the units in the key
+
+// configure: event streams (tactus/events.h), for what must not be lost
+// between rates. A stream has one writer, which declares it with its capacity
+// (a power of two in [2, TX_STREAM_CAPACITY_MAX]); any number of instances
+// (at most TX_STREAM_READERS_MAX) listen, each seeing every event once and in
+// order. The loader rejects two writers, or a listen that no one emits.
+tx_port tx_setup_emit(tx_setup* s, const char* stream, uint32_t capacity);
+tx_port tx_setup_listen(tx_setup* s, const char* stream);
 
 // configure: parameters through the class's table: the default and range come
 // from there. Asking for a key the table lacks, or as another kind, is a
@@ -165,6 +179,12 @@ void tx_set_result(tx_ctx* c, tx_result r, double value); // the last value set 
 // disk, a lost file); every thread stops at its next tick, finish still runs,
 // and the report names the first reason given. Lock-free; callable from any thread.
 void tx_stop_run(tx_ctx* c, const char* reason);
+// send an event (its seq and sim_ns are set here); returns its seq, or 0 when
+// the slowest listener is a whole ring behind: then it is dropped and counted
+// in the report. Lock-free, no allocation: safe at 1 kHz.
+uint64_t tx_emit(tx_ctx* c, tx_port p, const struct tx_event* e);
+// take the next event of a listened stream; false when there is none
+bool tx_next_event(tx_ctx* c, tx_port p, struct tx_event* out);
 
 #ifdef __cplusplus
 }

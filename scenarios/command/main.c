@@ -177,7 +177,9 @@ int tx_cmd_describe(int argc, char** argv) {
   printf("%s: %s\nfile: %s\ndefault duration: %g s\n\nthreads:\n", sc->name, sc->description, sc->path,
          sc->duration_s);
   for (int t = 0; t < tx_system_threads(s); t++) {
-    printf("  t%d:", t);
+    const char* tn = tx_system_thread_name(s, t);
+    printf("  t%d%s%s%s%s:", t, tn ? " (" : "", tn ? tn : "", tn ? ")" : "",
+           tx_system_thread_own(s, t) ? " (haptics: alone, top priority)" : "");
     for (int i = 0; i < tx_system_count(s); i++)
       if (tx_system_thread(s, i) == t) printf(" %s @ %g Hz", tx_system_name(s, i), tx_system_rate(s, i));
     printf("\n");
@@ -190,8 +192,9 @@ int tx_cmd_describe(int argc, char** argv) {
     for (int p = 0; p < tx_system_ports(s, i); p++) {
       tx_port_info pi = tx_system_port(s, i, p);
       if (p) printf("%-14s %-18s %10s %-6s", "", "", "", "");
-      printf(" %-6s %s (%s %ux%u, %s)\n", pi.write ? "writes" : "reads", pi.component, tx_type_name(pi.def->type),
-             pi.def->rows, pi.def->cols, pi.def->units);
+      if (pi.stream) printf(" %-6s %s (event stream)\n", pi.stream == 1 ? "emits" : "listens", pi.component);
+      else printf(" %-6s %s (%s %ux%u, %s)\n", pi.write ? "writes" : "reads", pi.component, tx_type_name(pi.def->type),
+                  pi.def->rows, pi.def->cols, pi.def->units);
     }
   }
   printf("\n");

@@ -377,6 +377,104 @@ static void no_finish_after_a_failed_init(void** state) {
   }
 }
 
+static tx_system* events_chain(int per_step) {
+  tx_system* s = tx_system_create();
+  tx_fault f;
+  char text[96];
+  snprintf(text, sizeof text, "{\"emit\":\"tool0.events\",\"per_step\":%d}", per_step);
+  json_t* w = json_loads(text, 0, NULL);
+  json_t* r = json_loads("{\"listen\":\"tool0.events\"}", 0, NULL);
+  json_t* c = json_loads("{\"write\":\"x\"}", 0, NULL);
+  assert_int_equal(tx_system_add(s, "writer", "test.events", 1000, w, &f), 0);
+  assert_int_equal(tx_system_add(s, "reader", "test.events", 20, r, &f), 0);
+  assert_int_equal(tx_system_add(s, "count", "test.counter", 100, c, &f), 0);
+  json_decref(w), json_decref(r), json_decref(c);
+  assert_int_equal(tx_system_finalize(s, &f), 0);
+  return s;
+}
+
+// the hash covers events: the same events give the same hash, other events another
+static void lockstep_hash_covers_events(void** state) {
+  (void)state;
+  FILE* t = tmpfile();
+  tx_system *a = events_chain(1), *b = events_chain(1), *c = events_chain(2), *none = events_chain(0);
+  uint64_t ha = lockstep(a, 0.5, t), hb = lockstep(b, 0.5, NULL), hc = lockstep(c, 0.5, NULL), h0 = lockstep(none, 0.5, NULL);
+  print_message("  hashes %016llx %016llx %016llx\n", (unsigned long long)ha, (unsigned long long)hc,
+                (unsigned long long)h0);
+  assert_true(ha == hb);
+  assert_true(ha != hc);
+  assert_true(ha != h0);
+  assert_true(hc != h0);
+  long n;
+  char* text = slurp(t, &n);
+  // each event is a trace line: "sim_ns,instance,stream,seq,event,hash"
+  assert_non_null(strstr(text, "\n0,writer,tool0.events,1,event,"));
+  assert_non_null(strstr(text, "\n499000000,writer,tool0.events,500,event,"));
+  free(text);
+  fclose(t);
+  tx_system_destroy(a), tx_system_destroy(b), tx_system_destroy(c), tx_system_destroy(none);
+}
+
+// in real time too, a 20 Hz listener takes every event of a 1 kHz writer once and in order
+static void realtime_events_arrive_whole(void** state) {
+  (void)state;
+  tx_system* s = events_chain(1);
+  tx_run_options o = {.duration_s = 0.5};
+  tx_run_result r;
+  char err[256];
+  assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+  tx_stream_info st = tx_system_stream(s, 0);
+  eventer *w = s->inst[0]->self, *rd = s->inst[1]->self;
+  print_message("  sent %llu, received %llu\n", (unsigned long long)st.sent, (unsigned long long)rd->received);
+  assert_int_equal(st.sent, w->sent);
+  assert_true(st.sent > 0);
+  assert_int_equal(st.overflows, 0);
+  assert_int_equal(st.lost[0], 0);
+  assert_int_equal(rd->gaps, 0);
+  assert_int_equal(rd->out_of_order, 0);
+  assert_int_equal(rd->received, rd->last_seq);
+  assert_true(rd->received + 100 >= st.sent); // at most the 50 ms after its last step unread, with slack
+  tx_system_destroy(s);
+}
+
+// sleeps sleep_ms every step: a physics step that never fits its period
+static void hog_step(tx_ctx* c, void* self) {
+  (void)c;
+  int64_t ns = (int64_t)(((sleeper*)self)->sleep_ms * 1e6);
+  struct timespec ts = {ns / 1000000000, ns % 1000000000};
+  nanosleep(&ts, NULL);
+}
+
+// a haptics instance beside an overrunning one of the same rate: separate
+// threads, so haptics keeps its rate while the other's overruns are counted
+static void haptics_keeps_its_rate_beside_an_overrun(void** state) {
+  (void)state;
+  static tx_controller_class hog = {.type = "test.hog", .summary = "overruns every step", .configure = sleeper_configure,
+                                    .step = hog_step, .fini = counter_fini};
+  if (!tx_find_controller(hog.type)) assert_int_equal(tx_register_controller(&hog), 0);
+  tx_system* s = tx_system_create();
+  tx_fault f;
+  json_t* p = json_pack("{s:f}", "sleep_ms", 3.0);
+  json_t* hp = json_loads("{\"write\":\"force\"}", 0, NULL);
+  assert_int_equal(tx_system_add(s, "tissue", "test.hog", 1000, p, &f), 0);
+  assert_int_equal(tx_system_add(s, "haptics", "haptics.test", 1000, hp, &f), 0);
+  json_decref(p), json_decref(hp);
+  assert_int_equal(tx_system_finalize(s, &f), 0);
+  assert_int_not_equal(tx_system_thread(s, 0), tx_system_thread(s, 1));
+  tx_run_options o = {.duration_s = 1.0, .realtime_priority = true};
+  tx_run_result r;
+  char err[256];
+  assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+  tx_controller_stats tissue = tx_system_stats(s, 0), hap = tx_system_stats(s, 1);
+  print_message("  %s\n  tissue %llu steps %llu missed; haptics %llu steps %llu missed\n", r.scheduler,
+                (unsigned long long)tissue.steps, (unsigned long long)tissue.missed, (unsigned long long)hap.steps,
+                (unsigned long long)hap.missed);
+  assert_true(tissue.missed > 500); // 3 ms steps in 1 ms periods: most ticks missed, and said so
+  assert_true(hap.steps >= 950);    // one thread, it would have been about 250
+  assert_true(hap.missed < 50);
+  tx_system_destroy(s);
+}
+
 int main(void) {
   register_test_classes();
   const struct CMUnitTest tests[] = {
@@ -393,6 +491,9 @@ int main(void) {
       cmocka_unit_test(lockstep_hears_a_stop_on_wall_time),
       cmocka_unit_test(a_trace_write_error_stops_the_run),
       cmocka_unit_test(no_finish_after_a_failed_init),
+      cmocka_unit_test(lockstep_hash_covers_events),
+      cmocka_unit_test(realtime_events_arrive_whole),
+      cmocka_unit_test(haptics_keeps_its_rate_beside_an_overrun),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

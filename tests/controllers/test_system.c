@@ -5,6 +5,7 @@
 #include <cmocka.h>
 
 #include "controllers/system.h"
+#include "controllers/system_internal.h"
 #include "test_support.h"
 
 #include <math.h>
@@ -289,6 +290,238 @@ static void misused_writes_stop_the_run(void** state) {
   }
 }
 
+static tx_fault add_as(tx_system* s, const char* name, const char* type, double rate, const char* p, int* rc) {
+  tx_fault f = {0};
+  json_t* js = p ? params(p) : NULL;
+  *rc = tx_system_add(s, name, type, rate, js, &f);
+  json_decref(js);
+  return f;
+}
+
+// haptics instances run alone and first, whatever their rate; the rest share by rate
+static void haptics_never_shares_a_thread(void** state) {
+  (void)state;
+  tx_system* s = tx_system_create();
+  int rc;
+  add(s, "tissue", 1000, NULL, &rc);                       // 0
+  add_as(s, "hap", "haptics.test", 1000, NULL, &rc);       // 1
+  add(s, "physics", 60, NULL, &rc);                        // 2
+  add_as(s, "hap2", "test.alone", 1000, NULL, &rc);        // 3: by the class flag
+  add(s, "collision", 1000, NULL, &rc);                    // 4
+  add_as(s, "slowhap", "haptics.test", 10, NULL, &rc);     // 5: even at 10 Hz
+  assert_int_equal(rc, 0);
+  tx_fault f;
+  assert_int_equal(tx_system_finalize(s, &f), 0);
+  assert_int_equal(tx_system_threads(s), 5);
+  // own threads first, in rate then scenario order
+  assert_int_equal(tx_system_thread(s, 1), 0);
+  assert_int_equal(tx_system_thread(s, 3), 1);
+  assert_int_equal(tx_system_thread(s, 5), 2);
+  for (int t = 0; t < 3; t++) assert_true(tx_system_thread_own(s, t));
+  assert_int_equal(tx_system_thread(s, 0), 3); // tissue and collision: one 1 kHz thread
+  assert_int_equal(tx_system_thread(s, 4), 3);
+  assert_int_equal(tx_system_thread(s, 2), 4);
+  assert_false(tx_system_thread_own(s, 3));
+  assert_null(tx_system_thread_name(s, 3));
+  // priority below haptics ranks by rate: 1 kHz, then 60 Hz
+  assert_int_equal(s->threads[3].rank, 0);
+  assert_int_equal(s->threads[4].rank, 1);
+  tx_system_destroy(s);
+}
+
+static int set_thread(tx_system* s, const char* name, tx_fault* f) {
+  return tx_system_set_thread(s, tx_system_count(s) - 1, name, f);
+}
+
+// a scenario's thread: shared by its instances of one rate, never by two rates or a haptics instance
+static void named_threads(void** state) {
+  (void)state;
+  tx_system* s = tx_system_create();
+  int rc;
+  tx_fault f;
+  add(s, "tissue", 1000, NULL, &rc);
+  assert_int_equal(set_thread(s, "tissue", &f), 0);
+  add(s, "tissue2", 1000, NULL, &rc);
+  assert_int_equal(set_thread(s, "tissue", &f), 0);
+  add(s, "other", 1000, NULL, &rc); // no name: its own rate thread
+  add(s, "slow", 20, NULL, &rc);
+  assert_int_equal(set_thread(s, "tissue", &f), -1); // another rate
+  assert_string_equal(f.key, "thread");
+  assert_non_null(strstr(f.message, "'tissue' runs tissue at 1000 Hz; slow at 20 Hz cannot share it"));
+  add_as(s, "hap", "haptics.test", 1000, NULL, &rc);
+  assert_int_equal(set_thread(s, "tissue", &f), -1);
+  assert_non_null(strstr(f.message, "runs alone"));
+  assert_int_equal(set_thread(s, "device", &f), 0); // a name alone is fine
+  static const char* const bad[] = {"", "Tissue", "a b", "a.b", "a/b", "0123456789012345678901234567890x"};
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    f = (tx_fault){0};
+    assert_int_equal(set_thread(s, bad[i], &f), -1);
+    assert_string_equal(f.key, "thread");
+    assert_non_null(strstr(f.message, "1-31 characters of a-z 0-9 _ -"));
+  }
+  assert_int_equal(set_thread(s, "abcdefghijklmnopqrstuvwxyz01234", &f), 0); // 31 characters
+  assert_int_equal(tx_system_finalize(s, &f), 0);
+  assert_int_equal(tx_system_threads(s), 4); // hap; tissue+tissue2; other; slow
+  assert_int_equal(tx_system_thread(s, 4), 0);
+  assert_int_equal(tx_system_thread(s, 0), tx_system_thread(s, 1));
+  assert_int_not_equal(tx_system_thread(s, 0), tx_system_thread(s, 2));
+  assert_string_equal(tx_system_thread_name(s, tx_system_thread(s, 0)), "tissue");
+  assert_null(tx_system_thread_name(s, tx_system_thread(s, 2)));
+  // threads of one rate share a priority; the 20 Hz one is next below
+  assert_int_equal(s->threads[tx_system_thread(s, 0)].rank, 0);
+  assert_int_equal(s->threads[tx_system_thread(s, 2)].rank, 0);
+  assert_int_equal(s->threads[tx_system_thread(s, 3)].rank, 1);
+  tx_system_destroy(s);
+}
+
+static tx_system* events_system(const char* writer, const char* reader, const char* reader2) {
+  tx_system* s = tx_system_create();
+  int rc;
+  tx_fault f = add_as(s, "writer", "test.events", 1000, writer, &rc);
+  assert_int_equal(rc, 0);
+  if (reader) add_as(s, "reader", "test.events", 20, reader, &rc), assert_int_equal(rc, 0);
+  if (reader2) add_as(s, "reader2", "test.events", 60, reader2, &rc), assert_int_equal(rc, 0);
+  (void)f;
+  return s;
+}
+
+static void event_streams_are_checked(void** state) {
+  (void)state;
+  tx_fault f;
+  int rc;
+  // two writers
+  tx_system* s = events_system("{\"emit\":\"tool0.events\"}", "{\"emit\":\"tool0.events\"}", NULL);
+  assert_int_equal(tx_system_finalize(s, &f), -1);
+  assert_string_equal(f.key, "reader");
+  assert_string_equal(f.message, "event stream 'tool0.events' has two writers: writer and reader");
+  tx_system_destroy(s);
+  // a listen that nobody emits
+  s = events_system("{\"emit\":\"tool0.events\"}", "{\"listen\":\"tool1.events\"}", NULL);
+  assert_int_equal(tx_system_finalize(s, &f), -1);
+  assert_string_equal(f.key, "reader");
+  assert_string_equal(f.message, "listens to event stream 'tool1.events', which no controller emits");
+  tx_system_destroy(s);
+  // a stream is not a component: a read of it has no writer
+  s = events_system("{\"emit\":\"tool0.events\"}", NULL, NULL);
+  add(s, "c", 10, "{\"read\":\"tool0.events\"}", &rc);
+  assert_int_equal(tx_system_finalize(s, &f), -1);
+  assert_non_null(strstr(f.message, "reads unknown component 'tool0.events'"));
+  tx_system_destroy(s);
+  // capacities and names
+  static const char* const bad[] = {"{\"emit\":\"e\",\"capacity\":3}", "{\"emit\":\"e\",\"capacity\":0}",
+                                    "{\"emit\":\"e\",\"capacity\":1}", "{\"emit\":\"e\",\"capacity\":2097152}",
+                                    "{\"emit\":\"Bad name\"}", "{\"listen\":\"\"}"};
+  static const char* const why[] = {"capacity 3 is not a power of two in [2, 1048576]", "capacity 0", "capacity 1",
+                                    "capacity 2097152", "bad component name 'Bad name'", "bad component name ''"};
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    s = tx_system_create();
+    f = add_as(s, "w", "test.events", 100, bad[i], &rc);
+    assert_int_equal(rc, -1);
+    if (!strstr(f.message, why[i])) fail_msg("'%s' does not mention '%s'", f.message, why[i]);
+    tx_system_destroy(s);
+  }
+  // at most TX_STREAM_READERS_MAX listeners
+  s = events_system("{\"emit\":\"e\"}", NULL, NULL);
+  for (int i = 0; i <= TX_STREAM_READERS_MAX; i++) {
+    char name[16];
+    snprintf(name, sizeof name, "r%d", i);
+    add_as(s, name, "test.events", 10, "{\"listen\":\"e\"}", &rc);
+  }
+  assert_int_equal(tx_system_finalize(s, &f), -1);
+  assert_string_equal(f.key, "r16");
+  assert_non_null(strstr(f.message, "more than 16 listeners"));
+  tx_system_destroy(s);
+}
+
+static tx_stream_info run_events(tx_system* s, bool lock, double seconds) {
+  tx_fault f;
+  assert_int_equal(tx_system_finalize(s, &f), 0);
+  tx_run_options o = {.duration_s = seconds, .lockstep = lock};
+  tx_run_result r;
+  char err[256];
+  assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+  assert_false(r.halted);
+  assert_int_equal(tx_system_streams(s), 1);
+  return tx_system_stream(s, 0);
+}
+
+static eventer* self_of(tx_system* s, int i) { return s->inst[i]->self; }
+
+// 1 kHz writer, 20 Hz and 60 Hz readers: each sees every event once and in order
+static void events_reach_every_listener_in_lockstep(void** state) {
+  (void)state;
+  tx_system* s = events_system("{\"emit\":\"tool0.events\"}", "{\"listen\":\"tool0.events\"}",
+                               "{\"listen\":\"tool0.events\"}");
+  for (int run = 0; run < 2; run++) { // a second run starts with empty streams
+    tx_stream_info st = run_events(s, true, 1.0);
+    assert_string_equal(st.name, "tool0.events");
+    assert_string_equal(st.writer, "writer");
+    assert_int_equal(st.capacity, 1024);
+    assert_int_equal(st.sent, 1000);
+    assert_int_equal(st.overflows, 0);
+    assert_int_equal(st.nreaders, 2);
+    assert_string_equal(st.readers[0], "reader");
+    assert_string_equal(st.readers[1], "reader2");
+    assert_int_equal(st.lost[0], 0);
+    assert_int_equal(st.lost[1], 0);
+    // the 20 Hz reader's last step is at 950 ms, before the writer's tick there
+    assert_int_equal(self_of(s, 1)->received, 950);
+    assert_int_equal(self_of(s, 1)->last_seq, 950);
+    assert_int_equal(self_of(s, 2)->received, 984); // 60 Hz: last step at 983.3 ms
+    for (int i = 1; i <= 2; i++) {
+      assert_int_equal(self_of(s, i)->gaps, 0);
+      assert_int_equal(self_of(s, i)->out_of_order, 0);
+    }
+  }
+  tx_system_destroy(s);
+}
+
+// a ring of 16 behind a 20 Hz reader: pushes are refused and counted, the reader counts the gaps
+static void a_full_stream_is_counted(void** state) {
+  (void)state;
+  tx_system* s = events_system("{\"emit\":\"e\",\"capacity\":16}", "{\"listen\":\"e\"}", NULL);
+  tx_stream_info st = run_events(s, true, 1.0);
+  eventer *w = self_of(s, 0), *r = self_of(s, 1);
+  assert_int_equal(st.sent, 1000);
+  assert_int_equal(st.overflows, 20 * 34); // 16 of each 50 between reads get through
+  assert_int_equal(w->dropped, st.overflows); // tx_emit said so each time
+  assert_int_equal(st.lost[0], r->gaps);
+  assert_true(r->gaps > 0);
+  assert_int_equal(r->out_of_order, 0);
+  assert_int_equal(r->received + r->gaps, r->last_seq); // every seq up to the last: taken or counted lost
+  assert_int_equal(r->received, 19 * 16);  // reads at 50 ms .. 950 ms, a full ring each
+  tx_system_destroy(s);
+}
+
+// tx_emit on a listen port, tx_next_event on an emit port: counted, and the run stops
+static void misused_events_stop_the_run(void** state) {
+  (void)state;
+  static const char* const want[] = {"writer: tx_next_event on port 1, which it did not declare with tx_setup_listen",
+                                     "writer: tx_emit on port 1, which it did not declare with tx_setup_emit"};
+  tx_system* s = tx_system_create();
+  int rc;
+  add_as(s, "writer", "test.events", 100, "{\"emit\":\"e\"}", &rc);
+  add_as(s, "reader", "test.events", 100, "{\"listen\":\"e\"}", &rc);
+  tx_fault f;
+  assert_int_equal(tx_system_finalize(s, &f), 0);
+  for (int which = 0; which < 2; which++) {
+    // swap the ports: the writer now listens on its emit port, or the reader emits on its listen port
+    eventer* e = self_of(s, which);
+    tx_port good_in = e->in, good_out = e->out;
+    if (which == 0) e->in = e->out;
+    else e->out = e->in;
+    tx_run_options o = {.duration_s = 0.5, .lockstep = true};
+    tx_run_result r;
+    char err[256];
+    assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+    assert_true(r.halted);
+    const char* expect = which == 0 ? want[0] : "reader: tx_emit on port 1, which it did not declare with tx_setup_emit";
+    assert_string_equal(r.halt_reason, expect);
+    e->in = good_in, e->out = good_out;
+  }
+  tx_system_destroy(s);
+}
+
 int main(void) {
   register_test_classes();
   const struct CMUnitTest tests[] = {
@@ -303,6 +536,12 @@ int main(void) {
       cmocka_unit_test(names_and_types_are_checked),
       cmocka_unit_test(registry_rejects_bad_classes),
       cmocka_unit_test(groups_follow_rates_fastest_first),
+      cmocka_unit_test(haptics_never_shares_a_thread),
+      cmocka_unit_test(named_threads),
+      cmocka_unit_test(event_streams_are_checked),
+      cmocka_unit_test(events_reach_every_listener_in_lockstep),
+      cmocka_unit_test(a_full_stream_is_counted),
+      cmocka_unit_test(misused_events_stop_the_run),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -67,6 +67,12 @@ scenario unknown_read.json "$(worker a 10 '"reads": ["t.nope"]')"
 expect_bad "read of an unknown component" "$S/unknown_read.json" "controllers[0]" "t.nope" -- run "$S/unknown_read.json"
 scenario two_writers.json "$(worker a 10 '"write": "t.x"')" "$(worker b 20 '"write": "t.x"')"
 expect_bad "two writers" "$S/two_writers.json" "controllers[1]" "two writers" -- run "$S/two_writers.json"
+scenario thread_number.json '{"name": "a", "type": "rates.worker", "rate_hz": 10, "thread": 3}'
+expect_bad "thread a number" "$S/thread_number.json" "controllers[0].thread" "a thread name" -- run "$S/thread_number.json"
+scenario thread_bad.json '{"name": "a", "type": "rates.worker", "rate_hz": 10, "thread": "Tissue Thread"}'
+expect_bad "thread of bad characters" "$S/thread_bad.json" "controllers[0].thread" "a-z 0-9 _ -" -- describe "$S/thread_bad.json"
+scenario thread_rates.json '{"name": "a", "type": "rates.worker", "rate_hz": 10, "thread": "x"}' '{"name": "b", "type": "rates.worker", "rate_hz": 20, "thread": "x"}'
+expect_bad "one thread, two rates" "$S/thread_rates.json" "controllers[1].thread" "cannot share it" -- run "$S/thread_rates.json"
 
 # --- files: wrong types -------------------------------------------------------
 scenario rate_string.json "$(worker a '"fast"')"

@@ -166,6 +166,38 @@ static void unknown_controller_key(void** state) {
                     LABEL ": controllers[0].rate: ", "unknown key");
 }
 
+// "thread": a name of a-z 0-9 _ -, at most 31 characters, one rate per name
+static void thread_names(void** state) {
+  (void)state;
+  const char* head = "{\"name\":\"t\",\"controllers\":[{\"name\":\"a\"," WORKER ",\"rate_hz\":10,\"thread\":";
+  static const struct { const char* value; const char* part; } bad[] = {
+      {"7", "expected a thread name (a string), got a number"},
+      {"null", "got null"},
+      {"\"\"", "must be 1-31 characters of a-z 0-9 _ -"},
+      {"\"Tissue\"", "'Tissue' must be 1-31"},
+      {"\"a b\"", "must be 1-31"},
+      {"\"abcdefghijklmnopqrstuvwxyz012345\"", "must be 1-31"},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    char text[512];
+    snprintf(text, sizeof text, "%s%s}]}", head, bad[i].value);
+    expect_text_error(text, LABEL ": controllers[0].thread: ", bad[i].part);
+  }
+  expect_text_error("{\"name\":\"t\",\"controllers\":[{\"name\":\"a\"," WORKER ",\"rate_hz\":10,\"thread\":\"x\"},"
+                    "{\"name\":\"b\"," WORKER ",\"rate_hz\":20,\"thread\":\"x\"}]}",
+                    LABEL ": controllers[1].thread: ", "'x' runs a at 10 Hz; b at 20 Hz cannot share it");
+  tx_scenario* s = load("{\"name\":\"t\",\"controllers\":[{\"name\":\"a\"," WORKER ",\"rate_hz\":10,\"thread\":\"x\"},"
+                        "{\"name\":\"b\"," WORKER ",\"rate_hz\":10},{\"name\":\"c\"," WORKER
+                        ",\"rate_hz\":10,\"thread\":\"x\"}]}");
+  if (!s) fail_msg("%s", err);
+  int a = find(s, "a"), b = find(s, "b"), c = find(s, "c");
+  assert_int_equal(tx_system_threads(s->system), 2);
+  assert_int_equal(tx_system_thread(s->system, a), tx_system_thread(s->system, c));
+  assert_int_not_equal(tx_system_thread(s->system, a), tx_system_thread(s->system, b));
+  assert_string_equal(tx_system_thread_name(s->system, tx_system_thread(s->system, a)), "x");
+  tx_scenario_free(s);
+}
+
 static void missing_or_bad_name_and_controllers(void** state) {
   (void)state;
   expect_text_error("{\"controllers\":[]}", LABEL ": name: ", "a-z 0-9 _ -");
@@ -520,6 +552,7 @@ int main(void) {
       cmocka_unit_test(unknown_top_level_key),
       cmocka_unit_test(control_characters_from_the_file_stay_out_of_the_message),
       cmocka_unit_test(unknown_controller_key),
+      cmocka_unit_test(thread_names),
       cmocka_unit_test(missing_or_bad_name_and_controllers),
       cmocka_unit_test(unknown_controller_type),
       cmocka_unit_test(rate_hz_of_the_wrong_type),

@@ -7,6 +7,7 @@
 #include <cmocka.h>
 
 #include "views/report.h"
+#include "tests/controllers/test_support.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -51,6 +52,11 @@ static void haptic_stalls_are_warnings(void** state) {
   json_t* warnings = json_object_get(report, "warnings");
   assert_int_equal(json_integer_value(json_object_get(warnings, "hand.missed_deadlines")), (json_int_t)missed);
   assert_null(json_object_get(warnings, "physics.missed_deadlines"));
+  // the haptics instance ran on a thread of its own, and the report says so
+  json_t* controllers = json_object_get(report, "controllers");
+  assert_true(json_is_true(json_object_get(json_array_get(controllers, 0), "own_thread")));
+  assert_null(json_object_get(json_array_get(controllers, 1), "own_thread"));
+  assert_string_equal(json_string_value(json_object_get(json_array_get(controllers, 0), "thread")), "t0");
 
   char* text = NULL;
   size_t len = 0;
@@ -69,7 +75,53 @@ static void haptic_stalls_are_warnings(void** state) {
   tx_system_destroy(s);
 }
 
+// per stream: events sent, overflows and what each listener lost; loss is a warning
+static void streams_are_reported(void** state) {
+  (void)state;
+  register_test_classes();
+  tx_system* s = tx_system_create();
+  tx_fault f;
+  static const struct { const char* name; double rate; const char* params; } spec[] = {
+      {"hand", 1000, "{\"emit\":\"tool0.events\",\"capacity\":16}"},
+      {"physics", 20, "{\"listen\":\"tool0.events\"}"},
+      {"tool", 1000, "{\"emit\":\"tool1.events\"}"},
+      {"cautery", 60, "{\"listen\":\"tool1.events\"}"},
+  };
+  for (int i = 0; i < 4; i++) {
+    json_t* p = json_loads(spec[i].params, 0, NULL);
+    assert_int_equal(tx_system_add(s, spec[i].name, "test.events", spec[i].rate, p, &f), 0);
+    json_decref(p);
+  }
+  assert_int_equal(tx_system_finalize(s, &f), 0);
+  tx_run_options o = {.duration_s = 1.0, .lockstep = true};
+  tx_run_result r;
+  char err[256];
+  assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+  json_t* report = tx_report_json(&(tx_report){"t", true, &r, s});
+  json_t* full = json_object_get(json_object_get(report, "streams"), "tool0.events");
+  json_t* clean = json_object_get(json_object_get(report, "streams"), "tool1.events");
+  assert_non_null(full);
+  assert_non_null(clean);
+  assert_string_equal(json_string_value(json_object_get(full, "writer")), "hand");
+  assert_int_equal(json_integer_value(json_object_get(full, "capacity")), 16);
+  assert_int_equal(json_integer_value(json_object_get(full, "sent")), 1000);
+  assert_int_equal(json_integer_value(json_object_get(full, "overflows")), 680); // 34 of each 50 between reads
+  json_int_t lost = json_integer_value(json_object_get(json_object_get(full, "lost"), "physics"));
+  assert_true(lost > 0);
+  json_t* warnings = json_object_get(report, "warnings");
+  assert_int_equal(json_integer_value(json_object_get(warnings, "tool0.events.overflows")), 680);
+  assert_int_equal(json_integer_value(json_object_get(warnings, "tool0.events.lost_by.physics")), lost);
+  assert_int_equal(json_integer_value(json_object_get(clean, "sent")), 1000);
+  assert_int_equal(json_integer_value(json_object_get(clean, "overflows")), 0);
+  assert_int_equal(json_integer_value(json_object_get(json_object_get(clean, "lost"), "cautery")), 0);
+  assert_null(json_object_get(warnings, "tool1.events.overflows")); // nothing lost, no warning
+  assert_null(json_object_get(warnings, "tool1.events.lost_by.cautery"));
+  json_decref(report);
+  tx_system_destroy(s);
+}
+
 int main(void) {
-  const struct CMUnitTest tests[] = {cmocka_unit_test(haptic_stalls_are_warnings)};
+  const struct CMUnitTest tests[] = {cmocka_unit_test(haptic_stalls_are_warnings),
+                                     cmocka_unit_test(streams_are_reported)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
