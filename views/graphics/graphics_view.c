@@ -9,6 +9,7 @@
 
 #include "../../controllers/system.h"
 
+#include <tactus/components.h>
 #include <tactus/config.h>
 
 #if TX_WITH_OSMESA
@@ -74,9 +75,12 @@ typedef struct view {
   tx_ctx* ctx;                          // the step's context, for warnings from the renderer
 } view;
 
+// the layouts of <tactus/components.h> that the renderer draws, by name suffix
+#define KIND(suffix, T) {suffix, T##_TYPE, T##_COLS}
 static const struct { const char* suffix; tx_type type; uint32_t cols; } kinds[] = {
-    {".x", TX_F32, 3}, {".tri", TX_I32, 3}, {".spheres", TX_F32, 4}, {".segments", TX_F32, 7},
-    {".pose", TX_F64, 7}, {".force", TX_F64, 3}};
+    KIND(".x", tx_vertex), KIND(".tri", tx_triangle), KIND(".spheres", tx_sphere), KIND(".segments", tx_segment),
+    KIND(".pose", tx_pose), KIND(".force", tx_force)};
+#undef KIND
 
 // the type and width a drawn component must have: by its suffix, and scalars are f32 N x 1
 static void schema_of(const tx_draw_item* it, const char* comp, tx_type* type, uint32_t* cols) {
