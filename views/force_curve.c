@@ -146,4 +146,5 @@ const tx_controller_class tx_view_force_curve = {
     .step = step,
     .finish = finish,
     .fini = fini,
+    .view = true,
 };

@@ -12,6 +12,9 @@
 //              it may block (flush a recording), the run is over
 //   fini       frees what configure and init made
 //
+// A class with .view = true is a view: it reads the model and never writes
+// it. The loader refuses a view that declares a write, naming the controller.
+//
 // No step may allocate, lock or block: the haptic thread shares nothing that
 // waits. Parameter errors are sticky: tx_param_* return the default after the
 // first error, and the loader reports "params.KEY: message" for the first one.
@@ -57,6 +60,9 @@ typedef struct tx_controller_class {
   void (*step)(tx_ctx* c, void* self);
   void (*fini)(void* self);                   // optional
   void (*finish)(tx_ctx* c, void* self);      // optional
+  // a view only reads the model (plots, graphics, recordings): the loader
+  // refuses a view that declares a write with tx_setup_write
+  bool view;
 } tx_controller_class;
 
 // registry; returns 0, or -1 for a bad class or a taken type name

@@ -77,6 +77,7 @@ static void recorder_step(tx_ctx* c, void* self) {
 static void recorder_fini(void* self) { free(self); }
 
 static const tx_controller_class recorder_class = {.type = "study.force_recorder",
+                                                   .view = true,
                                                    .summary = "keeps device0.pose y and device0.force y per tick",
                                                    .configure = recorder_configure,
                                                    .step = recorder_step,

@@ -79,6 +79,7 @@ static void guard_fini(void* self) { free(self); }
 
 static const tx_controller_class guard_class = {
     .type = "study.skin_guard",
+    .view = true,
     .summary = "counts non-finite values in skin.x, tool0.force_model, device0.force; largest forces",
     .configure = guard_configure,
     .step = guard_step,

@@ -595,4 +595,5 @@ const tx_controller_class tx_graphics_view = {
     .step = step,
     .fini = fini,
     .finish = finish,
+    .view = true,
 };
