@@ -91,6 +91,34 @@ static void an_ordinary_controller_may_write(void** state) {
   tx_scenario_free(s);
 }
 
+// a structured parameter reaches a view as JSON text through the public API
+static char seen_text[256];
+static bool seen_absent;
+static int text_configure(tx_setup* s, void** self) {
+  *self = NULL;
+  const char* t = tx_param_json_text(s, "view");
+  snprintf(seen_text, sizeof seen_text, "%s", t ? t : "(null)");
+  seen_absent = tx_param_json_text(s, "absent") == NULL;
+  return 0;
+}
+static const tx_controller_class text_class = {
+    .type = "test_views.text", .summary = "keeps params.view as text", .configure = text_configure, .step = nothing, .view = true};
+
+static void a_structured_parameter_comes_as_json_text(void** state) {
+  (void)state;
+  if (!tx_find_controller(text_class.type)) assert_int_equal(tx_register_controller(&text_class), 0);
+  const char* text = "{\"name\":\"t\",\"controllers\":[{\"name\":\"v\",\"type\":\"test_views.text\",\"rate_hz\":10,"
+                     "\"params\":{\"view\":{\"width\":640,\"eye\":[0.1,-2.5e-3,1]}}}]}";
+  char err[512] = "";
+  tx_load_options o = {0};
+  tx_scenario* sc = tx_scenario_load_text("text.json", text, strlen(text), &o, err, sizeof err);
+  if (!sc) fail_msg("%s", err);
+  tx_scenario_free(sc);
+  // every number as it was (17 digits), and the key counts as used (no "unknown parameter")
+  assert_string_equal(seen_text, "{\"width\":640,\"eye\":[0.10000000000000001,-0.0025000000000000001,1]}");
+  assert_true(seen_absent);
+}
+
 // the built-in views say that they are views
 static void the_builtin_views_are_views(void** state) {
   (void)state;
@@ -107,6 +135,7 @@ int main(void) {
       cmocka_unit_test(a_view_that_only_reads_loads),
       cmocka_unit_test(a_view_that_writes_is_refused_in_one_line),
       cmocka_unit_test(an_ordinary_controller_may_write),
+      cmocka_unit_test(a_structured_parameter_comes_as_json_text),
       cmocka_unit_test(the_builtin_views_are_views),
   };
   return cmocka_run_group_tests(tests, setup, NULL);

@@ -7,8 +7,6 @@
 #include "stereo_frame.h"
 #include "view_def.h"
 
-#include "../../controllers/system.h"
-
 #include <tactus/components.h>
 #include <tactus/config.h>
 
@@ -16,7 +14,6 @@
 #include "osmesa_target.h"
 #endif
 #if TX_WITH_GLFW
-#include "../../controllers/haptics/device_mouse.h"
 #include "glfw_window.h"
 #include "overlay.h"
 #endif
@@ -99,7 +96,7 @@ static int configure(tx_setup* s, void** self) {
   if (!v) return -1;
   *self = v;
   v->def = tx_view_def_default();
-  json_t* vj = tx_param_json(s, "view");
+  const char* vj = tx_param_json_text(s, "view");
   const char* target = tx_param_str(s, "target", "png");
   const char* stereo = tx_param_str(s, "stereo_mode", "mono");
   v->wait = tx_param_bool(s, "wait", false);
@@ -114,7 +111,7 @@ static int configure(tx_setup* s, void** self) {
     return tx_setup_fail(s, "stereo_mode", "expected mono, sbs, tb, anaglyph or lr, got \"%s\"", stereo);
   if (vj) {
     char key[128], msg[300];
-    if (tx_view_def_from_json(vj, &v->def, key, sizeof key, msg, sizeof msg))
+    if (tx_view_def_from_text(vj, &v->def, key, sizeof key, msg, sizeof msg))
       return tx_setup_fail(s, "view", "%s: %s", key, msg);
   }
   if (v->def.nitems == 0 && tx_view_def_auto_draw(&v->def, avail, navail) == 0)
