@@ -32,6 +32,7 @@ typedef struct haptics {
   tx_passivity passivity;
   tx_port model;                 // the force model read, 0 for none
   tx_port tool;                  // virtual coupling: the simulated tool's pose, 0 for none
+  tx_port input;                 // the device's input in the model (the mouse's window.pointer), 0 for none
   double coupling_k, coupling_b; // N/m, N s/m
   tx_port pose, velocity, force, energy;
   tx_warning warn[W_COUNT];
@@ -89,6 +90,7 @@ static int configure(tx_setup* s, void** self) {
   if (bad) return tx_setup_fail(s, NULL, "safety limits: %s", bad);
   tx_safety_init(&h->safety);
 
+  if (h->device.backend->input) h->input = TX_READ_EXPECT(s, h->device.backend->input, tx_pointer);
   if (*model) h->model = TX_READ_EXPECT(s, model, tx_force_model);
   if (*tool) h->tool = TX_READ_OF(s, tool, tx_pose);
   char name[TX_NAME_MAX];
@@ -120,6 +122,13 @@ static void warn_new(tx_ctx* c, haptics* h, const tx_safety_counts* before) {
   if (now->workspace > before->workspace) tx_warn(c, h->warn[W_WORKSPACE]);
 }
 
+// a device whose input is in the model gets this tick's row before it is read
+static void feed(tx_ctx* c, haptics* h) {
+  if (!h->input.id) return;
+  tx_snapshot in = tx_read(c, h->input);
+  h->device.backend->feed(h->device.device, in.seq ? in.data : NULL);
+}
+
 // what the rest of the model sees of the device
 static void publish(tx_ctx* c, haptics* h, const double force[3]) {
   tx_pose* pose = tx_write(c, h->pose);
@@ -138,6 +147,7 @@ static void publish(tx_ctx* c, haptics* h, const double force[3]) {
 // that run at time 0 (collision, physics) see where the tool really is
 static int init(tx_ctx* c, void* self) {
   haptics* h = self;
+  feed(c, h);
   if (!h->device.backend->read(h->device.device, 0, &h->state)) h->state.quat[0] = 1;
   const double zero[3] = {0, 0, 0};
   publish(c, h, zero);
@@ -157,6 +167,7 @@ static int init(tx_ctx* c, void* self) {
 static void step(tx_ctx* c, void* self) {
   haptics* h = self;
   const double dt = 1.0 / tx_rate(c), t = (double)tx_sim_ns(c) * 1e-9;
+  feed(c, h);
   if (h->device.backend->read(h->device.device, t, &h->state)) h->silent_s = 0;
   else h->silent_s += dt, tx_warn(c, h->warn[W_SILENT]);
 

@@ -186,6 +186,18 @@ typedef struct tx_damage {
 #define tx_damage_UNITS "1"
 TX_LAYOUT_ASSERT(tx_damage, float);
 
+// window.pointer (1 row), written by input.window (the window's mouse and
+// keyboard), read by the haptics controller for the `mouse` device
+typedef struct tx_pointer {
+  double pos[3];  // m, where the input puts the tool, in [-TX_POINTER_REACH_M, TX_POINTER_REACH_M]
+  double buttons; // the buttons held, one bit each (an integer below 2^32)
+} tx_pointer;
+#define tx_pointer_TYPE TX_F64
+#define tx_pointer_COLS 4u
+#define tx_pointer_UNITS "m, 1"
+#define TX_POINTER_REACH_M 0.2 // m, the pointer's box on each axis
+TX_LAYOUT_ASSERT(tx_pointer, double);
+
 // --- for the coming scenarios (suture thread, instruments) -------------------
 
 // THREAD.nodes (N rows, from the needle end): a follow-the-leader thread

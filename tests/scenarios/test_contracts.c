@@ -33,6 +33,7 @@ static const layout layouts[] = {
     L(".state", tx_hip_state),          L(".spheres", tx_sphere),          L(".segments", tx_segment),
     L(".x", tx_vertex),                 L(".tri", tx_triangle),            L(".thickness", tx_thickness),
     L(".torn", tx_torn),                L(".damage", tx_damage),           L(".nodes", tx_thread_node),
+    L(".pointer", tx_pointer),
 };
 #undef L
 
@@ -64,7 +65,7 @@ static void every_layout_is_its_columns(void** state) {
 
 typedef struct seen {
   int scenarios, loaded, checked;
-  char fail[512];
+  char fail[1024];
 } seen;
 
 static void check_scenario(const char* name, const char* path, const char* description, void* user) {
@@ -78,7 +79,7 @@ static void check_scenario(const char* name, const char* path, const char* descr
   if (!sc) {
     // a build without Bullet cannot load the skin; every other failure is a defect
     if (!TX_WITH_BULLET && strstr(err, "physics.")) return;
-    snprintf(s->fail, sizeof s->fail, "%s: %s", name, err);
+    snprintf(s->fail, sizeof s->fail, "%.100s: %.400s", name, err);
     return;
   }
   s->loaded++;
