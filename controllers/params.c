@@ -5,6 +5,7 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 const char* tx_setup_name(const tx_setup* s) { return s->in->name; }
@@ -240,6 +241,17 @@ int tx_param_strs(tx_setup* s, const char* key, const char** out, int max) {
     if (drifted(s, key, (double)max == d->max, code, table)) return 0;
   }
   return read_strs(s, key, out, max);
+}
+
+const char* tx_param_json_text(tx_setup* s, const char* key) {
+  json_t* v = param(s, key);
+  if (!v) return NULL;
+  // 17 digits: every double comes back exactly when the text is parsed again
+  char* text = json_dumps(v, JSON_COMPACT | JSON_ENCODE_ANY | JSON_REAL_PRECISION(17));
+  const char* kept = text ? keep(s, text) : NULL;
+  free(text);
+  if (!kept) tx_setup_fail(s, key, "out of memory");
+  return kept;
 }
 
 // the model's rule for component names (model/model.c)

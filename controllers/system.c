@@ -123,6 +123,11 @@ int tx_system_add(tx_system* s, const char* name, const char* type, double rate_
   in->configured = true; // fini frees whatever configure made, even on failure
   if (in->failed) return *f = in->fault, -1;
   if (rc != 0) return fault(f, "", "controller '%s' (%s) failed to configure", name, type);
+  // a view only reads: any write it declared is refused, by name
+  if (cls->view)
+    for (int p = 0; p < in->nports; p++)
+      if (in->ports[p].write)
+        return fault(f, "type", "controller '%s' (%s) is a view and may not write '%s'", name, type, in->ports[p].name);
   // without a table, every parameter in the scenario must be one configure asked for
   if (params && !cls->params) json_object_foreach(params, key, value) {
     if (json_object_get(in->used, key)) continue;

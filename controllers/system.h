@@ -114,8 +114,7 @@ const tx_controller_class* tx_controller_class_at(int i);
 
 // for built-in classes only: params.KEY as JSON (borrowed, marked as used), or NULL
 json_t* tx_param_json(tx_setup* s, const char* key);
-// the run's output folder (tx_run_options.out_dir), or NULL
-const char* tx_output_dir(const tx_ctx* c);
+// tx_output_dir (tactus/controller.h) is the run's tx_run_options.out_dir
 
 // introspection, valid after finalize
 int tx_system_count(const tx_system* s);

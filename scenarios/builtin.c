@@ -10,6 +10,9 @@
 #include "../controllers/voxel/needle_controller.h"
 #include "../views/force_curve.h"
 #include "../views/graphics/graphics_view.h"
+#if TX_WITH_GLFW
+#include "../views/graphics/window_input.h"
+#endif
 #if TX_WITH_BULLET
 #include "../controllers/physics/skin_controller.h"
 #endif
@@ -25,6 +28,9 @@ static void register_all(void) {
   tx_register_controller(&tx_voxel_needle_controller);
 #if TX_WITH_OSMESA || TX_WITH_GLFW
   tx_register_controller(&tx_graphics_view);
+#endif
+#if TX_WITH_GLFW
+  tx_register_controller(&tx_window_input);
 #endif
 #if TX_WITH_BULLET
   tx_register_controller(&tx_physics_skin);

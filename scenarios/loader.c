@@ -2,6 +2,7 @@
 #include "loader.h"
 
 #include "../views/graphics/view_def.h"
+#include "../views/graphics/window_input.h"
 
 #include <tactus/config.h>
 
@@ -273,6 +274,13 @@ static int add_view(const char* file, tx_system* sys, json_t* view, const tx_loa
   if (json_is_number(vr) && json_number_value(vr) < TX_RATE_MIN_HZ)
     return fail(err, n, "%s: view.rate_hz: %g Hz is below the least rate, %g Hz", file, json_number_value(vr), TX_RATE_MIN_HZ);
   if (!o || !o->view || strcmp(o->view, "none") == 0) return 0;
+  // a window's mouse and keyboard reach the model through a controller of
+  // their own (the view only reads): window.pointer, for the mouse device
+  if (strcmp(o->view, "window") == 0 && tx_find_controller("input.window")) {
+    tx_fault f;
+    if (tx_system_add(sys, "window_input", "input.window", TX_WINDOW_INPUT_HZ, NULL, &f))
+      return fail(err, n, "%s: view: %s", file, f.message);
+  }
   json_t* rate = view ? json_object_get(view, "rate_hz") : NULL;
   json_t* params = json_object();
   json_t* available = json_array();

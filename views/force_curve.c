@@ -5,6 +5,8 @@
 
 #include "plot.h"
 
+#include <tactus/components.h>
+
 #include "../model/prefault.h"
 
 #include <math.h>
@@ -57,10 +59,10 @@ static int configure(tx_setup* s, void** self) {
   memcpy(c->file, file, len + 1);
   c->rows = malloc(sizeof(double) * COLS * c->cap);
   if (!c->rows) return tx_setup_fail(s, "max_samples", "%llu samples do not fit in memory", (unsigned long long)c->cap);
-  c->pose = tx_setup_read_as(s, pose, TX_F64, 7);
-  c->force = tx_setup_read_as(s, force, TX_F64, 3);
-  if (*state) c->state = tx_setup_read_as(s, state, TX_F64, 8);
-  if (*torn) c->torn = tx_setup_read_as(s, torn, TX_I32, 1);
+  c->pose = TX_READ_OF(s, pose, tx_pose);
+  c->force = TX_READ_OF(s, force, tx_force);
+  if (*state) c->state = TX_READ_OF(s, state, tx_hip_state);
+  if (*torn) c->torn = TX_READ_OF(s, torn, tx_torn);
   c->w_full = tx_setup_warning(s, "recording_full");
   c->r_samples = tx_setup_result(s, "samples");
   return 0;
@@ -80,17 +82,17 @@ static void step(tx_ctx* ctx, void* self) {
     return;
   }
   double* r = c->rows + COLS * c->n++;
-  const double* p = tx_read(ctx, c->pose).data;
-  const double* f = tx_read(ctx, c->force).data;
+  const tx_pose* p = tx_read(ctx, c->pose).data;
+  const tx_force* f = tx_read(ctx, c->force).data;
   r[0] = tx_sim_ns(ctx) * 1e-9;
-  memcpy(r + 1, p, 3 * sizeof *r);
-  memcpy(r + 4, f, 3 * sizeof *r);
+  memcpy(r + 1, p->pos, 3 * sizeof *r);
+  memcpy(r + 4, f->f, 3 * sizeof *r);
   r[7] = r[8] = r[9] = r[10] = 0;
   if (c->state.id) {
-    const double* st = tx_read(ctx, c->state).data;
-    r[7] = st[0], r[8] = st[1], r[10] = st[7];
+    const tx_hip_state* st = tx_read(ctx, c->state).data;
+    r[7] = st->contacts, r[8] = st->pierced, r[10] = st->skin_t;
   }
-  if (c->torn.id) r[9] = ((const int32_t*)tx_read(ctx, c->torn).data)[0];
+  if (c->torn.id) r[9] = ((const tx_torn*)tx_read(ctx, c->torn).data)->links;
 }
 
 static void finish(tx_ctx* ctx, void* self) {
@@ -157,4 +159,5 @@ const tx_controller_class tx_view_force_curve = {
     .fini = fini,
     .params = params,
     .nparams = TX_PARAMS_COUNT(params),
+    .view = true,
 };

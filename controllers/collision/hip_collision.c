@@ -17,6 +17,8 @@
 
 #include "hip.h"
 
+#include <tactus/components.h>
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -90,13 +92,13 @@ static int configure(tx_setup* s, void** self) {
   if (snprintf(name[0], TX_NAME_MAX, "%s.x", skin) >= TX_NAME_MAX) return tx_setup_fail(s, "skin", "name too long");
   snprintf(name[1], TX_NAME_MAX, "%s.tri", skin);
   snprintf(name[2], TX_NAME_MAX, "%s.thickness", skin);
-  h->pose = tx_setup_read_as(s, pose, TX_F64, 7);
-  h->x = tx_setup_read_as(s, name[0], TX_F32, 3);
-  h->tri = tx_setup_read_as(s, name[1], TX_I32, 3);
-  h->thickness = tx_setup_read_as(s, name[2], TX_F64, 1);
-  h->model = tx_setup_write(s, &(tx_component_def){model, TX_F64, 1, 15, "N, m, N/m"});
-  h->state = tx_setup_write(s, &(tx_component_def){state, TX_F64, 1, 8, "1, N, m, s"});
-  h->spheres = tx_setup_write(s, &(tx_component_def){spheres, TX_F32, 1, 4, "m"});
+  h->pose = TX_READ_OF(s, pose, tx_pose);
+  h->x = TX_READ_OF(s, name[0], tx_vertex);
+  h->tri = TX_READ_OF(s, name[1], tx_triangle);
+  h->thickness = TX_READ_OF(s, name[2], tx_thickness);
+  h->model = tx_setup_write(s, &TX_COMPONENT_OF(model, tx_force_model, 1));
+  h->state = tx_setup_write(s, &TX_COMPONENT_OF(state, tx_hip_state, 1));
+  h->spheres = tx_setup_write(s, &TX_COMPONENT_OF(spheres, tx_sphere, 1));
   h->w_pose = tx_setup_warning(s, "pose_not_finite");
   h->w_skin = tx_setup_warning(s, "skin_not_finite");
   h->w_mesh = tx_setup_warning(s, "skin_mesh_rejected");
@@ -194,8 +196,8 @@ static void refit_some(hip_ctl* h) {
 
 static void step(tx_ctx* c, void* self) {
   hip_ctl* h = self;
-  const double* pose = tx_read(c, h->pose).data;
-  double centre[3] = {pose[0], pose[1], pose[2]};
+  const tx_pose* pose = tx_read(c, h->pose).data;
+  double centre[3] = {pose->pos[0], pose->pos[1], pose->pos[2]};
   if (!(isfinite(centre[0]) && isfinite(centre[1]) && isfinite(centre[2]))) {
     tx_warn(c, h->w_pose);
     memcpy(centre, h->last_c, sizeof centre); // hold the last good pose
@@ -204,7 +206,7 @@ static void step(tx_ctx* c, void* self) {
 
   // a new physics publish: take the skin
   tx_snapshot x = tx_read(c, h->x), tri = tx_read(c, h->tri);
-  double thickness = ((const double*)tx_read(c, h->thickness).data)[0];
+  double thickness = ((const tx_thickness*)tx_read(c, h->thickness).data)->m;
   if (!isfinite(thickness) || thickness < 0) thickness = 0;
   if (x.seq != 0 && (x.seq != h->x_seq || tri.seq != h->tri_seq)) {
     h->x_seq = x.seq;
@@ -225,29 +227,27 @@ static void step(tx_ctx* c, void* self) {
   h->was_pierced = out.pierced;
 
   // the local model: F0 where the frozen skin would just touch the HIP, K from the rays
-  double* m = tx_write(c, h->model);
-  memset(m, 0, 15 * sizeof *m);
+  tx_force_model* m = tx_write(c, h->model);
+  memset(m, 0, sizeof *m);
   bool force = out.contacts > 0;
-  memcpy(m + 3, force ? out.x0 : centre, 3 * sizeof *m);
+  memcpy(m->x0, force ? out.x0 : centre, sizeof m->x0);
   if (force) {
-    memcpy(m, out.f, 3 * sizeof *m);
-    memcpy(m + 6, out.k, 9 * sizeof *m);
+    memcpy(m->f0, out.f, sizeof m->f0);
+    memcpy(m->k, out.k, sizeof m->k);
     double f = sqrt(out.f[0] * out.f[0] + out.f[1] * out.f[1] + out.f[2] * out.f[2]);
     if (f > h->peak) h->peak = f;
     if ((uint64_t)out.contacts > h->max_contacts) h->max_contacts = (uint64_t)out.contacts;
   }
-  double* st = tx_write(c, h->state);
-  st[0] = out.contacts;
-  st[1] = out.pierced;
-  memcpy(st + 2, out.f, 3 * sizeof *st);
-  st[5] = out.depth;
-  st[6] = (double)h->hip.resets;
-  st[7] = h->act >= 0 ? h->ns[h->act] * 1e-9 : 0;
-  float* sp = tx_write(c, h->spheres);
-  sp[0] = (float)centre[0];
-  sp[1] = (float)centre[1];
-  sp[2] = (float)centre[2];
-  sp[3] = (float)h->hip.def.radius;
+  tx_hip_state* st = tx_write(c, h->state);
+  st->contacts = out.contacts;
+  st->pierced = out.pierced;
+  memcpy(st->f, out.f, sizeof st->f);
+  st->depth = out.depth;
+  st->resets = (double)h->hip.resets;
+  st->skin_t = h->act >= 0 ? h->ns[h->act] * 1e-9 : 0;
+  tx_sphere* sp = tx_write(c, h->spheres);
+  for (int a = 0; a < 3; a++) sp->c[a] = (float)centre[a];
+  sp->r = (float)h->hip.def.radius;
 }
 
 static void finish(tx_ctx* c, void* self) {

@@ -5,6 +5,8 @@
 // while in contact, so that between two publishes the force follows the hand.
 #include "wall.h"
 
+#include <tactus/components.h>
+
 #include <stdlib.h>
 #include <string.h>
 
@@ -31,21 +33,21 @@ static int configure(tx_setup* s, void** self) {
   const char* pose = tx_table_str(s, "pose");
   const char* model = tx_table_str(s, "force_model");
   if (!pose || !model) return -1;
-  w->pose = tx_setup_read_as(s, pose, TX_F64, 7); // x y z, qw qx qy qz
-  w->model = tx_setup_write(s, &(tx_component_def){model, TX_F64, 1, 15, "N, m, N/m"});
+  w->pose = TX_READ_OF(s, pose, tx_pose);
+  w->model = tx_setup_write(s, &TX_COMPONENT_OF(model, tx_force_model, 1));
   return 0;
 }
 
 static void step(tx_ctx* c, void* self) {
   wall* w = self;
-  const double* x = tx_read(c, w->pose).data; // x y z, then the orientation
-  double depth = w->height - x[1];
-  double* m = tx_write(c, w->model); // f0 (3), x0 (3), K (9)
-  memset(m, 0, 15 * sizeof *m);
-  memcpy(m + 3, x, 3 * sizeof *m);
+  const tx_pose* x = tx_read(c, w->pose).data;
+  double depth = w->height - x->pos[1];
+  tx_force_model* m = tx_write(c, w->model);
+  memset(m, 0, sizeof *m);
+  memcpy(m->x0, x->pos, sizeof m->x0);
   if (depth > 0) {
-    m[1] = w->stiffness * depth; // up, out of the wall
-    m[6 + 4] = -w->stiffness;    // K_yy: deeper is stronger
+    m->f0[1] = w->stiffness * depth; // up, out of the wall
+    m->k[3 * 1 + 1] = -w->stiffness; // K_yy (row-major): deeper is stronger
   }
 }
 

@@ -6,6 +6,7 @@
 #ifndef TX_CONTROLLERS_HAPTICS_DEVICE_H
 #define TX_CONTROLLERS_HAPTICS_DEVICE_H
 
+#include <tactus/components.h>
 #include <tactus/haptics.h>
 
 #include <stddef.h>
@@ -22,6 +23,11 @@ typedef struct tx_device_backend {
   bool (*read)(tx_device* d, double t_s, tx_device_state* out);
   void (*write)(tx_device* d, const double force[3]); // N, held until the next write
   void (*close)(tx_device* d);
+  // optional, for a device whose input is in the model (the mouse): the
+  // component the haptics controller reads for it, and each tick, before
+  // read, that component's row (NULL until it is first published)
+  const char* input;
+  void (*feed)(tx_device* d, const tx_pointer* input);
 } tx_device_backend;
 
 typedef struct tx_device_handle {
@@ -37,6 +43,6 @@ extern const tx_device_backend tx_device_scripted;
 extern const tx_device_backend tx_device_replay;
 extern const tx_device_backend tx_device_sim;
 extern const tx_device_backend tx_device_udp;
-extern const tx_device_backend tx_device_mouse; // driven by a window (device_mouse.h)
+extern const tx_device_backend tx_device_mouse; // driven by a window, through window.pointer (device_mouse.h)
 
 #endif

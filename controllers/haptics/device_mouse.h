@@ -1,23 +1,14 @@
-// Internal: the input channel of the `mouse` device. A window's input thread
-// sets where the mouse and keyboard put the tool; the haptics thread reads it
-// through the `mouse` device backend (device.h) at its own rate. A sequence
-// lock over sequentially consistent atomics: the writer never waits, a reader
-// retries only while a write is under way. One channel per process (one window).
+// Internal: the `mouse` device. A window's mouse and keyboard put the tool
+// somewhere; the window's input controller (input.window, views/graphics)
+// publishes that as window.pointer (tx_pointer), and the haptics controller
+// feeds each tick's row to this backend before it reads the device, so the
+// mouse goes through the model like any other input.
 #ifndef TX_CONTROLLERS_HAPTICS_DEVICE_MOUSE_H
 #define TX_CONTROLLERS_HAPTICS_DEVICE_MOUSE_H
 
-#include <stdbool.h>
-#include <stdint.h>
+#include <tactus/components.h>
 
-#define TX_MOUSE_WORKSPACE_M 0.2 // the tool stays in [-0.2, 0.2] m on each axis
-
-// from the window: the tool point, m (clamped to the workspace), and the buttons held
-void tx_mouse_input_set(const double pos[3], uint32_t buttons);
-// the latest input; false until a window has set one
-bool tx_mouse_input_get(double pos[3], uint32_t* buttons);
-// the force last sent to the mouse device, N (for the window's overlay)
-void tx_mouse_force_get(double force[3]);
-// whether a mouse device is open (the window then drives it)
-bool tx_mouse_device_open(void);
+#define TX_MOUSE_INPUT "window.pointer" // the component the mouse device reads
+#define TX_MOUSE_START_Y_M 0.02         // m, the tool waits this far above the origin until the first input
 
 #endif

@@ -53,4 +53,4 @@ static void close_replay(tx_device* d) {
   free(d);
 }
 
-const tx_device_backend tx_device_replay = {"replay", open_replay, info_replay, read_replay, write_replay, close_replay};
+const tx_device_backend tx_device_replay = {"replay", open_replay, info_replay, read_replay, write_replay, close_replay, NULL, NULL};

@@ -200,4 +200,4 @@ static void close_scripted(tx_device* d) {
 }
 
 const tx_device_backend tx_device_scripted = {"scripted", open_scripted, info_scripted, read_scripted, write_scripted,
-                                              close_scripted};
+                                              close_scripted, NULL, NULL};

@@ -71,4 +71,4 @@ static void close_sim(tx_device* d) {
   free(d);
 }
 
-const tx_device_backend tx_device_sim = {"sim", open_sim, info_sim, read_sim, write_sim, close_sim};
+const tx_device_backend tx_device_sim = {"sim", open_sim, info_sim, read_sim, write_sim, close_sim, NULL, NULL};

@@ -307,4 +307,4 @@ static void write_udp(tx_device* d, const double force[3]) {
 
 void tx_device_udp_counts_get(const tx_device* d, tx_device_udp_counts* out) { *out = d->counts; }
 
-const tx_device_backend tx_device_udp = {"udp", open_udp, info_udp, read_udp, write_udp, close_udp};
+const tx_device_backend tx_device_udp = {"udp", open_udp, info_udp, read_udp, write_udp, close_udp, NULL, NULL};

@@ -15,6 +15,8 @@
 #include "render.h"
 #include "safety.h"
 
+#include <tactus/components.h>
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -29,6 +31,7 @@ typedef struct haptics {
   tx_haptic_path path;           // passivity and safety: the force path the stability study measures
   tx_port model;                 // the force model read, 0 for none
   tx_port tool;                  // virtual coupling: the simulated tool's pose, 0 for none
+  tx_port input;                 // the device's input in the model (the mouse's window.pointer), 0 for none
   double coupling_k, coupling_b; // N/m, N s/m
   tx_port pose, velocity, force, energy;
   tx_warning warn[W_COUNT];
@@ -113,17 +116,18 @@ static int configure(tx_setup* s, void** self) {
   if (bad) return tx_setup_fail(s, NULL, "safety limits: %s", bad);
   tx_haptic_path_init(&h->path, &h->limits, control, ref, info.damping);
 
-  if (*model) h->model = tx_setup_read_expect(s, model, TX_F64, TX_FORCE_MODEL_COLS, TX_FORCE_MODEL_UNITS); // F0, x0, K
-  if (*tool) h->tool = tx_setup_read_as(s, tool, TX_F64, 7);     // a pose: x y z, qw qx qy qz
+  if (h->device.backend->input) h->input = TX_READ_EXPECT(s, h->device.backend->input, tx_pointer);
+  if (*model) h->model = TX_READ_EXPECT(s, model, tx_force_model);
+  if (*tool) h->tool = TX_READ_OF(s, tool, tx_pose);
   char name[TX_NAME_MAX];
   snprintf(name, sizeof name, "device%d.pose", hand);
-  h->pose = tx_setup_write(s, &(tx_component_def){name, TX_F64, 1, 7, "m"}); // x y z, qw qx qy qz
+  h->pose = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_pose, 1));
   snprintf(name, sizeof name, "device%d.velocity", hand);
-  h->velocity = tx_setup_write(s, &(tx_component_def){name, TX_F64, 1, 3, "m/s"});
+  h->velocity = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_velocity, 1));
   snprintf(name, sizeof name, "device%d.force", hand);
-  h->force = tx_setup_write(s, &(tx_component_def){name, TX_F64, 1, 3, "N"}); // what was sent
+  h->force = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_force, 1)); // what was sent
   snprintf(name, sizeof name, "device%d.energy", hand);
-  h->energy = tx_setup_write(s, &(tx_component_def){name, TX_F64, 1, 2, "J"}); // observed, dissipated
+  h->energy = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_device_energy, 1));
   static const char* const keys[W_COUNT] = {"force_non_finite", "force_clamped", "force_rate_limited",
                                             "watchdog", "outside_workspace", "device_silent",
                                             "record_dropped"};
@@ -145,22 +149,32 @@ static void warn_new(tx_ctx* c, haptics* h, const tx_safety_counts* before) {
   if (now->workspace > before->workspace) tx_warn(c, h->warn[W_WORKSPACE]);
 }
 
+// a device whose input is in the model gets this tick's row before it is read
+static void feed(tx_ctx* c, haptics* h) {
+  if (!h->input.id) return;
+  tx_snapshot in = tx_read(c, h->input);
+  h->device.backend->feed(h->device.device, in.seq ? in.data : NULL);
+}
+
 // what the rest of the model sees of the device
 static void publish(tx_ctx* c, haptics* h, const double force[3]) {
-  double* pose = tx_write(c, h->pose);
-  memcpy(pose, h->state.pos, 3 * sizeof *pose);
-  memcpy(pose + 3, h->state.quat, 4 * sizeof *pose);
-  memcpy(tx_write(c, h->velocity), h->state.vel, 3 * sizeof(double));
-  memcpy(tx_write(c, h->force), force, 3 * sizeof(double));
-  double* e = tx_write(c, h->energy);
-  e[0] = h->path.passivity.energy;
-  e[1] = h->path.passivity.dissipated;
+  tx_pose* pose = tx_write(c, h->pose);
+  memcpy(pose->pos, h->state.pos, sizeof pose->pos);
+  memcpy(pose->quat, h->state.quat, sizeof pose->quat);
+  tx_velocity* vel = tx_write(c, h->velocity);
+  memcpy(vel->v, h->state.vel, sizeof vel->v);
+  tx_force* sent = tx_write(c, h->force);
+  memcpy(sent->f, force, sizeof sent->f);
+  tx_device_energy* e = tx_write(c, h->energy);
+  e->observed = h->path.passivity.energy;
+  e->dissipated = h->path.passivity.dissipated;
 }
 
 // the device's first sample is published at time 0, so that the controllers
 // that run at time 0 (collision, physics) see where the tool really is
 static int init(tx_ctx* c, void* self) {
   haptics* h = self;
+  feed(c, h);
   if (!h->device.backend->read(h->device.device, 0, &h->state)) h->state.quat[0] = 1;
   const double zero[3] = {0, 0, 0};
   publish(c, h, zero);
@@ -180,18 +194,15 @@ static int init(tx_ctx* c, void* self) {
 static void step(tx_ctx* c, void* self) {
   haptics* h = self;
   const double dt = 1.0 / tx_rate(c), t = (double)tx_sim_ns(c) * 1e-9;
+  feed(c, h);
   if (h->device.backend->read(h->device.device, t, &h->state)) h->silent_s = 0;
   else h->silent_s += dt, tx_warn(c, h->warn[W_SILENT]);
 
   double f[3] = {0, 0, 0}, model_age = 0, stored = 0;
   if (h->model.id) {
     tx_snapshot snap = tx_read(c, h->model);
-    const double* m = snap.data; // f0 (3), x0 (3), K (9)
-    tx_force_model fm;
-    memcpy(fm.f0, m, sizeof fm.f0);
-    memcpy(fm.x0, m + 3, sizeof fm.x0);
-    memcpy(fm.k, m + 6, sizeof fm.k);
-    memcpy(h->rec.force_model, m, sizeof h->rec.force_model);
+    tx_force_model fm = *(const tx_force_model*)snap.data;
+    memcpy(h->rec.force_model, &fm, sizeof h->rec.force_model);
     // seq 0: never published yet (the first tick runs before collision), so
     // there is nothing to render and nothing stale to warn about
     if (snap.seq) {
@@ -202,11 +213,11 @@ static void step(tx_ctx* c, void* self) {
     }
   } else if (h->tool.id) {
     // virtual coupling: a spring-damper pulls the device toward the simulated
-    // tool, which the physics moves; the tool's pose is x y z (then orientation)
+    // tool, which the physics moves
     tx_snapshot snap = tx_read(c, h->tool);
     const double still[3] = {0, 0, 0};
     if (snap.seq) {
-      tx_render_coupling(h->coupling_k, h->coupling_b, snap.data, still, h->state.pos, h->state.vel, f);
+      tx_render_coupling(h->coupling_k, h->coupling_b, ((const tx_pose*)snap.data)->pos, still, h->state.pos, h->state.vel, f);
       model_age = (double)(tx_sim_ns(c) - snap.sim_ns) * 1e-9;
     }
   }

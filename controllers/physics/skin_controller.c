@@ -7,6 +7,8 @@
 
 #include "bullet/cloth.h"
 
+#include <tactus/components.h>
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -84,11 +86,11 @@ static int configure(tx_setup* s, void** self) {
   if (!k->cloth) return tx_setup_fail(s, NULL, "%s", tx_error());
 
   uint32_t n = (uint32_t)tx_cloth_particle_count(k->cloth), m = (uint32_t)tx_cloth_triangle_count(k->cloth);
-  if (k->hip_radius > 0) k->pose = tx_setup_read_as(s, pose, TX_F64, 7);
-  k->x = tx_setup_write(s, &(tx_component_def){"skin.x", TX_F32, n, 3, "m"});
-  k->tri = tx_setup_write(s, &(tx_component_def){"skin.tri", TX_I32, m, 3, "1"});
-  k->thickness = tx_setup_write(s, &(tx_component_def){"skin.thickness", TX_F64, 1, 1, "m"});
-  k->torn = tx_setup_write(s, &(tx_component_def){"skin.torn", TX_I32, 1, 1, "1"});
+  if (k->hip_radius > 0) k->pose = TX_READ_OF(s, pose, tx_pose);
+  k->x = tx_setup_write(s, &TX_COMPONENT_OF("skin.x", tx_vertex, n));
+  k->tri = tx_setup_write(s, &TX_COMPONENT_OF("skin.tri", tx_triangle, m));
+  k->thickness = tx_setup_write(s, &TX_COMPONENT_OF("skin.thickness", tx_thickness, 1));
+  k->torn = tx_setup_write(s, &TX_COMPONENT_OF("skin.torn", tx_torn, 1));
   k->fault = tx_setup_warning(s, "numerical_fault");
   k->bad_pose = tx_setup_warning(s, "bad_pose");
   k->torn_result = tx_setup_result(s, "torn_links");
@@ -97,18 +99,16 @@ static int configure(tx_setup* s, void** self) {
 }
 
 static void publish(tx_ctx* c, skin* k) {
-  float* x = tx_write(c, k->x);
+  float* x = ((tx_vertex*)tx_write(c, k->x))->x; // the cloth fills n x 3 floats: n tx_vertex
   if (!tx_cloth_positions(k->cloth, x)) { // the model must never hold a NaN: a last guard behind the cloth's own
     tx_warn(c, k->fault);
     tx_cloth_restore(k->cloth);
     tx_cloth_positions(k->cloth, x);
   }
-  int32_t* tri = tx_write(c, k->tri);
+  int32_t* tri = ((tx_triangle*)tx_write(c, k->tri))->v; // m x 3 indices: m tx_triangle
   tx_write_rows(c, k->tri, (uint32_t)tx_cloth_triangles(k->cloth, tri));
-  double* h = tx_write(c, k->thickness);
-  h[0] = tx_cloth_get_def(k->cloth)->thickness;
-  int32_t* torn = tx_write(c, k->torn);
-  torn[0] = tx_cloth_torn(k->cloth);
+  ((tx_thickness*)tx_write(c, k->thickness))->m = tx_cloth_get_def(k->cloth)->thickness;
+  ((tx_torn*)tx_write(c, k->torn))->links = tx_cloth_torn(k->cloth);
 }
 
 static int init(tx_ctx* c, void* self) {
@@ -121,8 +121,8 @@ static void step(tx_ctx* c, void* self) {
   if (k->pose.id) {
     tx_snapshot p = tx_read(c, k->pose);
     if (p.seq > 0) { // nothing published yet: the HIP waits
-      const double* pose = p.data;
-      if (tx_cloth_set_hip(k->cloth, pose, k->hip_radius) != TX_CLOTH_OK) tx_warn(c, k->bad_pose);
+      const tx_pose* pose = p.data;
+      if (tx_cloth_set_hip(k->cloth, pose->pos, k->hip_radius) != TX_CLOTH_OK) tx_warn(c, k->bad_pose);
     }
   }
   if (tx_cloth_step(k->cloth, k->dt) == TX_CLOTH_FAULT) tx_warn(c, k->fault);

@@ -10,6 +10,8 @@
 // events contact, puncture, retract and exit.
 #include "needle_controller.h"
 
+#include <tactus/components.h>
+
 #include "guard.h"
 #include "needle.h"
 #include "recording.h"
@@ -128,13 +130,12 @@ static int configure(tx_setup* s, void** self) {
   }
   c->ready = true;
   const uint32_t n = (uint32_t)c->tissue.n;
-  c->pose = tx_setup_read_as(s, pose, TX_F64, 7); // x y z, qw qx qy qz
-  c->model = tx_setup_write(s, &(tx_component_def){model, TX_F64, 1, 15, "N, m, N/m"});
-  c->spheres = tx_setup_write(s, &(tx_component_def){"tissue.spheres", TX_F32, n, 4, "m"});
-  c->damage = tx_setup_write(s, &(tx_component_def){"tissue.damage", TX_F32, n, 1, "1"});
-  c->segment = tx_setup_write(s, &(tx_component_def){"needle.segments", TX_F32, 1, 7, "m"});
-  // eq. 9 apart: the force, then stiffness, friction and cutting (N), then the depth (m)
-  c->force = tx_setup_write(s, &(tx_component_def){"needle.force", TX_F64, 1, 13, "N, m"});
+  c->pose = TX_READ_OF(s, pose, tx_pose);
+  c->model = tx_setup_write(s, &TX_COMPONENT_OF(model, tx_force_model, 1));
+  c->spheres = tx_setup_write(s, &TX_COMPONENT_OF("tissue.spheres", tx_sphere, n));
+  c->damage = tx_setup_write(s, &TX_COMPONENT_OF("tissue.damage", tx_damage, n));
+  c->segment = tx_setup_write(s, &TX_COMPONENT_OF("needle.segments", tx_segment, 1));
+  c->force = tx_setup_write(s, &TX_COMPONENT_OF("needle.force", tx_needle_force, 1)); // eq. 9 apart
   static const char* const keys[W_COUNT] = {"recovered", "voxel_faults", "neighbour_overflow", "record_full"};
   for (int w = 0; w < W_COUNT; w++) c->warn[w] = tx_setup_warning(s, keys[w]);
   c->peak_result = tx_setup_result(s, "peak_force_n");
@@ -145,43 +146,43 @@ static int configure(tx_setup* s, void** self) {
 
 static void publish_drawables(tx_ctx* ctx, needle_ctl* c) {
   const tx_voxel_tissue* t = &c->tissue;
-  float* sp = tx_write(ctx, c->spheres);
-  float* dm = tx_write(ctx, c->damage);
+  tx_sphere* sp = tx_write(ctx, c->spheres);
+  tx_damage* dm = tx_write(ctx, c->damage);
   for (int i = 0; i < t->n; i++) {
-    for (int a = 0; a < 3; a++) sp[4 * i + a] = (float)t->pos[3 * i + a];
-    sp[4 * i + 3] = (float)t->radius[i];
-    dm[i] = (float)t->damage[i];
+    for (int a = 0; a < 3; a++) sp[i].c[a] = (float)t->pos[3 * i + a];
+    sp[i].r = (float)t->radius[i];
+    dm[i].d = (float)t->damage[i];
   }
   const tx_voxel_needle* nd = &c->needle;
-  float* seg = tx_write(ctx, c->segment);
+  tx_segment* seg = tx_write(ctx, c->segment);
   for (int a = 0; a < 3; a++) {
-    seg[a] = (float)(nd->tip1[a] - nd->def.length * nd->dir[a]);
-    seg[3 + a] = (float)nd->tip1[a];
+    seg->a[a] = (float)(nd->tip1[a] - nd->def.length * nd->dir[a]);
+    seg->b[a] = (float)nd->tip1[a];
   }
-  seg[6] = (float)nd->radius;
+  seg->r = (float)nd->radius;
 }
 
 static void publish_forces(tx_ctx* ctx, needle_ctl* c) {
   const tx_voxel_needle* nd = &c->needle;
-  double* m = tx_write(ctx, c->model); // f0 (3), x0 (3), K (9)
-  memcpy(m, nd->force, 3 * sizeof *m);
-  memcpy(m + 3, nd->tip1, 3 * sizeof *m);
+  tx_force_model* m = tx_write(ctx, c->model);
+  memcpy(m->f0, nd->force, sizeof m->f0);
+  memcpy(m->x0, nd->tip1, sizeof m->x0);
   double k = fmin(nd->k_axial, c->max_stiffness);
   for (int r = 0; r < 3; r++)
-    for (int col = 0; col < 3; col++) m[6 + 3 * r + col] = -k * nd->dir[r] * nd->dir[col];
-  double* f = tx_write(ctx, c->force);
-  memcpy(f, nd->force, 3 * sizeof *f);
-  memcpy(f + 3, nd->stiffness, 3 * sizeof *f);
-  memcpy(f + 6, nd->friction, 3 * sizeof *f);
-  memcpy(f + 9, nd->cutting, 3 * sizeof *f);
-  f[12] = tx_voxel_needle_depth(nd, &c->tissue);
+    for (int col = 0; col < 3; col++) m->k[3 * r + col] = -k * nd->dir[r] * nd->dir[col];
+  tx_needle_force* f = tx_write(ctx, c->force);
+  memcpy(f->total, nd->force, sizeof f->total);
+  memcpy(f->stiffness, nd->stiffness, sizeof f->stiffness);
+  memcpy(f->friction, nd->friction, sizeof f->friction);
+  memcpy(f->cutting, nd->cutting, sizeof f->cutting);
+  f->depth = tx_voxel_needle_depth(nd, &c->tissue);
 }
 
 static int init(tx_ctx* ctx, void* self) {
   needle_ctl* c = self;
   // the needle is placed by the first step's pose (haptics publishes it at time 0)
   tx_snapshot pose = tx_read(ctx, c->pose);
-  if (pose.seq) memcpy(c->needle.tip1, pose.data, sizeof c->needle.tip1);
+  if (pose.seq) memcpy(c->needle.tip1, ((const tx_pose*)pose.data)->pos, sizeof c->needle.tip1);
   publish_forces(ctx, c);
   publish_drawables(ctx, c);
   if (c->record && tx_record_dir(ctx)) {
@@ -197,11 +198,11 @@ static int init(tx_ctx* ctx, void* self) {
 static void step(tx_ctx* ctx, void* self) {
   needle_ctl* c = self;
   const double dt = 1.0 / tx_rate(ctx);
-  const double* pose = tx_read(ctx, c->pose).data;
+  const tx_pose* pose = tx_read(ctx, c->pose).data;
   bool was_punctured = c->needle.punctured;
   int was_contacts = c->needle.contacts;
   double was_in = c->inward; // m/s, the needle's speed along its axis over the last frame
-  if (!tx_voxel_needle_step(&c->needle, &c->tissue, pose, pose + 3, dt)) {
+  if (!tx_voxel_needle_step(&c->needle, &c->tissue, pose->pos, pose->quat, dt)) {
     tx_warn(ctx, c->warn[W_RECOVERED]); // a non-finite pose: hold the last force model
     return;
   }

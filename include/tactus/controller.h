@@ -12,6 +12,9 @@
 //              it may block (flush a recording), the run is over
 //   fini       frees what configure and init made
 //
+// A class with .view = true is a view: it reads the model and never writes
+// it. The loader refuses a view that declares a write, naming the controller.
+//
 // No step may allocate, lock or block: the haptic thread shares nothing that
 // waits. Parameters are declared in the class's table (key, kind, units,
 // range, default, meaning); configure reads them with tx_table_*, which take
@@ -102,6 +105,9 @@ typedef struct tx_controller_class {
   // others (a device loop: no other step may delay it). Classes whose type
   // starts with "haptics" always do.
   bool own_thread;
+  // a view only reads the model (plots, graphics, recordings): the loader
+  // refuses a view that declares a write with tx_setup_write
+  bool view;
 } tx_controller_class;
 
 // registry; returns 0, or -1 for a bad class (a bad parameter table
@@ -156,6 +162,10 @@ bool tx_param_bool(tx_setup* s, const char* key, bool def);
 const char* tx_param_str(tx_setup* s, const char* key, const char* def); // valid until fini
 // a list of strings; returns how many (<= max) and fills out (valid until fini)
 int tx_param_strs(tx_setup* s, const char* key, const char** out, int max);
+// a parameter of any kind (an object, a list, ...) as compact JSON text, for a
+// controller that parses a structured parameter itself; valid until fini;
+// NULL when absent (or after an error)
+const char* tx_param_json_text(tx_setup* s, const char* key);
 // flag an error at params.KEY (or at the instance when key is NULL); returns -1
 int tx_setup_fail(tx_setup* s, const char* key, const char* fmt, ...)
     __attribute__((format(printf, 3, 4)));
@@ -174,6 +184,7 @@ uint64_t tx_step_index(const tx_ctx* c);             // 0 for the first step
 double tx_rate(const tx_ctx* c);                     // Hz
 void tx_warn(tx_ctx* c, tx_warning w);               // count one occurrence, lock-free
 const char* tx_record_dir(const tx_ctx* c);          // where this run keeps recordings, or NULL
+const char* tx_output_dir(const tx_ctx* c);          // where this run writes its outputs (frames, plots), or NULL
 void tx_set_result(tx_ctx* c, tx_result r, double value); // the last value set is reported (set it in finish)
 // end the run at once for a fault the controller cannot recover from (a full
 // disk, a lost file); every thread stops at its next tick, finish still runs,

@@ -32,9 +32,9 @@ extern "C" {
 // what happened; a stream's writer documents which kinds it sends and what
 // source and value mean for each
 typedef enum tx_event_kind {
-  TX_EVENT_GRASP = 1, // jaws closed on something: source = instrument, value = contact point (m)
+  TX_EVENT_GRASP = 1, // jaws closed on something: source = instrument, payload .grasp
   TX_EVENT_RELEASE,   // jaws opened: source = instrument
-  TX_EVENT_PUNCTURE,  // a surface was pierced: source = surface element, value = point (m)
+  TX_EVENT_PUNCTURE,  // a surface was pierced: source = surface element, payload .puncture
   TX_EVENT_CUT,       // something was cut: source = element (thread node, link)
   TX_EVENT_BURN,      // tissue reached a damage temperature: source = node, value[0] = K
   TX_EVENT_KNOT,      // a knot formed or was fixed: source = knot index
@@ -42,14 +42,39 @@ typedef enum tx_event_kind {
   TX_EVENT_USER = 1000 // kinds of plugins start here
 } tx_event_kind;
 
+// the payloads of the kinds that carry more than a source; each is read and
+// written through the tx_event union below, never by position in value[]
+typedef struct tx_grasp_payload { // TX_EVENT_GRASP, source = instrument
+  double point[3]; // m, the contact point between the jaws, world frame
+  double jaw;      // rad, the jaws' opening angle when they closed on it
+  double force;    // N, grip force at the grasp (0 when the instrument cannot tell)
+} tx_grasp_payload;
+typedef struct tx_puncture_payload { // TX_EVENT_PUNCTURE, source = surface element
+  double point[3]; // m, where the surface was pierced, world frame
+  double force;    // N, the axial force that pierced it
+  double depth;    // m, the tip's depth below the surface at the puncture
+} tx_puncture_payload;
+
 typedef struct tx_event {
   uint64_t seq;     // set by the push: 1, 2, ... per stream; a gap means events were lost
   int64_t sim_ns;   // simulation time of the step that sent it, ns
   uint32_t kind;    // a tx_event_kind
   uint32_t source;  // which instrument, node, element or step (per kind)
-  double value[5];  // payload (per kind), SI units
+  union {           // payload (per kind), SI units
+    double value[5];             // kinds without a payload struct (e.g. TX_EVENT_BURN: value[0] = K)
+    tx_grasp_payload grasp;      // TX_EVENT_GRASP
+    tx_puncture_payload puncture; // TX_EVENT_PUNCTURE
+  };
 } tx_event;
+#ifdef __cplusplus
+static_assert(sizeof(tx_event) == 64, "one event is one cache line");
+static_assert(sizeof(tx_grasp_payload) <= 5 * sizeof(double), "a grasp fits in an event");
+static_assert(sizeof(tx_puncture_payload) <= 5 * sizeof(double), "a puncture fits in an event");
+#else
 _Static_assert(sizeof(tx_event) == 64, "one event is one cache line");
+_Static_assert(sizeof(tx_grasp_payload) <= 5 * sizeof(double), "a grasp fits in an event");
+_Static_assert(sizeof(tx_puncture_payload) <= 5 * sizeof(double), "a puncture fits in an event");
+#endif
 
 typedef struct tx_stream tx_stream;
 

@@ -12,6 +12,7 @@
 
 #include "../../controllers/stats.h"
 
+#include <tactus/components.h>
 #include <tactus/config.h>
 
 #include <stdio.h>
@@ -44,7 +45,7 @@ static int script_configure(tx_setup* s, void** self) {
   script* k = calloc(1, sizeof *k);
   if (!k) return -1;
   *self = k;
-  k->pose = tx_setup_write(s, &(tx_component_def){"device0.pose", TX_F64, 1, 7, "m, 1"});
+  k->pose = tx_setup_write(s, &TX_COMPONENT_OF("device0.pose", tx_pose, 1));
   return 0;
 }
 static void script_step(tx_ctx* c, void* self) {

@@ -4,6 +4,7 @@
 #include "bench_render.h"
 #include "command.h"
 
+#include <tactus/components.h>
 #include <tactus/config.h>
 
 #include <math.h>
@@ -37,9 +38,9 @@ static int skin_configure(tx_setup* s, void** self) {
   k->spacing = tx_table_num(s, "spacing_m");
   k->voxels = (int)tx_table_int(s, "voxels");
   const uint32_t n = (uint32_t)(k->side * k->side), m = (uint32_t)(2 * (k->side - 1) * (k->side - 1));
-  k->x = tx_setup_write(s, &(tx_component_def){"skin.x", TX_F32, n, 3, "m"});
-  k->tri = tx_setup_write(s, &(tx_component_def){"skin.tri", TX_I32, m, 3, "1"});
-  k->ball = tx_setup_write(s, &(tx_component_def){"ball.spheres", TX_F32, (uint32_t)k->voxels, 4, "m"});
+  k->x = tx_setup_write(s, &TX_COMPONENT_OF("skin.x", tx_vertex, n));
+  k->tri = tx_setup_write(s, &TX_COMPONENT_OF("skin.tri", tx_triangle, m));
+  k->ball = tx_setup_write(s, &TX_COMPONENT_OF("ball.spheres", tx_sphere, (uint32_t)k->voxels));
   return 0;
 }
 

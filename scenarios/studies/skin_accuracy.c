@@ -25,6 +25,7 @@
 #include "../../views/plot.h"
 #include "../../views/report.h"
 
+#include <tactus/components.h>
 #include <tactus/config.h>
 
 #include <jansson.h>
@@ -57,18 +58,18 @@ static int recorder_configure(tx_setup* s, void** self) {
   recorder* r = calloc(1, sizeof *r);
   if (!r) return -1;
   *self = r;
-  r->pose = tx_setup_read_as(s, "device0.pose", TX_F64, 7);
-  r->force = tx_setup_read_as(s, "device0.force", TX_F64, 3);
+  r->pose = TX_READ_OF(s, "device0.pose", tx_pose);
+  r->force = TX_READ_OF(s, "device0.force", tx_force);
   return 0;
 }
 
 static void recorder_step(tx_ctx* c, void* self) {
   recorder* r = self;
-  const double* p = tx_read(c, r->pose).data;
-  const double* f = tx_read(c, r->force).data;
+  const tx_pose* p = tx_read(c, r->pose).data;
+  const tx_force* f = tx_read(c, r->force).data;
   if (recording && recording->n < TICKS_MAX) {
-    recording->y[recording->n] = p[1];
-    recording->f[recording->n] = f[1];
+    recording->y[recording->n] = p->pos[1];
+    recording->f[recording->n] = f->f[1];
     recording->n++;
   }
 }
@@ -76,6 +77,7 @@ static void recorder_step(tx_ctx* c, void* self) {
 static void recorder_fini(void* self) { free(self); }
 
 static const tx_controller_class recorder_class = {.type = "study.force_recorder",
+                                                   .view = true,
                                                    .summary = "keeps device0.pose y and device0.force y per tick",
                                                    .configure = recorder_configure,
                                                    .step = recorder_step,

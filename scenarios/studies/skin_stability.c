@@ -15,6 +15,7 @@
 #include "../command/command.h"
 #include "../../views/report.h"
 
+#include <tactus/components.h>
 #include <tactus/config.h>
 
 #include <jansson.h>
@@ -38,9 +39,9 @@ static int guard_configure(tx_setup* s, void** self) {
   guard* g = calloc(1, sizeof *g);
   if (!g) return -1;
   *self = g;
-  g->x = tx_setup_read_as(s, "skin.x", TX_F32, 3);
-  g->model = tx_setup_read_as(s, "tool0.force_model", TX_F64, 15);
-  g->force = tx_setup_read_as(s, "device0.force", TX_F64, 3);
+  g->x = TX_READ_OF(s, "skin.x", tx_vertex);
+  g->model = TX_READ_OF(s, "tool0.force_model", tx_force_model);
+  g->force = TX_READ_OF(s, "device0.force", tx_force);
   g->r_nan = tx_setup_result(s, "nan_values");
   g->r_force = tx_setup_result(s, "max_device_force_N");
   g->r_model = tx_setup_result(s, "max_model_force_N");
@@ -54,15 +55,17 @@ static void guard_step(tx_ctx* c, void* self) {
   tx_snapshot x = tx_read(c, g->x);
   if (x.seq != g->x_seq) { // a new skin: every coordinate
     g->x_seq = x.seq;
-    const float* p = x.data;
-    for (uint32_t i = 0; i < x.rows * 3; i++) g->nan_values += !isfinite(p[i]);
+    const tx_vertex* p = x.data;
+    for (uint32_t i = 0; i < x.rows; i++)
+      for (int a = 0; a < 3; a++) g->nan_values += !isfinite(p[i].x[a]);
   }
-  const double* m = tx_read(c, g->model).data;
-  for (int i = 0; i < 15; i++) g->nan_values += !isfinite(m[i]);
-  const double* f = tx_read(c, g->force).data;
-  for (int i = 0; i < 3; i++) g->nan_values += !isfinite(f[i]);
-  if (norm3(f) > g->max_force) g->max_force = norm3(f);
-  if (norm3(m) > g->max_model_force) g->max_model_force = norm3(m);
+  const tx_force_model* m = tx_read(c, g->model).data;
+  const double* every = &m->f0[0]; // each of the model's values, whatever it means
+  for (size_t i = 0; i < tx_force_model_COLS; i++) g->nan_values += !isfinite(every[i]);
+  const tx_force* f = tx_read(c, g->force).data;
+  for (int i = 0; i < 3; i++) g->nan_values += !isfinite(f->f[i]);
+  if (norm3(f->f) > g->max_force) g->max_force = norm3(f->f);
+  if (norm3(m->f0) > g->max_model_force) g->max_model_force = norm3(m->f0);
 }
 
 static void guard_finish(tx_ctx* c, void* self) {
@@ -76,6 +79,7 @@ static void guard_fini(void* self) { free(self); }
 
 static const tx_controller_class guard_class = {
     .type = "study.skin_guard",
+    .view = true,
     .summary = "counts non-finite values in skin.x, tool0.force_model, device0.force; largest forces",
     .configure = guard_configure,
     .step = guard_step,

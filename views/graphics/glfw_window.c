@@ -1,8 +1,10 @@
 // A GLFW window: GL 3.3 core context, quad-buffer stereo when offered, and
-// mouse and keyboard input for the `mouse` device.
+// mouse and keyboard input for the `mouse` device (through window_input.h).
 #include "glfw_window.h"
 
-#include "../../controllers/haptics/device_mouse.h"
+#include "window_input.h"
+
+#include <tactus/components.h>
 
 #include <GLFW/glfw3.h>
 #include <math.h>
@@ -29,7 +31,7 @@ static void on_error(int code, const char* text) {
   snprintf(glfw_error, sizeof glfw_error, "%s", text);
 }
 
-static void publish(tx_window* t) { tx_mouse_input_set(t->tool, t->buttons); }
+static void publish(tx_window* t) { tx_window_input_set(t->tool, t->buttons); }
 
 static void on_button(GLFWwindow* w, int button, int action, int mods) {
   (void)mods;
@@ -80,7 +82,7 @@ static void on_key(GLFWwindow* w, int key, int scancode, int action, int mods) {
   case GLFW_KEY_E: t->tool[1] -= KEY_M; break;
   default: break;
   }
-  for (int i = 0; i < 3; i++) t->tool[i] = fmax(-TX_MOUSE_WORKSPACE_M, fmin(TX_MOUSE_WORKSPACE_M, t->tool[i]));
+  for (int i = 0; i < 3; i++) t->tool[i] = fmax(-TX_POINTER_REACH_M, fmin(TX_POINTER_REACH_M, t->tool[i]));
   publish(t);
 }
 

@@ -7,15 +7,13 @@
 #include "stereo_frame.h"
 #include "view_def.h"
 
-#include "../../controllers/system.h"
-
+#include <tactus/components.h>
 #include <tactus/config.h>
 
 #if TX_WITH_OSMESA
 #include "osmesa_target.h"
 #endif
 #if TX_WITH_GLFW
-#include "../../controllers/haptics/device_mouse.h"
 #include "glfw_window.h"
 #include "overlay.h"
 #endif
@@ -74,9 +72,12 @@ typedef struct view {
   tx_ctx* ctx;                          // the step's context, for warnings from the renderer
 } view;
 
+// the layouts of <tactus/components.h> that the renderer draws, by name suffix
+#define KIND(suffix, T) {suffix, T##_TYPE, T##_COLS}
 static const struct { const char* suffix; tx_type type; uint32_t cols; } kinds[] = {
-    {".x", TX_F32, 3}, {".tri", TX_I32, 3}, {".spheres", TX_F32, 4}, {".segments", TX_F32, 7},
-    {".pose", TX_F64, 7}, {".force", TX_F64, 3}};
+    KIND(".x", tx_vertex), KIND(".tri", tx_triangle), KIND(".spheres", tx_sphere), KIND(".segments", tx_segment),
+    KIND(".pose", tx_pose), KIND(".force", tx_force)};
+#undef KIND
 
 // the type and width a drawn component must have: by its suffix, and scalars are f32 N x 1
 static void schema_of(const tx_draw_item* it, const char* comp, tx_type* type, uint32_t* cols) {
@@ -104,7 +105,7 @@ static int configure(tx_setup* s, void** self) {
   if (!v) return -1;
   *self = v;
   v->def = tx_view_def_default();
-  json_t* vj = tx_param_json(s, "view");
+  const char* vj = tx_param_json_text(s, "view");
   const char* target = tx_table_str(s, "target");
   const char* stereo = tx_table_str(s, "stereo_mode");
   v->wait = tx_table_bool(s, "wait");
@@ -119,7 +120,7 @@ static int configure(tx_setup* s, void** self) {
     return tx_setup_fail(s, "stereo_mode", "expected mono, sbs, tb, anaglyph or lr, got \"%s\"", stereo);
   if (vj) {
     char key[128], msg[300];
-    if (tx_view_def_from_json(vj, &v->def, key, sizeof key, msg, sizeof msg))
+    if (tx_view_def_from_text(vj, &v->def, key, sizeof key, msg, sizeof msg))
       return tx_setup_fail(s, "view", "%s: %s", key, msg);
   }
   if (v->def.nitems == 0 && tx_view_def_auto_draw(&v->def, avail, navail) == 0)
@@ -602,4 +603,5 @@ const tx_controller_class tx_graphics_view = {
     .finish = finish,
     .params = params,
     .nparams = TX_PARAMS_COUNT(params),
+    .view = true,
 };

@@ -1,6 +1,8 @@
 // GL 3.3 core drawing of meshes, spheres, cylinders, tools and planes.
 #include "renderer.h"
 
+#include <tactus/components.h>
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -536,52 +538,54 @@ void tx_renderer_upload(tx_renderer* r, const tx_scene* s) {
       break;
     }
     case TX_DRAW_SPHERES: {
-      const float* sp = si->data[0];
+      const tx_sphere* sp = si->data[0];
       const float* scalar = *it->scalar ? si->data[1] : NULL;
       uint32_t nscalar = *it->scalar ? si->rows[1] : 0;
       for (uint32_t i = 0; i < si->rows[0]; i++) {
-        if (!finite_n(sp + 4 * i, 4) || !(sp[4 * i + 3] > 0)) {
+        if (!finite_n(sp[i].c, 3) || !isfinite(sp[i].r) || !(sp[i].r > 0)) {
           r->skipped++;
           continue;
         }
         if (it->has_cut) { // cut away: not drawn, and not an error
-          const float* c = sp + 4 * i;
+          const float* c = sp[i].c;
           float side = (c[0] - it->cut[0]) * it->cut[3] + (c[1] - it->cut[1]) * it->cut[4] + (c[2] - it->cut[2]) * it->cut[5];
           if (side > 0) continue;
         }
         float colour[3];
         scalar_colour(it, scalar, nscalar, i, colour);
-        add_sphere(r, sp + 4 * i, sp[4 * i + 3], colour);
+        add_sphere(r, sp[i].c, sp[i].r, colour);
       }
       break;
     }
     case TX_DRAW_SEGMENTS: {
-      const float* sg = si->data[0];
+      const tx_segment* sg = si->data[0];
       const float* scalar = *it->scalar ? si->data[1] : NULL;
       uint32_t nscalar = *it->scalar ? si->rows[1] : 0;
       for (uint32_t i = 0; i < si->rows[0]; i++) {
-        if (!finite_n(sg + 7 * i, 7) || !(sg[7 * i + 6] > 0)) {
+        if (!finite_n(sg[i].a, 3) || !finite_n(sg[i].b, 3) || !isfinite(sg[i].r) || !(sg[i].r > 0)) {
           r->skipped++;
           continue;
         }
         float colour[3];
         scalar_colour(it, scalar, nscalar, i, colour);
-        add_cylinder(r, sg + 7 * i, sg + 7 * i + 3, sg[7 * i + 6], colour);
+        add_cylinder(r, sg[i].a, sg[i].b, sg[i].r, colour);
       }
       break;
     }
     case TX_DRAW_TOOL: {
-      const double* pose = si->data[0];
+      const tx_pose* pose = si->data[0];
       if (!si->rows[0]) break;
       bool ok = true;
-      for (int c = 0; c < 7; c++) ok = ok && isfinite(pose[c]);
-      double qn = sqrt(pose[3] * pose[3] + pose[4] * pose[4] + pose[5] * pose[5] + pose[6] * pose[6]);
+      for (int c = 0; c < 3; c++) ok = ok && isfinite(pose->pos[c]);
+      for (int c = 0; c < 4; c++) ok = ok && isfinite(pose->quat[c]);
+      const double* pq = pose->quat;
+      double qn = sqrt(pq[0] * pq[0] + pq[1] * pq[1] + pq[2] * pq[2] + pq[3] * pq[3]);
       if (!ok || !(qn > 1e-9)) {
         r->skipped++;
         break;
       }
-      double q[4] = {pose[3] / qn, pose[4] / qn, pose[5] / qn, pose[6] / qn};
-      float p[3] = {(float)pose[0], (float)pose[1], (float)pose[2]};
+      double q[4] = {pq[0] / qn, pq[1] / qn, pq[2] / qn, pq[3] / qn};
+      float p[3] = {(float)pose->pos[0], (float)pose->pos[1], (float)pose->pos[2]};
       add_sphere(r, p, it->radius, it->colour);
       // the instrument's shaft leaves the HIP along the tool's own +Y axis
       const float axis[3] = {0, 16 * it->radius, 0}, grey[3] = {0.7f, 0.72f, 0.75f};
@@ -590,10 +594,10 @@ void tx_renderer_upload(tx_renderer* r, const tx_scene* s) {
       for (int c = 0; c < 3; c++) tip[c] = p[c] + a[c];
       add_cylinder(r, p, tip, 0.35f * it->radius, grey);
       if (it->show_force && si->rows[1]) {
-        const double* f = si->data[1];
+        const tx_force* f = si->data[1];
         float end[3];
         const float yellow[3] = {0.95f, 0.85f, 0.1f};
-        for (int c = 0; c < 3; c++) end[c] = p[c] + (float)f[c] * it->force_scale;
+        for (int c = 0; c < 3; c++) end[c] = p[c] + (float)f->f[c] * it->force_scale;
         if (finite_n(end, 3)) add_cylinder(r, p, end, 0.45f * it->radius, yellow); // wider than the shaft it may run along
       }
       break;

@@ -293,6 +293,15 @@ int tx_view_def_from_json(const json_t* view, tx_view_def* d, char* key, size_t 
   return 0;
 }
 
+int tx_view_def_from_text(const char* text, tx_view_def* d, char* key, size_t kn, char* msg, size_t mn) {
+  json_error_t e;
+  json_t* view = text ? json_loads(text, JSON_DECODE_ANY, &e) : NULL;
+  if (!view) return bad(&(where){key, kn, msg, mn}, "", "not JSON: %s", text ? e.text : "no text");
+  int rc = tx_view_def_from_json(view, d, key, kn, msg, mn);
+  json_decref(view);
+  return rc;
+}
+
 static bool has(const char* const* written, int count, const char* name) {
   for (int i = 0; i < count; i++)
     if (strcmp(written[i], name) == 0) return true;

@@ -140,11 +140,29 @@ static void automatic_draw_list(void** state) {
   assert_int_equal(tx_view_def_auto_draw(&d, none, 2), 0);
 }
 
+// the graphics view gets "view" as text (tx_param_json_text): the same rules, and text that is not JSON is an error
+static void from_text(void** state) {
+  (void)state;
+  char key[128], msg[256];
+  tx_view_def d = tx_view_def_default();
+  assert_int_equal(tx_view_def_from_text("{\"width\":320,\"camera\":{\"fov_deg\":30}}", &d, key, 128, msg, 256), 0);
+  assert_int_equal(d.width, 320);
+  assert_true(fabs(d.camera.fov_y - 30 * M_PI / 180) < 1e-12);
+  d = tx_view_def_default();
+  assert_int_equal(tx_view_def_from_text("{\"width\":-1}", &d, key, 128, msg, 256), -1);
+  assert_string_equal(key, "width");
+  assert_int_equal(tx_view_def_from_text("{\"width\":", &d, key, 128, msg, 256), -1);
+  assert_non_null(strstr(msg, "not JSON"));
+  assert_int_equal(tx_view_def_from_text("[1]", &d, key, 128, msg, 256), -1);
+  assert_non_null(strstr(msg, "expected an object"));
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(full_view),
       cmocka_unit_test(errors_name_the_key),
       cmocka_unit_test(automatic_draw_list),
+      cmocka_unit_test(from_text),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,0 +1,227 @@
+// tactus/components.h: the layout of every component that crosses controllers.
+//
+// A controller that writes a component another controller reads makes its
+// definition from the layout, and every reader asks for the same layout, so
+// the two cannot disagree: the loader refuses a reader whose type or columns
+// differ from the writer's (and, with TX_READ_EXPECT, whose units differ).
+// One row of a component is one struct; a component of N rows is an array of
+// N structs. Nobody indexes another controller's data by number.
+//
+//     // writer, in configure
+//     h->pose = tx_setup_write(s, &TX_COMPONENT_OF("device0.pose", tx_pose, 1));
+//     // reader, in configure
+//     c->pose = TX_READ_OF(s, "device0.pose", tx_pose);
+//     // step
+//     const tx_pose* p = tx_read(ctx, c->pose).data;
+//     tx_pose* out = tx_write(ctx, h->pose);
+//
+// Each layout T comes with T_TYPE (element type), T_COLS (values per row,
+// checked against sizeof(T) at compile time) and T_UNITS (as the writer
+// spells them). Units are SI; frames are the world's (right-handed, Y up).
+#ifndef TACTUS_COMPONENTS_H
+#define TACTUS_COMPONENTS_H
+
+#include <tactus/haptics.h> // tx_force_model
+#include <tactus/model.h>
+
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#define TX_LAYOUT_ASSERT(T, elem) static_assert(sizeof(T) == T##_COLS * sizeof(elem), #T " is " #T "_COLS values")
+#else
+#define TX_LAYOUT_ASSERT(T, elem) _Static_assert(sizeof(T) == T##_COLS * sizeof(elem), #T " is " #T "_COLS values")
+#endif
+
+// the definition of a component of `rows` rows of layout T, named `name`
+#define TX_COMPONENT_OF(name, T, rows) ((tx_component_def){(name), T##_TYPE, (rows), T##_COLS, T##_UNITS})
+// a read that the loader checks against layout T (type and columns)
+#define TX_READ_OF(s, name, T) tx_setup_read_as((s), (name), T##_TYPE, T##_COLS)
+// the same, and the writer's units must be T's
+#define TX_READ_EXPECT(s, name, T) tx_setup_read_expect((s), (name), T##_TYPE, T##_COLS, T##_UNITS)
+
+// --- the device and the tool -------------------------------------------------
+
+// DEVICE.pose (1 row), written by haptics, read by collision, physics, views
+typedef struct tx_pose {
+  double pos[3];  // tool point, m
+  double quat[4]; // orientation, unit quaternion (w, x, y, z)
+} tx_pose;
+#define tx_pose_TYPE TX_F64
+#define tx_pose_COLS 7u
+#define tx_pose_UNITS "m"
+TX_LAYOUT_ASSERT(tx_pose, double);
+
+// DEVICE.velocity (1 row), written by haptics
+typedef struct tx_velocity {
+  double v[3]; // linear velocity of the tool point, m/s
+} tx_velocity;
+#define tx_velocity_TYPE TX_F64
+#define tx_velocity_COLS 3u
+#define tx_velocity_UNITS "m/s"
+TX_LAYOUT_ASSERT(tx_velocity, double);
+
+// DEVICE.force (1 row), written by haptics: the force sent, after every safety stage
+typedef struct tx_force {
+  double f[3]; // N, on the hand
+} tx_force;
+#define tx_force_TYPE TX_F64
+#define tx_force_COLS 3u
+#define tx_force_UNITS "N"
+TX_LAYOUT_ASSERT(tx_force, double);
+
+// DEVICE.energy (1 row), written by haptics: the passivity observer
+typedef struct tx_device_energy {
+  double observed;   // J, energy the port has taken in (negative: it gave energy out)
+  double dissipated; // J, taken out by the passivity controller's damping
+} tx_device_energy;
+#define tx_device_energy_TYPE TX_F64
+#define tx_device_energy_COLS 2u
+#define tx_device_energy_UNITS "J"
+TX_LAYOUT_ASSERT(tx_device_energy, double);
+
+// TOOL.force_model (1 row), written by collision, read by haptics; the struct
+// is tx_force_model of <tactus/haptics.h>
+#define tx_force_model_TYPE TX_F64
+#define tx_force_model_COLS TX_FORCE_MODEL_COLS
+#define tx_force_model_UNITS TX_FORCE_MODEL_UNITS
+TX_LAYOUT_ASSERT(tx_force_model, double);
+
+// --- the haptic interaction point (collision.hip) ----------------------------
+
+// HIP.state (1 row), written by collision.hip, read by view.force_curve
+typedef struct tx_hip_state {
+  double contacts; // rays in contact this step (a count)
+  double pierced;  // 1 while the HIP is through the skin, else 0
+  double f[3];     // N, the force of this step's query (eq. 8)
+  double depth;    // m, deepest ray penetration
+  double resets;   // eq. 8 updates of the anchor so far (a count)
+  double skin_t;   // s, simulation time of the skin publish the query used (0: none)
+} tx_hip_state;
+#define tx_hip_state_TYPE TX_F64
+#define tx_hip_state_COLS 8u
+#define tx_hip_state_UNITS "1, N, m, s"
+TX_LAYOUT_ASSERT(tx_hip_state, double);
+
+// *.spheres (N rows), drawn by the graphics view: the HIP, voxels
+typedef struct tx_sphere {
+  float c[3]; // centre, m
+  float r;    // radius, m
+} tx_sphere;
+#define tx_sphere_TYPE TX_F32
+#define tx_sphere_COLS 4u
+#define tx_sphere_UNITS "m"
+TX_LAYOUT_ASSERT(tx_sphere, float);
+
+// --- surfaces (skin) ---------------------------------------------------------
+
+// SKIN.x (N rows), written by physics, read by collision and views
+typedef struct tx_vertex {
+  float x[3]; // position, m
+} tx_vertex;
+#define tx_vertex_TYPE TX_F32
+#define tx_vertex_COLS 3u
+#define tx_vertex_UNITS "m"
+TX_LAYOUT_ASSERT(tx_vertex, float);
+
+// SKIN.tri (M rows, those in use are the live triangles)
+typedef struct tx_triangle {
+  int32_t v[3]; // indices into SKIN.x, counter-clockwise seen from outside
+} tx_triangle;
+#define tx_triangle_TYPE TX_I32
+#define tx_triangle_COLS 3u
+#define tx_triangle_UNITS "1"
+TX_LAYOUT_ASSERT(tx_triangle, int32_t);
+
+// SKIN.thickness (1 row)
+typedef struct tx_thickness {
+  double m; // m, the collision thickness of the surface
+} tx_thickness;
+#define tx_thickness_TYPE TX_F64
+#define tx_thickness_COLS 1u
+#define tx_thickness_UNITS "m"
+TX_LAYOUT_ASSERT(tx_thickness, double);
+
+// SKIN.torn (1 row)
+typedef struct tx_torn {
+  int32_t links; // links torn so far (a count)
+} tx_torn;
+#define tx_torn_TYPE TX_I32
+#define tx_torn_COLS 1u
+#define tx_torn_UNITS "1"
+TX_LAYOUT_ASSERT(tx_torn, int32_t);
+
+// --- the voxel needle (voxel.needle) -----------------------------------------
+
+// needle.segments (1 row per segment), drawn by the graphics view
+typedef struct tx_segment {
+  float a[3]; // one end (the needle's base), m
+  float b[3]; // the other end (the tip), m
+  float r;    // radius, m
+} tx_segment;
+#define tx_segment_TYPE TX_F32
+#define tx_segment_COLS 7u
+#define tx_segment_UNITS "m"
+TX_LAYOUT_ASSERT(tx_segment, float);
+
+// needle.force (1 row): the needle force of eq. 9, and its parts
+typedef struct tx_needle_force {
+  double total[3];     // N, stiffness + friction + cutting
+  double stiffness[3]; // N
+  double friction[3];  // N
+  double cutting[3];   // N
+  double depth;        // m, of the tip below the tissue's surface
+} tx_needle_force;
+#define tx_needle_force_TYPE TX_F64
+#define tx_needle_force_COLS 13u
+#define tx_needle_force_UNITS "N, m"
+TX_LAYOUT_ASSERT(tx_needle_force, double);
+
+// tissue.damage (N rows, one per voxel)
+typedef struct tx_damage {
+  float d; // 0 intact .. 1 destroyed
+} tx_damage;
+#define tx_damage_TYPE TX_F32
+#define tx_damage_COLS 1u
+#define tx_damage_UNITS "1"
+TX_LAYOUT_ASSERT(tx_damage, float);
+
+// window.pointer (1 row), written by input.window (the window's mouse and
+// keyboard), read by the haptics controller for the `mouse` device
+typedef struct tx_pointer {
+  double pos[3];  // m, where the input puts the tool, in [-TX_POINTER_REACH_M, TX_POINTER_REACH_M]
+  double buttons; // the buttons held, one bit each (an integer below 2^32)
+} tx_pointer;
+#define tx_pointer_TYPE TX_F64
+#define tx_pointer_COLS 4u
+#define tx_pointer_UNITS "m, 1"
+#define TX_POINTER_REACH_M 0.2 // m, the pointer's box on each axis
+TX_LAYOUT_ASSERT(tx_pointer, double);
+
+// --- for the coming scenarios (suture thread, instruments) -------------------
+
+// THREAD.nodes (N rows, from the needle end): a follow-the-leader thread
+typedef struct tx_thread_node {
+  double x[3];   // position, m
+  double radius; // m, of the thread at this node
+} tx_thread_node;
+#define tx_thread_node_TYPE TX_F64
+#define tx_thread_node_COLS 4u
+#define tx_thread_node_UNITS "m"
+TX_LAYOUT_ASSERT(tx_thread_node, double);
+
+// INSTRUMENT.pose (1 row): a pose and the angle of its jaws
+typedef struct tx_instrument_pose {
+  double pos[3];  // tool point (between the jaws), m
+  double quat[4]; // orientation, unit quaternion (w, x, y, z)
+  double jaw;     // rad, opening angle of the jaws (0: closed)
+} tx_instrument_pose;
+#define tx_instrument_pose_TYPE TX_F64
+#define tx_instrument_pose_COLS 8u
+#define tx_instrument_pose_UNITS "m, 1, rad"
+TX_LAYOUT_ASSERT(tx_instrument_pose, double);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
