@@ -22,6 +22,7 @@
 #include "studies.h"
 
 #include "../scenarios/command.h"
+#include "../controllers/haptics/device_scripted.h"
 #include "../views/plot.h"
 #include "../views/report.h"
 
@@ -117,7 +118,14 @@ typedef struct row {
   int torn;
 } row;
 
-static const double motion[4][4] = {{0, 0, 0.010, 0}, {0.2, 0, 0.010, 0}, {2.7, 0, -0.015, 0}, {3.0, 0, -0.015, 0}};
+// the hand motion: down through the skin at 1 cm/s (controllers/haptics/device_scripted.c)
+#define MOTION "accuracy-pierce-down"
+
+// when the motion ends, s
+static double motion_end_s(void) {
+  const tx_hand_motion* m = tx_hand_motion_find(MOTION);
+  return m ? m->t_pos[m->count - 1][0] : 0;
+}
 
 static int write_motion(const char* path) {
   char tmp[4300];
@@ -125,7 +133,8 @@ static int write_motion(const char* path) {
   FILE* f = fopen(tmp, "w");
   if (!f) return -1;
   fprintf(f, "# t_s, x_m, y_m, z_m: pierce-down at 1 cm/s, tactus study skin-accuracy\n");
-  for (int i = 0; i < 4; i++) fprintf(f, "%g,%g,%g,%g\n", motion[i][0], motion[i][1], motion[i][2], motion[i][3]);
+  const tx_hand_motion* m = tx_hand_motion_find(MOTION);
+  for (int i = 0; m && i < m->count; i++) fprintf(f, "%g,%g,%g,%g\n", m->t_pos[i][0], m->t_pos[i][1], m->t_pos[i][2], m->t_pos[i][3]);
   if (fclose(f) != 0 || rename(tmp, path) != 0) return remove(tmp), -1;
   return 0;
 }
@@ -160,7 +169,7 @@ static int run_setting(const setting* s, const char* device, curve* out, row* r,
   if (!sc) return -1;
   out->n = 0;
   recording = out;
-  tx_run_options o = {.duration_s = motion[3][0], .lockstep = true};
+  tx_run_options o = {.duration_s = motion_end_s(), .lockstep = true};
   tx_run_result res;
   int64_t t0 = tx_mono_ns();
   struct timespec c0, c1;
@@ -168,7 +177,7 @@ static int run_setting(const setting* s, const char* device, curve* out, row* r,
   int rc = tx_system_run(sc->system, &o, &res, err, en);
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
   r->wall_s = (double)(tx_mono_ns() - t0) * 1e-9;
-  r->cpu_s_per_s = ((double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec)) / motion[3][0];
+  r->cpu_s_per_s = ((double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec)) / motion_end_s();
   recording = NULL;
   if (rc == 0) {
     for (int k = 0; k < tx_system_results(sc->system); k++)

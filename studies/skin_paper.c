@@ -12,6 +12,7 @@
 #include "skin_metrics.h"
 
 #include "../scenarios/command.h"
+#include "../controllers/haptics/device_scripted.h"
 #include "../scenarios/run.h"
 #include "../views/plot.h"
 #include "../views/report.h"
@@ -27,25 +28,18 @@
 #define TICKS_MAX 14000 // 14 s at 1 kHz, longer than every motion
 #define SETS_MAX 24
 
-// a hand motion: waypoints t, x, y, z (s, m), written as a scripted CSV
+// the hand motions, each written as a scripted CSV under its file name (the
+// waypoints are the one table of controllers/haptics/device_scripted.c)
 typedef struct motion {
-  const char* name;
-  int n;
-  double w[6][4];
+  const char* name;  // the CSV's stem, as the cases name it
+  const char* table; // its name in the table of hand motions
 } motion;
 
-// 5 mm/s along y through the mid-plane; sliding 10 mm/s along x or z, 0.5 mm
-// into a 0.4 cm skin (the HIP's centre 2 mm from the mid-plane). The pierce
-// motions start 3 cm away; under gravity the 42 x 42 skin hangs about 3 cm
-// (docs/skin.md), so its pierce starts 6 cm below.
 static const motion motions[] = {
-    {"pierce-up", 4, {{0, 0, -0.030, 0}, {0.2, 0, -0.030, 0}, {9.2, 0, 0.015, 0}, {9.5, 0, 0.015, 0}}},
-    {"pierce-up-hanging", 4, {{0, 0, -0.060, 0}, {0.2, 0, -0.060, 0}, {12.2, 0, 0.0, 0}, {12.5, 0, 0.0, 0}}},
-    {"pierce-down", 4, {{0, 0, 0.030, 0}, {0.2, 0, 0.030, 0}, {9.2, 0, -0.015, 0}, {9.5, 0, -0.015, 0}}},
-    {"slide-x-over", 5, {{0, -0.03, 0.010, 0}, {1.0, -0.03, 0.002, 0}, {7.0, 0.03, 0.002, 0}, {8.0, 0.03, 0.010, 0}, {8.5, 0.03, 0.010, 0}}},
-    {"slide-x-under", 5, {{0, -0.03, -0.010, 0}, {1.0, -0.03, -0.002, 0}, {7.0, 0.03, -0.002, 0}, {8.0, 0.03, -0.010, 0}, {8.5, 0.03, -0.010, 0}}},
-    {"slide-z-over", 5, {{0, 0, 0.010, -0.03}, {1.0, 0, 0.002, -0.03}, {7.0, 0, 0.002, 0.03}, {8.0, 0, 0.010, 0.03}, {8.5, 0, 0.010, 0.03}}},
-    {"slide-z-under", 5, {{0, 0, -0.010, -0.03}, {1.0, 0, -0.002, -0.03}, {7.0, 0, -0.002, 0.03}, {8.0, 0, -0.010, 0.03}, {8.5, 0, -0.010, 0.03}}},
+    {"pierce-up", "paper-pierce-up"},     {"pierce-up-hanging", "paper-pierce-up-hanging"},
+    {"pierce-down", "paper-pierce-down"}, {"slide-x-over", "slide-x-over"},
+    {"slide-x-under", "slide-x-under"},   {"slide-z-over", "slide-z-over"},
+    {"slide-z-under", "slide-z-under"},
 };
 
 typedef struct skin_case {
@@ -94,9 +88,10 @@ typedef struct run_data {
   tx_skin_metrics m;
 } run_data;
 
-static const motion* find_motion(const char* name) {
+// the waypoints of a case's motion (every name in motions[] is in the table)
+static const tx_hand_motion* find_motion(const char* name) {
   for (size_t i = 0; i < sizeof motions / sizeof motions[0]; i++)
-    if (strcmp(motions[i].name, name) == 0) return &motions[i];
+    if (strcmp(motions[i].name, name) == 0) return tx_hand_motion_find(motions[i].table);
   return NULL;
 }
 
@@ -106,9 +101,11 @@ static int write_motions(const char* dir) {
     snprintf(path, sizeof path, "%s/%s.csv", dir, motions[i].name);
     FILE* f = fopen(path, "w");
     if (!f) return -1;
+    const tx_hand_motion* m = tx_hand_motion_find(motions[i].table);
+    if (!m) return fclose(f), -1;
     fprintf(f, "t_s,x_m,y_m,z_m\n");
-    for (int k = 0; k < motions[i].n; k++)
-      fprintf(f, "%g,%g,%g,%g\n", motions[i].w[k][0], motions[i].w[k][1], motions[i].w[k][2], motions[i].w[k][3]);
+    for (int k = 0; k < m->count; k++)
+      fprintf(f, "%g,%g,%g,%g\n", m->t_pos[k][0], m->t_pos[k][1], m->t_pos[k][2], m->t_pos[k][3]);
     if (fclose(f) != 0) return -1;
   }
   return 0;
@@ -136,11 +133,11 @@ static int read_curve(const char* path, run_data* d) {
 }
 
 static int run_case(const tx_study_args* a, const char* motions_dir, const skin_case* c, int index, run_data* d) {
-  const motion* mo = find_motion(c->motion);
+  const tx_hand_motion* mo = find_motion(c->motion);
   char buf[SETS_MAX][4400];
   const char* sets[SETS_MAX + 64];
   int n = 0;
-  snprintf(buf[n++], sizeof buf[0], "duration_s=%g", mo->w[mo->n - 1][0]);
+  snprintf(buf[n++], sizeof buf[0], "duration_s=%g", mo->t_pos[mo->count - 1][0]);
   snprintf(buf[n++], sizeof buf[0], "skin.spacing_m=%g", c->spacing);
   snprintf(buf[n++], sizeof buf[0], "skin.thickness_m=%g", c->thickness);
   snprintf(buf[n++], sizeof buf[0], "skin.gravity=%s", c->gravity ? "true" : "false");
