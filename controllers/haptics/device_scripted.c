@@ -34,13 +34,7 @@ struct tx_device {
 // mid-plane is y = 0; a 0.4 cm skin and a 0.05 cm HIP touch at |y| = 2.5 mm,
 // so the sliding motions run at |y| = 2 mm, 0.5 mm into the skin.
 // Piercing moves at 5 mm/s along y, sliding at 10 mm/s along x or z.
-typedef struct motion {
-  const char* name;
-  int count;
-  double t_pos[6][4]; // t, x, y, z
-} motion;
-
-static const motion motions[] = {
+static const tx_hand_motion motions[] = {
     {"pierce-down", 4, {{0, 0, 0.010, 0}, {0.5, 0, 0.010, 0}, {4.5, 0, -0.010, 0}, {5.0, 0, -0.010, 0}}},
     {"pierce-up", 4, {{0, 0, -0.010, 0}, {0.5, 0, -0.010, 0}, {4.5, 0, 0.010, 0}, {5.0, 0, 0.010, 0}}},
     {"slide-x-over", 5, {{0, -0.03, 0.010, 0}, {1.0, -0.03, 0.002, 0}, {7.0, 0.03, 0.002, 0}, {8.0, 0.03, 0.010, 0}, {8.5, 0.03, 0.010, 0}}},
@@ -50,7 +44,21 @@ static const motion motions[] = {
     // the voxel needle-insertion scenario: from 1 mm above the surface y = 0
     // straight down at 3 mm/s to 4 mm deep, then straight back out at 3 mm/s
     {"insert", 5, {{0, 0, 0.001, 0}, {0.2, 0, 0.001, 0}, {0.2 + 5.0 / 3, 0, -0.004, 0}, {0.2 + 10.0 / 3, 0, 0.001, 0}, {3.8, 0, 0.001, 0}}},
+    // tactus study skin-paper: the pierce motions start 3 cm away; under
+    // gravity the 42 x 42 skin hangs about 3 cm (docs/skin.md), so its pierce
+    // starts 6 cm below (5 mm/s)
+    {"paper-pierce-up", 4, {{0, 0, -0.030, 0}, {0.2, 0, -0.030, 0}, {9.2, 0, 0.015, 0}, {9.5, 0, 0.015, 0}}},
+    {"paper-pierce-up-hanging", 4, {{0, 0, -0.060, 0}, {0.2, 0, -0.060, 0}, {12.2, 0, 0.0, 0}, {12.5, 0, 0.0, 0}}},
+    {"paper-pierce-down", 4, {{0, 0, 0.030, 0}, {0.2, 0, 0.030, 0}, {9.2, 0, -0.015, 0}, {9.5, 0, -0.015, 0}}},
+    // tactus study skin-accuracy: down through the skin at 1 cm/s
+    {"accuracy-pierce-down", 4, {{0, 0, 0.010, 0}, {0.2, 0, 0.010, 0}, {2.7, 0, -0.015, 0}, {3.0, 0, -0.015, 0}}},
 };
+
+const tx_hand_motion* tx_hand_motion_find(const char* name) {
+  for (size_t i = 0; i < sizeof motions / sizeof motions[0]; i++)
+    if (strcmp(name, motions[i].name) == 0) return &motions[i];
+  return NULL;
+}
 
 static tx_device* with_rows(size_t count) {
   tx_device* d = calloc(1, sizeof *d);
@@ -62,7 +70,7 @@ static tx_device* with_rows(size_t count) {
   return d;
 }
 
-static tx_device* from_motion(const motion* m) {
+static tx_device* from_motion(const tx_hand_motion* m) {
   tx_device* d = with_rows((size_t)m->count);
   for (int i = 0; d && i < m->count; i++)
     d->w[i] = (waypoint){m->t_pos[i][0], {m->t_pos[i][1], m->t_pos[i][2], m->t_pos[i][3]}, {1, 0, 0, 0}, 0};
@@ -143,8 +151,8 @@ tx_device* tx_scripted_read_csv(FILE* f, const char* path, char* err, size_t n) 
 
 static tx_device* open_scripted(const char* arg, double period_s, char* err, size_t n) {
   (void)period_s;
-  for (size_t i = 0; i < sizeof motions / sizeof motions[0]; i++)
-    if (strcmp(arg, motions[i].name) == 0) return from_motion(&motions[i]);
+  const tx_hand_motion* m = tx_hand_motion_find(arg);
+  if (m) return from_motion(m);
   size_t len = strlen(arg);
   if (len > 4 && strcmp(arg + len - 4, ".csv") == 0) {
     FILE* f = fopen(arg, "r");
@@ -153,8 +161,12 @@ static tx_device* open_scripted(const char* arg, double period_s, char* err, siz
     fclose(f);
     return d;
   }
-  snprintf(err, n, "device 'scripted:%s': expected a .csv file or one of pierce-down, pierce-up, slide-x-over, "
-                   "slide-x-under, slide-z-over, slide-z-under, insert", arg);
+  char names[512] = "";
+  for (size_t i = 0; i < sizeof motions / sizeof motions[0]; i++) {
+    size_t used = strlen(names);
+    snprintf(names + used, sizeof names - used, "%s%s", i ? ", " : "", motions[i].name);
+  }
+  snprintf(err, n, "device 'scripted:%s': expected a .csv file or one of %s", arg, names);
   return NULL;
 }
 

@@ -11,4 +11,15 @@
 // The device it returns is driven through tx_device_scripted's read and close.
 tx_device* tx_scripted_read_csv(FILE* f, const char* path, char* err, size_t n);
 
+// a named hand motion: waypoints t, x, y, z (s, m), the tool moving in straight
+// lines between them. One table holds every motion that a scenario
+// (`scripted:NAME`) or a study drives.
+typedef struct tx_hand_motion {
+  const char* name;
+  int count;
+  double t_pos[6][4];
+} tx_hand_motion;
+// the motion of that name, or NULL
+const tx_hand_motion* tx_hand_motion_find(const char* name);
+
 #endif

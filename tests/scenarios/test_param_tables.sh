@@ -14,7 +14,7 @@ WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 cd "$WORK" || exit 1
 unset TACTUS_SCENARIO_PATH
-. "$HERE/bad_input_lib.sh" || exit 1
+. "$HERE/../bad_input_lib.sh" || exit 1
 
 # expect_out "what" ARGS... -- FRAGMENT...: exit 0 and every fragment in stdout
 expect_out() {

@@ -10,7 +10,7 @@ TACTUS=$(realpath "$1")
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 cd "$WORK" || exit 1
-. "$HERE/bad_input_lib.sh" || exit 1
+. "$HERE/../bad_input_lib.sh" || exit 1
 
 controllers='"controllers": [{"name": "a", "type": "rates.worker", "rate_hz": 10}]'
 printf '{"name": "t", "plugins": ["/nonexistent/libnope.so"], %s}\n' "$controllers" >"$WORK/absolute.json"

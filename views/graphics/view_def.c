@@ -1,6 +1,8 @@
 // A scenario's "view" object to a checked tx_view_def.
 #include "view_def.h"
 
+#include "../../controllers/system.h" // tx_json_kind, shared with the parameter readers
+
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -31,17 +33,6 @@ static int bad(const where* w, const char* key, const char* fmt, ...) {
   return -1;
 }
 
-static const char* kind_of(const json_t* v) {
-  switch (json_typeof(v)) {
-  case JSON_OBJECT: return "an object";
-  case JSON_ARRAY: return "an array";
-  case JSON_STRING: return "a string";
-  case JSON_INTEGER: case JSON_REAL: return "a number";
-  case JSON_TRUE: case JSON_FALSE: return "a boolean";
-  default: return "null";
-  }
-}
-
 static int check_keys(const where* w, const char* at, const json_t* obj, const char* const* known) {
   const char* k;
   json_t* v;
@@ -63,7 +54,7 @@ static int check_keys(const where* w, const char* at, const json_t* obj, const c
 // n finite numbers in [lo, hi]
 static int numbers(const where* w, const char* key, const json_t* v, int n, double lo, double hi, double* out) {
   if (!json_is_array(v) || (int)json_array_size(v) != n)
-    return bad(w, key, "expected an array of %d numbers, got %s", n, kind_of(v));
+    return bad(w, key, "expected an array of %d numbers, got %s", n, tx_json_kind(v));
   for (int i = 0; i < n; i++) {
     const json_t* e = json_array_get(v, (size_t)i);
     double x = json_number_value(e);
@@ -78,7 +69,7 @@ static int number(const where* w, const char* key, const json_t* v, double lo, d
   double x = json_number_value(v);
   if (!json_is_number(v) || !isfinite(x) || x < lo || x > hi || (open_lo && x == lo))
     return bad(w, key, "expected a number in %s%g, %g], got %s", open_lo ? "(" : "[", lo, hi,
-               json_is_number(v) ? "an out-of-range number" : kind_of(v));
+               json_is_number(v) ? "an out-of-range number" : tx_json_kind(v));
   *out = x;
   return 0;
 }
@@ -115,7 +106,7 @@ static bool plain_name(const char* s) {
 
 static int read_camera(const where* w, const json_t* cam, tx_view_def* d) {
   static const char* const keys[] = {"eye", "target", "up", "fov_deg", "near_m", "far_m", NULL};
-  if (!json_is_object(cam)) return bad(w, "camera", "expected an object, got %s", kind_of(cam));
+  if (!json_is_object(cam)) return bad(w, "camera", "expected an object, got %s", tx_json_kind(cam));
   if (check_keys(w, "camera", cam, keys)) return -1;
   tx_camera* c = &d->camera;
   const json_t* v;
@@ -140,7 +131,7 @@ static int read_item(const where* w, size_t i, const json_t* e, tx_draw_item* it
                                      "range", "texture", "radius_m", "show_force", "force_scale_m_per_n", "cut", NULL};
   char at[48], key[96];
   snprintf(at, sizeof at, "draw[%zu]", i);
-  if (!json_is_object(e)) return bad(w, at, "expected an object, got %s", kind_of(e));
+  if (!json_is_object(e)) return bad(w, at, "expected an object, got %s", tx_json_kind(e));
   if (check_keys(w, at, e, keys)) return -1;
   static const struct { const char* key; tx_draw_kind kind; } kinds[] = {
       {"mesh", TX_DRAW_MESH}, {"spheres", TX_DRAW_SPHERES}, {"segments", TX_DRAW_SEGMENTS}, {"tool", TX_DRAW_TOOL},
@@ -154,7 +145,7 @@ static int read_item(const where* w, size_t i, const json_t* e, tx_draw_item* it
     snprintf(key, sizeof key, "%s.%s", at, kinds[k].key);
     if (it->kind == TX_DRAW_PLANE) {
       static const char* const pkeys[] = {"point", "normal", "size_m", NULL};
-      if (!json_is_object(v)) return bad(w, key, "expected an object, got %s", kind_of(v));
+      if (!json_is_object(v)) return bad(w, key, "expected an object, got %s", tx_json_kind(v));
       if (check_keys(w, key, v, pkeys)) return -1;
       double p[3] = {0, 0, 0}, nrm[3] = {0, 1, 0}, size = 0.2;
       if (point_normal(w, key, v, p, nrm, it->plane)) return -1;
@@ -204,7 +195,7 @@ static int read_item(const where* w, size_t i, const json_t* e, tx_draw_item* it
     if (!t || (strcmp(t, "skin") != 0 && strcmp(t, "none") != 0)) return bad(w, key, "expected \"skin\" or \"none\"");
     it->skin_texture = strcmp(t, "skin") == 0;
   }
-  double x;
+  double x = 0; // set by number() whenever it returns 0
   snprintf(key, sizeof key, "%s.radius_m", at);
   if ((v = json_object_get(e, "radius_m"))) {
     if (it->kind != TX_DRAW_TOOL) return bad(w, key, "only tools take a radius");
@@ -214,7 +205,7 @@ static int read_item(const where* w, size_t i, const json_t* e, tx_draw_item* it
   snprintf(key, sizeof key, "%s.show_force", at);
   if ((v = json_object_get(e, "show_force"))) {
     if (it->kind != TX_DRAW_TOOL) return bad(w, key, "only tools show a force");
-    if (!json_is_boolean(v)) return bad(w, key, "expected true or false, got %s", kind_of(v));
+    if (!json_is_boolean(v)) return bad(w, key, "expected true or false, got %s", tx_json_kind(v));
     it->show_force = json_is_true(v);
   }
   snprintf(key, sizeof key, "%s.force_scale_m_per_n", at);
@@ -228,7 +219,7 @@ static int read_item(const where* w, size_t i, const json_t* e, tx_draw_item* it
   if ((v = json_object_get(e, "cut"))) {
     static const char* const ckeys[] = {"point", "normal", NULL};
     if (it->kind != TX_DRAW_SPHERES) return bad(w, key, "only spheres take a cut");
-    if (!json_is_object(v)) return bad(w, key, "expected an object, got %s", kind_of(v));
+    if (!json_is_object(v)) return bad(w, key, "expected an object, got %s", tx_json_kind(v));
     if (check_keys(w, key, v, ckeys)) return -1;
     double p[3] = {0, 0, 0}, nrm[3] = {0, 0, 1};
     if (point_normal(w, key, v, p, nrm, it->cut)) return -1;
@@ -241,7 +232,7 @@ int tx_view_def_from_json(const json_t* view, tx_view_def* d, char* key, size_t 
   where w = {key, kn, msg, mn};
   static const char* const keys[] = {"rate_hz", "width", "height", "frame_every", "camera", "stereo",
                                      "background", "light", "draw", NULL};
-  if (!json_is_object(view)) return bad(&w, "", "expected an object, got %s", kind_of(view));
+  if (!json_is_object(view)) return bad(&w, "", "expected an object, got %s", tx_json_kind(view));
   if (check_keys(&w, "", view, keys)) return -1;
   const json_t* v;
   if ((v = json_object_get(view, "rate_hz"))) {
@@ -255,7 +246,7 @@ int tx_view_def_from_json(const json_t* view, tx_view_def* d, char* key, size_t 
   if ((v = json_object_get(view, "camera")) && read_camera(&w, v, d)) return -1;
   if ((v = json_object_get(view, "stereo"))) {
     static const char* const skeys[] = {"interaxial_m", "convergence_m", NULL};
-    if (!json_is_object(v)) return bad(&w, "stereo", "expected an object, got %s", kind_of(v));
+    if (!json_is_object(v)) return bad(&w, "stereo", "expected an object, got %s", tx_json_kind(v));
     if (check_keys(&w, "stereo", v, skeys)) return -1;
     const json_t* q;
     if ((q = json_object_get(v, "interaxial_m")) && number(&w, "stereo.interaxial_m", q, 0, 1, false, &d->camera.interaxial))

@@ -8,7 +8,7 @@
 #include <cmocka.h>
 
 #include "controllers/collision/hip.h"
-#include "controllers/collision/skin_grid.h"
+#include "studies/experiments/skin_grid.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -7,7 +7,7 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
-#include "controllers/collision/skin_grid.h"
+#include "studies/experiments/skin_grid.h"
 #include "scenarios/loader.h"
 #include "tests/scenario_support.h"
 

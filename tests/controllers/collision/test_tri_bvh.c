@@ -6,7 +6,7 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
-#include "controllers/collision/skin_grid.h"
+#include "studies/experiments/skin_grid.h"
 #include "controllers/collision/tri_bvh.h"
 
 #include <math.h>

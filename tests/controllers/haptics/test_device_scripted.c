@@ -6,6 +6,7 @@
 #include <cmocka.h>
 
 #include "controllers/haptics/device.h"
+#include "controllers/haptics/device_scripted.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -67,6 +68,35 @@ static void every_named_motion_opens(void** state) {
     if (strstr(names[i], "slide")) assert_true(fabs(s.pos[1] - sign * 0.002) < 1e-12); // sliding in contact
     tx_device_close(&h);
   }
+}
+
+// one table of hand motions: pierce-down is the scenarios' (5 mm/s from y = 10 mm
+// to -10 mm), the studies' own pierce motions have names of their own, and an
+// unknown name is answered with every name of the table
+static void one_table_of_hand_motions(void** state) {
+  (void)state;
+  const tx_hand_motion* m = tx_hand_motion_find("pierce-down");
+  assert_non_null(m);
+  assert_int_equal(m->count, 4);
+  assert_true(m->t_pos[0][2] == 0.010 && m->t_pos[1][0] == 0.5 && m->t_pos[2][0] == 4.5 && m->t_pos[3][2] == -0.010);
+  const tx_hand_motion* paper = tx_hand_motion_find("paper-pierce-down");
+  assert_non_null(paper);
+  assert_true(paper->t_pos[0][2] == 0.030 && paper->t_pos[2][0] == 9.2 && paper->t_pos[3][2] == -0.015);
+  const tx_hand_motion* fast = tx_hand_motion_find("accuracy-pierce-down");
+  assert_non_null(fast);
+  assert_true(fast->t_pos[2][0] == 2.7 && fast->t_pos[3][0] == 3.0 && fast->t_pos[3][2] == -0.015);
+  assert_non_null(tx_hand_motion_find("paper-pierce-up"));
+  assert_non_null(tx_hand_motion_find("paper-pierce-up-hanging"));
+  assert_null(tx_hand_motion_find("pierce-sideways"));
+
+  tx_device_handle h;
+  char err[512];
+  assert_int_equal(tx_device_open("scripted:paper-pierce-down", 1e-3, &h, err, sizeof err), 0);
+  assert_true(fabs(at(&h, 9.2).pos[1] + 0.015) < 1e-12);
+  tx_device_close(&h);
+  assert_int_not_equal(tx_device_open("scripted:pierce-sideways", 1e-3, &h, err, sizeof err), 0);
+  assert_non_null(strstr(err, "pierce-down, pierce-up, slide-x-over"));
+  assert_non_null(strstr(err, "insert, paper-pierce-up, paper-pierce-up-hanging, paper-pierce-down, accuracy-pierce-down"));
 }
 
 static void waypoint_file_is_interpolated(void** state) {
@@ -132,6 +162,7 @@ int main(void) {
       cmocka_unit_test(pierce_down_moves_down_through_the_skin),
       cmocka_unit_test(insert_goes_in_and_out_at_3_mm_per_s),
       cmocka_unit_test(every_named_motion_opens),
+      cmocka_unit_test(one_table_of_hand_motions),
       cmocka_unit_test(waypoint_file_is_interpolated),
       cmocka_unit_test(bad_files_name_the_line),
   };

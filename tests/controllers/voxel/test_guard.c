@@ -7,7 +7,7 @@
 #include <cmocka.h>
 
 #include "controllers/voxel/guard.h"
-#include "controllers/voxel/needle_fit.h"
+#include "studies/experiments/needle_fit.h"
 #include "tactus/model.h"
 
 #include <math.h>

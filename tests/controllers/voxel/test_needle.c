@@ -8,7 +8,7 @@
 #include <cmocka.h>
 
 #include "controllers/voxel/needle.h"
-#include "controllers/voxel/needle_fit.h"
+#include "studies/experiments/needle_fit.h"
 #include "tactus/model.h"
 
 #include <math.h>

@@ -122,6 +122,18 @@ static void errors_name_the_key(void** state) {
   expect_error("[1]", "", "an object");
 }
 
+// a value of the wrong type is named in the words of the parameter readers (tx_json_kind)
+static void wrong_types_named_as_parameters_name_them(void** state) {
+  (void)state;
+  expect_error("{\"stereo\": \"sbs\"}", "stereo", "got a string");
+  expect_error("{\"draw\": [3]}", "draw[0]", "got a number");
+  expect_error("{\"camera\": null}", "camera", "got null");
+  expect_error("{\"camera\": [1]}", "camera", "got an array");
+  expect_error("{\"draw\": [{\"tool\": \"device0\", \"show_force\": 1}]}", "draw[0].show_force", "got a number");
+  expect_error("{\"camera\": {\"eye\": {}, \"target\": [0, 0, 0]}}", "camera.eye", "got an object");
+  expect_error("{\"draw\": [{\"mesh\": \"skin\", \"colour\": true}]}", "draw[0].colour", "got a boolean");
+}
+
 static void automatic_draw_list(void** state) {
   (void)state;
   const char* written[] = {"tool0.force_model", "skin.x", "device0.pose", "skin.tri", "tissue.spheres", "tissue.damage",
@@ -161,6 +173,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(full_view),
       cmocka_unit_test(errors_name_the_key),
+      cmocka_unit_test(wrong_types_named_as_parameters_name_them),
       cmocka_unit_test(automatic_draw_list),
       cmocka_unit_test(from_text),
   };

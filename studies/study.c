@@ -1,0 +1,83 @@
+// tactus study: experiments that write JSON, CSV and PNG plots.
+#include "../scenarios/command.h"
+
+#include "studies.h"
+
+#include <tactus/config.h>
+
+#include <getopt.h>
+#include <limits.h>
+#include <stdio.h>
+#include <string.h>
+
+static const struct {
+  const char* name;
+  int (*run)(const tx_study_args*);
+  const char* what;
+} studies[] = {
+    {"haptic-stability", tx_study_haptic_stability,
+     "largest stable wall stiffness vs Colgate's bound, with and without passivity control"},
+    {"needle-fit", tx_study_needle_fit, "FILE: fit the voxel tissue to a needle recording, RMS vs run time, Figure 5"},
+    {"needle-stability", tx_study_needle_stability, "needle in voxels at stiff, elastic, light, fast and overlapping extremes"},
+    {"skin-paper", tx_study_skin_paper, "the SutureHap journal paper's skin tests (Figs. 15-19) and the 60 Hz hold"},
+    {"skin-stability", tx_study_skin_stability,
+     "the skin under stiffness x1e-3..x1e3, steps 1/20..1/1000 s, a teleporting and a 10 m/s HIP, zero thickness"},
+    {"skin-accuracy", tx_study_skin_accuracy,
+     "pierce-down force curve error against run time over spacing, iterations and rate"},
+};
+
+// the studies that take a FILE after their name
+static const char* const with_file[] = {"needle-fit"};
+
+static bool takes_file(const char* name) {
+  for (size_t i = 0; i < sizeof with_file / sizeof with_file[0]; i++)
+    if (strcmp(name, with_file[i]) == 0) return true;
+  return false;
+}
+
+int tx_cmd_study(int argc, char** argv) {
+  static const struct option longs[] = {
+      {"out", required_argument, 0, 'o'}, {"set", required_argument, 0, 's'}, {"help", no_argument, 0, 'h'},
+      {"force", no_argument, 0, 'F'},     {0, 0, 0, 0}};
+  const char* out = NULL;
+  bool force = false;
+  const char* sets[64];
+  int nsets = 0;
+  bool help = false;
+  optind = 1;
+  opterr = 0;
+  for (int c; (c = getopt_long(argc, argv, "", longs, NULL)) != -1;) {
+    if (c == 'o') out = optarg;
+    else if (c == 's') {
+      if (nsets == 64) return tx_bad_input("--set: at most 64");
+      sets[nsets++] = optarg;
+    } else if (c == 'h') help = true;
+    else if (c == 'F') force = true;
+    else return tx_bad_input("study: unknown or incomplete option '%s'", argv[optind - 1]);
+  }
+  if (help || optind < argc - 2 || optind > argc - 1) {
+    printf("usage: tactus study NAME [FILE] [--out DIR [--force]] [--set KEY=VALUE]...\n\n"
+           "A --out that holds files is refused unless --force. A relative FILE not found here is looked for\n"
+           "in the source tree and its assets/ folder (" TX_SCENARIO_DIR "/..).\n\n");
+    for (size_t i = 0; i < sizeof studies / sizeof studies[0]; i++) printf("  %-18s %s\n", studies[i].name, studies[i].what);
+    return help ? 0 : tx_bad_input("study: expected one NAME from the list above");
+  }
+  for (size_t i = 0; i < sizeof studies / sizeof studies[0]; i++) {
+    if (strcmp(argv[optind], studies[i].name) != 0) continue;
+    const char* file = optind == argc - 2 ? argv[optind + 1] : NULL;
+    if (takes_file(studies[i].name) && !file) return tx_bad_input("study %s: expected a FILE after the name", studies[i].name);
+    if (!takes_file(studies[i].name) && file) return tx_bad_input("study %s: unexpected argument '%s'", studies[i].name, file);
+    char path[PATH_MAX], err[1024];
+    if (file && tx_asset_locate(file, path, sizeof path) == 0) file = path;
+    if (tx_out_check(out, force)) return TX_EXIT_BAD_INPUT;
+    tx_out o;
+    if (tx_out_open(&o, out, studies[i].name, err, sizeof err)) return tx_bad_input("%s", err);
+    tx_study_args a = {o.dir, sets, nsets, file};
+    int rc = studies[i].run(&a);
+    // bad input keeps nothing; a failed study keeps what it wrote, but never an empty folder
+    if (rc == TX_EXIT_BAD_INPUT || (rc != 0 && tx_out_empty(&o))) tx_out_discard(&o);
+    else tx_out_close(&o);
+    return rc;
+  }
+  return tx_bad_input("study %s: unknown study (tactus study lists them)", argv[optind]);
+}
