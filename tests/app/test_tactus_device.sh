@@ -58,8 +58,8 @@ zero_within_10_ticks() {
       for (i = last; i <= NR; i++) if (f[i] == 0) break
       if (i > NR) { printf "the force never reached zero after the last new state at %.3f s\n", t[last]; exit 1 }
       printf "last new state at %.3f s (|F| up to %.3f N before it); zero %d ticks (%.1f ms) later\n", t[last], before, i - last, (t[i] - t[last]) * 1e3
-      # a force of 0.1 N or more shows the stream was rendering; under load a lossy
-      # relay's gaps ramp it down and up again, so it may be well below the 2-3 N of a quiet run
+      # a force of 0.1 N or more shows the stream was rendering; under load the gaps of a lossy
+      # relay ramp it down and up again, so it may be well below the 2-3 N of a quiet run
       exit !(before >= 0.1 && i - last <= 10)
     }' "$1"
 }
