@@ -1,5 +1,6 @@
-// Touching pages ahead of a real-time loop.
-#include "prefault.h"
+// Touching pages ahead of a real-time loop. A volatile write per page: the
+// compiler may drop a memset that follows calloc, leaving the pages unmapped.
+#include <tactus/model.h>
 
 #include <unistd.h>
 

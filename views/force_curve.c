@@ -7,8 +7,6 @@
 
 #include <tactus/components.h>
 
-#include "../model/prefault.h"
-
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

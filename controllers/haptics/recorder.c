@@ -1,9 +1,9 @@
 // Full-rate device recording through a lock-free ring and a writer thread.
 #include "recorder.h"
 
-#include "../../model/prefault.h"
-
 #include "device_protocol.h" // tx_dp_crc32: the CRC-32 of zlib, already in the library
+
+#include <tactus/model.h>
 
 #include <errno.h>
 #include <math.h>

@@ -68,6 +68,11 @@ const char* tx_type_name(tx_type t);
 tx_type tx_type_from_name(const char* name);
 // CLOCK_MONOTONIC, ns
 int64_t tx_mono_ns(void);
+// map a buffer's pages before a real-time loop uses it: writes one zero byte
+// per page of p[0, n), so use it on memory that is still all zeros (fresh
+// from calloc, or before it is filled). A page fault inside a 1 kHz step is a
+// late tick; a buffer touched at init also keeps a long run's memory flat.
+void tx_prefault(void* p, size_t n);
 // 64-bit FNV-1a-style hash of n bytes by words, continuing from h (start with TX_HASH_SEED)
 #define TX_HASH_SEED 1469598103934665603ull
 uint64_t tx_hash(uint64_t h, const void* data, size_t n);
