@@ -6,7 +6,7 @@
 #ifndef TX_CONTROLLERS_SYSTEM_H
 #define TX_CONTROLLERS_SYSTEM_H
 
-#include "stats.h"
+#include <tactus/stats.h>
 
 #include <tactus/controller.h>
 

@@ -7,7 +7,7 @@
 #include "../scenarios/command.h"
 #include "../scenarios/run.h"
 
-#include "../controllers/stats.h"
+#include <tactus/stats.h>
 
 #include <tactus/events.h>
 
@@ -159,12 +159,13 @@ static void* listener_main(void* arg) {
 static int bench_stream_push(tx_percentiles* p, uint64_t* pushes, uint64_t* taken, uint64_t* overflows, bool* fifo_ok) {
   enum { PUSHES = 2000 };
   listener l = {.stream = tx_stream_create("bench.events", 1024)};
-  tx_samples push;
-  if (!l.stream || tx_stream_add_reader(l.stream) != 0 || !tx_samples_init(&push, PUSHES))
+  static tx_hist push; // not on the stack
+  tx_hist_clear(&push);
+  if (!l.stream || tx_stream_add_reader(l.stream) != 0)
     return tx_stream_destroy(l.stream), -1;
   atomic_init(&l.stop, false);
   pthread_t th;
-  if (pthread_create(&th, NULL, listener_main, &l) != 0) return tx_samples_free(&push), tx_stream_destroy(l.stream), -1;
+  if (pthread_create(&th, NULL, listener_main, &l) != 0) return tx_stream_destroy(l.stream), -1;
   // the writer as a device thread runs: SCHED_FIFO where granted, restored after
   int policy;
   struct sched_param was, fifo = {.sched_priority = sched_get_priority_max(SCHED_FIFO) - 10};
@@ -177,16 +178,15 @@ static int bench_stream_push(tx_percentiles* p, uint64_t* pushes, uint64_t* take
     tx_event e = {.kind = TX_EVENT_USER, .sim_ns = k * 1000000LL, .source = (uint32_t)k, .value = {k}};
     int64_t t0 = tx_mono_ns();
     tx_stream_push(l.stream, &e);
-    tx_samples_add(&push, tx_mono_ns() - t0);
+    tx_hist_add(&push, tx_mono_ns() - t0);
   }
   if (*fifo_ok) pthread_setschedparam(pthread_self(), policy, &was);
   atomic_store(&l.stop, true);
   pthread_join(th, NULL);
-  *p = tx_samples_percentiles(&push);
+  *p = tx_hist_percentiles(&push);
   *pushes = tx_stream_pushed(l.stream);
   *overflows = tx_stream_overflows(l.stream);
   *taken = l.taken;
-  tx_samples_free(&push);
   tx_stream_destroy(l.stream);
   return 0;
 }
@@ -201,8 +201,10 @@ static int bench_model(const bench_args* a) {
   tx_model_add_reader(m, c); // a second reader holds an older buffer, as graphics would
   if (!c.id || !r.id || !tx_model_commit(m)) return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   float* source = malloc(sizeof(float) * ROWS * COLS);
-  tx_samples swap, full;
-  if (!source || !tx_samples_init(&swap, ITER) || !tx_samples_init(&full, ITER)) return fprintf(stderr, "tactus: out of memory\n"), 1;
+  static tx_hist swap, full; // not on the stack
+  tx_hist_clear(&swap);
+  tx_hist_clear(&full);
+  if (!source) return fprintf(stderr, "tactus: out of memory\n"), 1;
   for (int i = 0; i < ROWS * COLS; i++) source[i] = (float)i;
   volatile float sink = 0;
   for (int k = 0; k < ITER; k++) {
@@ -214,10 +216,10 @@ static int bench_model(const bench_args* a) {
     tx_snapshot s = tx_model_acquire(m, r);
     sink += ((const float*)s.data)[k % (ROWS * COLS)];
     int64_t t2 = tx_mono_ns();
-    tx_samples_add(&swap, t2 - t1);
-    tx_samples_add(&full, t2 - t0);
+    tx_hist_add(&swap, t2 - t1);
+    tx_hist_add(&full, t2 - t0);
   }
-  tx_percentiles ps = tx_samples_percentiles(&swap), pf = tx_samples_percentiles(&full);
+  tx_percentiles ps = tx_hist_percentiles(&swap), pf = tx_hist_percentiles(&full);
   printf("bench model: %d publishes of a %dx%d f32 component (%.0f KiB), 2 readers\n\n", ITER, ROWS, COLS,
          ROWS * COLS * 4 / 1024.0);
   printf("  %-40s %10s %10s %10s\n", "operation", "p50 us", "p99 us", "max us");
@@ -238,8 +240,6 @@ static int bench_model(const bench_args* a) {
   snprintf(measured, sizeof measured, "%.3f us", pe.p99 * 1e-3);
   print_target("event push of a 1 kHz writer, p99", measured, "<= 1 us", pe.p99 * 1e-3 <= 1 && taken == pushes);
   if (sink == -1.0f) printf("(unreachable: keeps the reads)\n");
-  tx_samples_free(&swap);
-  tx_samples_free(&full);
   free(source);
   tx_model_destroy(m);
   return 0;

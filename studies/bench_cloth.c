@@ -10,7 +10,7 @@
 
 #include "../scenarios/command.h"
 
-#include "../controllers/stats.h"
+#include <tactus/stats.h>
 
 #include <tactus/components.h>
 #include <tactus/config.h>
@@ -62,7 +62,7 @@ static const tx_controller_class script_class = {.type = "bench.hip_script",
 // ticks: it times the adapter's set_hip + step and nothing else
 typedef struct bare {
   tx_cloth* cloth;
-  tx_samples ns;
+  tx_hist ns; // step times, ns
 } bare;
 static bare* bench_bare; // the bench's own, for the one run it makes
 
@@ -78,7 +78,7 @@ static void bare_step(tx_ctx* c, void* self) {
   int64_t t0 = tx_mono_ns();
   tx_cloth_set_hip(b->cloth, pose, HIP_RADIUS);
   tx_cloth_step(b->cloth, 1 / RATE_HZ);
-  tx_samples_add(&b->ns, tx_mono_ns() - t0);
+  tx_hist_add(&b->ns, tx_mono_ns() - t0);
 }
 static const tx_controller_class bare_class = {.type = "bench.bare_cloth",
                                                .summary = "steps a cloth through the adapter alone, timed",
@@ -95,13 +95,14 @@ int tx_bench_cloth(double duration_s) {
   if (!tx_find_controller(bare_class.type)) tx_register_controller(&bare_class);
 
   // the bare cloth, as physics.skin builds it for the same parameters
-  bare b = {0};
+  static bare b; // its histogram is large: not on the stack
+  b = (bare){0};
   tx_cloth_def d = tx_cloth_def_default();
   d.res[0] = d.res[1] = (int)lround(0.1 / SPACING) + 2;
   d.size[0] = d.size[1] = (d.res[0] - 1) * SPACING;
   b.cloth = tx_cloth_create(&d);
-  if (!b.cloth || !tx_samples_init(&b.ns, (uint64_t)(seconds * RATE_HZ) + 16)) {
-    fprintf(stderr, "tactus: bench cloth: %s\n", b.cloth ? "out of memory" : tx_error());
+  if (!b.cloth) {
+    fprintf(stderr, "tactus: bench cloth: %s\n", tx_error());
     tx_cloth_destroy(b.cloth);
     return 1;
   }
@@ -138,7 +139,7 @@ int tx_bench_cloth(double duration_s) {
       if (strcmp(tx_system_name(sc->system, i), "skin") == 0) st = tx_system_stats(sc->system, i);
   }
   if (rc == 0) {
-    tx_percentiles p = tx_samples_percentiles(&b.ns);
+    tx_percentiles p = tx_hist_percentiles(&b.ns);
     int torn = tx_cloth_torn(b.cloth);
     printf("  %-58s %9s %9s %9s\n", "one physics step", "p50 ms", "p99 ms", "max ms");
     printf("  %-58s %9.3f %9.3f %9.3f\n", "bare loop: adapter step (Bullet, contact, rupture)", p.p50 * 1e-6,
@@ -160,7 +161,6 @@ int tx_bench_cloth(double duration_s) {
   }
   bench_bare = NULL;
   tx_scenario_free(sc);
-  tx_samples_free(&b.ns);
   tx_cloth_destroy(b.cloth);
   return rc;
 }

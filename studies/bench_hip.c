@@ -7,7 +7,7 @@
 
 #include "../controllers/collision/hip.h"
 #include "experiments/skin_grid.h"
-#include "../controllers/stats.h"
+#include <tactus/stats.h>
 
 #include <tactus/model.h>
 
@@ -47,10 +47,10 @@ static int run_size(uint32_t n, hip_bench_row* row) {
   float* x = malloc(sizeof(float) * 3 * count);
   float* copy = malloc(sizeof(float) * 3 * count);
   int32_t* tri = malloc(sizeof(int32_t) * 3 * ntri_max);
-  tx_samples q, r, tk, sh;
+  static tx_hist q, r, tk, sh; // not on the stack
+  tx_hist_clear(&q), tx_hist_clear(&r), tx_hist_clear(&tk), tx_hist_clear(&sh);
   tx_tri_bvh b;
-  bool ok = flat && x && copy && tri && tx_samples_init(&q, QUERIES) && tx_samples_init(&r, QUERIES / PER_PUBLISH + 1) &&
-            tx_samples_init(&tk, QUERIES / PER_PUBLISH + 1) && tx_samples_init(&sh, QUERIES) &&
+  bool ok = flat && x && copy && tri &&
             tx_tri_bvh_init(&b, ntri_max) == 0;
   if (!ok) return fprintf(stderr, "tactus: bench hip: out of memory\n"), 1;
   uint32_t ntri = tx_skin_grid(n, 0.1 / (n - 1), flat, tri);
@@ -73,7 +73,7 @@ static int run_size(uint32_t n, hip_bench_row* row) {
       int64_t a = tx_mono_ns();
       memcpy(x, copy, sizeof(float) * 3 * count);
       bool good = finite_all(x, 3 * (size_t)count) && tx_tri_bvh_same(&b, tri, ntri);
-      tx_samples_add(&tk, tx_mono_ns() - a);
+      tx_hist_add(&tk, tx_mono_ns() - a);
       // the refit in the controller's shares (up to 8 steps at 4 kHz)
       uint32_t chunk = 2 * ntri_max / 8 + 1 > 8192 ? 2 * ntri_max / 8 + 1 : 8192;
       int64_t whole = 0;
@@ -82,11 +82,11 @@ static int run_size(uint32_t n, hip_bench_row* row) {
         int64_t s0 = tx_mono_ns();
         tx_tri_bvh_refit_nodes(&b, x, from, to);
         int64_t d = tx_mono_ns() - s0;
-        tx_samples_add(&sh, d);
+        tx_hist_add(&sh, d);
         whole += d;
         to = from;
       }
-      tx_samples_add(&r, whole);
+      tx_hist_add(&r, whole);
     }
     // the HIP touches the dent's bottom and circles 0.2 mm around it
     double c[3] = {1e-3 * sin(3 * t) + 2e-4 * cos(40 * t), -5e-3 - 1e-3 * sin(5 * t) + 1.5e-3,
@@ -94,20 +94,16 @@ static int run_size(uint32_t n, hip_bench_row* row) {
     tx_hip_out o;
     int64_t a = tx_mono_ns();
     tx_hip_query(&hip, &b, x, thickness, c, &o);
-    tx_samples_add(&q, tx_mono_ns() - a);
+    tx_hist_add(&q, tx_mono_ns() - a);
     contacts += (uint64_t)o.contacts;
   }
   row->particles = count;
-  row->query = tx_samples_percentiles(&q);
-  row->refit = tx_samples_percentiles(&r);
-  row->take = tx_samples_percentiles(&tk);
-  row->share = tx_samples_percentiles(&sh);
+  row->query = tx_hist_percentiles(&q);
+  row->refit = tx_hist_percentiles(&r);
+  row->take = tx_hist_percentiles(&tk);
+  row->share = tx_hist_percentiles(&sh);
   row->nodes_per_query = (double)b.visited / QUERIES;
   row->contacts = (double)contacts / QUERIES;
-  tx_samples_free(&q);
-  tx_samples_free(&r);
-  tx_samples_free(&tk);
-  tx_samples_free(&sh);
   tx_tri_bvh_free(&b);
   free(copy);
   free(flat);

@@ -9,7 +9,7 @@
 
 #include "../scenarios/loader.h"
 
-#include "../controllers/stats.h"
+#include <tactus/stats.h>
 #include "../controllers/system.h"
 #include "experiments/needle_fit.h"
 
@@ -79,9 +79,10 @@ static double all_awake(const int c[3], int frames, double* p99) {
   td.origin[0] = -0.5 * td.block_size[0], td.origin[1] = -td.block_size[1], td.origin[2] = -0.5 * td.block_size[2];
   tx_voxel_tissue t;
   tx_voxel_needle n;
-  tx_samples st;
+  static tx_hist st; // not on the stack
+  tx_hist_clear(&st);
   if (!tx_voxel_tissue_init(&t, &td)) return -1;
-  if (!tx_voxel_needle_init(&n, &nd, &t) || !tx_samples_init(&st, (uint64_t)frames)) {
+  if (!tx_voxel_needle_init(&n, &nd, &t)) {
     tx_voxel_tissue_fini(&t);
     return -1;
   }
@@ -100,12 +101,11 @@ static double all_awake(const int c[3], int frames, double* p99) {
     int64_t t0 = tx_mono_ns();
     tx_voxel_needle_step(&n, &t, tip, q, 1e-3);
     energy += tx_voxel_tissue_energy(&t);
-    tx_samples_add(&st, tx_mono_ns() - t0);
+    tx_hist_add(&st, tx_mono_ns() - t0);
   }
   if (!isfinite(energy)) fprintf(stderr, "tactus: bench voxels: the all-awake tissue's energy is not finite\n");
-  tx_percentiles pc = tx_samples_percentiles(&st);
+  tx_percentiles pc = tx_hist_percentiles(&st);
   *p99 = pc.p99;
-  tx_samples_free(&st);
   tx_voxel_needle_fini(&n);
   tx_voxel_tissue_fini(&t);
   return pc.p50;

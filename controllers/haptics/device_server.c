@@ -19,7 +19,6 @@
 
 #define DRAIN_MAX 256          // packets taken per wake: a flood cannot starve the state ticks
 #define IDLE_WAIT_NS 100000000 // between checks of the stop flag before the first hello
-#define SAMPLES (1u << 18)     // round trips kept for percentiles: 4 min at 1 kHz
 
 struct tx_device_server {
   tx_device_server_def def;
@@ -43,7 +42,7 @@ struct tx_device_server {
   int64_t last_force_ns;      // arrival of the newest force
   bool forcing;               // a force from the peer is on the device
   int64_t last_echo_measured; // the newest state a round trip was measured for
-  tx_samples loop, link;
+  tx_hist loop, link;         // round trips, ns, the whole session
   tx_device_server_stats stats;
 };
 
@@ -71,11 +70,6 @@ tx_device_server* tx_device_server_open(const tx_device_server_def* def, char* e
   if (!s) return snprintf(err, n, "out of memory"), NULL;
   s->def = *def;
   s->fd = -1;
-  if (!tx_samples_init(&s->loop, SAMPLES) || !tx_samples_init(&s->link, SAMPLES)) {
-    snprintf(err, n, "out of memory");
-    tx_device_server_close(s);
-    return NULL;
-  }
   if (tx_device_open(def->spec, 1 / def->rate_hz, &s->dev, err, n)) {
     tx_device_server_close(s);
     return NULL;
@@ -212,8 +206,8 @@ static void consider(tx_device_server* s, const uint8_t* buf, size_t n, const st
     if (p.echo_ns > s->last_echo_measured && p.echo_ns >= s->t0_ns && p.echo_ns <= arrival) {
       s->last_echo_measured = p.echo_ns;
       int64_t loop = arrival - p.echo_ns;
-      tx_samples_add(&s->loop, loop);
-      tx_samples_add(&s->link, loop - (int64_t)p.echo_hold_ns);
+      tx_hist_add(&s->loop, loop);
+      tx_hist_add(&s->link, loop - (int64_t)p.echo_hold_ns);
       s->stats.round_trips++;
       align(s, p.echo_hold_ns);
     }
@@ -286,8 +280,8 @@ int tx_device_server_run(tx_device_server* s, const atomic_int* stop, char* err,
 
 void tx_device_server_get_stats(const tx_device_server* s, tx_device_server_stats* out) {
   *out = s->stats;
-  out->loop = tx_samples_percentiles(&s->loop);
-  out->link = tx_samples_percentiles(&s->link);
+  out->loop = tx_hist_percentiles(&s->loop);
+  out->link = tx_hist_percentiles(&s->link);
 }
 
 void tx_device_server_close(tx_device_server* s) {
@@ -295,7 +289,5 @@ void tx_device_server_close(tx_device_server* s) {
   if (s->dev.device) zero_device(s);
   tx_device_close(&s->dev);
   if (s->fd >= 0) close(s->fd);
-  tx_samples_free(&s->loop);
-  tx_samples_free(&s->link);
   free(s);
 }

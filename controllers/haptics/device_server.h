@@ -19,7 +19,7 @@
 #ifndef TX_CONTROLLERS_HAPTICS_DEVICE_SERVER_H
 #define TX_CONTROLLERS_HAPTICS_DEVICE_SERVER_H
 
-#include "../stats.h"
+#include <tactus/stats.h>
 
 #include <netinet/in.h>
 #include <stdatomic.h>

@@ -14,6 +14,7 @@
 #include <tactus/controller.h>
 #include <tactus/haptics.h>
 #include <tactus/model.h>
+#include <tactus/stats.h>
 
 #define TX_VERSION "0.1.0"
 

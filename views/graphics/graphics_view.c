@@ -9,6 +9,7 @@
 
 #include <tactus/components.h>
 #include <tactus/config.h>
+#include <tactus/stats.h>
 
 #if TX_WITH_OSMESA
 #include "osmesa_target.h"
@@ -32,7 +33,6 @@
 #include <time.h>
 #include <unistd.h>
 
-#define FRAME_TIMES 65536 // frame times kept for the percentiles (a ring)
 #define SHEET_THUMBS 24
 
 typedef enum { TARGET_PNG, TARGET_WINDOW } target_kind;
@@ -62,10 +62,10 @@ typedef struct view {
   char frames_dir[4200];
   // the rendering thread's own
   uint64_t rendered, written, dropped, write_errors;
-  uint64_t timed;                       // frames in frame_ms (all but the first)
+  uint64_t timed;                       // frames in frame_ns (all but the first)
   double first_frame_ms;                // ms, the first frame (shader compilation included)
-  float* frame_ms;                      // (FRAME_TIMES) render + read-back time of a frame, ms
-  float* frame_cpu_ms;                  // (FRAME_TIMES) CPU time of the rendering thread for it, ms
+  tx_hist frame_ns;                     // render + read-back time of every frame, ns
+  tx_hist frame_cpu_ns;                 // CPU time of the rendering thread for each, ns
   tx_result r_frames, r_dropped, r_p50, r_p99, r_threads, r_written, r_first, r_cpu50;
   tx_warning w_write, w_skipped;
   uint64_t skipped_reported;
@@ -198,8 +198,9 @@ static void record_time(view* v, double ms, double cpu_ms) {
     v->first_frame_ms = ms;
     return;
   }
-  v->frame_cpu_ms[v->timed % FRAME_TIMES] = (float)cpu_ms;
-  v->frame_ms[v->timed++ % FRAME_TIMES] = (float)ms;
+  tx_hist_add(&v->frame_cpu_ns, llround(cpu_ms * 1e6));
+  tx_hist_add(&v->frame_ns, llround(ms * 1e6));
+  v->timed++;
 }
 
 static int64_t thread_cpu_ns(void) {
@@ -208,22 +209,8 @@ static int64_t thread_cpu_ns(void) {
   return (int64_t)t.tv_sec * 1000000000 + t.tv_nsec;
 }
 
-static int cmp_float(const void* a, const void* b) {
-  float x = *(const float*)a, y = *(const float*)b;
-  return (x > y) - (x < y);
-}
-
-static double percentile(const view* v, const float* samples, double p) {
-  uint64_t n = v->timed < FRAME_TIMES ? v->timed : FRAME_TIMES;
-  if (!n) return NAN;
-  float* copy = malloc(n * sizeof *copy);
-  if (!copy) return NAN;
-  memcpy(copy, samples, n * sizeof *copy);
-  qsort(copy, n, sizeof *copy, cmp_float);
-  double x = copy[(size_t)fmin((double)n - 1, floor(p * (double)n))];
-  free(copy);
-  return x;
-}
+// ms, NaN before any timed frame
+static double frame_ms(const view* v, const tx_hist* h, double q) { return v->timed ? tx_hist_percentile(h, q) * 1e-6 : NAN; }
 
 static void frame_path(const view* v, char* path, size_t n, uint64_t index, const char* eye) {
   snprintf(path, n, "%s/frame_%06llu%s.png", v->frames_dir, (unsigned long long)index, eye);
@@ -509,9 +496,6 @@ static int init(tx_ctx* c, void* self) {
     fprintf(stderr, "tactus: view: %s: %s\n", v->frames_dir, strerror(errno));
     return -1;
   }
-  if (!(v->frame_ms = calloc(FRAME_TIMES, sizeof *v->frame_ms)) ||
-      !(v->frame_cpu_ms = calloc(FRAME_TIMES, sizeof *v->frame_cpu_ms)))
-    return -1;
   sem_init(&v->go, 0, 0);
   sem_init(&v->idle, 0, 1);
   sem_init(&v->started, 0, 0);
@@ -572,9 +556,9 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, v->r_frames, (double)v->rendered);
   tx_set_result(c, v->r_written, (double)v->written);
   tx_set_result(c, v->r_dropped, (double)v->dropped);
-  tx_set_result(c, v->r_p50, percentile(v, v->frame_ms, 0.5));
-  tx_set_result(c, v->r_p99, percentile(v, v->frame_ms, 0.99));
-  tx_set_result(c, v->r_cpu50, percentile(v, v->frame_cpu_ms, 0.5));
+  tx_set_result(c, v->r_p50, frame_ms(v, &v->frame_ns, 0.5));
+  tx_set_result(c, v->r_p99, frame_ms(v, &v->frame_ns, 0.99));
+  tx_set_result(c, v->r_cpu50, frame_ms(v, &v->frame_cpu_ns, 0.5));
   tx_set_result(c, v->r_threads, v->target == TARGET_PNG ? v->render_threads : NAN);
   tx_set_result(c, v->r_first, v->rendered ? v->first_frame_ms : NAN);
 }
@@ -588,8 +572,6 @@ static void fini(void* self) {
     sem_destroy(&v->idle);
     sem_destroy(&v->started);
   }
-  free(v->frame_ms);
-  free(v->frame_cpu_ms);
   free(v);
 }
 
