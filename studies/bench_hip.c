@@ -6,7 +6,8 @@
 #include "bench_hip.h"
 
 #include "../controllers/collision/hip.h"
-#include "experiments/skin_grid.h"
+#include "experiments/skin_dent.h"
+#include "../controllers/physics/skin_grid.h"
 #include <tactus/stats.h>
 
 #include <tactus/model.h>
@@ -53,7 +54,7 @@ static int run_size(uint32_t n, hip_bench_row* row) {
   bool ok = flat && x && copy && tri &&
             tx_tri_bvh_init(&b, ntri_max) == 0;
   if (!ok) return fprintf(stderr, "tactus: bench hip: out of memory\n"), 1;
-  uint32_t ntri = tx_skin_grid(n, 0.1 / (n - 1), flat, tri);
+  uint32_t ntri = tx_skin_grid((int)n, (int)n, 0.1 / (n - 1), 0.1 / (n - 1), (double[3]){0, 0, 0}, flat, tri);
   press(x, flat, count, 0);
   int64_t t0 = tx_mono_ns();
   tx_tri_bvh_build(&b, x, count, tri, ntri);

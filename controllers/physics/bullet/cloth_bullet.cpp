@@ -7,11 +7,11 @@
 extern "C" {
 #include "../../../model/error.h"
 #include "../../range_check.h"
+#include "../skin_grid.h"
 }
 
 #include <BulletSoftBody/btSoftBody.h>
 
-#include <algorithm>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -180,15 +180,18 @@ static bool build(tx_cloth* c) {
   c->ntri = 2 * (nx - 1) * (nz - 1);
   const double hx = d.size[0] / (nx - 1), hz = d.size[1] / (nz - 1);
 
-  // particles on the grid; the border is fixed by zero mass
+  // particles and triangles on the skin's grid (skin_grid.h); the border is fixed by zero mass
+  std::vector<float> grid((size_t)c->n * 3);
+  c->tri.resize((size_t)c->ntri * 3);
+  tx_skin_grid(nx, nz, hx, hz, d.center, grid.data(), c->tri.data());
   std::vector<btVector3> x((size_t)c->n);
   std::vector<btScalar> m((size_t)c->n);
   c->node_mass = d.mass / c->n;
   for (int iz = 0; iz < nz; iz++)
     for (int ix = 0; ix < nx; ix++) {
       int i = node_index(d, ix, iz);
-      x[(size_t)i] = btVector3((btScalar)(d.center[0] - 0.5 * d.size[0] + ix * hx), (btScalar)d.center[1],
-                               (btScalar)(d.center[2] - 0.5 * d.size[1] + iz * hz));
+      const float* g = &grid[(size_t)i * 3];
+      x[(size_t)i] = btVector3(g[0], g[1], g[2]);
       bool border = ix == 0 || iz == 0 || ix == nx - 1 || iz == nz - 1;
       m[(size_t)i] = (d.fixed_border && border) ? 0 : (btScalar)c->node_mass;
     }
@@ -200,21 +203,6 @@ static bool build(tx_cloth* c) {
   c->stretch_mat = c->body->m_materials[0];
   c->bend_mat = c->body->appendMaterial();
 
-  // two triangles per cell along an alternating diagonal, normals towards +y
-  c->tri.resize((size_t)c->ntri * 3);
-  for (int cz = 0; cz < nz - 1; cz++)
-    for (int cx = 0; cx < nx - 1; cx++) {
-      int a = node_index(d, cx, cz), b = node_index(d, cx + 1, cz), cc = node_index(d, cx, cz + 1),
-          dd = node_index(d, cx + 1, cz + 1);
-      int32_t* t = &c->tri[(size_t)(cz * (nx - 1) + cx) * 6];
-      if (((cx + cz) & 1) == 0) {
-        int32_t v[6] = {a, dd, b, a, cc, dd};
-        std::memcpy(t, v, sizeof v);
-      } else {
-        int32_t v[6] = {a, cc, b, b, cc, dd};
-        std::memcpy(t, v, sizeof v);
-      }
-    }
   c->tri_alive.assign((size_t)c->ntri, 1);
   c->live = c->tri;
   c->nlive = c->ntri;

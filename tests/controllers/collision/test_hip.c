@@ -8,7 +8,8 @@
 #include <cmocka.h>
 
 #include "controllers/collision/hip.h"
-#include "studies/experiments/skin_grid.h"
+#include "controllers/physics/skin_grid.h"
+#include "studies/experiments/skin_dent.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -33,7 +34,7 @@ typedef struct skin {
 static skin* flat(void) {
   skin* s = calloc(1, sizeof *s);
   assert_non_null(s);
-  s->ntri = tx_skin_grid(N, SPACING, s->x, s->tri);
+  s->ntri = tx_skin_grid(N, N, SPACING, SPACING, (double[3]){0, 0, 0}, s->x, s->tri);
   assert_int_equal(tx_tri_bvh_init(&s->bvh, s->ntri), 0);
   assert_int_equal(tx_tri_bvh_build(&s->bvh, s->x, N * N, s->tri, s->ntri), 0);
   return s;
@@ -274,7 +275,7 @@ static uint64_t query_nodes(uint32_t n) {
   int32_t* tri = malloc(sizeof(int32_t) * 6 * (n - 1) * (n - 1));
   assert_non_null(x);
   assert_non_null(tri);
-  uint32_t m = tx_skin_grid(n, SPACING, x, tri);
+  uint32_t m = tx_skin_grid((int)n, (int)n, SPACING, SPACING, (double[3]){0, 0, 0}, x, tri);
   tx_skin_dent(x, n * n, (double[3]){0, 0, 0}, 2e-3, 4e-3);
   tx_tri_bvh b;
   assert_int_equal(tx_tri_bvh_init(&b, m), 0);

@@ -7,7 +7,7 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
-#include "studies/experiments/skin_grid.h"
+#include "controllers/physics/skin_grid.h"
 #include "scenarios/loader.h"
 #include "tests/scenario_support.h"
 
@@ -35,7 +35,7 @@ static int skin_configure(tx_setup* s, void** self) {
   *self = k;
   k->tear_at_s = tx_param_num(s, "tear_at_s", 1e9, 0, 1e9);
   k->nan_at_s = tx_param_num(s, "nan_at_s", 1e9, 0, 1e9);
-  k->ntri = tx_skin_grid(N, SPACING, k->px, k->ptri);
+  k->ntri = tx_skin_grid(N, N, SPACING, SPACING, (double[3]){0, 0, 0}, k->px, k->ptri);
   k->x = tx_setup_write(s, &(tx_component_def){"skin.x", TX_F32, N * N, 3, "m"});
   k->tri = tx_setup_write(s, &(tx_component_def){"skin.tri", TX_I32, k->ntri, 3, "1"});
   k->thickness = tx_setup_write(s, &(tx_component_def){"skin.thickness", TX_F64, 1, 1, "m"});

@@ -6,7 +6,8 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
-#include "studies/experiments/skin_grid.h"
+#include "controllers/physics/skin_grid.h"
+#include "studies/experiments/skin_dent.h"
 #include "controllers/collision/tri_bvh.h"
 
 #include <math.h>
@@ -23,7 +24,7 @@ static mesh make(uint32_t n, double spacing) {
   mesh m = {n, 0, malloc(sizeof(float) * 3 * n * n), malloc(sizeof(int32_t) * 6 * (n - 1) * (n - 1))};
   assert_non_null(m.x);
   assert_non_null(m.tri);
-  m.ntri = tx_skin_grid(n, spacing, m.x, m.tri);
+  m.ntri = tx_skin_grid((int)n, (int)n, spacing, spacing, (double[3]){0, 0, 0}, m.x, m.tri);
   return m;
 }
 
