@@ -567,7 +567,7 @@ int tx_study_skin_paper(const tx_study_args* a) {
     printf("\nfindings (holds from: mechanics = the skin's mechanics; construction = the force is a fixed function of "
            "the HIP's displacement, or it holds only in paper mode):\n");
     printf("  %-54s", "finding");
-    for (int k = 0; k < nmodes; k++) printf(" %-48s", modes[k]);
+    for (int k = 0; k < nmodes; k++) printf(" %-52s", modes[k]);
     printf(" holds from\n");
     bool all = true;
     for (int i = 0; i < NFINDINGS; i++) {
@@ -576,7 +576,7 @@ int tx_study_skin_paper(const tx_study_args* a) {
         int m = strcmp(modes[k], "paper") == 0 ? 0 : 1;
         char cell[200];
         snprintf(cell, sizeof cell, "%s %s", holds[i][m] ? "met" : "MISSED", measured[i][m]);
-        printf(" %-48.48s", cell);
+        printf(" %-52.52s", cell);
         if (m == 0 && findings[i].counted) all &= holds[i][m]; // the papers' method reproduces the papers
       }
       printf(" %s\n", from[i]);
