@@ -350,7 +350,7 @@ static int parse_options(const tx_study_args* a, options* o) {
         return tx_bad_input("--set indentation_m: expected a depth in (0, 0.01] m, not '%s'", v);
       o->depth = d;
     } else
-      return tx_bad_input("--set %.*s: skin-accuracy takes path, levels and indentation_m", (int)(eq - s), s);
+      return tx_bad_input("--set %s: skin-accuracy takes path, levels and indentation_m", s);
   }
   if (!o->levels) o->levels = o->quick ? 3 : 4;
   // the finest level must stay within physics.skin's spacing (>= 0.5 mm) and iterations (<= 200)
@@ -430,7 +430,7 @@ static int write_outputs(const char* dir, const setting* set, const row* rows, c
   json_t* doc = json_pack(
       "{s:s,s:s,s:{s:i,s:f,s:s,s:f,s:s},s:s,s:s,s:o,s:o}", "study", "skin-accuracy", "path", o->quick ? "quick" : "full",
       "refinement", "levels", nset - 1, "ratio", 2.0, "rule",
-      "spacing halves, iterations and physics rate double, at each level; 10 cm edge", "indentation_m", o->depth,
+      "at each level the spacing halves, the iterations double and the time step halves (physics.skin's rate up to 120 Hz, then its substep); 10 cm edge", "indentation_m", o->depth,
       "motion", motion, "error",
       "|q - reference| / |reference|; reference: Richardson from the three finest levels with the observed order "
       "(the finest level when the quantity does not converge: see status)",
