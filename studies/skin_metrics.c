@@ -71,3 +71,39 @@ tx_skin_metrics tx_skin_measure(const tx_skin_series* s, double steady_from, dou
   }
   return m;
 }
+
+tx_convergence tx_converge(const double* q, int n, double ratio, double* err) {
+  tx_convergence c = {TX_CONV_MISSING, NAN, NAN, false};
+  for (int i = 0; err && i < n; i++) err[i] = NAN;
+  bool all = n >= 3 && ratio > 1;
+  for (int i = 0; all && i < n; i++) all = isfinite(q[i]);
+  if (!all) return c;
+  double d1 = q[n - 2] - q[n - 3], d2 = q[n - 1] - q[n - 2];
+  // a step within rounding of the values is no step (a quantity fixed by construction)
+  double tiny = 1e-9 * fmax(fabs(q[n - 1]), fmax(fabs(q[n - 2]), fabs(q[n - 3])));
+  if (fabs(d1) <= tiny) d1 = 0;
+  if (fabs(d2) <= tiny) d2 = 0;
+  c.reference = q[n - 1];
+  if (d1 == 0 && d2 == 0) c.status = TX_CONV_CONSTANT;
+  else if (d1 * d2 <= 0) c.status = TX_CONV_OSCILLATING;
+  else {
+    c.p = log(d1 / d2) / log(ratio);
+    c.status = c.p >= 0.5 ? TX_CONV_CONVERGING : c.p > 0 ? TX_CONV_SLOW : TX_CONV_DIVERGING;
+    if (c.status == TX_CONV_CONVERGING) c.reference = q[n - 1] + d2 / (pow(ratio, c.p) - 1);
+  }
+  // the error at each level, and whether it falls at every refinement
+  c.monotone = c.status == TX_CONV_CONVERGING && c.reference != 0;
+  double prev = INFINITY;
+  for (int i = 0; i < n; i++) {
+    double e = c.reference != 0 ? fabs(q[i] - c.reference) / fabs(c.reference) : NAN;
+    if (err) err[i] = e;
+    if (!(e < prev)) c.monotone = false;
+    prev = e;
+  }
+  return c;
+}
+
+const char* tx_conv_status_name(tx_conv_status s) {
+  static const char* const names[] = {"converging", "constant", "oscillating", "diverging", "missing", "slow"};
+  return (unsigned)s < sizeof names / sizeof names[0] ? names[s] : "?";
+}

@@ -41,4 +41,33 @@ typedef struct tx_skin_metrics {
 // the metrics of a run; steady_from/steady_to (s) bound the sliding phase for tangent_*
 tx_skin_metrics tx_skin_measure(const tx_skin_series* s, double steady_from, double steady_to);
 
+// Convergence of one quantity along a refinement path (skin-accuracy): the
+// levels refine by a constant ratio, coarsest first. From the three finest,
+// d1 = q[n-2] - q[n-3] and d2 = q[n-1] - q[n-2]: when both have the same sign
+// and |d2| < |d1| the path is in its asymptotic range, the observed order is
+// p = ln(d1 / d2) / ln(ratio) and the Richardson reference is
+// q[n-1] + d2 / (ratio^p - 1). Below p = 0.5 (steps shrinking by less than
+// 1 / sqrt(2) at ratio 2) that correction is more than 2.4 times the last
+// step and is not trusted. Otherwise, and when the steps do not shrink, the
+// finest level stands in for the reference.
+typedef enum tx_conv_status {
+  TX_CONV_CONVERGING = 0, // same sign, shrinking steps: p > 0, Richardson reference
+  TX_CONV_CONSTANT,       // d1 = d2 = 0 (within 1e-9 of the values): the quantity does not change along the path
+  TX_CONV_OSCILLATING,    // the steps change sign (or only the last is 0)
+  TX_CONV_DIVERGING,      // the steps do not shrink: p <= 0
+  TX_CONV_MISSING,        // fewer than 3 levels, or a level without a value
+  TX_CONV_SLOW,           // same sign, shrinking, but 0 < p < 0.5: no extrapolation
+} tx_conv_status;
+
+typedef struct tx_convergence {
+  tx_conv_status status;
+  double p;         // observed order (NaN unless CONVERGING, SLOW or DIVERGING)
+  double reference; // Richardson reference, or the finest level when not CONVERGING (NaN when MISSING)
+  bool monotone;    // the error against the reference falls at every level
+} tx_convergence;
+
+// err (n, may be NULL): |q[l] - reference| / |reference| per level
+tx_convergence tx_converge(const double* q, int n, double ratio, double* err);
+const char* tx_conv_status_name(tx_conv_status s);
+
 #endif

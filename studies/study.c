@@ -19,11 +19,12 @@ static const struct {
      "largest stable wall stiffness vs Colgate's bound, with and without passivity control"},
     {"needle-fit", tx_study_needle_fit, "FILE: fit the voxel tissue to a needle recording, RMS vs run time, Figure 5"},
     {"needle-stability", tx_study_needle_stability, "needle in voxels at stiff, elastic, light, fast and overlapping extremes"},
-    {"skin-paper", tx_study_skin_paper, "the SutureHap journal paper's skin tests (Figs. 15-19) and the 60 Hz hold"},
+    {"skin-paper", tx_study_skin_paper,
+     "the SutureHap journal paper's skin tests (Figs. 15-19) and the 60 Hz hold, per force mode; mechanics or construction"},
     {"skin-stability", tx_study_skin_stability,
      "the skin under stiffness x1e-3..x1e3, steps 1/20..1/1000 s, a teleporting and a 10 m/s HIP, zero thickness"},
     {"skin-accuracy", tx_study_skin_accuracy,
-     "pierce-down force curve error against run time over spacing, iterations and rate"},
+     "spacing, iterations and step refined together: observed order, Richardson reference, error vs CPU time"},
 };
 
 // the studies that take a FILE after their name

@@ -3,8 +3,13 @@
 //
 //   skin_paper_check OUT/skin-paper.json
 //
-// Exit status 0 when every finding holds, 1 with one line per failure on
-// stderr. The thresholds are those docs/hip.md states.
+// In paper mode (the papers' method) every counted finding must hold, with
+// the thresholds docs/hip.md states. In every mode the study ran, 20 cases;
+// every finding has a verdict per mode and a holds_from that agrees with
+// them: "mechanics" only where it holds in mechanics mode (or, for the sag,
+// in some mode) and that mode's force moves with the skin's stiffness,
+// "construction" only where it holds in some mode. Exit status 0, or 1 with
+// one line per failure on stderr.
 #include <jansson.h>
 
 #include <math.h>
@@ -18,7 +23,8 @@ static int failures;
 static double get(const char* label, const char* key) {
   size_t i;
   json_t* c;
-  json_array_foreach(cases, i, c) if (strcmp(json_string_value(json_object_get(c, "case")), label) == 0) {
+  json_array_foreach(cases, i, c) if (strcmp(json_string_value(json_object_get(c, "case")), label) == 0 &&
+                                      strcmp(json_string_value(json_object_get(c, "mode")), "paper") == 0) {
     json_t* v = json_object_get(c, key);
     return json_is_number(v) ? json_number_value(v) : NAN;
   }
@@ -37,7 +43,46 @@ int main(int argc, char** argv) {
   json_t* doc = json_load_file(argv[1], 0, &e);
   if (!doc) return fprintf(stderr, "skin_paper_check: %s: %s\n", argv[1], e.text), 1;
   cases = json_object_get(doc, "cases");
-  if (!json_is_array(cases) || json_array_size(cases) != 20) return fprintf(stderr, "skin_paper_check: expected 20 cases\n"), 1;
+  json_t* modes = json_object_get(doc, "modes");
+  json_t* findings = json_object_get(doc, "findings");
+  json_t* change = json_object_get(json_object_get(doc, "stiffness_x1000"), "change");
+  if (!json_is_array(modes) || !json_is_array(findings) || json_array_size(findings) != 10 || !json_is_object(change))
+    return fprintf(stderr, "skin_paper_check: expected modes, 10 findings and stiffness_x1000.change\n"), 1;
+  if (!json_is_array(cases) || json_array_size(cases) != 20 * json_array_size(modes))
+    return fprintf(stderr, "skin_paper_check: expected 20 cases per mode\n"), 1;
+  bool paper = false, mechanics = false;
+  size_t k;
+  json_t* v;
+  json_array_foreach(modes, k, v) {
+    paper |= strcmp(json_string_value(v), "paper") == 0;
+    mechanics |= strcmp(json_string_value(v), "mechanics") == 0;
+  }
+  // every finding: a verdict per mode run, and a holds_from that follows from them
+  json_array_foreach(findings, k, v) {
+    const char* name = json_string_value(json_object_get(v, "finding"));
+    const char* from = json_string_value(json_object_get(v, "holds_from"));
+    json_t* holds = json_object_get(v, "holds");
+    json_t* hp = json_object_get(holds, "paper");
+    json_t* hm = json_object_get(holds, "mechanics");
+    char what[128];
+    snprintf(what, sizeof what, "finding %s: a verdict per mode and holds_from", name ? name : "?");
+    if (!name || !from || (paper && !json_is_boolean(hp)) || (mechanics && !json_is_boolean(hm))) {
+      expect(false, what, 0, 0);
+      continue;
+    }
+    bool sag = strcmp(name, "gravity_sag") == 0;
+    double dm = json_number_value(json_object_get(change, "mechanics"));
+    snprintf(what, sizeof what, "finding %s: holds_from %s against its verdicts", name, from);
+    if (strcmp(from, "mechanics") == 0)
+      expect(sag ? (json_is_true(hp) || json_is_true(hm)) : (json_is_true(hm) && dm > 1e-6), what, 0, 0);
+    else if (strcmp(from, "construction") == 0)
+      expect(!sag && (json_is_true(hp) || json_is_true(hm)), what, 0, 0);
+    else if (strcmp(from, "neither") == 0)
+      expect(!json_is_true(hp) && !json_is_true(hm), what, 0, 0);
+    else
+      expect(strcmp(from, "undetermined") == 0 && !mechanics && json_is_true(hp), what, 0, 0);
+  }
+  if (!paper) return json_decref(doc), failures ? 1 : 0; // the papers' thresholds are for the papers' method
   static const char* const pierces[] = {"26 rays", "98 rays", "radius 0.05 cm", "radius 0.1 cm", "0.2 cm", "0.8 cm",
                                         "0.2 cm, gravity", "0.8 cm, gravity", "bottom-up", "top-down",
                                         "0.25 cm, pierce", "0.1 cm, pierce", "local model"};

@@ -88,6 +88,70 @@ static void test_no_contact(void** state) {
   assert_true(isnan(m.r2) && isnan(m.contact_pos) && m.peak == 0);
 }
 
+// q = 0.1 + 0.02 h^2 on h = 1, 1/2, 1/4, 1/8: order 2, the exact limit, errors falling
+static void test_converge_second_order(void** state) {
+  (void)state;
+  double q[4], err[4];
+  for (int l = 0; l < 4; l++) q[l] = 0.1 + 0.02 * pow(0.5, 2 * l);
+  tx_convergence c = tx_converge(q, 4, 2, err);
+  assert_int_equal(c.status, TX_CONV_CONVERGING);
+  assert_true(fabs(c.p - 2) < 1e-9);
+  assert_true(fabs(c.reference - 0.1) < 1e-12);
+  assert_true(c.monotone);
+  for (int l = 0; l < 4; l++) assert_true(fabs(err[l] - 0.2 * pow(0.25, l)) < 1e-9);
+  // from below, first order, ratio 3
+  for (int l = 0; l < 3; l++) q[l] = 2 - 0.5 * pow(1.0 / 3, l);
+  c = tx_converge(q, 3, 3, err);
+  assert_true(fabs(c.p - 1) < 1e-9 && fabs(c.reference - 2) < 1e-12 && c.monotone);
+}
+
+// what is not convergence is said, and the finest level stands in
+static void test_converge_refuses_what_does_not_converge(void** state) {
+  (void)state;
+  double err[4];
+  // the steps grow towards the finest level
+  double grow[3] = {0.80, 0.81, 0.83};
+  tx_convergence c = tx_converge(grow, 3, 2, err);
+  assert_int_equal(c.status, TX_CONV_DIVERGING);
+  assert_true(fabs(c.p + 1) < 1e-9 && c.reference == 0.83 && !c.monotone);
+  // shrinking so slowly that the extrapolation would run away (p = 0.06)
+  double slow[3] = {0.0666, 0.0476, 0.0476 - 0.019 * pow(2, -0.06)};
+  c = tx_converge(slow, 3, 2, err);
+  assert_int_equal(c.status, TX_CONV_SLOW);
+  assert_true(fabs(c.p - 0.06) < 1e-9 && c.reference == slow[2] && !c.monotone);
+  // a step that changes sign
+  double zig[4] = {1.0, 1.2, 1.1, 1.15};
+  c = tx_converge(zig, 4, 2, err);
+  assert_int_equal(c.status, TX_CONV_OSCILLATING);
+  assert_true(isnan(c.p) && c.reference == 1.15 && !c.monotone);
+  // barely moving, then a jump to the finest (the old spacing sweep)
+  double jump[3] = {0.50, 0.50, 0.30};
+  c = tx_converge(jump, 3, 2, err);
+  assert_int_equal(c.status, TX_CONV_OSCILLATING);
+  // converging from the three finest, but the coarsest is closer than the next: not monotone
+  double bump[4] = {0.1001, 0.14, 0.12, 0.11};
+  c = tx_converge(bump, 4, 2, err);
+  assert_int_equal(c.status, TX_CONV_CONVERGING);
+  assert_true(fabs(c.p - 1) < 1e-9 && fabs(c.reference - 0.1) < 1e-12);
+  assert_false(c.monotone);
+  // unchanged along the path: constant, error 0, no order
+  double flat[3] = {0.3, 0.3, 0.3};
+  c = tx_converge(flat, 3, 2, err);
+  assert_int_equal(c.status, TX_CONV_CONSTANT);
+  assert_true(isnan(c.p) && err[0] == 0 && !c.monotone);
+  double rounding[3] = {0.0802, 0.0802 * (1 + 1e-14), 0.0802 * (1 - 1e-14)};
+  c = tx_converge(rounding, 3, 2, err);
+  assert_int_equal(c.status, TX_CONV_CONSTANT);
+  // a level without a value, or too few levels
+  double gap[3] = {0.1, NAN, 0.3};
+  c = tx_converge(gap, 3, 2, err);
+  assert_int_equal(c.status, TX_CONV_MISSING);
+  assert_true(isnan(c.reference) && isnan(err[0]));
+  c = tx_converge(gap, 2, 2, NULL);
+  assert_int_equal(c.status, TX_CONV_MISSING);
+  assert_string_equal(tx_conv_status_name(TX_CONV_DIVERGING), "diverging");
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_linear_push_and_rupture),
@@ -95,6 +159,8 @@ int main(void) {
       cmocka_unit_test(test_hold_steps_sixteen_times_larger),
       cmocka_unit_test(test_sawtooth_slide_is_steady),
       cmocka_unit_test(test_no_contact),
+      cmocka_unit_test(test_converge_second_order),
+      cmocka_unit_test(test_converge_refuses_what_does_not_converge),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

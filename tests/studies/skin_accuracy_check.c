@@ -1,0 +1,86 @@
+// Checks skin-accuracy.json, for the study's tests:
+//
+//   skin_accuracy_check OUT/skin-accuracy.json            the outputs are whole
+//   skin_accuracy_check --converges OUT/skin-accuracy.json and the skin converges
+//
+// Whole: the documented keys, one row per level and the real-time default,
+// every row with its CPU time, the levels refining by 2 (spacing halves,
+// iterations double, time step halves). Converges: for each quantity the
+// status is "converging", the order p and the reference are finite, and the
+// error falls at every level of the path. Exit status 0, or 1 with one line
+// per failure on stderr.
+#include <jansson.h>
+
+#include <math.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <string.h>
+
+static int failures;
+
+static void expect(bool ok, const char* what, const char* detail) {
+  if (ok) return;
+  fprintf(stderr, "skin_accuracy_check: %s%s%s\n", what, detail ? ": " : "", detail ? detail : "");
+  failures++;
+}
+
+static double num(json_t* o, const char* key) {
+  json_t* v = json_object_get(o, key);
+  return json_is_number(v) ? json_number_value(v) : NAN;
+}
+
+int main(int argc, char** argv) {
+  bool converges = argc == 3 && strcmp(argv[1], "--converges") == 0;
+  if (argc != 2 && !converges) return fprintf(stderr, "usage: skin_accuracy_check [--converges] SKIN_ACCURACY_JSON\n"), 2;
+  const char* path = argv[argc - 1];
+  json_error_t e;
+  json_t* doc = json_load_file(path, 0, &e);
+  if (!doc) return fprintf(stderr, "skin_accuracy_check: %s: %s\n", path, e.text), 1;
+  static const char* const keys[] = {"force_at_indentation_n", "rupture_force_n", "rupture_depth_m", "sag_m"};
+  json_t* settings = json_object_get(doc, "settings");
+  json_t* quantities = json_object_get(doc, "quantities");
+  int levels = (int)num(json_object_get(doc, "refinement"), "levels");
+  if (!json_is_array(settings) || !json_is_object(quantities) || !(levels >= 3) ||
+      json_array_size(settings) != (size_t)levels + 1)
+    return fprintf(stderr, "skin_accuracy_check: %s: expected settings (levels + 1), quantities, refinement.levels\n",
+                   path), 1;
+  // the path and the real-time default
+  for (int i = 0; i <= levels; i++) {
+    json_t* r = json_array_get(settings, (size_t)i);
+    char what[96];
+    snprintf(what, sizeof what, "setting %d", i);
+    expect(num(r, "cpu_s_per_sim_s") > 0, what, "no CPU time per simulated second");
+    for (int k = 0; k < 4; k++) expect(json_object_get(r, keys[k]) != NULL, what, keys[k]);
+    if (i == 0 || i == levels) continue;
+    json_t* p = json_array_get(settings, (size_t)i - 1);
+    expect(fabs(num(p, "spacing_m") / num(r, "spacing_m") - 2) < 1e-9, what, "spacing does not halve");
+    expect(num(r, "iterations") == 2 * num(p, "iterations"), what, "iterations do not double");
+    expect(fabs(num(p, "time_step_s") / num(r, "time_step_s") - 2) < 1e-9, what, "time step does not halve");
+    expect(fabs(num(p, "edge_m") - num(r, "edge_m")) < 1e-12, what, "the patch's edge changes along the path");
+  }
+  expect(strcmp(json_string_value(json_object_get(json_array_get(settings, (size_t)levels), "setting")), "real time") == 0,
+         "the last setting", "is not the real-time default");
+  for (int k = 0; k < 4; k++) {
+    json_t* q = json_object_get(quantities, keys[k]);
+    const char* status = json_string_value(json_object_get(q, "status"));
+    expect(status != NULL && json_is_boolean(json_object_get(q, "error_falls")), keys[k], "no status or error_falls");
+    if (!converges || !status) continue;
+    char detail[160];
+    snprintf(detail, sizeof detail, "status %s, p %g, reference %g", status, num(q, "order_p"), num(q, "reference"));
+    expect(strcmp(status, "converging") == 0 && isfinite(num(q, "order_p")) && isfinite(num(q, "reference")), keys[k],
+           detail);
+    // the error at every level, falling
+    double prev = INFINITY;
+    char err_key[64];
+    snprintf(err_key, sizeof err_key, "%s_error_rel", keys[k]);
+    for (int i = 0; i < levels; i++) {
+      double err = num(json_array_get(settings, (size_t)i), err_key);
+      snprintf(detail, sizeof detail, "level %d error %g after %g", i, err, prev);
+      expect(err < prev, keys[k], detail);
+      prev = err;
+    }
+    expect(json_is_true(json_object_get(q, "error_falls")), keys[k], "error_falls is not true");
+  }
+  json_decref(doc);
+  return failures ? 1 : 0;
+}
