@@ -65,7 +65,7 @@ static tx_scenario* load(const char* skin_params) {
   snprintf(text, sizeof text,
            "{\"name\":\"t\",\"controllers\":["
            "{\"name\":\"skin\",\"type\":\"test.skin\",\"rate_hz\":60,\"params\":{%s}},"
-           "{\"name\":\"hip\",\"type\":\"collision.hip\",\"rate_hz\":4000},"
+           "{\"name\":\"hip\",\"type\":\"collision.hip\",\"rate_hz\":4000,\"params\":{\"force_mode\":\"paper\"}},"
            "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:pierce-down\","
            "\"force_model\":\"tool0.force_model\",\"record\":false}}]}",
            skin_params);
