@@ -108,6 +108,14 @@ static void query(tx_hip* h, tx_tri_bvh* b, const float* x, double thickness, co
     h->touching = false;
   }
   if (n == 0 && !(r && r->touching > 0 && !h->pierced)) { // contact over: a later touch starts afresh
+    // unless it ended through a hole: nothing ahead along the approach (the rays lost a
+    // torn skin all at once); then it is a pierce, and a flap touching again is no skin
+    tx_ray_hit gone;
+    if (h->touching && !h->pierced && !tx_tri_bvh_ray(b, x, c, h->approach, h->def.pierce_range, &gone) &&
+        (!r || r->torn > h->torn_at_touch)) {
+      h->pierced = true;
+      memcpy(h->pierce_at, c, sizeof h->pierce_at);
+    }
     h->touching = false;
     out->pierced = h->pierced;
     return;
