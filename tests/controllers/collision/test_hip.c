@@ -10,6 +10,8 @@
 #include "controllers/collision/hip.h"
 #include "studies/experiments/skin_grid.h"
 
+#include <tactus/components.h>
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -286,6 +288,47 @@ static void test_pierced_gives_zero_until_contact_ends(void** state) {
   drop(s);
 }
 
+// mechanics mode: the skin's reaction, carried from where the physics computed it
+// along its normal with its tangent stiffness, at most r + h/2 deep, never a pull;
+// no pierce without a tear, and zero force before the physics has seen the contact
+static void test_reaction_carried_bounded_never_a_pull(void** state) {
+  (void)state;
+  skin* s = flat();
+  tx_hip h = make_hip(26);
+  const double y = 2.4e-3;
+  tx_skin_contact r = {.f = {0, 0.1, 0}, .x = {CX, y, CZ}, .n = {0, 1, 0}, .k = 50, .depth = 1e-3, .touching = 1};
+  tx_skin_contact none = {0};
+  tx_hip_out o;
+  tx_hip_query_reaction(&h, &s->bvh, s->x, H, (double[3]){CX, y, CZ}, &none, &o);
+  assert_int_equal(o.contacts, 0); // the rays touch, the physics has not pushed yet: no force
+  assert_true(o.f[1] == 0);
+  tx_hip_query_reaction(&h, &s->bvh, s->x, H, (double[3]){CX, y, CZ}, &r, &o);
+  assert_true(fabs(o.f[1] - 0.1) < 1e-12 && o.f[0] == 0 && o.f[2] == 0);
+  assert_true(o.x0[1] == y);
+  // 0.1 mm deeper: F = f + k 0.1 mm, K = -k n n^T
+  tx_hip_query_reaction(&h, &s->bvh, s->x, H, (double[3]){CX, y - 1e-4, CZ}, &r, &o);
+  assert_true(fabs(o.f[1] - (0.1 + 50 * 1e-4)) < 1e-12);
+  for (int i = 0; i < 9; i++) assert_true(fabs(o.k[i] - (i == 4 ? -50.0 : 0)) < 1e-12);
+  // 5 mm deeper, past the still skin's mid-plane: no tear, so no pierce; the force holds
+  // at f + k (r + h/2) and K = 0 (past the trusted reach)
+  tx_hip_query_reaction(&h, &s->bvh, s->x, H, (double[3]){CX, y - 5e-3, CZ}, &r, &o);
+  assert_false(o.pierced);
+  assert_true(fabs(o.f[1] - (0.1 + 50 * REACH)) < 1e-12);
+  for (int i = 0; i < 9; i++) assert_true(o.k[i] == 0);
+  // back out 3 mm above x: f - k 3 mm < 0, the skin does not pull
+  tx_hip_query_reaction(&h, &s->bvh, s->x, H, (double[3]){CX, y + 3e-3, CZ}, &r, &o);
+  assert_true(o.f[0] == 0 && o.f[1] == 0 && o.f[2] == 0);
+  // a torn skin with nothing ahead along the approach: pierced, no force
+  tx_hip h2 = make_hip(26);
+  tx_hip_query_reaction(&h2, &s->bvh, s->x, H, (double[3]){CX, y, CZ}, &r, &o);
+  assert_true(o.f[1] > 0);
+  r.torn = 1;
+  tx_hip_query_reaction(&h2, &s->bvh, s->x, H, (double[3]){CX, -5e-3, CZ}, &r, &o);
+  assert_true(o.pierced);
+  assert_true(o.f[0] == 0 && o.f[1] == 0 && o.f[2] == 0);
+  drop(s);
+}
+
 // BVH nodes one 98-ray query visits on an n x n skin of the same spacing
 static uint64_t query_nodes(uint32_t n) {
   float* x = malloc(sizeof(float) * 3 * n * n);
@@ -339,6 +382,7 @@ int main(void) {
       cmocka_unit_test(test_eq8_moves_first_contact_after_slide),
       cmocka_unit_test(test_eq8_not_for_a_straight_push_into_tilted_skin),
       cmocka_unit_test(test_pierced_gives_zero_until_contact_ends),
+      cmocka_unit_test(test_reaction_carried_bounded_never_a_pull),
       cmocka_unit_test(test_query_cost_independent_of_far_triangles),
       cmocka_unit_test(test_query_allocates_nothing),
   };

@@ -83,13 +83,14 @@ static void test_touching_then_through(void** state) {
   const double* m = latest(s, "tool0.force_model");
   const double* st = latest(s, "hip0.state");
   // rays with |d_y| > 1 / 2.5 touch: the down ray, four at 45 and four at 54.7 degrees.
-  // The down ray began at y_on = 2.5 mm and anchors the contact; its contact point is on the
-  // still skin, R = 0. The 8 others joined it, P_in = (0, y_on, 0) + t d, R = c - A = (y - y_on):
-  // F_y = alpha 8/9 (y_on - y), within the 5 um a pose moves per 1 ms tick
+  // The down ray began at y_on = r + h/2 = 2.5 mm and anchors the contact; its contact point
+  // is on the still skin, R = 0. A ray at |d_y| joins at y_j = 2.5 mm |d_y| with
+  // P_in = (0, y_on, 0) + t d, so R = (c - A) + (t - t_j) d, whose y part stays y_j - y_on
+  // on the still skin: F_y = alpha / 9 x 4 ((y_on - y_45) + (y_on - y_54.7)), within the
+  // 5 um a pose moves per 1 ms tick (each onset up to a tick late)
   assert_int_equal((int)st[0], 9);
-  // (bounded: no ray's R exceeds the HIP's move since the contact began, 1.5 mm, and the
-  // force started from zero)
-  assert_true(m[1] > 0.01 && m[1] <= 20.0 * (2.5e-3 - 1e-3) + 1e-9);
+  double want = 20.0 / 9 * 4 * (2 * 2.5e-3 - 2.5e-3 / sqrt(2.0) - 2.5e-3 / sqrt(3.0));
+  assert_true(fabs(m[1] - want) < 1e-4);
   assert_true(fabs(m[0]) < 1e-9 && fabs(m[2]) < 1e-9);
   assert_true(fabs(m[6 + 4] + 20.0) < 1e-9); // K_yy = -alpha
   assert_true(st[1] == 0);
