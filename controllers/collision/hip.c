@@ -92,6 +92,7 @@ static void query(tx_hip* h, tx_tri_bvh* b, const float* x, double thickness, co
       for (int a = 0; a < 3; a++) anchor[a] += h->p_in[i][a] - h->t0[i] * h->dir[i][a];
     }
   for (int a = 0; a < 3 && held > 0; a++) anchor[a] /= held;
+  if (held == 0 && h->touching && !h->pierced) memcpy(anchor, h->anchor, sizeof anchor); // through a gap
   // first contact of a ray: where it meets the skin now (each ray by its own
   // onset) or as seen from the anchor (rays joining a contact start where it started)
   for (int i = 0; i < h->nrays; i++)
@@ -116,6 +117,18 @@ static void query(tx_hip* h, tx_tri_bvh* b, const float* x, double thickness, co
       h->pierced = true;
       memcpy(h->pierce_at, c, sizeof h->pierce_at);
     }
+    // the rays lost an untorn skin that is still ahead, with the HIP pressed past where
+    // the contact began: the skin wraps the HIP between the rays, the contact goes on
+    double in = (c[0] - h->anchor[0]) * h->approach[0] + (c[1] - h->anchor[1]) * h->approach[1] +
+                (c[2] - h->anchor[2]) * h->approach[2];
+    if (!r && h->touching && !h->pierced && in > 0 &&
+        tx_tri_bvh_ray(b, x, c, h->approach, h->def.pierce_range, &gone)) {
+      for (int e = 0; e < 3; e++) {
+        out->f[e] = h->def.alpha * in * h->approach[e] * -1;
+        for (int a = 0; a < 3; a++) out->k[3 * e + a] = -h->def.alpha * h->approach[e] * h->approach[a];
+      }
+      return;
+    }
     h->touching = false;
     out->pierced = h->pierced;
     return;
@@ -131,6 +144,7 @@ static void query(tx_hip* h, tx_tri_bvh* b, const float* x, double thickness, co
     h->torn_at_touch = r ? r->torn : 0;
   }
   h->touching = true;
+  memcpy(h->anchor, anchor, sizeof h->anchor);
   // through the skin: no skin left ahead along the approach (in mechanics mode,
   // with links torn since the contact began). Where it is found, the HIP would
   // just touch this (frozen) skin at x0 = c + (t - reach) approach

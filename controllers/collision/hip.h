@@ -22,7 +22,11 @@
 // more) the force is zero until no ray touches the skin and the HIP is clear
 // of the pierce: back on the side it came from, or pierce_range away from
 // where it went through, so a torn flap that swings back never pushes as if
-// the skin were whole.
+// the skin were whole. Rays that all lose an untorn skin at once (it wraps
+// the HIP between them) while the skin is still ahead along the approach and
+// the HIP is past where the contact began do not end the contact: the force
+// goes on as -alpha ((c - A) . a) a (the rays' common part, A the anchor),
+// and rays that meet the skin again measure from A.
 //
 // Mechanics mode (tx_hip_query_reaction) keeps the rays for contact and
 // pierce, but the force is the skin's own reaction as the physics computed
@@ -73,6 +77,7 @@ typedef struct tx_hip {
   bool pierced;                       // through the skin: no force until contact ends
   double approach[3];                 // 1, toward the skin when contact began
   double pierce_at[3];                // m, the HIP centre when it went through
+  double anchor[3];                   // m, the contact's anchor at the last query in contact
   double torn_at_touch;               // links torn when the contact began (mechanics mode)
   uint64_t resets;                    // eq. 8 updates so far
 } tx_hip;

@@ -251,7 +251,7 @@ static void step(tx_ctx* c, void* self) {
   // the local model: F0 where the frozen skin would just touch the HIP, K from the rays
   tx_force_model* m = tx_write(c, h->model);
   memset(m, 0, sizeof *m);
-  bool force = out.contacts > 0;
+  bool force = out.contacts > 0 || out.f[0] != 0 || out.f[1] != 0 || out.f[2] != 0; // (a contact held through a gap in the rays has none)
   memcpy(m->x0, force ? out.x0 : centre, sizeof m->x0);
   if (force) {
     memcpy(m->f0, out.f, sizeof m->f0);

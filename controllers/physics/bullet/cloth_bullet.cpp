@@ -59,6 +59,8 @@ struct tx_cloth {
   std::vector<int32_t> tri_stamp;  // (ntri) scratch: triangles already tested this pass
   int32_t stamp;
   std::vector<int32_t> near_tris;  // (ntri) scratch: candidate triangles of one pass
+  std::vector<int32_t> held_tri;   // (ntri) the last substep whose contact touched it
+  int32_t substep_id;              // counts substeps, for held_tri
   int torn;
   int faults;
 
@@ -310,6 +312,7 @@ static bool build(tx_cloth* c) {
   c->breaking.resize((size_t)c->nlink);
   c->tri_stamp.assign((size_t)c->ntri, 0);
   c->near_tris.resize((size_t)c->ntri);
+  c->held_tri.assign((size_t)c->ntri, 0);
   c->good_x.resize((size_t)c->n * 3);
   c->rest_x.assign((size_t)c->n * 3, 0.0f);
   c->in_contact.assign((size_t)c->n, 0);
@@ -530,7 +533,22 @@ static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& fr
       btScalar dist2 = dq.length2();
       // a triangle resting on the sphere (within 1 %) holds the HIP too, pushed this pass or not
       const btScalar touch = rcs * (btScalar)1.01;
-      if (dist2 >= touch * touch) continue;
+      int32_t* held = &c->held_tri[(size_t)c->near_tris[(size_t)k]];
+      bool near = dist2 < touch * touch;
+      // after the links, a triangle the HIP touched (this substep before them, or at the end of
+      // the last) is checked however far it went: links stretched far enough pull it across
+      // the sphere in one solve, and it must come back to the HIP's side instead of leaving
+      // the HIP through an untorn skin. Only one that went over the HIP (its closest point less
+      // than the contact distance across its plane): a hole's rim beside the HIP lets it by
+      bool recheck = false;
+      if (fix_velocity && !(dist2 < touch * touch) && *held >= c->substep_id - 1) {
+        btVector3 nn = (p[1]->m_x - p[0]->m_x).cross(p[2]->m_x - p[0]->m_x);
+        btScalar nl2 = nn.length2();
+        btVector3 across = nl2 > 0 ? dq - nn * (dq.dot(nn) / nl2) : dq;
+        recheck = across.length2() < rcs * rcs;
+      }
+      if (near) *held = c->substep_id;
+      if (!near && !recheck) continue;
       btVector3 nt = (p[1]->m_x - p[0]->m_x).cross(p[2]->m_x - p[0]->m_x);
       btScalar ntl = nt.length();
       if (!(ntl > 0)) continue;
@@ -542,6 +560,7 @@ static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& fr
       btVector3 n0 = (p[1]->m_q - p[0]->m_q).cross(p[2]->m_q - p[0]->m_q);
       btScalar side_from = (from - q0).dot(n0.length2() > 0 ? n0 : nt), side_now = (h - q).dot(nt);
       btScalar side = side_from != 0 ? (side_from > 0 ? 1 : -1) : (side_now >= 0 ? 1 : -1);
+      if (!near && side_now * side > 0) continue; // held, but on its side and out of reach: let go
       btVector3 dir;
       if (side_now * side > 0 && dist2 > 1e-20f) dir = dq / btSqrt(dist2); // still on its side: away from the centre
       else dir = nt * -side;                                                // crossed: back to the far side
@@ -577,6 +596,10 @@ static void rupture(tx_cloth* c);
 static void sweep_contact(tx_cloth* c, const btVector3& h0, const btVector3& h1, double dt, bool count) {
   const double rc = c->hip_radius + 0.5 * c->def.thickness;
   if (c->hip_radius <= 0 || rc <= 0) return;
+  if (++c->substep_id == INT32_MAX) {
+    std::fill(c->held_tri.begin(), c->held_tri.end(), 0);
+    c->substep_id = 1;
+  }
   double len = (h1 - h0).length();
   int moves = (int)std::ceil(len / (0.5 * rc));
   if (moves < 1) moves = 1;
