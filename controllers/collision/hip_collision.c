@@ -34,10 +34,14 @@ typedef struct hip_ctl {
   uint32_t job_next;        // its nodes [0, job_next) are still to refit
   uint32_t chunk;           // nodes refitted per step: a refit is spread over a few steps
   uint32_t tri_cap, xcap;   // triangles and particles the trees and copies were sized for
-  tx_port pose, x, tri, thickness;           // reads
+  bool mechanics;           // force_mode "mechanics": the skin's reaction (SKIN.contact), else the papers' rays
+  tx_port pose, x, tri, thickness, contact;  // reads (contact: mechanics mode only)
   tx_port model, state, spheres;             // writes
   uint64_t x_seq, tri_seq;  // last publishes seen
   double last_c[3];         // m, last finite pose
+  double prev_c[3];         // m, the pose of the last pose publish
+  uint64_t pose_seq;        // last pose publish seen
+  double pose_step;         // m, how far the pose moved between its last two publishes
   tx_warning w_pose, w_skin, w_mesh; // non-finite pose, non-finite skin, triangle set too large or bad
   tx_result r_peak, r_contacts, r_pierced, r_rebuilds, r_refits, r_resets, r_tears;
   double peak;              // N, largest force sent
@@ -47,6 +51,7 @@ typedef struct hip_ctl {
 
 // defaults are tx_hip_def_default()'s (tests/controllers/test_param_tables.c checks)
 static const tx_param_def params[] = {
+    {"force_mode", TX_PARAM_STR, NULL, 0, 0, 0, "mechanics", "\"mechanics\": the skin's reaction from the physics (SKIN.contact); \"paper\": the papers' rays, F = -alpha sum(R_n)/N"},
     {"radius_m", TX_PARAM_NUM, "m", 1e-5, 0.05, 0.0005, NULL, "the HIP sphere's radius (the papers' 0.05 cm)"},
     {"rays", TX_PARAM_INT, "1", 26, 98, 26, NULL, "rays cast from the HIP: 26 or 98"},
     {"alpha", TX_PARAM_NUM, "N/m", 0, 1e6, 20, NULL, "force per metre of mean ray depth, F = -alpha sum(R_n)/N (0.2 N/cm)"},
@@ -78,6 +83,11 @@ static int configure(tx_setup* s, void** self) {
   if (!join) return -1;
   if (strcmp(join, "anchor") && strcmp(join, "own")) return tx_setup_fail(s, "join", "expected \"anchor\" or \"own\", got \"%s\"", join);
   def.join_anchor = strcmp(join, "anchor") == 0;
+  const char* mode = tx_table_str(s, "force_mode");
+  if (!mode) return -1;
+  if (strcmp(mode, "mechanics") && strcmp(mode, "paper"))
+    return tx_setup_fail(s, "force_mode", "expected \"mechanics\" or \"paper\", got \"%s\"", mode);
+  h->mechanics = strcmp(mode, "mechanics") == 0;
   if (def.rays != 26 && def.rays != 98) return tx_setup_fail(s, "rays", "must be 26 or 98, got %d", def.rays);
   const char* err = tx_hip_def_check(&def);
   if (err) return tx_setup_fail(s, NULL, "%s", err);
@@ -88,14 +98,16 @@ static int configure(tx_setup* s, void** self) {
   const char* state = tx_table_str(s, "state");
   const char* spheres = tx_table_str(s, "spheres");
   if (!pose || !skin || !model || !state || !spheres) return -1;
-  char name[3][TX_NAME_MAX];
+  char name[4][TX_NAME_MAX];
   if (snprintf(name[0], TX_NAME_MAX, "%s.x", skin) >= TX_NAME_MAX) return tx_setup_fail(s, "skin", "name too long");
   snprintf(name[1], TX_NAME_MAX, "%s.tri", skin);
   snprintf(name[2], TX_NAME_MAX, "%s.thickness", skin);
+  if (snprintf(name[3], TX_NAME_MAX, "%s.contact", skin) >= TX_NAME_MAX) return tx_setup_fail(s, "skin", "name too long");
   h->pose = TX_READ_OF(s, pose, tx_pose);
   h->x = TX_READ_OF(s, name[0], tx_vertex);
   h->tri = TX_READ_OF(s, name[1], tx_triangle);
   h->thickness = TX_READ_OF(s, name[2], tx_thickness);
+  if (h->mechanics) h->contact = TX_READ_OF(s, name[3], tx_skin_contact);
   h->model = tx_setup_write(s, &TX_COMPONENT_OF(model, tx_force_model, 1));
   h->state = tx_setup_write(s, &TX_COMPONENT_OF(state, tx_hip_state, 1));
   h->spheres = tx_setup_write(s, &TX_COMPONENT_OF(spheres, tx_sphere, 1));
@@ -203,6 +215,13 @@ static void step(tx_ctx* c, void* self) {
     memcpy(centre, h->last_c, sizeof centre); // hold the last good pose
   }
   memcpy(h->last_c, centre, sizeof centre);
+  tx_snapshot ps = tx_read(c, h->pose);
+  if (ps.seq != h->pose_seq) { // the hand's move over one device tick
+    double d[3] = {centre[0] - h->prev_c[0], centre[1] - h->prev_c[1], centre[2] - h->prev_c[2]};
+    h->pose_step = h->pose_seq ? sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) : 0;
+    h->pose_seq = ps.seq;
+    memcpy(h->prev_c, centre, sizeof centre);
+  }
 
   // a new physics publish: take the skin
   tx_snapshot x = tx_read(c, h->x), tri = tx_read(c, h->tri);
@@ -216,7 +235,10 @@ static void step(tx_ctx* c, void* self) {
   if (h->job) refit_some(h);
 
   tx_hip_out out;
-  if (h->act >= 0) {
+  if (h->act >= 0 && h->mechanics) {
+    const tx_skin_contact* r = tx_read(c, h->contact).data;
+    tx_hip_query_reaction(&h->hip, &h->tree[h->act], h->xs[h->act], thickness, centre, r, &out);
+  } else if (h->act >= 0) {
     tx_hip_query(&h->hip, &h->tree[h->act], h->xs[h->act], thickness, centre, &out);
   } else {
     tx_hip_reset(&h->hip);
@@ -229,11 +251,13 @@ static void step(tx_ctx* c, void* self) {
   // the local model: F0 where the frozen skin would just touch the HIP, K from the rays
   tx_force_model* m = tx_write(c, h->model);
   memset(m, 0, sizeof *m);
-  bool force = out.contacts > 0;
+  bool force = out.contacts > 0 || out.f[0] != 0 || out.f[1] != 0 || out.f[2] != 0; // (a contact held through a gap in the rays has none)
   memcpy(m->x0, force ? out.x0 : centre, sizeof m->x0);
   if (force) {
     memcpy(m->f0, out.f, sizeof m->f0);
-    memcpy(m->k, out.k, sizeof m->k);
+    // a hand that moves more than the contact distance in one device tick would carry
+    // the linear model past the skin (through a pierce the next query will see): hold F0
+    if (h->pose_step <= h->hip.def.radius + 0.5 * thickness) memcpy(m->k, out.k, sizeof m->k);
     double f = sqrt(out.f[0] * out.f[0] + out.f[1] * out.f[1] + out.f[2] * out.f[2]);
     if (f > h->peak) h->peak = f;
     if ((uint64_t)out.contacts > h->max_contacts) h->max_contacts = (uint64_t)out.contacts;

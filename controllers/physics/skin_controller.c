@@ -18,7 +18,9 @@ typedef struct skin {
   double hip_radius;   // m, 0: no HIP
   double dt;           // s, one step at the instance's rate
   tx_port pose;        // read: the pose the HIP follows (f64 1 x 7)
-  tx_port x, tri, thickness, torn; // written: skin.*
+  tx_port x, tri, thickness, torn, contact; // written: skin.*
+  double prev_f, prev_w; // N, m: the reaction along its normal and the indentation of the last step in contact (0: none)
+  double k;              // N/m, the last tangent stiffness
   tx_warning fault, bad_pose;
   tx_result torn_result, fault_result;
 } skin;
@@ -91,11 +93,46 @@ static int configure(tx_setup* s, void** self) {
   k->tri = tx_setup_write(s, &TX_COMPONENT_OF("skin.tri", tx_triangle, m));
   k->thickness = tx_setup_write(s, &TX_COMPONENT_OF("skin.thickness", tx_thickness, 1));
   k->torn = tx_setup_write(s, &TX_COMPONENT_OF("skin.torn", tx_torn, 1));
+  k->contact = tx_setup_write(s, &TX_COMPONENT_OF("skin.contact", tx_skin_contact, 1));
   k->fault = tx_setup_warning(s, "numerical_fault");
   k->bad_pose = tx_setup_warning(s, "bad_pose");
   k->torn_result = tx_setup_result(s, "torn_links");
   k->fault_result = tx_setup_result(s, "faults");
   return 0;
+}
+
+// The skin's reaction on the HIP and its tangent stiffness k = d|f|/dw. A
+// membrane under a point load pushes back as |f| ~ w^p, p from 1 (held by its
+// pre-tension: w = |f| ln(a/r0) / (2 pi T)) to 3 (stretched by the load alone,
+// Foppl-Hencky), so k = p |f| / w lies in [|f|/w, 3|f|/w]. The secant between
+// two steps in contact picks p; the bounds keep it sound when the indentation
+// barely moved (noise, a hand at rest).
+static void publish_contact(tx_ctx* c, skin* k) {
+  tx_cloth_contact_info ci;
+  tx_cloth_contact(k->cloth, &ci);
+  tx_skin_contact* out = tx_write(c, k->contact);
+  memset(out, 0, sizeof *out);
+  out->torn = tx_cloth_torn(k->cloth);
+  double f = sqrt(ci.f[0] * ci.f[0] + ci.f[1] * ci.f[1] + ci.f[2] * ci.f[2]), w = ci.depth;
+  memcpy(out->x, ci.x, sizeof out->x);
+  if (ci.held == 0 || !(f > 0) || !isfinite(f) || !isfinite(w)) {
+    k->prev_f = k->prev_w = k->k = 0;
+    return;
+  }
+  for (int a = 0; a < 3; a++) {
+    out->f[a] = ci.f[a];
+    out->n[a] = ci.f[a] / f;
+  }
+  out->depth = w;
+  out->touching = 1;
+  if (w > 1e-7) {
+    double lo = f / w, hi = 3 * f / w, kk = k->k;
+    if (k->prev_w > 0 && fabs(w - k->prev_w) > 1e-6) kk = (f - k->prev_f) / (w - k->prev_w);
+    k->k = kk < lo ? lo : kk > hi ? hi : kk;
+  }
+  out->k = k->k;
+  k->prev_f = f;
+  k->prev_w = w;
 }
 
 static void publish(tx_ctx* c, skin* k) {
@@ -109,6 +146,7 @@ static void publish(tx_ctx* c, skin* k) {
   tx_write_rows(c, k->tri, (uint32_t)tx_cloth_triangles(k->cloth, tri));
   ((tx_thickness*)tx_write(c, k->thickness))->m = tx_cloth_get_def(k->cloth)->thickness;
   ((tx_torn*)tx_write(c, k->torn))->links = tx_cloth_torn(k->cloth);
+  publish_contact(c, k);
 }
 
 static int init(tx_ctx* c, void* self) {
@@ -144,7 +182,7 @@ static void fini(void* self) {
 
 const tx_controller_class tx_physics_skin = {
     .type = "physics.skin",
-    .summary = "suturing skin on a Bullet soft body: rupture, HIP contact; writes skin.x, skin.tri, skin.thickness, skin.torn",
+    .summary = "suturing skin on a Bullet soft body: rupture, HIP contact; writes skin.x, skin.tri, skin.thickness, skin.torn, skin.contact",
     .configure = configure,
     .init = init,
     .step = step,

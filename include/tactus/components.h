@@ -103,6 +103,25 @@ typedef struct tx_hip_state {
 #define tx_hip_state_UNITS "1, N, m, s"
 TX_LAYOUT_ASSERT(tx_hip_state, double);
 
+// SKIN.contact (1 row), written by physics.skin, read by collision.hip in
+// mechanics mode: the skin's reaction on the HIP, from the momentum the
+// cloth solver's contact gave the particles over the last physics step, and
+// how it changes with the HIP's position there, so that the collision can
+// carry it at 4 kHz as F = f + K (c - x), K = -k n n^T
+typedef struct tx_skin_contact {
+  double f[3];     // N, force of the skin on the HIP, the mean over the last physics step
+  double x[3];     // m, the HIP centre f holds at (the end of that step)
+  double n[3];     // 1, unit direction of f (0 without contact)
+  double k;        // N/m, tangent stiffness along n: d|f|/dw at the contact (0 without contact)
+  double depth;    // m, indentation w: how far the contact pushed the skin from rest
+  double touching; // 1 when the contact moved the skin in the step, else 0
+  double torn;     // links torn so far (a count), as in SKIN.torn
+} tx_skin_contact;
+#define tx_skin_contact_TYPE TX_F64
+#define tx_skin_contact_COLS 13u
+#define tx_skin_contact_UNITS "N, m, 1, N/m"
+TX_LAYOUT_ASSERT(tx_skin_contact, double);
+
 // *.spheres (N rows), drawn by the graphics view: the HIP, voxels
 typedef struct tx_sphere {
   float c[3]; // centre, m

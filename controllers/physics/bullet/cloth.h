@@ -115,9 +115,19 @@ bool tx_cloth_positions(const tx_cloth* c, float* out);
 int tx_cloth_triangles(tx_cloth* c, int32_t* out);
 // stretch and shear links broken so far
 int tx_cloth_torn(const tx_cloth* c);
-// force of the skin on the HIP over the last step (N, from the momentum the
-// contact gave the particles); zero without contact
+// force of the skin on the HIP at the end of the last step (N): the links'
+// pull (k (l - l0) each), the weight and less the m a of the particles the
+// contact holds, along the contact's normal, never a pull; zero without contact
 void tx_cloth_contact_force(const tx_cloth* c, double out[3]);
+// the contact over the last step, what the skin's reaction on the HIP is
+typedef struct tx_cloth_contact_info {
+  double f[3];  // N, force of the skin on the HIP, as tx_cloth_contact_force
+  double x[3];  // m, the HIP centre at the end of that step: where f holds
+  double depth; // m, indentation: the largest distance from rest of a particle the contact moved in the step
+  int moves;    // particle moves the contact made in the step
+  int held;     // particles the contact holds at the end of the step (0: no contact)
+} tx_cloth_contact_info;
+void tx_cloth_contact(const tx_cloth* c, tx_cloth_contact_info* out);
 // the largest strain (length - rest) / rest of a stretch or shear link now
 double tx_cloth_max_strain(const tx_cloth* c);
 // faults found and recovered so far

@@ -59,6 +59,8 @@ struct tx_cloth {
   std::vector<int32_t> tri_stamp;  // (ntri) scratch: triangles already tested this pass
   int32_t stamp;
   std::vector<int32_t> near_tris;  // (ntri) scratch: candidate triangles of one pass
+  std::vector<int32_t> held_tri;   // (ntri) the last substep whose contact touched it
+  int32_t substep_id;              // counts substeps, for held_tri
   int torn;
   int faults;
 
@@ -66,8 +68,14 @@ struct tx_cloth {
   double hip[3];      // m, centre at the end of the next step
   double hip_prev[3]; // m, centre at the end of the last step
   double hip_radius;  // m, 0: none
-  double contact_impulse[3]; // N s, momentum the contact gave the skin this step
   double contact_force[3];   // N, of the skin on the HIP over the last step
+  double contact_at[3];      // m, the HIP centre at the end of the last step, where contact_force holds
+  double contact_depth;      // m, the largest displacement from rest of a particle the contact moved in the last step
+  int contact_moves;         // particle moves the contact made in the last step
+  int contact_held;          // particles the contact holds at the end of the last step
+  std::vector<float> rest_x; // (n x 3) m, the particles at rest (after settling): what the indentation is measured from
+  std::vector<uint8_t> in_contact; // (n) the last substep's contact moved this particle
+  double contact_dir[3];     // 1, the pushes of the last substep's contact on the skin, summed (depth-weighted)
   double max_edge;           // m, longest rest length of a stretch or shear link
   double reach_factor;       // 1, the longest a live stretch or shear link gets, over max_edge
 
@@ -292,7 +300,10 @@ static bool build(tx_cloth* c) {
   c->breaking.resize((size_t)c->nlink);
   c->tri_stamp.assign((size_t)c->ntri, 0);
   c->near_tris.resize((size_t)c->ntri);
+  c->held_tri.assign((size_t)c->ntri, 0);
   c->good_x.resize((size_t)c->n * 3);
+  c->rest_x.assign((size_t)c->n * 3, 0.0f);
+  c->in_contact.assign((size_t)c->n, 0);
   c->good_v.resize((size_t)c->n * 3);
   c->good_link.assign((size_t)c->nlink, 1);
   c->good_tri.assign((size_t)c->ntri, 1);
@@ -324,6 +335,15 @@ static void settle(tx_cloth* c) {
   for (int a = 0; a < 3; a++) c->contact_force[a] = 0;
 }
 
+// the indentation of the contact is measured from the patch at rest: flat, or hanging after settling
+static void take_rest(tx_cloth* c) {
+  for (int i = 0; i < c->n; i++)
+    for (int a = 0; a < 3; a++) c->rest_x[(size_t)i * 3 + a] = c->body->m_nodes[i].m_x[a];
+  c->contact_depth = 0;
+  c->contact_moves = 0;
+  c->contact_held = 0;
+}
+
 extern "C" tx_cloth* tx_cloth_create(const tx_cloth_def* def) {
   const char* e = def ? tx_cloth_def_check(def) : "skin: no definition";
   if (e) {
@@ -348,6 +368,7 @@ extern "C" tx_cloth* tx_cloth_create(const tx_cloth_def* def) {
   }
   for (int a = 0; a < 3; a++) c->hip[a] = c->hip_prev[a] = c->good_hip[a] = def->center[a];
   settle(c);
+  take_rest(c);
   tx_cloth_save(c);
   return c;
 }
@@ -367,6 +388,16 @@ extern "C" int tx_cloth_faults(const tx_cloth* c) { return c->faults; }
 
 extern "C" void tx_cloth_contact_force(const tx_cloth* c, double out[3]) {
   for (int a = 0; a < 3; a++) out[a] = c->contact_force[a];
+}
+
+extern "C" void tx_cloth_contact(const tx_cloth* c, tx_cloth_contact_info* out) {
+  for (int a = 0; a < 3; a++) {
+    out->f[a] = c->contact_force[a];
+    out->x[a] = c->contact_at[a];
+  }
+  out->depth = c->contact_depth;
+  out->moves = c->contact_moves;
+  out->held = c->contact_held;
 }
 
 extern "C" tx_cloth_status tx_cloth_set_hip(tx_cloth* c, const double pos[3], double radius) {
@@ -448,8 +479,9 @@ static void closest_on_triangle(const btVector3& p, const btVector3& a, const bt
 
 // the HIP at h, at `from` when the substep began: every live triangle closer
 // than the contact distance is pushed out to it, away from the side the HIP
-// came from. Adds the momentum given to the skin to the contact impulse when
-// count is set, and the implied velocity to the particles when fix_velocity is.
+// came from. With count set, records the indentation and (after the links,
+// fix_velocity) the particles held and the push's direction; with fix_velocity,
+// gives the particles the implied velocity.
 static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& from, double dt, bool count,
                             bool fix_velocity) {
   const double rc = c->hip_radius + 0.5 * c->def.thickness;
@@ -487,7 +519,24 @@ static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& fr
       btVector3 q = p[0]->m_x * w[0] + p[1]->m_x * w[1] + p[2]->m_x * w[2];
       btVector3 dq = q - h;
       btScalar dist2 = dq.length2();
-      if (dist2 >= rcs * rcs) continue;
+      // a triangle resting on the sphere (within 1 %) holds the HIP too, pushed this pass or not
+      const btScalar touch = rcs * (btScalar)1.01;
+      int32_t* held = &c->held_tri[(size_t)c->near_tris[(size_t)k]];
+      bool near = dist2 < touch * touch;
+      // after the links, a triangle the HIP touched (this substep before them, or at the end of
+      // the last) is checked however far it went: links stretched far enough pull it across
+      // the sphere in one solve, and it must come back to the HIP's side instead of leaving
+      // the HIP through an untorn skin. Only one that went over the HIP (its closest point less
+      // than the contact distance across its plane): a hole's rim beside the HIP lets it by
+      bool recheck = false;
+      if (fix_velocity && !(dist2 < touch * touch) && *held >= c->substep_id - 1) {
+        btVector3 nn = (p[1]->m_x - p[0]->m_x).cross(p[2]->m_x - p[0]->m_x);
+        btScalar nl2 = nn.length2();
+        btVector3 across = nl2 > 0 ? dq - nn * (dq.dot(nn) / nl2) : dq;
+        recheck = across.length2() < rcs * rcs;
+      }
+      if (near) *held = c->substep_id;
+      if (!near && !recheck) continue;
       btVector3 nt = (p[1]->m_x - p[0]->m_x).cross(p[2]->m_x - p[0]->m_x);
       btScalar ntl = nt.length();
       if (!(ntl > 0)) continue;
@@ -499,10 +548,16 @@ static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& fr
       btVector3 n0 = (p[1]->m_q - p[0]->m_q).cross(p[2]->m_q - p[0]->m_q);
       btScalar side_from = (from - q0).dot(n0.length2() > 0 ? n0 : nt), side_now = (h - q).dot(nt);
       btScalar side = side_from != 0 ? (side_from > 0 ? 1 : -1) : (side_now >= 0 ? 1 : -1);
+      if (!near && side_now * side > 0) continue; // held, but on its side and out of reach: let go
       btVector3 dir;
       if (side_now * side > 0 && dist2 > 1e-20f) dir = dq / btSqrt(dist2); // still on its side: away from the centre
       else dir = nt * -side;                                                // crossed: back to the far side
       btScalar depth = rcs - (q - h).dot(dir);
+      if (count && fix_velocity) { // the particles the HIP holds, and which way it pushes them
+        for (int j = 0; j < 3; j++)
+          if (w[j] > 0) c->in_contact[(size_t)(p[j] - &nodes[0])] = 1;
+        for (int a = 0; a < 3; a++) c->contact_dir[a] += dir[a];
+      }
       if (!(depth > 0)) continue;
       btScalar wsum = 0;
       for (int j = 0; j < 3; j++) wsum += p[j]->m_im * w[j] * w[j];
@@ -514,8 +569,10 @@ static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& fr
         p[j]->m_x += dx;
         if (fix_velocity) p[j]->m_v += dx * (btScalar)(1 / dt);
         if (count) {
-          double m = 1.0 / p[j]->m_im;
-          for (int a = 0; a < 3; a++) c->contact_impulse[a] += m * dx[a] / dt;
+          const float* r0 = &c->rest_x[(size_t)(p[j] - &nodes[0]) * 3];
+          double moved = (p[j]->m_x - btVector3(r0[0], r0[1], r0[2])).length();
+          if (moved > c->contact_depth) c->contact_depth = moved;
+          c->contact_moves++;
         }
       }
     }
@@ -527,13 +584,17 @@ static void rupture(tx_cloth* c);
 static void sweep_contact(tx_cloth* c, const btVector3& h0, const btVector3& h1, double dt, bool count) {
   const double rc = c->hip_radius + 0.5 * c->def.thickness;
   if (c->hip_radius <= 0 || rc <= 0) return;
+  if (++c->substep_id == INT32_MAX) {
+    std::fill(c->held_tri.begin(), c->held_tri.end(), 0);
+    c->substep_id = 1;
+  }
   double len = (h1 - h0).length();
   int moves = (int)std::ceil(len / (0.5 * rc));
   if (moves < 1) moves = 1;
   if (moves > 64) moves = 64; // a teleport: the path is sampled, not followed
   for (int k = 1; k <= moves; k++) {
     btVector3 h = h0.lerp(h1, (btScalar)k / (btScalar)moves);
-    project_contact(c, h, h0, dt, count && k == moves, false);
+    project_contact(c, h, h0, dt, count, false);
   }
   // a HIP this fast drags the skin further than the links can follow within
   // the substep, and the solve would spread the strain before anyone saw it:
@@ -636,6 +697,52 @@ extern "C" void tx_cloth_restore(tx_cloth* c) {
   c->torn = c->good_torn;
   for (int a = 0; a < 3; a++) c->hip_prev[a] = c->good_hip[a];
   for (int a = 0; a < 3; a++) c->contact_force[a] = 0;
+  c->contact_depth = 0;
+  c->contact_moves = 0;
+  c->contact_held = 0;
+}
+
+// The force of the skin on the HIP: the springs of eq. 1 (k (l - l0) along each
+// link, stretch and shear at stretch_stiffness, bending at bend_stiffness) pulling
+// on the particles the contact holds, plus their weight, less what accelerates
+// them (m a over the step): the HIP holds them against all of it. The contact's momentum
+// is no measure of it here: a position solver's correction at 60 Hz is m/dt^2
+// times what the links' last iterations left over, which the iteration count sets,
+// not the material.
+static int link_reaction(const tx_cloth* c, double dt, double out[3]) {
+  out[0] = out[1] = out[2] = 0;
+  int held = 0;
+  for (int i = 0; i < c->n; i++) {
+    const btSoftBody::Node& nd = c->body->m_nodes[i];
+    if (!c->in_contact[(size_t)i] || !(nd.m_im > 0)) continue;
+    held++;
+    double m = 1.0 / nd.m_im;
+    for (int e = 0; e < 3; e++)
+      out[e] += m * (c->world.m_gravity[e] - (nd.m_v[e] - c->good_v[(size_t)i * 3 + e]) / dt);
+  }
+  if (held == 0) return 0;
+  const btAlignedObjectArray<btSoftBody::Link>& links = c->body->m_links;
+  const btSoftBody::Node* base = &c->body->m_nodes[0];
+  for (int i = 0, ni = links.size(); i < ni; i++) {
+    const btSoftBody::Link& l = links[i];
+    int a = (int)(l.m_n[0] - base), b = (int)(l.m_n[1] - base);
+    bool ia = c->in_contact[(size_t)a] != 0, ib = c->in_contact[(size_t)b] != 0;
+    if (ia == ib) continue; // none held, or both: a link inside the contact pulls both ways
+    btVector3 d = l.m_n[1]->m_x - l.m_n[0]->m_x;
+    double len = d.length();
+    if (!(len > 0)) continue;
+    bool bend = c->info[(size_t)(intptr_t)l.m_tag].kind == BEND;
+    double k = bend ? c->def.bend_stiffness : c->def.stretch_stiffness;
+    double s = k * (len - (double)l.m_rl) / len * (ia ? 1 : -1); // on the held end, toward the other
+    for (int e = 0; e < 3; e++) out[e] += s * d[e];
+  }
+  // a smooth sphere takes only the push along its contact normal: the rest is the held
+  // particles' own imbalance, which the solver has not yet spread (no pull either)
+  double n[3] = {-c->contact_dir[0], -c->contact_dir[1], -c->contact_dir[2]};
+  double nl = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  double along = nl > 0 ? (out[0] * n[0] + out[1] * n[1] + out[2] * n[2]) / nl : 0;
+  for (int e = 0; e < 3; e++) out[e] = along > 0 ? along * n[e] / nl : 0;
+  return held;
 }
 
 extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
@@ -649,14 +756,16 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
   prepare(c, h);
   btSoftBody* b = c->body;
   const btScalar ih = (btScalar)(1 / h);
-  for (int a = 0; a < 3; a++) c->contact_impulse[a] = 0;
+  c->contact_depth = 0;
+  c->contact_moves = 0;
+  c->contact_held = 0;
   const btVector3 start((btScalar)c->hip_prev[0], (btScalar)c->hip_prev[1], (btScalar)c->hip_prev[2]);
   const btVector3 end((btScalar)c->hip[0], (btScalar)c->hip[1], (btScalar)c->hip[2]);
   for (int s = 0; s < substeps; s++) {
     btVector3 h0 = start.lerp(end, (btScalar)s / (btScalar)substeps);
     btVector3 h1 = start.lerp(end, (btScalar)(s + 1) / (btScalar)substeps);
     b->predictMotion((btScalar)h);
-    sweep_contact(c, h0, h1, h, false);
+    sweep_contact(c, h0, h1, h, true);
     // Bullet's position solver for links, as btSoftBody::solveConstraints runs
     // it; that function also applies clusters through arrays it allocates on
     // every call, and this patch has no clusters, anchors or Bullet contacts
@@ -669,6 +778,8 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
       nodes[i].m_f = btVector3(0, 0, 0);
     }
     // the contact again after the links, with the velocities it implies
+    std::fill(c->in_contact.begin(), c->in_contact.end(), 0);
+    for (int a = 0; a < 3; a++) c->contact_dir[a] = 0;
     project_contact(c, h1, h0, h, true, true);
     if (!healthy(c)) {
       c->faults++;
@@ -679,8 +790,9 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
     }
     rupture(c);
   }
+  c->contact_held = link_reaction(c, dt, c->contact_force);
   for (int a = 0; a < 3; a++) {
-    c->contact_force[a] = -c->contact_impulse[a] / dt;
+    c->contact_at[a] = c->hip[a];
     c->hip_prev[a] = c->hip[a];
   }
   tx_cloth_save(c);

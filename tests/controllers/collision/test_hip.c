@@ -11,6 +11,8 @@
 #include "controllers/physics/skin_grid.h"
 #include "studies/experiments/skin_dent.h"
 
+#include <tactus/components.h>
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -92,7 +94,7 @@ static void test_contact_threshold_radius_plus_half_thickness(void** state) {
   assert_true(o.f[0] == 0 && o.f[1] == 0 && o.f[2] == 0);
   o = query(&h, s, CX, REACH - 1e-7, CZ);
   assert_int_equal(o.contacts, 1); // only the straight-down ray is that close
-  assert_true(o.f[1] > 0);
+  assert_true(o.f[0] == 0 && o.f[1] == 0 && o.f[2] == 0); // the contact point is where it met the skin
   // a contact, once made, holds up to reach + hold (0.5 mm), then lets go
   o = query(&h, s, CX, REACH + 4e-4, CZ);
   assert_int_equal(o.contacts, 1);
@@ -110,9 +112,8 @@ static void test_one_ray_force_and_push(void** state) {
   const double y = 2.4e-3; // the 45-degree rays meet the plane at 2.4 sqrt(2) mm > reach
   tx_hip_out o = query(&h, s, CX, y, CZ);
   assert_int_equal(o.contacts, 1);
-  // P_in = c + r d = (cx, y - r, cz), P_n = (cx, 0, cz): F = -alpha R = alpha (y - r) up
-  assert_true(fabs(o.f[1] - ALPHA * (y - R)) < 1e-9);
-  assert_true(fabs(o.f[0]) < 1e-12 && fabs(o.f[2]) < 1e-12);
+  // P_in = P_n = (cx, 0, cz) at first contact: the force starts from zero (no alpha h/2 step)
+  assert_true(o.f[0] == 0 && o.f[1] == 0 && o.f[2] == 0);
   // K = -alpha I: every R_n grows with the HIP while the skin is held at its surface
   for (int i = 0; i < 9; i++) assert_true(fabs(o.k[i] - (i % 4 == 0 ? -ALPHA : 0)) < 1e-9);
   assert_true(fabs(o.depth - (REACH - y)) < 1e-12);
@@ -122,37 +123,34 @@ static void test_one_ray_force_and_push(void** state) {
   tx_tri_bvh_refit(&s->bvh, s->x);
   o = query(&h, s, CX, y - push, CZ);
   assert_int_equal(o.contacts, 1);
-  assert_true(fabs(o.f[1] - ALPHA * (y - R + push)) < 1e-6);
+  assert_true(fabs(o.f[1] - ALPHA * push) < 1e-6);
   drop(s);
 }
 
-// every ray starting contact at one query: R_n = (t_n - r) d_n, t_n = D / |d_ny|
-static void check_fan(int rays, int want_contacts, double want_fy) {
+// every ray starting contact at one query starts at zero force; the skin then
+// pushed 1 mm down with the HIP moves every contact point by 1 mm: F = alpha x 1 mm
+static void check_fan(int rays, int want_contacts) {
   skin* s = flat();
   tx_hip h = make_hip(rays);
-  tx_hip_out o = query(&h, s, CX, 0.6 * REACH, CZ);
+  const double D = 0.6 * REACH, push = 1e-3;
+  tx_hip_out o = query(&h, s, CX, D, CZ);
   assert_int_equal(o.contacts, want_contacts);
-  assert_true(fabs(o.f[1] - want_fy) < 1e-6 * want_fy);
-  assert_true(fabs(o.f[0]) < 1e-9 && fabs(o.f[2]) < 1e-9); // symmetric fan on a flat skin
+  assert_true(fabs(o.f[0]) < 1e-12 && fabs(o.f[1]) < 1e-12 && fabs(o.f[2]) < 1e-12);
+  for (int i = 0; i < N * N; i++) s->x[3 * i + 1] -= (float)push;
+  tx_tri_bvh_refit(&s->bvh, s->x);
+  o = query(&h, s, CX, D - push, CZ);
+  assert_int_equal(o.contacts, want_contacts);
+  assert_true(fabs(o.f[1] - ALPHA * push) < 1e-6 * ALPHA * push + 1e-7);
+  assert_true(fabs(o.f[0]) < 1e-7 && fabs(o.f[2]) < 1e-7); // symmetric fan on a flat skin
   drop(s);
 }
 
 static void test_26_and_98_rays_by_hand(void** state) {
   (void)state;
-  const double D = 0.6 * REACH;
   // 26 rays: contact needs |d_y| > 0.6: the down ray and four at 45 degrees
-  double f26 = ALPHA / 5 * (5 * D - R * (1 + 4 / sqrt(2.0)));
-  check_fan(26, 5, f26);
+  check_fan(26, 5);
   // 98 rays: the j = -2 face with i^2 + k^2 <= 5 (|d_y| = 2 / sqrt(4 + i^2 + k^2) > 0.6): 21 rays
-  double sum = 0;
-  int count = 0;
-  for (int i = -2; i <= 2; i++)
-    for (int k = -2; k <= 2; k++)
-      if (i * i + k * k <= 5) sum += D - R * 2 / sqrt(4.0 + i * i + k * k), count++;
-  assert_int_equal(count, 21);
-  check_fan(98, 21, ALPHA * sum / 21);
-  // the two fans agree within a few percent: the papers found no difference that users felt
-  assert_true(fabs(f26 - ALPHA * sum / 21) < 0.1 * f26);
+  check_fan(98, 21);
 }
 
 // rays joining a contact: by the contact's anchor (default) or each at its own onset
@@ -166,9 +164,10 @@ static void test_joining_rays_anchor_or_own(void** state) {
     query(&h, s, CX, y0, CZ); // the down ray alone; it anchors the contact at y0
     tx_hip_out o = query(&h, s, CX, D, CZ); // four 45-degree rays join
     assert_int_equal(o.contacts, 5);
-    // anchor: P_in = (cx, y0, cz) + r d, so R_y = -(y0 - r / sqrt 2); own: P_in = c + r d, R_y = -(D - r / sqrt 2)
-    double joined = own ? D - R / sqrt(2.0) : y0 - R / sqrt(2.0);
-    assert_true(fabs(o.f[1] - ALPHA / 5 * (y0 - R + 4 * joined)) < 1e-9);
+    // the down ray meets the still skin where it first did: R = 0. Anchor: a joining ray's
+    // P_in = A + t d, R = c - A = -(y0 - D) y; own: P_in = its hit now, R = 0
+    double joined = own ? 0 : y0 - D;
+    assert_true(fabs(o.f[1] - ALPHA / 5 * 4 * joined) < 1e-9);
   }
   drop(s);
 }
@@ -186,7 +185,7 @@ static void test_dented_skin_pushes_straight_back(void** state) {
   o = query(&h, s, CX, y - depth, CZ);
   assert_true(o.contacts >= 1);
   assert_true(fabs(o.f[0]) < 1e-3 * o.f[1] && fabs(o.f[2]) < 1e-3 * o.f[1]);
-  assert_true(fabs(o.f[1] - ALPHA * (y - R + depth)) < 0.02 * o.f[1]);
+  assert_true(fabs(o.f[1] - ALPHA * depth) < 0.02 * o.f[1]); // from zero at first contact
   drop(s);
 }
 
@@ -194,9 +193,9 @@ static void test_eq8_moves_first_contact_after_slide(void** state) {
   (void)state;
   skin* s = flat();
   tx_hip h = make_hip(26);
-  const double y = 2.4e-3, up = ALPHA * (y - R);
+  const double y = 2.4e-3, up = 0; // the still skin: no push, P_in was set on it
   query(&h, s, CX, y, CZ);
-  // 2 mm along x, below slide_max (3 mm): R = (2 mm, -(y - r), 0)
+  // 2 mm along x, below slide_max (3 mm): R = (2 mm, 0, 0)
   tx_hip_out o = query(&h, s, CX + 2e-3, y, CZ);
   assert_true(fabs(o.f[0] + ALPHA * 2e-3) < 1e-6 && fabs(o.f[1] - up) < 1e-6);
   assert_int_equal(h.resets, 0);
@@ -204,7 +203,7 @@ static void test_eq8_moves_first_contact_after_slide(void** state) {
   o = query(&h, s, CX + 4e-3, y, CZ);
   assert_int_equal(h.resets, 1);
   assert_true(fabs(o.f[0] + 0.3 * ALPHA * 4e-3) < 1e-6 && fabs(o.f[1] - up) < 1e-6);
-  // 1 mm more: the new first point stays, R = (0.3 x 4 + 1 mm, -(y - r), 0)
+  // 1 mm more: the new first point stays, R = (0.3 x 4 + 1 mm, 0, 0)
   o = query(&h, s, CX + 5e-3, y, CZ);
   assert_int_equal(h.resets, 1);
   assert_true(fabs(o.f[0] + ALPHA * (1.2e-3 + 1e-3)) < 1e-6 && fabs(o.f[1] - up) < 1e-6);
@@ -231,6 +230,12 @@ static void test_eq8_not_for_a_straight_push_into_tilted_skin(void** state) {
   // slide_max of it lies along the leaning triangle: measured against the hit normal, eq. 8
   // would have fired; the force still points out of the skin
   assert_true(y - R - skin_y > 5e-3);
+  assert_true(o.contacts > 1);
+  // the skin 0.5 mm further down with the HIP: the force points out of the skin
+  for (int i = 0; i < N * N; i++) s->x[3 * i + 1] -= 5e-4f;
+  tx_tri_bvh_refit(&s->bvh, s->x);
+  o = query(&h, s, CX, y - 5.5e-3, CZ);
+  assert_int_equal(h.resets, 0);
   assert_true(o.contacts > 1 && o.f[1] > 0);
   drop(s);
 }
@@ -262,10 +267,66 @@ static void test_pierced_gives_zero_until_contact_ends(void** state) {
   assert_int_equal(o.contacts, 0);
   assert_true(o.f[0] == 0 && o.f[1] == 0 && o.f[2] == 0);
   for (int i = 0; i < 9; i++) assert_true(o.k[i] == 0);
-  // clear of the skin the state resets: the next touch starts afresh
-  o = query(&h, s, 0, -0.01, 0);
+  // out of reach of the skin and back (a torn flap swinging onto the HIP): still
+  // pierced, no force, while within pierce_range (1 cm) of where it went through
+  o = query(&h, s, 0, -5e-3, 0);
+  assert_true(o.pierced);
+  o = query(&h, s, 0, -1.5e-3, 0);
+  assert_true(o.pierced);
+  assert_true(o.f[0] == 0 && o.f[1] == 0 && o.f[2] == 0);
+  // clear of the pierce (over 1 cm from it) the state resets: the next touch starts afresh
+  o = query(&h, s, 0, -0.012, 0);
   assert_false(o.pierced);
   assert_false(h.touching);
+  // and back on the side it came from too
+  tx_hip h2 = make_hip(98);
+  o = query(&h2, s, 0.004, 2.4e-3, 0.004);
+  assert_int_equal(o.contacts, 1);
+  h2.pierced = true; // as if it had gone through here
+  memcpy(h2.pierce_at, (double[3]){0.004, 0, 0.004}, sizeof h2.pierce_at);
+  o = query(&h2, s, 0.004, 2.6e-3 + 1e-4, 0.004); // above the pierce by more than r + h/2
+  assert_false(o.pierced);
+  drop(s);
+}
+
+// mechanics mode: the skin's reaction, carried from where the physics computed it
+// along its normal with its tangent stiffness, at most r + h/2 deep, never a pull;
+// no pierce without a tear, and zero force before the physics has seen the contact
+static void test_reaction_carried_bounded_never_a_pull(void** state) {
+  (void)state;
+  skin* s = flat();
+  tx_hip h = make_hip(26);
+  const double y = 2.4e-3;
+  tx_skin_contact r = {.f = {0, 0.1, 0}, .x = {CX, y, CZ}, .n = {0, 1, 0}, .k = 50, .depth = 1e-3, .touching = 1};
+  tx_skin_contact none = {0};
+  tx_hip_out o;
+  tx_hip_query_reaction(&h, &s->bvh, s->x, H, (double[3]){CX, y, CZ}, &none, &o);
+  assert_int_equal(o.contacts, 0); // the rays touch, the physics has not pushed yet: no force
+  assert_true(o.f[1] == 0);
+  tx_hip_query_reaction(&h, &s->bvh, s->x, H, (double[3]){CX, y, CZ}, &r, &o);
+  assert_true(fabs(o.f[1] - 0.1) < 1e-12 && o.f[0] == 0 && o.f[2] == 0);
+  assert_true(o.x0[1] == y);
+  // 0.1 mm deeper: F = f + k 0.1 mm, K = -k n n^T
+  tx_hip_query_reaction(&h, &s->bvh, s->x, H, (double[3]){CX, y - 1e-4, CZ}, &r, &o);
+  assert_true(fabs(o.f[1] - (0.1 + 50 * 1e-4)) < 1e-12);
+  for (int i = 0; i < 9; i++) assert_true(fabs(o.k[i] - (i == 4 ? -50.0 : 0)) < 1e-12);
+  // 5 mm deeper, past the still skin's mid-plane: no tear, so no pierce; the force holds
+  // at f + k (r + h/2) and K = 0 (past the trusted reach)
+  tx_hip_query_reaction(&h, &s->bvh, s->x, H, (double[3]){CX, y - 5e-3, CZ}, &r, &o);
+  assert_false(o.pierced);
+  assert_true(fabs(o.f[1] - (0.1 + 50 * REACH)) < 1e-12);
+  for (int i = 0; i < 9; i++) assert_true(o.k[i] == 0);
+  // back out 3 mm above x: f - k 3 mm < 0, the skin does not pull
+  tx_hip_query_reaction(&h, &s->bvh, s->x, H, (double[3]){CX, y + 3e-3, CZ}, &r, &o);
+  assert_true(o.f[0] == 0 && o.f[1] == 0 && o.f[2] == 0);
+  // a torn skin with nothing ahead along the approach: pierced, no force
+  tx_hip h2 = make_hip(26);
+  tx_hip_query_reaction(&h2, &s->bvh, s->x, H, (double[3]){CX, y, CZ}, &r, &o);
+  assert_true(o.f[1] > 0);
+  r.torn = 1;
+  tx_hip_query_reaction(&h2, &s->bvh, s->x, H, (double[3]){CX, -5e-3, CZ}, &r, &o);
+  assert_true(o.pierced);
+  assert_true(o.f[0] == 0 && o.f[1] == 0 && o.f[2] == 0);
   drop(s);
 }
 
@@ -322,6 +383,7 @@ int main(void) {
       cmocka_unit_test(test_eq8_moves_first_contact_after_slide),
       cmocka_unit_test(test_eq8_not_for_a_straight_push_into_tilted_skin),
       cmocka_unit_test(test_pierced_gives_zero_until_contact_ends),
+      cmocka_unit_test(test_reaction_carried_bounded_never_a_pull),
       cmocka_unit_test(test_query_cost_independent_of_far_triangles),
       cmocka_unit_test(test_query_allocates_nothing),
   };

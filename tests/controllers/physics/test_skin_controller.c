@@ -10,6 +10,8 @@
 #include "scenarios/loader.h"
 #include "tests/scenario_support.h"
 
+#include <tactus/components.h>
+
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -86,6 +88,36 @@ static void hip_follows_the_device_and_pierces(void** state) {
   tx_scenario_free(s);
 }
 
+// skin.contact: nothing before the HIP arrives; pressing, the skin's reaction up
+// (along +y) at the HIP position of the step, the indentation since first touch and
+// a tangent stiffness between |f|/w and 3|f|/w (a membrane's p in |f| ~ w^p, 1 to 3)
+static void publishes_the_contact(void** state) {
+  (void)state;
+  char err[512];
+  tx_scenario* s = load("\"hip_radius_m\":0.0005", 60, err, sizeof err);
+  if (!s) fail_msg("%s", err);
+  run(s, 1.0); // the HIP at 7.5 mm, out of reach (2.5 mm)
+  const tx_skin_contact* k = latest_snapshot(s, "skin.contact").data;
+  assert_true(k->touching == 0 && k->f[0] == 0 && k->f[1] == 0 && k->f[2] == 0 && k->k == 0);
+  tx_scenario_free(s);
+  s = load("\"hip_radius_m\":0.0005", 60, err, sizeof err);
+  run(s, 2.6); // the HIP at -0.5 mm: 3 mm past first touch
+  tx_snapshot ks = latest_snapshot(s, "skin.contact");
+  k = ks.data;
+  double pose_y = ((const double*)latest_snapshot(s, "device0.pose").data)[1];
+  double f = sqrt(k->f[0] * k->f[0] + k->f[1] * k->f[1] + k->f[2] * k->f[2]);
+  print_message("  HIP %.3f mm: f %.4f N along (%.3f %.3f %.3f), w %.3f mm, k %.1f N/m\n", k->x[1] * 1e3, f, k->n[0],
+                k->n[1], k->n[2], k->depth * 1e3, k->k);
+  assert_true(k->touching == 1);
+  assert_true(k->f[1] > 0 && k->n[1] > 0.95);
+  assert_true(fabs(k->n[0] * k->n[0] + k->n[1] * k->n[1] + k->n[2] * k->n[2] - 1) < 1e-9);
+  assert_true(fabs(k->x[1] - pose_y) < 0.005 / 60 + 1e-9); // the HIP of the last step: at most one step behind
+  assert_true(fabs(k->depth - (0.0025 - k->x[1])) < 3e-4);  // pushed from where it first touched
+  assert_true(k->k >= f / k->depth * (1 - 1e-9) && k->k <= 3 * f / k->depth * (1 + 1e-9));
+  assert_true(k->torn == ((const int*)latest_snapshot(s, "skin.torn").data)[0]);
+  tx_scenario_free(s);
+}
+
 // parameters out of range name themselves; rates outside 20-120 Hz are refused
 static void bad_parameters_are_named(void** state) {
   (void)state;
@@ -116,6 +148,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(publishes_the_skin),
       cmocka_unit_test(hip_follows_the_device_and_pierces),
+      cmocka_unit_test(publishes_the_contact),
       cmocka_unit_test(bad_parameters_are_named),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
