@@ -110,7 +110,137 @@ bool tx_membrane_run(const tx_membrane_case* k, double spacing, tx_membrane_resu
   tx_cloth_destroy(c);
   return true;
 }
+// the vertical force the membrane puts on its clamp (N, up positive): the
+// tensions of the links from a free particle to a clamped one; at rest it
+// balances the HIP's push, without the contact's impulses and their noise
+static double clamp_force(const tx_cloth* c, const unsigned char* fixed) {
+  double sum = 0;
+  for (int id = 0, n = tx_cloth_link_total(c); id < n; id++) {
+    int32_t e[2];
+    tx_cloth_link_ends(c, id, e);
+    if (fixed[e[0]] == fixed[e[1]]) continue;
+    int in = fixed[e[0]] ? e[1] : e[0], out = fixed[e[0]] ? e[0] : e[1];
+    double pi[3], po[3];
+    tx_cloth_particle(c, in, pi);
+    tx_cloth_particle(c, out, po);
+    double dx = po[0] - pi[0], dy = po[1] - pi[1], dz = po[2] - pi[2], len = sqrt(dx * dx + dy * dy + dz * dz);
+    if (len > 0) sum += tx_cloth_link_tension(c, id) * dy / len; // pulls the free particle towards the clamp
+  }
+  return sum;
+}
+
+bool tx_membrane_rupture_run(double spacing, tx_membrane_rupture* out) {
+  const double a = 0.015, r = 0.0005, thickness = 0.004, rc = r + 0.5 * thickness, speed = 0.02;
+  double cells = a / spacing;
+  if (!(spacing > 0) || fabs(cells - lround(cells)) > 1e-6 * cells || lround(cells) < 4) {
+    tx_set_error("skin-membrane: spacing %g m must divide the radius %g m into at least 4 cells", spacing, a);
+    return false;
+  }
+  const int half = (int)lround(cells) + 1, res = 2 * half + 1;
+  const double size = (res - 1) * spacing;
+  tx_cloth_def d = tx_cloth_def_default();
+  d.size[0] = d.size[1] = size;
+  d.res[0] = d.res[1] = res;
+  d.thickness = thickness;
+  d.mass = 100 * 4.4 * size * size * (double)(res * res) / ((double)(res - 1) * (res - 1));
+  d.stretch_stiffness = 2000;
+  d.bend_stiffness = 0;
+  d.clamp_radius = a;
+  d.pretension = 50;
+  d.rupture_tension = 150;
+  d.rupture_length = 0.002;
+  d.damping = 5;
+  const double m = d.mass / (res * res);
+  d.max_substep = 0.5 / sqrt(d.stretch_stiffness * 2 / m);
+  d.iterations = 4;
+  unsigned char* fixed = calloc((size_t)(res * res), 1);
+  tx_cloth* c = fixed ? tx_cloth_create(&d) : NULL;
+  if (!c) return free(fixed), false;
+  for (int iz = 0; iz < res; iz++)
+    for (int ix = 0; ix < res; ix++) {
+      double x = (ix - half) * spacing, z = (iz - half) * spacing;
+      fixed[iz * res + ix] = ix == 0 || iz == 0 || ix == res - 1 || iz == res - 1 || x * x + z * z >= a * a * (1 - 1e-12);
+    }
+  const double dt = 1.0 / 600;
+  double h[3] = {0, rc + 0.0005, 0}, last = 0, t0 = wall_now();
+  out->force = out->depth = out->tension = NAN;
+  for (int s = 0; s < 600 && tx_cloth_torn(c) == 0; s++) { // at most 1 s, 2 cm down
+    h[1] = rc + 0.0005 - speed * dt * (s + 1);
+    tx_cloth_set_hip(c, h, r);
+    if (tx_cloth_step(c, dt) != TX_CLOTH_OK) {
+      tx_cloth_destroy(c);
+      free(fixed);
+      tx_set_error("skin-membrane: the cloth faulted at %g m spacing", spacing);
+      return false;
+    }
+    if (tx_cloth_torn(c) > 0) {
+      out->force = last; // the step before the tear, whole
+      out->depth = -(h[1] - rc);
+      out->tension = tx_cloth_peak_tension(c);
+    }
+    last = clamp_force(c, fixed);
+  }
+  free(fixed);
+  out->spacing = spacing;
+  out->particles = res * res;
+  out->seconds = wall_now() - t0;
+  tx_cloth_destroy(c);
+  if (isnan(out->force)) {
+    tx_set_error("skin-membrane: no tear within 2 cm at %g m spacing", spacing);
+    return false;
+  }
+  return true;
+}
+// the centre's sag (m) after `time` s hanging from flat; drift: its change over the last 10 %
+static bool hang(const tx_cloth_def* d, double time, double* sag, double* drift) {
+  tx_cloth* c = tx_cloth_create(d);
+  if (!c) return false;
+  const int centre = (d->res[1] / 2) * d->res[0] + d->res[0] / 2;
+  const int frames = (int)ceil(time * 60), tail = frames / 10 > 0 ? frames / 10 : 1;
+  double p[3], before = 0;
+  for (int f = 0; f < frames; f++) {
+    if (tx_cloth_step(c, 1.0 / 60) != TX_CLOTH_OK) {
+      tx_cloth_destroy(c);
+      return tx_set_error("skin-membrane: the hanging cloth faulted"), false;
+    }
+    if (f == frames - 1 - tail) tx_cloth_particle(c, centre, p), before = p[1];
+  }
+  tx_cloth_particle(c, centre, p);
+  *sag = -p[1];
+  *drift = fabs(p[1] - before);
+  tx_cloth_destroy(c);
+  return true;
+}
+
+bool tx_membrane_gravity_run(int res, tx_membrane_sag* out) {
+  if (res < 5 || res > 201) return tx_set_error("skin-membrane: %d particles a side, expected 5 to 201", res), false;
+  tx_cloth_def d = tx_cloth_def_default();
+  d.res[0] = d.res[1] = res;
+  d.mass = 1100 * 0.004 * d.size[0] * d.size[1];
+  d.gravity = 9.81;
+  d.settle_time = 0;
+  d.rupture_tension = 0;
+  double t0 = wall_now(), drift;
+  if (!hang(&d, 3, &out->realtime, &drift)) return false; // the real-time default, as it comes
+  d.damping = 50; // to rest sooner; the rest state does not depend on it
+  d.max_substep = 0.5 / sqrt(d.stretch_stiffness * 2 / (d.mass / (res * res)));
+  d.iterations = 4;
+  if (!hang(&d, 0.5, &out->converged, &out->drift)) return false;
+  out->res = res;
+  out->seconds = wall_now() - t0;
+  return true;
+}
 #else
+bool tx_membrane_gravity_run(int res, tx_membrane_sag* out) {
+  (void)res, (void)out;
+  tx_set_error("skin-membrane: this build has no Bullet (configured with TX_WITH_BULLET=OFF)");
+  return false;
+}
+bool tx_membrane_rupture_run(double spacing, tx_membrane_rupture* out) {
+  (void)spacing, (void)out;
+  tx_set_error("skin-membrane: this build has no Bullet (configured with TX_WITH_BULLET=OFF)");
+  return false;
+}
 bool tx_membrane_run(const tx_membrane_case* k, double spacing, tx_membrane_result* out) {
   (void)k, (void)spacing, (void)out;
   tx_set_error("skin-membrane: this build has no Bullet (configured with TX_WITH_BULLET=OFF)");

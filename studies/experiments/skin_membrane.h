@@ -49,6 +49,39 @@ typedef struct tx_membrane_result {
 tx_membrane_case tx_membrane_case_default(tx_membrane_kind kind);
 // the closed-form centre deflection (m) of the case
 double tx_membrane_exact(const tx_membrane_case* k);
+// Rupture under a HIP pressing down: a pre-tensioned circular membrane
+// (radius 1.5 cm, T = 50 N/m, k = 2000 N/m) tears where its tension averaged
+// over rupture_length (2 mm) reaches 150 N/m. The HIP (radius 0.5 mm, skin
+// 4 mm thick) comes down at its centre at 2 cm/s; the rupture force is the
+// largest contact force before the first tear. Quasi-static: the force does
+// not depend on the mass, so the membrane is 100 times denser than skin
+// (dynamic relaxation), which makes the converged substep 10 times longer.
+typedef struct tx_membrane_rupture {
+  double spacing;  // m
+  int particles;
+  double force;    // N, the rupture force
+  double depth;    // m, how far the HIP's centre went below the flat skin by then
+  double tension;  // N/m, the membrane tension at the tear (tx_cloth_peak_tension)
+  double seconds;  // wall time
+} tx_membrane_rupture;
+
+bool tx_membrane_rupture_run(double spacing, tx_membrane_rupture* out);
+
+// The journal paper's gravity test with physical skin: the 10 x 10 cm patch,
+// border fixed, no pretension, 1100 kg/m^3, 4 mm, k = 2000 N/m (E t =
+// 3000 N/m: E = 0.75 MPa), hanging under 9.81 m/s^2 with the solver
+// converged (k w h^2 = 1/4, 4 iterations) and, for comparison, at the
+// real-time default; res particles a side.
+typedef struct tx_membrane_sag {
+  int res;
+  double converged;  // m, the centre's sag, converged solver
+  double drift;      // m, how much it still moved over the last 10 % of the time
+  double realtime;   // m, the centre's sag at the real-time default (1 iteration, 1/600 s substeps)
+  double seconds;    // wall time
+} tx_membrane_sag;
+
+bool tx_membrane_gravity_run(int res, tx_membrane_sag* out);
+
 // runs the case at this particle spacing (m; it must divide the radius into
 // at least 4 cells); false and tx_error() when the cloth cannot be built
 bool tx_membrane_run(const tx_membrane_case* k, double spacing, tx_membrane_result* out);

@@ -103,7 +103,7 @@ extern "C" tx_cloth_def tx_cloth_def_default(void) {
   d.fixed_border = true;
   d.clamp_radius = 0;
   d.pretension = 0;
-  d.rupture_tension = 20;
+  d.rupture_tension = 3;
   d.rupture_length = 0.002;
   d.iterations = 1;
   d.max_substep = 1.0 / 600;
@@ -606,7 +606,7 @@ static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& fr
 }
 
 // the HIP over one substep from h0 to h1, in moves of at most half the contact distance
-static void rupture(tx_cloth* c);
+static void rupture(tx_cloth* c, const btVector3* near);
 
 static void sweep_contact(tx_cloth* c, const btVector3& h0, const btVector3& h1, double dt, bool count) {
   const double rc = c->hip_radius + 0.5 * c->def.thickness;
@@ -622,7 +622,7 @@ static void sweep_contact(tx_cloth* c, const btVector3& h0, const btVector3& h1,
   // a HIP this fast drags the skin further than the links can follow within
   // the substep, and the solve would spread the strain before anyone saw it:
   // what it overstretched tears now
-  if (moves > 1) rupture(c);
+  if (moves > 1) rupture(c, &h1);
 }
 
 // every particle finite, slower than max_speed and near the patch
@@ -733,13 +733,28 @@ static void measure_links(tx_cloth* c, double h) {
 // reach it are averaged (the average over a disc is at most about the
 // largest of its particles' own sums of f L / 2 over their area), so a
 // step without a tear costs one pass over the links.
-static void rupture(tx_cloth* c) {
+//
+// With `near` (a fast HIP, before the solve): the links it dragged have no
+// solved tension yet, so those with a particle within the contact's reach
+// of it count with their spring's force k (length - rest) where that is
+// larger, and only particles there are checked.
+static void rupture(tx_cloth* c, const btVector3* near) {
   const double tc = c->def.rupture_tension;
   if (tc <= 0) return;
   const btAlignedObjectArray<btSoftBody::Link>& links = c->body->m_links;
+  const btSoftBody::Node* base = &c->body->m_nodes[0];
+  const btScalar reach = (btScalar)(c->hip_radius + 0.5 * c->def.thickness + 2 * c->max_edge), reach2 = reach * reach;
+  if (near)
+    for (int i = 0, ni = links.size(); i < ni; i++) {
+      const btSoftBody::Link& l = links[i];
+      if ((l.m_n[0]->m_x - *near).length2() > reach2 && (l.m_n[1]->m_x - *near).length2() > reach2) continue;
+      const int id = (int)reinterpret_cast<intptr_t>(l.m_tag);
+      const double k = c->info[(size_t)id].kind == BEND ? c->def.bend_stiffness : c->def.stretch_stiffness;
+      const float f = (float)(k * ((l.m_n[1]->m_x - l.m_n[0]->m_x).length() - l.m_rl));
+      if (f > c->tension[(size_t)id]) c->tension[(size_t)id] = f;
+    }
   float* local = c->local.data();
   std::fill(local, local + c->n, 0.0f);
-  const btSoftBody::Node* base = &c->body->m_nodes[0];
   for (int i = 0, ni = links.size(); i < ni; i++) {
     const btSoftBody::Link& l = links[i];
     const float f = c->tension[(size_t)(intptr_t)l.m_tag];
@@ -757,6 +772,7 @@ static void rupture(tx_cloth* c) {
     if (local[p] > local[most]) most = p;
   for (int p = 0; p < c->n; p++) {
     if (local[p] < bar && p != most) continue; // the most loaded particle always, for tx_cloth_peak_tension
+    if (near && (base[p].m_x - *near).length2() > reach2) continue;
     const double t = membrane_tension(c, p);
     if (t > c->peak_tension) c->peak_tension = t;
     if (t < tc) continue;
@@ -867,7 +883,7 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
       return TX_CLOTH_FAULT;
     }
     measure_links(c, h);
-    rupture(c);
+    rupture(c, nullptr);
   }
   for (int a = 0; a < 3; a++) {
     c->contact_force[a] = -c->contact_impulse[a] / dt;
