@@ -122,7 +122,7 @@ int tx_study_skin_membrane(const tx_study_args* a) {
   printf("  rupture force changes by %.1f%% between the two finest: %s\n\n", 100 * change, converged ? "yes" : "NO");
 
   // the journal paper's gravity test
-  printf("  gravity: the 10 x 10 cm patch, border fixed, 1100 kg/m^3, 4 mm, E t = 3000 N/m, 9.81 m/s^2\n"
+  printf("  gravity: the 10 x 10 cm patch, border fixed, 1100 kg/m^3, 4 mm, E t = 3100 N/m, 9.81 m/s^2\n"
          "  %9s %14s %16s\n",
          "particles", "converged mm", "real-time mm");
   json_t* grav = json_array();

@@ -74,8 +74,9 @@ typedef struct tx_cloth_def {
   double center[3];         // m, centre of the patch; 0 (mid-plane y = 0)
   double thickness;         // m, in [0, 0.02]; 0.004 (the papers' 0.4 cm); only the contact uses it
   double mass;              // kg, the whole patch, spread evenly; 0.044 (10 x 10 x 0.4 cm at 1100 kg/m^3)
-  double stretch_stiffness; // N/m, k of eq. 1 for stretch and shear links, in (0, 1e9]; 2000 (E t = 1.5 k
-                            // along x and z: 3000 N/m, E = 0.75 MPa at 4 mm; docs/skin.md)
+  double stretch_stiffness; // N/m, k of eq. 1 for stretch and shear links, in (0, 1e9]; 2000 (E t along x
+                            // and z is C11 - C12^2 / C11, C11 = 2 k + 4 k_bend, C12 = k: 3100 N/m, E = 0.77 MPa
+                            // at 4 mm; docs/skin.md)
   double bend_stiffness;    // N/m, k of the bending links, in [0, 1e9]; 20
   double damping;           // 1/s, decay rate of particle velocities (b of eq. 1 per unit mass), in [0, 1e4]; 5
   double gravity;           // m/s^2, along -y, in [0, 100]; 0 (9.81 with gravity on)
