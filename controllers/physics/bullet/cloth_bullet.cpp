@@ -47,6 +47,7 @@ struct tx_cloth {
   double node_mass; // kg per particle
   double area;      // m^2, rest area per particle (one cell)
   std::vector<double> lambda;      // (links now, by slot) XPBD multipliers of the substep, N s^2
+  std::vector<float> length;       // (links now, by slot) m, each link's length in the last iteration
   std::vector<float> tension;      // (nlink, by id) N, each link's tension over the last substep
   std::vector<float> local;        // (n) scratch: sum of f L / 2 over a particle's stretched links, N m
   std::vector<int32_t> node_links; // (n x 12) link ids at each particle, -1 padded
@@ -345,6 +346,7 @@ static bool build(tx_cloth* c) {
         }
     }
   c->lambda.assign((size_t)c->nlink, 0);
+  c->length.assign((size_t)c->nlink, 0);
   c->tension.assign((size_t)c->nlink, 0);
   c->local.assign((size_t)c->n, 0);
   c->load.assign((size_t)c->n, btVector3(0, 0, 0));
@@ -474,7 +476,9 @@ static void solve_links(tx_cloth* c, double h) {
   const double as = 1 / (c->def.stretch_stiffness * h * h);
   const double ab = c->def.bend_stiffness > 0 ? 1 / (c->def.bend_stiffness * h * h) : -1;
   const btSoftBody::Material* bend = c->bend_mat;
+  float* length = c->length.data(); // kept for measure_links, which then need not visit the particles
   std::fill(lam, lam + nl, 0.0);
+  std::fill(length, length + nl, 0.0f);
   for (int it = 0; it < c->def.iterations; it++)
     for (int i = 0; i < nl; i++) {
       btSoftBody::Link& l = links[i];
@@ -486,6 +490,7 @@ static void solve_links(tx_cloth* c, double h) {
       if (!(w > 0)) continue;
       const btVector3 d = n1->m_x - n0->m_x;
       const double len = d.length();
+      length[i] = (float)len;
       if (!(len > 0)) continue;
       const double dl = (-(len - l.m_rl) - at * lam[i]) / (w + at);
       lam[i] += dl;
@@ -713,18 +718,31 @@ static double membrane_tension(const tx_cloth* c, int i) {
 }
 
 // the links' tensions after a substep's solve (the multipliers over h^2),
-// and the longest live stretch or shear link for the contact's reach
+// the longest live stretch or shear link for the contact's reach and, with
+// rupture on, each particle's sum of f L / 2 over its stretched links (one
+// pass over the links for all three)
 static void measure_links(tx_cloth* c, double h) {
   const btAlignedObjectArray<btSoftBody::Link>& links = c->body->m_links;
+  const btSoftBody::Node* base = &c->body->m_nodes[0];
+  const bool sums = c->def.rupture_tension > 0;
+  float* local = c->local.data();
+  if (sums) std::fill(local, local + c->n, 0.0f);
   const double ih2 = 1 / (h * h);
-  double longest2 = 0;
+  btScalar longest = 0;
   for (int i = 0, ni = links.size(); i < ni; i++) {
     const btSoftBody::Link& l = links[i];
     const int id = (int)reinterpret_cast<intptr_t>(l.m_tag);
-    c->tension[(size_t)id] = (float)(-c->lambda[(size_t)i] * ih2);
-    if (c->info[(size_t)id].kind != BEND) longest2 = std::max(longest2, (double)(l.m_n[1]->m_x - l.m_n[0]->m_x).length2());
+    const float f = (float)(-c->lambda[(size_t)i] * ih2);
+    c->tension[(size_t)id] = f;
+    const btScalar len = c->length[(size_t)i]; // before the last correction and the contact: close enough
+    if (len > longest && c->info[(size_t)id].kind != BEND) longest = len;
+    if (sums && f > 0) {
+      const float fl = 0.5f * f * len;
+      local[l.m_n[0] - base] += fl;
+      local[l.m_n[1] - base] += fl;
+    }
   }
-  if (c->max_edge > 0) c->reach_factor = std::max(2.0, 2 * std::sqrt(longest2) / c->max_edge);
+  if (c->max_edge > 0) c->reach_factor = std::max(2.0, 2 * (double)longest / c->max_edge);
 }
 
 // Where the membrane tension passes rupture_tension, the most tensed
@@ -754,14 +772,16 @@ static void rupture(tx_cloth* c, const btVector3* near) {
       if (f > c->tension[(size_t)id]) c->tension[(size_t)id] = f;
     }
   float* local = c->local.data();
-  std::fill(local, local + c->n, 0.0f);
-  for (int i = 0, ni = links.size(); i < ni; i++) {
-    const btSoftBody::Link& l = links[i];
-    const float f = c->tension[(size_t)(intptr_t)l.m_tag];
-    if (!(f > 0)) continue;
-    const float fl = 0.5f * f * (l.m_n[1]->m_x - l.m_n[0]->m_x).length();
-    local[l.m_n[0] - base] += fl;
-    local[l.m_n[1] - base] += fl;
+  if (near) { // the sums again, with the spring forces just put in (after a solve, measure_links made them)
+    std::fill(local, local + c->n, 0.0f);
+    for (int i = 0, ni = links.size(); i < ni; i++) {
+      const btSoftBody::Link& l = links[i];
+      const float f = c->tension[(size_t)(intptr_t)l.m_tag];
+      if (!(f > 0)) continue;
+      const float fl = 0.5f * f * (l.m_n[1]->m_x - l.m_n[0]->m_x).length();
+      local[l.m_n[0] - base] += fl;
+      local[l.m_n[1] - base] += fl;
+    }
   }
   // a margin of 2 below the criterion: in a uniform field a particle's own
   // sum over its area is at least the largest principal tension, and the
