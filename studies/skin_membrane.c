@@ -34,7 +34,7 @@ int tx_study_skin_membrane(const tx_study_args* a) {
     quick = v == 1;
   }
 #if !TX_WITH_BULLET
-  (void)num;
+  (void)num, (void)quick;
   return tx_bad_input("study skin-membrane: this build has no Bullet (configured with TX_WITH_BULLET=OFF)");
 #else
   // the closed forms at a / 8, a / 16, a / 32 (a = 4 cm); quick: the first two
