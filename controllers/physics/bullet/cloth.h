@@ -26,7 +26,9 @@
 //              (a smooth kernel), breaks the most tensed stretch or shear
 //              link at a particle where it passes rupture_tension (N/m): a
 //              criterion in physical units that does not depend on the
-//              spacing. A broken link leaves Bullet, the triangles it
+//              spacing. With gravity the tension each link holds once the
+//              patch hangs (settle_time) is not counted: the weight alone
+//              never tears it. A broken link leaves Bullet, the triangles it
 //              bordered (the two of its cell for a diagonal) leave the mesh,
 //              so a hole opens; bending links across it go too
 //   HIP        a kinematic sphere (the haptic interaction point). Its contact
@@ -84,7 +86,7 @@ typedef struct tx_cloth_def {
   double clamp_radius;      // m, particles this far or further from the centre (in the plane) cannot move
                             // either, in [0, 10]; 0: none (a circular membrane inside the square)
   double pretension;        // N/m, isotropic tension of the flat patch at rest, in [0, (3 k + 4 k_bend) / 2]; 0
-  double rupture_tension;   // N/m, membrane tension that tears, in [0, 1e7]; 20; 0: never
+  double rupture_tension;   // N/m, membrane tension that tears, in [0, 1e7]; 1; 0: never
   double rupture_length;    // m, radius over which the tension is averaged, in [1e-4, 0.05]; 0.002
   int iterations;           // XPBD iterations per substep, in [1, 200]; 1
   double max_substep;       // s, a step is split into substeps of at most this, in [1e-6, 0.1]; 1/600
@@ -149,6 +151,7 @@ bool tx_cloth_link_ends(const tx_cloth* c, int link, int32_t ends[2]);
 double tx_cloth_link_tension(const tx_cloth* c, int link);
 // the membrane tension at particle i now (N/m): the largest principal value
 // of the link stresses averaged over rupture_length, as rupture sees it
+// (with gravity: beyond the hanging state)
 double tx_cloth_membrane_tension(const tx_cloth* c, int i);
 // the largest membrane tension found by the rupture checks of the last step
 // (N/m): at the particle whose own links carry the most in each substep, and

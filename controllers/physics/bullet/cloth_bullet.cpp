@@ -49,6 +49,7 @@ struct tx_cloth {
   std::vector<double> lambda;      // (links now, by slot) XPBD multipliers of the substep, N s^2
   std::vector<float> length;       // (links now, by slot) m, each link's length in the last iteration
   std::vector<float> tension;      // (nlink, by id) N, each link's tension over the last substep
+  std::vector<float> hanging;      // (nlink, by id) N, its tension once the patch hung (settle; 0 without gravity)
   std::vector<float> local;        // (n) scratch: sum of f L / 2 over a particle's stretched links, N m
   std::vector<int32_t> node_links; // (n x 12) link ids at each particle, -1 padded
   std::vector<btVector3> load;     // (n) N, external force on each particle
@@ -90,6 +91,9 @@ struct tx_cloth {
   bool topology_dirty; // links broke since the last save
 };
 
+// what rupture counts of a link's tension: beyond what it held once the patch hung
+static inline float excess(const tx_cloth* c, int id) { return c->tension[(size_t)id] - c->hanging[(size_t)id]; }
+
 extern "C" tx_cloth_def tx_cloth_def_default(void) {
   tx_cloth_def d;
   std::memset(&d, 0, sizeof d);
@@ -104,7 +108,7 @@ extern "C" tx_cloth_def tx_cloth_def_default(void) {
   d.fixed_border = true;
   d.clamp_radius = 0;
   d.pretension = 0;
-  d.rupture_tension = 3;
+  d.rupture_tension = 1;
   d.rupture_length = 0.002;
   d.iterations = 1;
   d.max_substep = 1.0 / 600;
@@ -348,6 +352,7 @@ static bool build(tx_cloth* c) {
   c->lambda.assign((size_t)c->nlink, 0);
   c->length.assign((size_t)c->nlink, 0);
   c->tension.assign((size_t)c->nlink, 0);
+  c->hanging.assign((size_t)c->nlink, 0);
   c->local.assign((size_t)c->n, 0);
   c->load.assign((size_t)c->n, btVector3(0, 0, 0));
   c->reach_factor = 2;
@@ -373,6 +378,7 @@ static void settle(tx_cloth* c) {
   for (int s = 0; s < steps; s++)
     if (tx_cloth_step(c, 1.0 / 60) != TX_CLOTH_OK) break;
   c->def.rupture_tension = tear;
+  if (steps > 0) c->hanging = c->tension; // same size: no allocation beyond create
   for (int a = 0; a < 3; a++) c->contact_force[a] = 0;
   c->peak_tension = 0;
 }
@@ -696,7 +702,7 @@ static double membrane_tension(const tx_cloth* c, int i) {
       for (int k = 0; k < 12 && ls[k] >= 0; k++) {
         const link_info& li = c->info[(size_t)ls[k]];
         if (li.end[0] != q || li.slot < 0) continue; // each link once, from its first particle
-        const double f = c->tension[(size_t)ls[k]];
+        const double f = excess(c, ls[k]);
         if (f == 0) continue;
         const int o = li.end[1];
         // the link's middle in the rest grid, relative to particle i
@@ -736,8 +742,9 @@ static void measure_links(tx_cloth* c, double h) {
     c->tension[(size_t)id] = f;
     const btScalar len = c->length[(size_t)i]; // before the last correction and the contact: close enough
     if (len > longest && c->info[(size_t)id].kind != BEND) longest = len;
-    if (sums && f > 0) {
-      const float fl = 0.5f * f * len;
+    const float fx = f - c->hanging[(size_t)id];
+    if (sums && fx > 0) {
+      const float fl = 0.5f * fx * len;
       local[l.m_n[0] - base] += fl;
       local[l.m_n[1] - base] += fl;
     }
@@ -769,14 +776,14 @@ static void rupture(tx_cloth* c, const btVector3* near) {
       const int id = (int)reinterpret_cast<intptr_t>(l.m_tag);
       const double k = c->info[(size_t)id].kind == BEND ? c->def.bend_stiffness : c->def.stretch_stiffness;
       const float f = (float)(k * ((l.m_n[1]->m_x - l.m_n[0]->m_x).length() - l.m_rl));
-      if (f > c->tension[(size_t)id]) c->tension[(size_t)id] = f;
+      if (f - c->hanging[(size_t)id] > excess(c, id)) c->tension[(size_t)id] = f;
     }
   float* local = c->local.data();
   if (near) { // the sums again, with the spring forces just put in (after a solve, measure_links made them)
     std::fill(local, local + c->n, 0.0f);
     for (int i = 0, ni = links.size(); i < ni; i++) {
       const btSoftBody::Link& l = links[i];
-      const float f = c->tension[(size_t)(intptr_t)l.m_tag];
+      const float f = excess(c, (int)(intptr_t)l.m_tag);
       if (!(f > 0)) continue;
       const float fl = 0.5f * f * (l.m_n[1]->m_x - l.m_n[0]->m_x).length();
       local[l.m_n[0] - base] += fl;
@@ -802,7 +809,7 @@ static void rupture(tx_cloth* c, const btVector3* near) {
     for (int k = 0; k < 12 && ls[k] >= 0; k++) {
       const link_info& li = c->info[(size_t)ls[k]];
       if (li.slot < 0 || li.kind == BEND) continue;
-      if (c->tension[(size_t)ls[k]] > fbest) fbest = c->tension[(size_t)ls[k]], best = ls[k];
+      if (excess(c, ls[k]) > fbest) fbest = excess(c, ls[k]), best = ls[k];
     }
     if (best >= 0) c->breaking[(size_t)nb++] = best;
   }
