@@ -123,10 +123,10 @@ int tx_bench_cloth(double duration_s) {
     fprintf(stderr, "tactus: %s\n", err);
     rc = 1;
   }
-  printf("bench cloth: %d x %d = %d particles (0.1 cm), rupture at strain %g, %d iterations, HIP r = %g mm\n"
+  printf("bench cloth: %d x %d = %d particles (0.1 cm), rupture at %g N/m over %g mm, %d XPBD iterations, HIP r = %g mm\n"
          "piercing at 2 cm/s every second; %g s at %g Hz in lockstep, the bare loop and physics.skin stepped "
          "alternately\n\n",
-         d.res[0], d.res[1], d.res[0] * d.res[1], d.rupture_strain, d.iterations, HIP_RADIUS * 1e3, seconds, RATE_HZ);
+         d.res[0], d.res[1], d.res[0] * d.res[1], d.rupture_tension, d.rupture_length * 1e3, d.iterations, HIP_RADIUS * 1e3, seconds, RATE_HZ);
   tx_controller_stats st = {0};
   if (rc == 0) {
     tx_run_options o = {.duration_s = seconds, .lockstep = true};

@@ -23,6 +23,8 @@ static const struct {
      "the SutureHap journal paper's skin tests (Figs. 15-19) and the 60 Hz hold, per force mode; mechanics or construction"},
     {"skin-stability", tx_study_skin_stability,
      "the skin under stiffness x1e-3..x1e3, steps 1/20..1/1000 s, a teleporting and a 10 m/s HIP, zero thickness"},
+    {"skin-membrane", tx_study_skin_membrane,
+     "the skin against closed-form membranes (disc load, own weight), rupture under refinement, gravity sag"},
     {"skin-accuracy", tx_study_skin_accuracy,
      "spacing, iterations and step refined together: observed order, Richardson reference, error vs CPU time"},
 };

@@ -31,14 +31,19 @@ static const tx_param_def params[] = {
     {"spacing_m", TX_PARAM_NUM, "m", 0.0005, 0.05, 0.0025, NULL, "particle spacing, dividing size_m; 0.001 is the papers' high density"},
     {"thickness_m", TX_PARAM_NUM, "m", 0, 0.02, 0.004, NULL, "the skin's thickness; only the contact uses it"},
     {"mass_kg", TX_PARAM_NUM, "kg", 1e-6, 100, 0.044, NULL, "the whole patch (10 x 10 x 0.4 cm at 1100 kg/m^3)"},
-    {"stretch_stiffness", TX_PARAM_NUM, "N/m", 1e-6, 1e9, 2000, NULL, "k of eq. 1 for stretch and shear links"},
+    {"stretch_stiffness", TX_PARAM_NUM, "N/m", 1e-6, 1e9, 2000, NULL,
+     "k of eq. 1 for stretch and shear links; the membrane's E t along x and z is 1.5 k (docs/skin.md)"},
     {"bend_stiffness", TX_PARAM_NUM, "N/m", 0, 1e9, 20, NULL, "k of the bending links"},
     {"damping", TX_PARAM_NUM, "1/s", 0, 1e4, 5, NULL, "decay rate of particle velocities"},
     {"gravity", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "9.81 m/s^2 along -y"},
     {"fixed_border", TX_PARAM_BOOL, NULL, 0, 0, 1, NULL, "the outer ring of particles does not move"},
-    {"rupture_strain", TX_PARAM_NUM, "1", 0, 100, 0.6, NULL, "a link breaks above this strain; 0: never"},
-    {"iterations", TX_PARAM_INT, "1", 1, 200, 10, NULL, "Bullet position iterations per substep"},
-    {"max_substep_s", TX_PARAM_NUM, "s", 1e-5, 0.1, 1.0 / 60, NULL, "a step is split into substeps of at most this"},
+    {"pretension_n_per_m", TX_PARAM_NUM, "N/m", 0, 1e9, 0, NULL,
+     "isotropic tension of the flat skin at rest against its fixed border; below (3 k + 4 k_bend) / 2"},
+    {"rupture_tension_n_per_m", TX_PARAM_NUM, "N/m", 0, 1e7, 1, NULL,
+     "membrane tension, averaged over rupture_length_m, that tears the skin; 0: never"},
+    {"rupture_length_m", TX_PARAM_NUM, "m", 1e-4, 0.05, 0.002, NULL, "radius over which the tension is averaged"},
+    {"iterations", TX_PARAM_INT, "1", 1, 200, 1, NULL, "XPBD iterations per substep"},
+    {"max_substep_s", TX_PARAM_NUM, "s", 1e-6, 0.1, 1.0 / 600, NULL, "a step is split into substeps of at most this"},
     {"max_speed", TX_PARAM_NUM, "m/s", 1e-3, 1e4, 100, NULL, "a faster particle is a blow-up"},
     {"hip_radius_m", TX_PARAM_NUM, "m", 0, 0.01, 0.0005, NULL, "the HIP sphere (0.05 cm); 0: no HIP"},
     {"pose", TX_PARAM_STR, NULL, 0, 0, 0, "device0.pose", "the pose the HIP follows (f64 1 x 7)"},
@@ -65,7 +70,9 @@ static int configure(tx_setup* s, void** self) {
   d.damping = tx_table_num(s, "damping");
   d.gravity = tx_table_bool(s, "gravity") ? 9.81 : 0;
   d.fixed_border = tx_table_bool(s, "fixed_border");
-  d.rupture_strain = tx_table_num(s, "rupture_strain");
+  d.pretension = tx_table_num(s, "pretension_n_per_m");
+  d.rupture_tension = tx_table_num(s, "rupture_tension_n_per_m");
+  d.rupture_length = tx_table_num(s, "rupture_length_m");
   d.iterations = (int)tx_table_int(s, "iterations");
   d.max_substep = tx_table_num(s, "max_substep_s");
   d.max_speed = tx_table_num(s, "max_speed");

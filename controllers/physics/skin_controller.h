@@ -6,7 +6,8 @@
 //   0.001 (0.1 cm: 102 x 102); size / spacing + 1 cells a side, as the
 //   journal paper counts them, so the edge is size + spacing; thickness_m 0.004 (0.2 to 0.8 cm), mass_kg,
 //   stretch_stiffness and bend_stiffness (N/m, k of eq. 1), damping (1/s),
-//   gravity (bool), fixed_border (bool), rupture_strain (0: never),
+//   gravity (bool), fixed_border (bool), pretension_n_per_m (N/m),
+//   rupture_tension_n_per_m (N/m, 0: never), rupture_length_m (m),
 //   iterations, max_substep_s, max_speed (m/s), hip_radius_m 0.0005
 //   (0.05 cm; 0: no HIP), pose (the component the HIP follows, default
 //   device0.pose, f64 1 x 7).

@@ -293,7 +293,9 @@ static void builtin_tables_hold_the_library_defaults(void** state) {
   assert_true(def_of("physics.skin", "damping")->def_num == c.damping);
   assert_true((def_of("physics.skin", "gravity")->def_num != 0) == (c.gravity != 0));
   assert_true((def_of("physics.skin", "fixed_border")->def_num != 0) == c.fixed_border);
-  assert_true(def_of("physics.skin", "rupture_strain")->def_num == c.rupture_strain);
+  assert_true(def_of("physics.skin", "pretension_n_per_m")->def_num == c.pretension);
+  assert_true(def_of("physics.skin", "rupture_tension_n_per_m")->def_num == c.rupture_tension);
+  assert_true(def_of("physics.skin", "rupture_length_m")->def_num == c.rupture_length);
   assert_true(def_of("physics.skin", "iterations")->def_num == c.iterations);
   assert_true(def_of("physics.skin", "max_substep_s")->def_num == c.max_substep);
   assert_true(def_of("physics.skin", "max_speed")->def_num == c.max_speed);

@@ -2,29 +2,42 @@
 //
 // A rectangular patch in the plane y = center[1] (Y up), res[0] x res[1]
 // particles on a regular grid, each cell split into two triangles along an
-// alternating diagonal. Bullet (btSoftBody, position-based links) moves the
-// particles; the links are the springs of the suturing conference paper's
-// eq. 1: stretch links along x and z, shear links along both diagonals of a
-// cell (8 neighbours for an inner particle, the paper's Fig. 2) and bending
-// links two spacings long along x and z.
+// alternating diagonal. The links are the springs of the suturing conference
+// paper's eq. 1: stretch links along x and z, shear links along both
+// diagonals of a cell (8 neighbours for an inner particle, the paper's
+// Fig. 2) and bending links two spacings long along x and z. Bullet's
+// btSoftBody holds the particles and links; this adapter integrates them.
 //
-//   stiffness  the paper's k (N/m) per link, turned into Bullet's per-iteration
-//              link stiffness k dt^2 w / (1 + k dt^2 w) (w: the two inverse
-//              masses; the implicit spring's correction over one substep), so
-//              any k is stable; a very stiff link is limited by iterations
-//   rupture    a stretch or shear link whose strain (length - reference) /
-//              reference passes rupture_strain breaks (the reference is the
-//              rest length, or with gravity the length once the patch hangs
-//              after settle_time): it leaves Bullet, and the
-//              triangles it bordered (the two of its cell for a diagonal)
-//              leave the mesh, so a hole opens; bending links across it go too
+//   solver     XPBD (Macklin et al. 2016): each link is a distance constraint
+//              of compliance 1/k with a Lagrange multiplier accumulated over
+//              the iterations of a substep, so the cloth tends to implicit
+//              Euler with the true k as iterations grow and substeps shrink
+//              (a per-iteration stiffness, as Bullet's own solver has, tends
+//              to a rigid link instead). A link's tension is its multiplier
+//              over the substep squared. The lattice is a membrane of 2D
+//              moduli C11 = 2k + 4 k_bend, C12 = C66 = k (docs/skin.md)
+//   pretension the links' rest lengths are shortened so that the flat patch
+//              at rest holds an isotropic tension (N/m) against its clamp
+//   clamp      the border ring (fixed_border) and, with clamp_radius > 0,
+//              every particle at or beyond that distance from the centre
+//   load       an external force per particle (tx_cloth_set_load)
+//   rupture    the membrane tension, the largest principal value of the
+//              link stresses averaged over a disc of radius rupture_length
+//              (a smooth kernel), breaks the most tensed stretch or shear
+//              link at a particle where it passes rupture_tension (N/m): a
+//              criterion in physical units that does not depend on the
+//              spacing. With gravity the tension each link holds once the
+//              patch hangs (settle_time) is not counted: the weight alone
+//              never tears it. A broken link leaves Bullet, the triangles it
+//              bordered (the two of its cell for a diagonal) leave the mesh,
+//              so a hole opens; bending links across it go too
 //   HIP        a kinematic sphere (the haptic interaction point). Its contact
 //              is a point-triangle constraint against every live triangle:
 //              the closest point of a triangle within radius + thickness / 2
 //              of the centre is projected out to that distance, moving the
 //              triangle's three particles by their barycentric weights
 //              (inverse mass weighted), before and after each substep's
-//              Bullet solve. Bullet's own node-vs-rigid contact tests
+//              link solve. Bullet's own node-vs-rigid contact tests
 //              particles only, and a 0.5 mm sphere slips between particles
 //              2.5 mm apart; the face test cannot. A fast HIP is swept in
 //              moves of at most half the contact distance, and the side it
@@ -63,17 +76,22 @@ typedef struct tx_cloth_def {
   double center[3];         // m, centre of the patch; 0 (mid-plane y = 0)
   double thickness;         // m, in [0, 0.02]; 0.004 (the papers' 0.4 cm); only the contact uses it
   double mass;              // kg, the whole patch, spread evenly; 0.044 (10 x 10 x 0.4 cm at 1100 kg/m^3)
-  double stretch_stiffness; // N/m, k of eq. 1 for stretch and shear links, in (0, 1e9]; 2000 (E t for 0.5 MPa, 4 mm)
+  double stretch_stiffness; // N/m, k of eq. 1 for stretch and shear links, in (0, 1e9]; 2000 (E t along x
+                            // and z is C11 - C12^2 / C11, C11 = 2 k + 4 k_bend, C12 = k: 3100 N/m, E = 0.77 MPa
+                            // at 4 mm; docs/skin.md)
   double bend_stiffness;    // N/m, k of the bending links, in [0, 1e9]; 20
   double damping;           // 1/s, decay rate of particle velocities (b of eq. 1 per unit mass), in [0, 1e4]; 5
   double gravity;           // m/s^2, along -y, in [0, 100]; 0 (9.81 with gravity on)
   bool fixed_border;        // the outer ring of particles cannot move; true
-  double rupture_strain;    // 1, a stretch or shear link breaks above this strain, in [0, 100]; 0.6; 0: never
-  int iterations;           // Bullet position iterations per substep, in [1, 200]; 10
-  double max_substep;       // s, a step is split into substeps of at most this, in [1e-5, 0.1]; 1/60
+  double clamp_radius;      // m, particles this far or further from the centre (in the plane) cannot move
+                            // either, in [0, 10]; 0: none (a circular membrane inside the square)
+  double pretension;        // N/m, isotropic tension of the flat patch at rest, in [0, (3 k + 4 k_bend) / 2]; 0
+  double rupture_tension;   // N/m, membrane tension that tears, in [0, 1e7]; 1; 0: never
+  double rupture_length;    // m, radius over which the tension is averaged, in [1e-4, 0.05]; 0.002
+  int iterations;           // XPBD iterations per substep, in [1, 200]; 1
+  double max_substep;       // s, a step is split into substeps of at most this, in [1e-6, 0.1]; 1/600
   double max_speed;         // m/s, a faster particle is a blow-up, in (0, 1e4]; 100
-  double settle_time;       // s, with gravity the patch first hangs this long without rupture, and the
-                            // hanging lengths become the rupture reference, in [0, 10]; 1
+  double settle_time;       // s, with gravity the patch first hangs this long without rupture, in [0, 10]; 1
 } tx_cloth_def;
 
 typedef struct tx_cloth tx_cloth;
@@ -129,7 +147,26 @@ typedef struct tx_cloth_contact_info {
 } tx_cloth_contact_info;
 void tx_cloth_contact(const tx_cloth* c, tx_cloth_contact_info* out);
 // the largest strain (length - rest) / rest of a stretch or shear link now
+// (the rest length is shorter than the spacing under pretension)
 double tx_cloth_max_strain(const tx_cloth* c);
+// an external force (N) on particle i from the next step on, until set
+// again (zero removes it); TX_CLOTH_BAD for a bad index or a non-finite force
+tx_cloth_status tx_cloth_set_load(tx_cloth* c, int i, const double f[3]);
+// link ids run from 0 to the count at creation (tx_cloth_link_total); a
+// broken link keeps its id. Its two particles; false for a bad id
+int tx_cloth_link_total(const tx_cloth* c);
+bool tx_cloth_link_ends(const tx_cloth* c, int link, int32_t ends[2]);
+// the link's tension over the last substep (N, > 0 stretched): its XPBD
+// multiplier / substep^2, i.e. the force the solver applied; 0 once broken
+double tx_cloth_link_tension(const tx_cloth* c, int link);
+// the membrane tension at particle i now (N/m): the largest principal value
+// of the link stresses averaged over rupture_length, as rupture sees it
+// (with gravity: beyond the hanging state)
+double tx_cloth_membrane_tension(const tx_cloth* c, int i);
+// the largest membrane tension found by the rupture checks of the last step
+// (N/m): at the particle whose own links carry the most in each substep, and
+// at every particle whose links could reach rupture_tension; 0 without rupture
+double tx_cloth_peak_tension(const tx_cloth* c);
 // faults found and recovered so far
 int tx_cloth_faults(const tx_cloth* c);
 

@@ -1,7 +1,8 @@
 // The skin patch on a Bullet soft body: the C interface of cloth.h over
-// btSoftBody. Bullet integrates the particles and solves the links; this
-// file builds the patch, drives the substeps, projects the HIP contact,
-// breaks overstretched links and guards against numerical faults.
+// btSoftBody. Bullet holds the particles and links; this file builds the
+// patch, integrates it (XPBD links), projects the HIP contact, breaks links
+// where the membrane tension passes the rupture tension and guards against
+// numerical faults.
 #include "cloth.h"
 
 extern "C" {
@@ -29,7 +30,7 @@ struct link_info {
   int32_t tri[2];  // triangles it borders, -1 for none (bending links: none)
   int32_t dep[2];  // bending links that span this stretch link, or -1
   int32_t part[2]; // for a bending link: the two stretch links it spans
-  float limit2;    // m^2, squared length at which it breaks: ((1 + rupture_strain) reference)^2
+  int32_t end[2];  // its particles
   link_kind kind;
 };
 
@@ -45,7 +46,16 @@ struct tx_cloth {
   btSoftBody::Material* stretch_mat; // stretch and shear links
   btSoftBody::Material* bend_mat;    // bending links
   double node_mass; // kg per particle
-  double prepared_dt; // s, substep length the link constants were computed for (0: none)
+  double area;      // m^2, rest area per particle (one cell)
+  std::vector<double> lambda;      // (links now, by slot) XPBD multipliers of the substep, N s^2
+  std::vector<float> length;       // (links now, by slot) m, each link's length in the last iteration
+  std::vector<float> tension;      // (nlink, by id) N, each link's tension over the last substep
+  std::vector<float> hanging;      // (nlink, by id) N, its tension once the patch hung (settle; 0 without gravity)
+  std::vector<float> local;        // (n) scratch: sum of f L / 2 over a particle's stretched links, N m
+  std::vector<int32_t> node_links; // (n x 12) link ids at each particle, -1 padded
+  std::vector<btVector3> load;     // (n) N, external force on each particle
+  int loaded;                      // particles with a non-zero load
+  double peak_tension;             // N/m, largest averaged tension of the last step's checks
 
   std::vector<int32_t> tri;        // (ntri x 3) vertex indices
   std::vector<uint8_t> tri_alive;  // (ntri)
@@ -77,16 +87,21 @@ struct tx_cloth {
   std::vector<uint8_t> in_contact; // (n) the last substep's contact moved this particle
   double contact_dir[3];     // 1, the pushes of the last substep's contact on the skin, summed (depth-weighted)
   double max_edge;           // m, longest rest length of a stretch or shear link
-  double reach_factor;       // 1, the longest a live stretch or shear link gets, over max_edge
+  double reach_factor;       // 1, twice the longest live stretch or shear link after the last substep, over
+                             // max_edge: a triangle in contact has a corner within rc + reach_factor max_edge
 
   // last good state
   std::vector<float> good_x, good_v;   // (n x 3) m, m/s
   std::vector<uint8_t> good_link;      // (nlink) 1 = present
   std::vector<uint8_t> good_tri;       // (ntri)
+  std::vector<float> good_tension;     // (nlink) N, the warm start
   int good_torn;
   double good_hip[3];
   bool topology_dirty; // links broke since the last save
 };
+
+// what rupture counts of a link's tension: beyond what it held once the patch hung
+static inline float excess(const tx_cloth* c, int id) { return c->tension[(size_t)id] - c->hanging[(size_t)id]; }
 
 extern "C" tx_cloth_def tx_cloth_def_default(void) {
   tx_cloth_def d;
@@ -100,9 +115,12 @@ extern "C" tx_cloth_def tx_cloth_def_default(void) {
   d.damping = 5;
   d.gravity = 0;
   d.fixed_border = true;
-  d.rupture_strain = 0.6;
-  d.iterations = 10;
-  d.max_substep = 1.0 / 60;
+  d.clamp_radius = 0;
+  d.pretension = 0;
+  d.rupture_tension = 1;
+  d.rupture_length = 0.002;
+  d.iterations = 1;
+  d.max_substep = 1.0 / 600;
   d.max_speed = 100;
   d.settle_time = 1;
   return d;
@@ -130,9 +148,14 @@ extern "C" const char* tx_cloth_def_check(const tx_cloth_def* d) {
   if ((e = range("bend_stiffness", d->bend_stiffness, 0, false, 1e9, false, "N/m"))) return e;
   if ((e = range("damping", d->damping, 0, false, 1e4, false, "1/s"))) return e;
   if ((e = range("gravity", d->gravity, 0, false, 100, false, "m/s^2"))) return e;
-  if ((e = range("rupture_strain", d->rupture_strain, 0, false, 100, false, "(strain)"))) return e;
+  if ((e = range("clamp_radius", d->clamp_radius, 0, false, 10, false, "m"))) return e;
+  // a prestrain under 50 %: the links stay far from zero length
+  if ((e = range("pretension", d->pretension, 0, false, 0.5 * (3 * d->stretch_stiffness + 4 * d->bend_stiffness), false,
+                 "N/m"))) return e;
+  if ((e = range("rupture_tension", d->rupture_tension, 0, false, 1e7, false, "N/m"))) return e;
+  if ((e = range("rupture_length", d->rupture_length, 1e-4, false, 0.05, false, "m"))) return e;
   if ((e = tx_check_count("skin", "iterations", d->iterations, 1, 200))) return e;
-  if ((e = range("max_substep", d->max_substep, 1e-5, false, 0.1, false, "s"))) return e;
+  if ((e = range("max_substep", d->max_substep, 1e-6, false, 0.1, false, "s"))) return e;
   if ((e = range("max_speed", d->max_speed, 0, true, 1e4, false, "m/s"))) return e;
   if ((e = range("settle_time", d->settle_time, 0, false, 10, false, "s"))) return e;
   return NULL;
@@ -164,6 +187,8 @@ static int add_link(tx_cloth* c, int a, int b, link_kind kind) {
   link_info li;
   li.slot = c->body->m_links.size() - 1;
   li.tri[0] = li.tri[1] = li.dep[0] = li.dep[1] = li.part[0] = li.part[1] = -1;
+  li.end[0] = a;
+  li.end[1] = b;
   li.kind = kind;
   c->info.push_back(li);
   if (kind != BEND && l.m_rl > c->max_edge) c->max_edge = l.m_rl;
@@ -188,20 +213,24 @@ static bool build(tx_cloth* c) {
   c->ntri = 2 * (nx - 1) * (nz - 1);
   const double hx = d.size[0] / (nx - 1), hz = d.size[1] / (nz - 1);
 
-  // particles and triangles on the skin's grid (skin_grid.h); the border is fixed by zero mass
+  // particles and triangles on the skin's grid (skin_grid.h); the border and
+  // what lies beyond the clamp radius are fixed by zero mass
   std::vector<float> grid((size_t)c->n * 3);
   c->tri.resize((size_t)c->ntri * 3);
   tx_skin_grid(nx, nz, hx, hz, d.center, grid.data(), c->tri.data());
   std::vector<btVector3> x((size_t)c->n);
   std::vector<btScalar> m((size_t)c->n);
   c->node_mass = d.mass / c->n;
+  c->area = hx * hz;
   for (int iz = 0; iz < nz; iz++)
     for (int ix = 0; ix < nx; ix++) {
       int i = node_index(d, ix, iz);
       const float* g = &grid[(size_t)i * 3];
       x[(size_t)i] = btVector3(g[0], g[1], g[2]);
       bool border = ix == 0 || iz == 0 || ix == nx - 1 || iz == nz - 1;
-      m[(size_t)i] = (d.fixed_border && border) ? 0 : (btScalar)c->node_mass;
+      double rx = ix * hx - 0.5 * d.size[0], rz = iz * hz - 0.5 * d.size[1];
+      bool clamped = d.clamp_radius > 0 && rx * rx + rz * rz >= d.clamp_radius * d.clamp_radius * (1 - 1e-12);
+      m[(size_t)i] = ((d.fixed_border && border) || clamped) ? 0 : (btScalar)c->node_mass;
     }
   c->body = new btSoftBody(&c->world, c->n, x.data(), m.data());
   c->body->m_cfg.collisions = 0; // the HIP contact is ours (see cloth.h)
@@ -291,12 +320,40 @@ static bool build(tx_cloth* c) {
     }
   }
 
-  // rest lengths and constants now, so that Bullet never resets them to a deformed shape
+  // rest lengths now, so that Bullet never resets them to a deformed shape;
+  // under pretension every link is shortened by the same factor 1 - T / K,
+  // K = C11 + C12 = 3 k + 4 k_bend the lattice's biaxial modulus, so that
+  // the flat patch holds the isotropic tension T (docs/skin.md)
   c->body->updateConstants();
   c->body->m_bUpdateRtCst = false;
+  if (d.pretension > 0) {
+    const double shrink = 1 - d.pretension / (3 * d.stretch_stiffness + 4 * d.bend_stiffness);
+    for (int i = 0; i < c->body->m_links.size(); i++) {
+      btSoftBody::Link& l = c->body->m_links[i];
+      if (l.m_material == c->bend_mat && d.bend_stiffness <= 0) continue;
+      l.m_rl = (btScalar)(l.m_rl * shrink);
+    }
+  }
   c->original.assign(c->body->m_links.size(), btSoftBody::Link());
   for (int i = 0; i < c->body->m_links.size(); i++) c->original[(size_t)i] = c->body->m_links[i];
 
+  c->node_links.assign((size_t)c->n * 12, -1);
+  for (int id = 0; id < c->nlink; id++)
+    for (int e = 0; e < 2; e++) {
+      int32_t* slots = &c->node_links[(size_t)c->info[(size_t)id].end[e] * 12];
+      for (int k = 0; k < 12; k++)
+        if (slots[k] < 0) {
+          slots[k] = id;
+          break;
+        }
+    }
+  c->lambda.assign((size_t)c->nlink, 0);
+  c->length.assign((size_t)c->nlink, 0);
+  c->tension.assign((size_t)c->nlink, 0);
+  c->hanging.assign((size_t)c->nlink, 0);
+  c->local.assign((size_t)c->n, 0);
+  c->load.assign((size_t)c->n, btVector3(0, 0, 0));
+  c->reach_factor = 2;
   c->breaking.resize((size_t)c->nlink);
   c->tri_stamp.assign((size_t)c->ntri, 0);
   c->near_tris.resize((size_t)c->ntri);
@@ -307,32 +364,24 @@ static bool build(tx_cloth* c) {
   c->good_v.resize((size_t)c->n * 3);
   c->good_link.assign((size_t)c->nlink, 1);
   c->good_tri.assign((size_t)c->ntri, 1);
+  c->good_tension.assign((size_t)c->nlink, 0);
   return true;
 }
 
-// Under gravity the patch first hangs for settle_time without rupture, and
-// the links' lengths there become the reference of the rupture strain: the
-// sag is the skin's state before any contact (the journal paper's skin hangs
-// about 1 cm before the HIP arrives), and a position solver that stretches
-// a hanging cloth more at finer grids must not tear it by itself.
+// Under gravity the patch first hangs for settle_time without rupture: the
+// skin is then already sagging when the HIP arrives (the journal paper's
+// skin hangs about 1 cm before first contact), and the fall from flat, which
+// is no part of any experiment, cannot tear it.
 static void settle(tx_cloth* c) {
-  const double strain = c->def.rupture_strain;
-  c->def.rupture_strain = 0;
+  const double tear = c->def.rupture_tension;
+  c->def.rupture_tension = 0;
   int steps = c->def.gravity > 0 ? (int)std::ceil(c->def.settle_time * 60) : 0;
   for (int s = 0; s < steps; s++)
     if (tx_cloth_step(c, 1.0 / 60) != TX_CLOTH_OK) break;
-  c->def.rupture_strain = strain;
-  const double f = (1 + strain) * (1 + strain);
-  btAlignedObjectArray<btSoftBody::Link>& links = c->body->m_links;
-  for (int i = 0, ni = links.size(); i < ni; i++) {
-    btSoftBody::Link& l = links[i];
-    double now2 = (l.m_n[1]->m_x - l.m_n[0]->m_x).length2(), rest2 = (double)l.m_rl * l.m_rl;
-    float limit2 = (float)(f * (now2 > rest2 ? now2 : rest2));
-    c->info[(size_t)(intptr_t)l.m_tag].limit2 = limit2;
-    if (c->info[(size_t)(intptr_t)l.m_tag].kind != BEND && c->max_edge > 0)
-      c->reach_factor = std::max(c->reach_factor, std::sqrt((double)limit2) / c->max_edge);
-  }
+  c->def.rupture_tension = tear;
+  if (steps > 0) c->hanging = c->tension; // same size: no allocation beyond create
   for (int a = 0; a < 3; a++) c->contact_force[a] = 0;
+  c->peak_tension = 0;
 }
 
 // the indentation of the contact is measured from the patch at rest: flat, or hanging after settling
@@ -421,25 +470,61 @@ extern "C" tx_cloth_status tx_cloth_set_hip(tx_cloth* c, const double pos[3], do
 // ---------------------------------------------------------------------------
 // stepping
 
-// Bullet's per-iteration link stiffness for a spring k (N/m) over a substep
-// dt: the fraction k dt^2 w / (1 + k dt^2 w) of the stretch that an implicit
-// spring removes in one substep (w: the two inverse masses, 1/kg)
-static btScalar link_stiffness(double k, double dt, double w) {
-  if (k <= 0) return 0;
-  double a = k * dt * dt * w;
-  double s = a / (1 + a);
-  if (!(s > 1e-9)) s = 1e-9; // Bullet divides by it
-  return (btScalar)(s < 1 ? s : 1);
+// One substep of the particles: gravity and the loads, then the positions
+// they predict (explicit velocity, as Bullet's predictMotion, without its
+// collision trees, which this patch does not use)
+static void predict(tx_cloth* c, double h) {
+  btAlignedObjectArray<btSoftBody::Node>& nodes = c->body->m_nodes;
+  const btVector3 g = c->world.m_gravity * (btScalar)h;
+  const btScalar hs = (btScalar)h;
+  for (int i = 0; i < c->n; i++) {
+    btSoftBody::Node& nd = nodes[i];
+    nd.m_q = nd.m_x;
+    if (nd.m_im > 0) {
+      nd.m_v += g;
+      if (c->loaded > 0) nd.m_v += c->load[(size_t)i] * (nd.m_im * hs);
+    }
+    nd.m_x += nd.m_v * hs;
+  }
 }
 
-static void prepare(tx_cloth* c, double dt) {
-  if (dt == c->prepared_dt) return;
-  double w = 2 / c->node_mass;
-  c->stretch_mat->m_kLST = link_stiffness(c->def.stretch_stiffness, dt, w);
-  c->bend_mat->m_kLST = link_stiffness(c->def.bend_stiffness > 0 ? c->def.bend_stiffness : 1e-12, dt, w);
-  c->body->updateLinkConstants();
-  c->body->m_cfg.kDP = (btScalar)(1 - std::exp(-c->def.damping * dt));
-  c->prepared_dt = dt;
+// XPBD (Macklin, Mueller and Chentanez 2016): each link is the constraint
+// C = |x1 - x0| - rest with compliance 1/k; its multiplier lambda collects
+// the correction over the iterations, and the update
+// dlambda = (-C - a lambda) / (w + a), a = 1 / (k h^2), makes the converged
+// substep implicit Euler with the spring's true k, whatever the iterations
+// (Bullet's PSolve_Links scales each iteration's correction instead, which
+// tends to a rigid link as iterations grow). The links run in the colour
+// order of build().
+static void solve_links(tx_cloth* c, double h) {
+  btAlignedObjectArray<btSoftBody::Link>& links = c->body->m_links;
+  const int nl = links.size();
+  double* lam = c->lambda.data();
+  const double as = 1 / (c->def.stretch_stiffness * h * h);
+  const double ab = c->def.bend_stiffness > 0 ? 1 / (c->def.bend_stiffness * h * h) : -1;
+  const btSoftBody::Material* bend = c->bend_mat;
+  float* length = c->length.data(); // kept for measure_links, which then need not visit the particles
+  std::fill(lam, lam + nl, 0.0);
+  std::fill(length, length + nl, 0.0f);
+  for (int it = 0; it < c->def.iterations; it++)
+    for (int i = 0; i < nl; i++) {
+      btSoftBody::Link& l = links[i];
+      const double at = l.m_material == bend ? ab : as;
+      if (at < 0) continue; // bending links without stiffness
+      btSoftBody::Node* n0 = l.m_n[0];
+      btSoftBody::Node* n1 = l.m_n[1];
+      const double w = (double)n0->m_im + n1->m_im;
+      if (!(w > 0)) continue;
+      const btVector3 d = n1->m_x - n0->m_x;
+      const double len = d.length();
+      length[i] = (float)len;
+      if (!(len > 0)) continue;
+      const double dl = (-(len - l.m_rl) - at * lam[i]) / (w + at);
+      lam[i] += dl;
+      const btVector3 corr = d * (btScalar)(dl / len);
+      n0->m_x -= corr * n0->m_im;
+      n1->m_x += corr * n1->m_im;
+    }
 }
 
 // closest point of triangle (a, b, cc) to p, as barycentric weights (Ericson's region tests)
@@ -488,8 +573,8 @@ static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& fr
   if (c->hip_radius <= 0 || rc <= 0) return;
   btAlignedObjectArray<btSoftBody::Node>& nodes = c->body->m_nodes;
   // candidates: triangles of particles within reach (a triangle in contact has a corner this close)
-  // a live link is at most (1 + rupture_strain) its reference (the settled length under gravity)
-  const double stretch = c->def.rupture_strain > 0 ? c->reach_factor : 10;
+  // a triangle's edges are live links: at most reach_factor max_edge within the substep (see tx_cloth)
+  const double stretch = c->reach_factor;
   const btScalar reach = (btScalar)(rc + stretch * c->max_edge);
   const btScalar reach2 = reach * reach;
   int ncand = 0;
@@ -579,7 +664,7 @@ static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& fr
 }
 
 // the HIP over one substep from h0 to h1, in moves of at most half the contact distance
-static void rupture(tx_cloth* c);
+static void rupture(tx_cloth* c, const btVector3* near);
 
 static void sweep_contact(tx_cloth* c, const btVector3& h0, const btVector3& h1, double dt, bool count) {
   const double rc = c->hip_radius + 0.5 * c->def.thickness;
@@ -599,7 +684,7 @@ static void sweep_contact(tx_cloth* c, const btVector3& h0, const btVector3& h1,
   // a HIP this fast drags the skin further than the links can follow within
   // the substep, and the solve would spread the strain before anyone saw it:
   // what it overstretched tears now
-  if (moves > 1) rupture(c);
+  if (moves > 1) rupture(c, &h1);
 }
 
 // every particle finite, slower than max_speed and near the patch
@@ -629,27 +714,167 @@ static void remove_link(tx_cloth* c, int id) {
   li.slot = -1;
 }
 
-// links strained past the threshold break, taking their triangles and the bending links over them
-static void rupture(tx_cloth* c) {
-  if (c->def.rupture_strain <= 0) return;
-  btAlignedObjectArray<btSoftBody::Link>& links = c->body->m_links;
-  int nb = 0;
+// largest eigenvalue of the symmetric 3 x 3 matrix (xx, yy, zz, xy, xz, yz)
+// (the trigonometric solution of the characteristic cubic)
+static double largest_eigenvalue(const double m[6]) {
+  const double p1 = m[3] * m[3] + m[4] * m[4] + m[5] * m[5];
+  const double q = (m[0] + m[1] + m[2]) / 3;
+  if (p1 <= 1e-30 * (q * q + 1e-300)) return std::max(m[0], std::max(m[1], m[2]));
+  const double a = m[0] - q, b = m[1] - q, cc = m[2] - q;
+  const double p2 = a * a + b * b + cc * cc + 2 * p1;
+  const double p = std::sqrt(p2 / 6);
+  // det((M - q I) / p) / 2
+  const double det = a * (b * cc - m[5] * m[5]) - m[3] * (m[3] * cc - m[5] * m[4]) + m[4] * (m[3] * m[5] - b * m[4]);
+  double r = det / (2 * p * p * p);
+  r = r < -1 ? -1 : (r > 1 ? 1 : r);
+  return q + 2 * p * std::cos(std::acos(r) / 3);
+}
+
+// The membrane tension at particle i (N/m): the link stresses f L n n^T
+// around it, weighted by the smooth kernel (1 - r^2 / l^2)^2 of the rest
+// distance r from the particle to a link's middle (l = rupture_length),
+// over the kernel's integral pi l^2 / 3, and its largest principal value.
+// As the spacing shrinks the sum tends to the continuum average of the
+// stress over the disc, so the value does not depend on the mesh once
+// l spans a few spacings; below that it is the average over what the mesh
+// resolves.
+static double membrane_tension(const tx_cloth* c, int i) {
+  const tx_cloth_def& d = c->def;
+  const int nx = d.res[0], nz = d.res[1];
+  const double hx = d.size[0] / (nx - 1), hz = d.size[1] / (nz - 1), l = d.rupture_length, l2 = l * l;
+  const int ix = i % nx, iz = i / nx;
+  const int mx = (int)std::ceil(l / hx) + 1, mz = (int)std::ceil(l / hz) + 1;
+  const btAlignedObjectArray<btSoftBody::Node>& nodes = c->body->m_nodes;
+  double m[6] = {0, 0, 0, 0, 0, 0};
+  for (int qz = std::max(0, iz - mz); qz <= std::min(nz - 1, iz + mz); qz++)
+    for (int qx = std::max(0, ix - mx); qx <= std::min(nx - 1, ix + mx); qx++) {
+      const int q = qz * nx + qx;
+      const int32_t* ls = &c->node_links[(size_t)q * 12];
+      for (int k = 0; k < 12 && ls[k] >= 0; k++) {
+        const link_info& li = c->info[(size_t)ls[k]];
+        if (li.end[0] != q || li.slot < 0) continue; // each link once, from its first particle
+        const double f = excess(c, ls[k]);
+        if (f == 0) continue;
+        const int o = li.end[1];
+        // the link's middle in the rest grid, relative to particle i
+        const double rx = (0.5 * (qx + o % nx) - ix) * hx, rz = (0.5 * (qz + o / nx) - iz) * hz;
+        const double r2 = rx * rx + rz * rz;
+        if (r2 >= l2) continue;
+        const double w = (1 - r2 / l2) * (1 - r2 / l2);
+        const btVector3 dv = nodes[o].m_x - nodes[q].m_x;
+        const double len = dv.length();
+        if (!(len > 0)) continue;
+        const double s = w * f / len; // f L n n^T = f d d^T / L
+        m[0] += s * dv[0] * dv[0], m[1] += s * dv[1] * dv[1], m[2] += s * dv[2] * dv[2];
+        m[3] += s * dv[0] * dv[1], m[4] += s * dv[0] * dv[2], m[5] += s * dv[1] * dv[2];
+      }
+    }
+  const double norm = 3 / (M_PI * l2);
+  for (double& v : m) v *= norm;
+  return largest_eigenvalue(m);
+}
+
+// the links' tensions after a substep's solve (the multipliers over h^2),
+// the longest live stretch or shear link for the contact's reach and, with
+// rupture on, each particle's sum of f L / 2 over its stretched links (one
+// pass over the links for all three)
+static void measure_links(tx_cloth* c, double h) {
+  const btAlignedObjectArray<btSoftBody::Link>& links = c->body->m_links;
+  const btSoftBody::Node* base = &c->body->m_nodes[0];
+  const bool sums = c->def.rupture_tension > 0;
+  float* local = c->local.data();
+  if (sums) std::fill(local, local + c->n, 0.0f);
+  const double ih2 = 1 / (h * h);
+  btScalar longest = 0;
   for (int i = 0, ni = links.size(); i < ni; i++) {
     const btSoftBody::Link& l = links[i];
-    int id = (int)reinterpret_cast<intptr_t>(l.m_tag);
-    if ((l.m_n[1]->m_x - l.m_n[0]->m_x).length2() <= c->info[(size_t)id].limit2) continue;
-    if (c->info[(size_t)id].kind != BEND) c->breaking[(size_t)nb++] = id;
+    const int id = (int)reinterpret_cast<intptr_t>(l.m_tag);
+    const float f = (float)(-c->lambda[(size_t)i] * ih2);
+    c->tension[(size_t)id] = f;
+    const btScalar len = c->length[(size_t)i]; // before the last correction and the contact: close enough
+    if (len > longest && c->info[(size_t)id].kind != BEND) longest = len;
+    const float fx = f - c->hanging[(size_t)id];
+    if (sums && fx > 0) {
+      const float fl = 0.5f * fx * len;
+      local[l.m_n[0] - base] += fl;
+      local[l.m_n[1] - base] += fl;
+    }
+  }
+  if (c->max_edge > 0) c->reach_factor = std::max(2.0, 2 * (double)longest / c->max_edge);
+}
+
+// Where the membrane tension passes rupture_tension, the most tensed
+// stretch or shear link at that particle breaks, with its triangles and the
+// bending links over it. Only particles whose own stretched links could
+// reach it are averaged (the average over a disc is at most about the
+// largest of its particles' own sums of f L / 2 over their area), so a
+// step without a tear costs one pass over the links.
+//
+// With `near` (a fast HIP, before the solve): the links it dragged have no
+// solved tension yet, so those with a particle within the contact's reach
+// of it count with their spring's force k (length - rest) where that is
+// larger, and only particles there are checked.
+static void rupture(tx_cloth* c, const btVector3* near) {
+  const double tc = c->def.rupture_tension;
+  if (tc <= 0) return;
+  const btAlignedObjectArray<btSoftBody::Link>& links = c->body->m_links;
+  const btSoftBody::Node* base = &c->body->m_nodes[0];
+  const btScalar reach = (btScalar)(c->hip_radius + 0.5 * c->def.thickness + 2 * c->max_edge), reach2 = reach * reach;
+  if (near)
+    for (int i = 0, ni = links.size(); i < ni; i++) {
+      const btSoftBody::Link& l = links[i];
+      if ((l.m_n[0]->m_x - *near).length2() > reach2 && (l.m_n[1]->m_x - *near).length2() > reach2) continue;
+      const int id = (int)reinterpret_cast<intptr_t>(l.m_tag);
+      const double k = c->info[(size_t)id].kind == BEND ? c->def.bend_stiffness : c->def.stretch_stiffness;
+      const float f = (float)(k * ((l.m_n[1]->m_x - l.m_n[0]->m_x).length() - l.m_rl));
+      if (f - c->hanging[(size_t)id] > excess(c, id)) c->tension[(size_t)id] = f;
+    }
+  float* local = c->local.data();
+  if (near) { // the sums again, with the spring forces just put in (after a solve, measure_links made them)
+    std::fill(local, local + c->n, 0.0f);
+    for (int i = 0, ni = links.size(); i < ni; i++) {
+      const btSoftBody::Link& l = links[i];
+      const float f = excess(c, (int)(intptr_t)l.m_tag);
+      if (!(f > 0)) continue;
+      const float fl = 0.5f * f * (l.m_n[1]->m_x - l.m_n[0]->m_x).length();
+      local[l.m_n[0] - base] += fl;
+      local[l.m_n[1] - base] += fl;
+    }
+  }
+  // a margin of 2 below the criterion: in a uniform field a particle's own
+  // sum over its area is at least the largest principal tension, and the
+  // kernel's average of a peaked field is at most its peak
+  const float bar = (float)(tc * c->area / 2);
+  int nb = 0, most = 0;
+  for (int p = 1; p < c->n; p++)
+    if (local[p] > local[most]) most = p;
+  for (int p = 0; p < c->n; p++) {
+    if (local[p] < bar && p != most) continue; // the most loaded particle always, for tx_cloth_peak_tension
+    if (near && (base[p].m_x - *near).length2() > reach2) continue;
+    const double t = membrane_tension(c, p);
+    if (t > c->peak_tension) c->peak_tension = t;
+    if (t < tc) continue;
+    int best = -1;
+    float fbest = 0;
+    const int32_t* ls = &c->node_links[(size_t)p * 12];
+    for (int k = 0; k < 12 && ls[k] >= 0; k++) {
+      const link_info& li = c->info[(size_t)ls[k]];
+      if (li.slot < 0 || li.kind == BEND) continue;
+      if (excess(c, ls[k]) > fbest) fbest = excess(c, ls[k]), best = ls[k];
+    }
+    if (best >= 0) c->breaking[(size_t)nb++] = best;
   }
   for (int k = 0; k < nb; k++) {
     int id = c->breaking[(size_t)k];
     link_info& li = c->info[(size_t)id];
     if (li.slot < 0) continue;
     remove_link(c, id);
+    c->tension[(size_t)id] = 0;
     c->torn++;
     c->topology_dirty = true;
     for (int j = 0; j < 2; j++) {
       if (li.tri[j] >= 0) c->tri_alive[(size_t)li.tri[j]] = 0, c->live_dirty = true;
-      if (li.dep[j] >= 0) remove_link(c, li.dep[j]);
+      if (li.dep[j] >= 0) remove_link(c, li.dep[j]), c->tension[(size_t)li.dep[j]] = 0;
     }
   }
 }
@@ -667,6 +892,7 @@ extern "C" void tx_cloth_save(tx_cloth* c) {
     c->topology_dirty = false;
   }
   c->good_torn = c->torn;
+  std::memcpy(c->good_tension.data(), c->tension.data(), (size_t)c->nlink * sizeof(float));
   for (int a = 0; a < 3; a++) c->good_hip[a] = c->hip_prev[a];
 }
 
@@ -691,10 +917,10 @@ extern "C" void tx_cloth_restore(tx_cloth* c) {
     }
     std::memcpy(c->tri_alive.data(), c->good_tri.data(), (size_t)c->ntri);
     c->live_dirty = true;
-    c->prepared_dt = 0; // the restored links carry their build-time constants
     c->topology_dirty = false;
   }
   c->torn = c->good_torn;
+  std::memcpy(c->tension.data(), c->good_tension.data(), (size_t)c->nlink * sizeof(float));
   for (int a = 0; a < 3; a++) c->hip_prev[a] = c->good_hip[a];
   for (int a = 0; a < 3; a++) c->contact_force[a] = 0;
   c->contact_depth = 0;
@@ -753,8 +979,8 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
   int substeps = (int)std::ceil(dt / c->def.max_substep - 1e-9);
   if (substeps < 1) substeps = 1;
   const double h = dt / substeps;
-  prepare(c, h);
   btSoftBody* b = c->body;
+  c->peak_tension = 0;
   const btScalar ih = (btScalar)(1 / h);
   c->contact_depth = 0;
   c->contact_moves = 0;
@@ -764,15 +990,11 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
   for (int s = 0; s < substeps; s++) {
     btVector3 h0 = start.lerp(end, (btScalar)s / (btScalar)substeps);
     btVector3 h1 = start.lerp(end, (btScalar)(s + 1) / (btScalar)substeps);
-    b->predictMotion((btScalar)h);
+    predict(c, h);
     sweep_contact(c, h0, h1, h, true);
-    // Bullet's position solver for links, as btSoftBody::solveConstraints runs
-    // it; that function also applies clusters through arrays it allocates on
-    // every call, and this patch has no clusters, anchors or Bullet contacts
-    for (int it = 0; it < c->def.iterations; it++)
-      btSoftBody::PSolve_Links(b, 1, (btScalar)it / (btScalar)c->def.iterations);
+    solve_links(c, h);
     btAlignedObjectArray<btSoftBody::Node>& nodes = b->m_nodes;
-    const btScalar vc = ih * (1 - b->m_cfg.kDP);
+    const btScalar vc = (btScalar)(ih * std::exp(-c->def.damping * h));
     for (int i = 0; i < c->n; i++) {
       nodes[i].m_v = (nodes[i].m_x - nodes[i].m_q) * vc;
       nodes[i].m_f = btVector3(0, 0, 0);
@@ -788,7 +1010,8 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
       for (int a = 0; a < 3; a++) c->hip_prev[a] = c->hip[a];
       return TX_CLOTH_FAULT;
     }
-    rupture(c);
+    measure_links(c, h);
+    rupture(c, nullptr);
   }
   c->contact_held = link_reaction(c, dt, c->contact_force);
   for (int a = 0; a < 3; a++) {
@@ -853,3 +1076,41 @@ extern "C" void tx_cloth_particle(const tx_cloth* c, int i, double out[3]) {
   const btVector3& x = c->body->m_nodes[i].m_x;
   for (int a = 0; a < 3; a++) out[a] = x[a];
 }
+
+extern "C" tx_cloth_status tx_cloth_set_load(tx_cloth* c, int i, const double f[3]) {
+  if (i < 0 || i >= c->n) {
+    tx_set_error("skin: load on particle %d, there are %d", i, c->n);
+    return TX_CLOTH_BAD;
+  }
+  if (!(std::isfinite(f[0]) && std::isfinite(f[1]) && std::isfinite(f[2]) && std::fabs(f[0]) <= 1e6 &&
+        std::fabs(f[1]) <= 1e6 && std::fabs(f[2]) <= 1e6)) {
+    tx_set_error("skin: load (%g, %g, %g) N on particle %d, must be finite and within 1e6 N", f[0], f[1], f[2], i);
+    return TX_CLOTH_BAD;
+  }
+  btVector3& l = c->load[(size_t)i];
+  c->loaded -= l.length2() > 0;
+  l = btVector3((btScalar)f[0], (btScalar)f[1], (btScalar)f[2]);
+  c->loaded += l.length2() > 0;
+  return TX_CLOTH_OK;
+}
+
+extern "C" int tx_cloth_link_total(const tx_cloth* c) { return c->nlink; }
+
+extern "C" bool tx_cloth_link_ends(const tx_cloth* c, int link, int32_t ends[2]) {
+  if (link < 0 || link >= c->nlink) return false;
+  ends[0] = c->info[(size_t)link].end[0];
+  ends[1] = c->info[(size_t)link].end[1];
+  return true;
+}
+
+extern "C" double tx_cloth_link_tension(const tx_cloth* c, int link) {
+  if (link < 0 || link >= c->nlink || c->info[(size_t)link].slot < 0) return 0;
+  return c->tension[(size_t)link];
+}
+
+extern "C" double tx_cloth_membrane_tension(const tx_cloth* c, int i) {
+  if (i < 0 || i >= c->n) return NAN;
+  return membrane_tension(c, i);
+}
+
+extern "C" double tx_cloth_peak_tension(const tx_cloth* c) { return c->peak_tension; }

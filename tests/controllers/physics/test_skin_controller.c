@@ -131,7 +131,7 @@ static void bad_parameters_are_named(void** state) {
       {"\"thickness_m\":-0.001", 60, "params.thickness_m"},
       {"\"iterations\":0", 60, "params.iterations"},
       {"\"gravity\":3", 60, "params.gravity"},
-      {"\"rupture_strain\":\"x\"", 60, "params.rupture_strain"},
+      {"\"rupture_tension_n_per_m\":\"x\"", 60, "params.rupture_tension_n_per_m"},
       {"\"stiffnes\":1", 60, "params.stiffnes"},
       {"", 10, "20 to 120 Hz"},
       {"", 240, "20 to 120 Hz"},

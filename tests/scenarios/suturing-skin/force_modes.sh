@@ -11,9 +11,10 @@ fail() { echo "force_modes: $*"; exit 1; }
 
 # paper: from zero at first contact (no step above alpha x the hand's move over the two ticks
 # between the pose the collision saw and the one rendered, 2 x 5 um: 2e-4 N; it was alpha h/2 = 0.04 N), and
-# blind to the skin's stiffness (2 vs 2e6 N/m: the same trace)
-run p2 --set hip.force_mode=paper --set skin.stretch_stiffness=2
-run p6 --set hip.force_mode=paper --set skin.stretch_stiffness=2e6
+# blind to the skin's stiffness (2 vs 2e6 N/m: the same trace). When the skin tears depends on its
+# tension, so on its stiffness: the two skins here cannot tear, and the whole trace must match
+run p2 --set hip.force_mode=paper --set skin.stretch_stiffness=2 --set skin.rupture_tension_n_per_m=0
+run p6 --set hip.force_mode=paper --set skin.stretch_stiffness=2e6 --set skin.rupture_tension_n_per_m=0
 cmp <(cut -d, -f5-8 "$d/p2/force_displacement.csv") <(cut -d, -f5-8 "$d/p6/force_displacement.csv") || fail "paper: stiffness changed the force"
 awk -F, 'NR > 1 && $8 > 0 && n < 10 { s = $6 - f; if (s < 0) s = -s; if (s > m) m = s; n++ } { f = $6 } END { exit !(n == 10 && m <= 2.1e-4) }' \
   "$d/p2/force_displacement.csv" || fail "paper: a force step at first contact"
@@ -27,9 +28,15 @@ a=$(at ms 2.700000) b=$(at mk 2.700000) c=$(at mt 2.700000) e=$(at mT 2.700000)
 echo "mechanics at 2.7 s: stiffness 200 -> $a N, 2000 -> $b N; thickness 0.2 cm -> $c N, 0.8 cm -> $e N"
 awk -v a="$a" -v b="$b" 'BEGIN { exit !(a > 0 && b > a) }' || fail "mechanics: stiffness"
 awk -v a="$c" -v b="$e" 'BEGIN { exit !(a > 0 && b > a) }' || fail "mechanics: thickness"
-# a heavier hanging skin (22 vs 88 g, gravity), pushed from below, 50 ms after contact
-printf 't_s,x_m,y_m,z_m\n0,0,-0.06,0\n0.2,0,-0.06,0\n12.2,0,0,0\n' > "$d/up.csv"
-for m in 0.022 0.088; do run "g$m" --set duration_s=7 --set skin.gravity=true --set skin.mass_kg=$m --set "haptics.device=scripted:$d/up.csv"; done
+# a heavier hanging skin (22 vs 88 g, gravity), pushed from below, 50 ms after contact: density
+# acts through the weight the skin hangs by. On a converged solver (0.5 cm spacing, 0.15 ms
+# substeps: k w h^2 < 1), since the real-time default is not converged, and there a heavier
+# skin is a softer one (XPBD's correction per substep shrinks with the particles' mass)
+printf 't_s,x_m,y_m,z_m\n0,0,-0.03,0\n0.2,0,-0.03,0\n6.2,0,0,0\n' > "$d/up.csv"
+for m in 0.022 0.088; do
+  run "g$m" --set duration_s=7 --set skin.gravity=true --set skin.mass_kg=$m --set "haptics.device=scripted:$d/up.csv" \
+    --set skin.spacing_m=0.005 --set skin.max_substep_s=0.00015 --set skin.iterations=2
+done
 first50() { awk -F, 'NR > 1 && $8 > 0 && !t { t = $1 } NR > 1 && t && $1 >= t + 0.05 { print -$6; exit }' "$d/$1/force_displacement.csv"; }
 a=$(first50 g0.022) b=$(first50 g0.088)
 echo "mechanics, hanging skin: 22 g -> $a N, 88 g -> $b N"
@@ -42,16 +49,16 @@ after() {
            NR > 1 && r && $1 > r + 0.0025 && ($5 != 0 || $6 != 0 || $7 != 0) { bad = 1 } END { exit !(r && !bad) }' \
     "$d/$1/force_displacement.csv" || fail "$1: a force after rupture"
 }
-after p2
+run pd --set hip.force_mode=paper && after pd
 run m0 && after m0
 run pr --set hip.force_mode=paper --set hip.rays=98 && after pr
 run mr --set hip.rays=98 && after mr
 
-# a skin that never tears (rupture_strain = 0) is never passed: pushed 1 cm in, the force
+# a skin that never tears (rupture_tension_n_per_m = 0) is never passed: pushed 1 cm in, the force
 # never drops to zero (the physics holds the skin over the HIP; in paper mode the rays
 # that all lose the wrapped skin at once do not end the contact). It used to after 0.87 cm
 for m in paper mechanics; do
-  run "n$m" --set hip.force_mode=$m --set skin.rupture_strain=0
+  run "n$m" --set hip.force_mode=$m --set skin.rupture_tension_n_per_m=0
   awk -F, 'NR > 1 && $8 > 0 { c = 1 } c && $3 < -0.003 && $6 <= 0 { exit 1 } END { exit !(c && $10 == 0) }' \
     "$d/n$m/force_displacement.csv" || fail "$m: the HIP passed an untorn skin"
 done
