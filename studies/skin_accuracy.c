@@ -164,9 +164,9 @@ static int run_setting(const setting* s, const char* device, curve* out, row* r,
   char* text = doc ? json_dumps(doc, JSON_COMPACT) : NULL;
   json_decref(doc);
   if (!text) return snprintf(err, en, "skin-accuracy: out of memory"), -1;
-  tx_scenario* sc = tx_scenario_load_text("skin-accuracy", text, strlen(text), NULL, err, en);
+  tx_scenario* sc = tx_scenario_load_text("skin-accuracy", text, strlen(text), NULL);
   free(text);
-  if (!sc) return -1;
+  if (!sc) return snprintf(err, en, "%s", tx_error()), -1;
   out->n = 0;
   recording = out;
   tx_run_options o = {.duration_s = motion_end_s(), .lockstep = true};
@@ -174,7 +174,8 @@ static int run_setting(const setting* s, const char* device, curve* out, row* r,
   int64_t t0 = tx_mono_ns();
   struct timespec c0, c1;
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
-  int rc = tx_system_run(sc->system, &o, &res, err, en);
+  int rc = tx_system_run(sc->system, &o, &res);
+  if (rc) snprintf(err, en, "%s", tx_error());
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
   r->wall_s = (double)(tx_mono_ns() - t0) * 1e-9;
   r->cpu_s_per_s = ((double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec)) / motion_end_s();
@@ -211,7 +212,7 @@ static int write_plot(const char* dir, const row* rows, char* err, size_t en) {
   tx_plot p = {"Skin force error vs run time (pierce-down; ref. spacing 1 mm, 20 it, 120 Hz)",
                "run time (CPU s per simulated s)", "RMS force error (% of the reference peak)",
                true, true, s, ns};
-  return tx_plot_png(path, &p, err, en);
+  return tx_plot_png(path, &p) ? (snprintf(err, en, "%s", tx_error()), -1) : 0;
 }
 
 int tx_study_skin_accuracy(const tx_study_args* a) {
@@ -299,8 +300,8 @@ int tx_study_skin_accuracy(const tx_study_args* a) {
                             "over the reference's peak force",
                             "run_time", "process CPU time of the whole lockstep run (skin, HIP, haptics) per simulated second",
                             "settings", list);
-    if (rc == 0 && (!doc || tx_report_save(doc, a->out_dir, "skin-accuracy.json", err, sizeof err))) {
-      fprintf(stderr, "tactus: %s\n", err);
+    if (rc == 0 && (!doc || tx_report_save(doc, a->out_dir, "skin-accuracy.json"))) {
+      fprintf(stderr, "tactus: %s\n", tx_error());
       rc = 1;
     }
     json_decref(doc);

@@ -246,9 +246,9 @@ static int write_experiment(const char* dir, const char* name, run_data** runs, 
   snprintf(path, sizeof path, "%s/%s.png", dir, name);
   if (np == 1) {
     snprintf(titles[0], sizeof titles[0], "skin-paper: %s", name);
-    return tx_plot_png(path, &panels[0], err, en);
+    return tx_plot_png(path, &panels[0]) ? (snprintf(err, en, "%s", tx_error()), -1) : 0;
   }
-  return tx_plot_png_panels(path, panels, np, 2, err, en);
+  return tx_plot_png_panels(path, panels, np, 2) ? (snprintf(err, en, "%s", tx_error()), -1) : 0;
 }
 
 static bool check(const char* what, bool ok, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
@@ -327,8 +327,8 @@ int tx_study_skin_paper(const tx_study_args* a) {
     if (fclose(f) != 0 || rename(tmp, path) != 0) return remove(tmp), json_decref(list), fprintf(stderr, "tactus: %s: cannot be written\n", path), 1;
     json_t* doc = json_pack("{s:s,s:s,s:o}", "study", "skin-paper", "units",
                             "SI: m, N, s; roughness and tangent_cv are ratios", "cases", list);
-    if (!doc || tx_report_save(doc, a->out_dir, "skin-paper.json", err, sizeof err))
-      return json_decref(doc), fprintf(stderr, "tactus: %s\n", err), 1;
+    if (!doc || tx_report_save(doc, a->out_dir, "skin-paper.json"))
+      return json_decref(doc), fprintf(stderr, "tactus: %s\n", tx_error()), 1;
     json_decref(doc);
   }
   if (!rc) {

@@ -192,15 +192,14 @@ int tx_skin_stability_run(const tx_skin_stability_case* c, const char* dir, tx_s
   char* text = doc ? json_dumps(doc, JSON_COMPACT) : NULL;
   json_decref(doc);
   if (!text) return snprintf(err, (size_t)en, "skin-stability: out of memory"), -1;
-  char lerr[1024];
-  tx_scenario* sc = tx_scenario_load_text("skin-stability", text, strlen(text), NULL, lerr, sizeof lerr);
+  tx_scenario* sc = tx_scenario_load_text("skin-stability", text, strlen(text), NULL);
   free(text);
-  if (!sc) return snprintf(err, (size_t)en, "%s", lerr), -1;
+  if (!sc) return snprintf(err, (size_t)en, "%s", tx_error()), -1;
   tx_run_options o = {.duration_s = m->duration, .lockstep = true};
   tx_run_result r;
-  int rc = tx_system_run(sc->system, &o, &r, lerr, sizeof lerr);
+  int rc = tx_system_run(sc->system, &o, &r);
   if (rc) {
-    snprintf(err, (size_t)en, "%s", lerr);
+    snprintf(err, (size_t)en, "%s", tx_error());
     tx_scenario_free(sc);
     return -1;
   }
@@ -283,9 +282,9 @@ int tx_study_skin_stability(const tx_study_args* a) {
   }
   json_t* doc = json_pack("{s:s,s:f,s:s,s:o}", "study", "skin-stability", "clamp_n", TX_SKIN_STABILITY_CLAMP_N,
                           "units", "stiffness as a factor on 2000 N/m stretch and 20 N/m bend; s, m, N", "cases", list);
-  if (!doc || tx_report_save(doc, a->out_dir, "skin-stability.json", err, sizeof err)) {
+  if (!doc || tx_report_save(doc, a->out_dir, "skin-stability.json")) {
     json_decref(doc);
-    return fprintf(stderr, "tactus: %s\n", err), 1;
+    return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   }
   json_decref(doc);
   printf("\ntargets:\n  every case stable or recovered, no NaN in the model, |F| <= %.1f N: %s (%d of %d failed)\n",

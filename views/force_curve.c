@@ -98,7 +98,7 @@ static void finish(tx_ctx* ctx, void* self) {
   tx_set_result(ctx, c->r_samples, (double)c->n);
   const char* dir = tx_record_dir(ctx);
   if (!dir || c->n == 0) return;
-  char path[4200], tmp[4300], err[512];
+  char path[4200], tmp[4300];
   snprintf(path, sizeof path, "%s/%s.csv", dir, c->file);
   snprintf(tmp, sizeof tmp, "%s.tmp", path);
   FILE* f = fopen(tmp, "w"); // written aside, renamed once whole
@@ -135,7 +135,7 @@ static void finish(tx_ctx* ctx, void* self) {
   tx_plot_series s = {"force", xs, ys, (int)(c->n > 2147483647u ? 2147483647u : c->n), false, 1};
   tx_plot p = {"force against displacement", xl, yl, false, false, &s, 1};
   snprintf(path, sizeof path, "%s/%s.png", dir, c->file);
-  if (tx_plot_png(path, &p, err, sizeof err)) fprintf(stderr, "tactus: %s\n", err);
+  if (tx_plot_png(path, &p)) fprintf(stderr, "tactus: %s\n", tx_error());
   free(xs);
   free(ys);
 }

@@ -47,9 +47,9 @@ typedef struct tx_plot {
 } tx_plot;
 
 // one panel, 800 x 600 px; 0, or -1 with a message
-int tx_plot_png(const char* path, const tx_plot* p, char* err, size_t n);
+int tx_plot_png(const char* path, const tx_plot* p);
 // n panels in rows of `columns`, each 640 x 480 px, one legend per panel; 0, or -1 with a message
-int tx_plot_png_panels(const char* path, const tx_plot* panels, int count, int columns, char* err, size_t n);
+int tx_plot_png_panels(const char* path, const tx_plot* panels, int count, int columns);
 // the palette as RGB 0-255 (index 1-15), for anything drawn to match; every
 // colour has at least 3:1 contrast against the white background
 void tx_plot_color(int index, int rgb[3]);

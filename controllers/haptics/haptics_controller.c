@@ -228,7 +228,7 @@ static void step(tx_ctx* c, void* self) {
     if (e) {
       char reason[4200];
       snprintf(reason, sizeof reason, "%s: %s", file, strerror(e));
-      tx_stop_run(c, reason);
+      tx_stop_run(c, "%s", reason);
       h->record_failed = true;
     }
   }

@@ -24,6 +24,6 @@ void tx_contact_sheet_free(tx_contact_sheet* s);
 // offer a frame (RGBA, bottom row first); `last` always keeps it, replacing the newest if full
 void tx_contact_sheet_add(tx_contact_sheet* s, const uint8_t* rgba, int w, int h, bool last);
 // write the kept thumbnails in rows of `columns`; 0 or -1 with a message
-int tx_contact_sheet_write(const tx_contact_sheet* s, const char* path, int columns, char* err, size_t n);
+int tx_contact_sheet_write(const tx_contact_sheet* s, const char* path, int columns);
 
 #endif

@@ -16,7 +16,7 @@ typedef struct tx_osmesa tx_osmesa;
 // unless LP_NUM_THREADS is already set, which wins; call before any thread starts
 int tx_osmesa_bound_threads(int wanted);
 // a current context with a width x height RGBA buffer; NULL and a message on failure
-tx_osmesa* tx_osmesa_create(int width, int height, char* err, size_t n);
+tx_osmesa* tx_osmesa_create(int width, int height);
 void tx_osmesa_destroy(tx_osmesa* o);
 // the proc-address function for tx_gl_load
 tx_gl_proc tx_osmesa_proc(const char* name);

@@ -8,8 +8,8 @@
 #include <stdint.h>
 
 // write width x height RGBA (bottom row first when bottom_up) as an RGB PNG; 0 or -1 with a message
-int tx_png_write(const char* path, const uint8_t* rgba, int width, int height, bool bottom_up, char* err, size_t n);
+int tx_png_write(const char* path, const uint8_t* rgba, int width, int height, bool bottom_up);
 // read a PNG as RGBA, top row first (caller frees *rgba); 0 or -1 with a message
-int tx_png_read(const char* path, uint8_t** rgba, int* width, int* height, char* err, size_t n);
+int tx_png_read(const char* path, uint8_t** rgba, int* width, int* height);
 
 #endif

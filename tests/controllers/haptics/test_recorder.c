@@ -294,8 +294,7 @@ static void the_csv_reads_back_bit_for_bit(void** state) {
   char csv[128];
   snprintf(csv, sizeof csv, "%s/device0.csv", dir);
   tx_trace t;
-  char err[512];
-  if (tx_trace_load(csv, &t, err, sizeof err)) fail_msg("%s", err);
+  if (tx_trace_load(csv, &t)) fail_msg("%s", tx_error());
   assert_int_equal(t.n, 20);
   for (int i = 0; i < 20; i++) {
     tx_record want = i >= 5 && i < 9 ? fine[i - 5] : sample((size_t)i);
@@ -373,9 +372,8 @@ static void a_failed_write_stops_the_run(void** state) {
       "{\"name\":\"wall\",\"type\":\"collision.wall\",\"rate_hz\":60,\"params\":{\"stiffness\":300}},"
       "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":"
       "\"sim:hand_stiffness=200,hand=pierce-down\",\"force_model\":\"tool0.force_model\"}}]}";
-  char err[512];
-  tx_scenario* sc = tx_scenario_load_text("test", text, strlen(text), NULL, err, sizeof err);
-  if (!sc) fail_msg("%s", err);
+  tx_scenario* sc = tx_scenario_load_text("test", text, strlen(text), NULL);
+  if (!sc) fail_msg("%s", tx_error());
   struct rlimit old;
   assert_int_equal(getrlimit(RLIMIT_FSIZE, &old), 0);
   void (*was)(int) = signal(SIGXFSZ, SIG_IGN);
@@ -383,10 +381,10 @@ static void a_failed_write_stops_the_run(void** state) {
   assert_int_equal(setrlimit(RLIMIT_FSIZE, &small), 0);
   tx_run_options o = {.duration_s = 600, .lockstep = true, .record_dir = dir};
   tx_run_result r;
-  int rc = tx_system_run(sc->system, &o, &r, err, sizeof err);
+  int rc = tx_system_run(sc->system, &o, &r);
   assert_int_equal(setrlimit(RLIMIT_FSIZE, &old), 0);
   signal(SIGXFSZ, was);
-  if (rc) fail_msg("%s", err);
+  if (rc) fail_msg("%s", tx_error());
   print_message("  %s at t = %.3f s of 600 s\n", r.halt_reason, r.halt_t_s);
   assert_true(r.halted);
   char want[256];

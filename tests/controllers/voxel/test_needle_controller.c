@@ -33,9 +33,8 @@ static const void* latest_rows(tx_scenario* s, const char* name, uint32_t* rows)
 // so it sees the pose of one tick, 3 um, earlier)
 static void shipped_scenario_inserts(void** state) {
   (void)state;
-  char err[512];
-  tx_scenario* s = tx_scenario_load(TX_SOURCE_DIR "/scenarios/needle-voxel/needle-voxel.json", NULL, err, sizeof err);
-  if (!s) fail_msg("%s", err);
+  tx_scenario* s = tx_scenario_load(TX_SOURCE_DIR "/scenarios/needle-voxel/needle-voxel.json", NULL);
+  if (!s) fail_msg("%s", tx_error());
   run(s, 1.6);
   const double* pose = latest_rows(s, "device0.pose", NULL);
   const double tick = 3e-6 + 1e-9; // m the hand moves in 1 ms
@@ -78,13 +77,13 @@ static void shipped_scenario_inserts(void** state) {
 // was fitted to within 10% of its peak, row by row
 static void recording_follows_the_reference(void** state) {
   (void)state;
-  char dir[] = "/tmp/tx-needle-XXXXXX", err[512], path[128];
+  char dir[] = "/tmp/tx-needle-XXXXXX", path[128];
   assert_non_null(mkdtemp(dir));
-  tx_scenario* s = tx_scenario_load(TX_SOURCE_DIR "/scenarios/needle-voxel/needle-voxel.json", NULL, err, sizeof err);
-  if (!s) fail_msg("%s", err);
+  tx_scenario* s = tx_scenario_load(TX_SOURCE_DIR "/scenarios/needle-voxel/needle-voxel.json", NULL);
+  if (!s) fail_msg("%s", tx_error());
   tx_run_options o = {.duration_s = 3.8, .lockstep = true, .record_dir = dir};
   tx_run_result r;
-  assert_int_equal(tx_system_run(s->system, &o, &r, err, sizeof err), 0);
+  assert_int_equal(tx_system_run(s->system, &o, &r), 0);
   tx_scenario_free(s);
   snprintf(path, sizeof path, "%s/needle-recording.csv", dir);
   tx_recording got, ref;
@@ -125,16 +124,16 @@ static void bad_params_named(void** state) {
       {"\"bogus\":1", "params.bogus"},
   };
   for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
-    char text[512], err[512];
+    char text[512];
     snprintf(text, sizeof text,
              "{\"name\":\"t\",\"controllers\":[{\"name\":\"needle\",\"type\":\"voxel.needle\",\"rate_hz\":1000,"
              "\"params\":{%s}},{\"name\":\"h\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":"
              "\"scripted:insert\",\"force_model\":\"tool0.force_model\"}}]}",
              cases[k].params);
-    tx_scenario* s = tx_scenario_load_text("t.json", text, strlen(text), NULL, err, sizeof err);
+    tx_scenario* s = tx_scenario_load_text("t.json", text, strlen(text), NULL);
     if (s) fail_msg("case %zu loaded", k);
-    if (!strstr(err, cases[k].key)) fail_msg("case %zu: '%s' lacks '%s'", k, err, cases[k].key);
-    assert_null(strchr(err, '\n'));
+    if (!strstr(tx_error(), cases[k].key)) fail_msg("case %zu: '%s' lacks '%s'", k, tx_error(), cases[k].key);
+    assert_null(strchr(tx_error(), '\n'));
   }
 }
 

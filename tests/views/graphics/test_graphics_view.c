@@ -32,25 +32,23 @@ static double result(tx_system* s, const char* key) {
   return NAN;
 }
 
-static tx_scenario* load(const char* view, const char* stereo, bool with_view, char* err) {
+static tx_scenario* load(const char* view, const char* stereo, bool with_view) {
   char text[2048];
   snprintf(text, sizeof text, wall_scene, with_view ? view_json : "");
   tx_load_options o = {.view = view, .stereo = stereo, .view_wait = true};
-  return tx_scenario_load_text("wall-view", text, strlen(text), &o, err, 1024);
+  return tx_scenario_load_text("wall-view", text, strlen(text), &o);
 }
 
 static void run(tx_scenario* sc, const char* dir, double seconds) {
-  char err[512];
   tx_run_options o = {.duration_s = seconds, .lockstep = true, .out_dir = dir};
   tx_run_result r;
-  if (tx_system_run(sc->system, &o, &r, err, sizeof err)) fail_msg("%s", err);
+  if (tx_system_run(sc->system, &o, &r)) fail_msg("%s", tx_error());
 }
 
 // the height (row from the top) of the red tool's lowest pixel in a frame
 static int tool_bottom(const char* path, int* w, int* h) {
   uint8_t* img;
-  char err[256];
-  if (tx_png_read(path, &img, w, h, err, sizeof err)) fail_msg("%s", err);
+  if (tx_png_read(path, &img, w, h)) fail_msg("%s", tx_error());
   int bottom = -1;
   for (int y = 0; y < *h; y++)
     for (int x = 0; x < *w; x++) {
@@ -63,10 +61,10 @@ static int tool_bottom(const char* path, int* w, int* h) {
 
 static void png_frames_every_nth_and_last(void** state) {
   (void)state;
-  char dir[] = "/tmp/tx_view_XXXXXX", err[1024], path[4200];
+  char dir[] = "/tmp/tx_view_XXXXXX", path[4200];
   assert_non_null(mkdtemp(dir));
-  tx_scenario* sc = load("png", "mono", true, err);
-  if (!sc) fail_msg("%s", err);
+  tx_scenario* sc = load("png", "mono", true);
+  if (!sc) fail_msg("%s", tx_error());
   run(sc, dir, 3.0); // 90 frames at 30 Hz: 0, 8, ..., 88, and the last, 89
   assert_true(result(sc->system, "view.frames") == 90);
   assert_true(result(sc->system, "view.frames_written") == 13);
@@ -100,15 +98,15 @@ static void stereo_files_and_sizes(void** state) {
       {"anaglyph", "frame_000000.png", 160, 120}, {"lr", "frame_000000_left.png", 160, 120},
       {"lr", "frame_000029_right.png", 160, 120}};
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-    char dir[] = "/tmp/tx_view_XXXXXX", err[1024], path[4200];
+    char dir[] = "/tmp/tx_view_XXXXXX", path[4200];
     assert_non_null(mkdtemp(dir));
-    tx_scenario* sc = load("png", cases[i].mode, true, err);
-    if (!sc) fail_msg("%s", err);
+    tx_scenario* sc = load("png", cases[i].mode, true);
+    if (!sc) fail_msg("%s", tx_error());
     run(sc, dir, 1.0);
     snprintf(path, sizeof path, "%s/frames/%s", dir, cases[i].file);
     uint8_t* img;
     int w, h;
-    if (tx_png_read(path, &img, &w, &h, err, sizeof err)) fail_msg("%s: %s", cases[i].mode, err);
+    if (tx_png_read(path, &img, &w, &h)) fail_msg("%s: %s", cases[i].mode, tx_error());
     assert_int_equal(w, cases[i].w);
     assert_int_equal(h, cases[i].h);
     free(img);
@@ -122,9 +120,8 @@ static void stereo_files_and_sizes(void** state) {
 // no "view" in the scenario: the draw list comes from the model's names (device0.pose here)
 static void automatic_draw_list(void** state) {
   (void)state;
-  char err[1024];
-  tx_scenario* sc = load("png", "mono", false, err);
-  if (!sc) fail_msg("%s", err);
+  tx_scenario* sc = load("png", "mono", false);
+  if (!sc) fail_msg("%s", tx_error());
   int view = -1;
   for (int i = 0; i < tx_system_count(sc->system); i++)
     if (strcmp(tx_system_name(sc->system, i), "view") == 0) view = i;
@@ -142,10 +139,10 @@ static void automatic_draw_list(void** state) {
   tx_load_options none = {0};
   char text[2048];
   snprintf(text, sizeof text, wall_scene, ", \"view\": {\"widht\": 3}");
-  assert_null(tx_scenario_load_text("wall-view", text, strlen(text), &none, err, sizeof err));
-  assert_non_null(strstr(err, "view.widht: unknown key"));
+  assert_null(tx_scenario_load_text("wall-view", text, strlen(text), &none));
+  assert_non_null(strstr(tx_error(), "view.widht: unknown key"));
   snprintf(text, sizeof text, wall_scene, view_json);
-  sc = tx_scenario_load_text("wall-view", text, strlen(text), &none, err, sizeof err);
+  sc = tx_scenario_load_text("wall-view", text, strlen(text), &none);
   assert_non_null(sc);
   assert_int_equal(tx_system_count(sc->system), 2);
   tx_scenario_free(sc);
@@ -153,34 +150,34 @@ static void automatic_draw_list(void** state) {
 
 static void draw_errors_name_the_view(void** state) {
   (void)state;
-  char err[1024], text[2048];
+  char text[2048];
   tx_load_options o = {.view = "png"};
   snprintf(text, sizeof text, wall_scene, ", \"view\": {\"draw\": [{\"mesh\": \"skin\"}]}");
-  assert_null(tx_scenario_load_text("f.json", text, strlen(text), &o, err, sizeof err));
-  assert_non_null(strstr(err, "f.json: view.draw: "));
-  assert_non_null(strstr(err, "skin.x"));
+  assert_null(tx_scenario_load_text("f.json", text, strlen(text), &o));
+  assert_non_null(strstr(tx_error(), "f.json: view.draw: "));
+  assert_non_null(strstr(tx_error(), "skin.x"));
   // a component of the wrong shape: device0.force is f64 1x3, not spheres
   snprintf(text, sizeof text, wall_scene, ", \"view\": {\"draw\": [{\"spheres\": \"device0.force\"}]}");
-  assert_null(tx_scenario_load_text("f.json", text, strlen(text), &o, err, sizeof err));
-  assert_non_null(strstr(err, "view.draw"));
+  assert_null(tx_scenario_load_text("f.json", text, strlen(text), &o));
+  assert_non_null(strstr(tx_error(), "view.draw"));
   tx_load_options bad = {.view = "png", .stereo = "3d"};
   snprintf(text, sizeof text, wall_scene, view_json);
-  assert_null(tx_scenario_load_text("f.json", text, strlen(text), &bad, err, sizeof err));
-  assert_non_null(strstr(err, "stereo_mode"));
+  assert_null(tx_scenario_load_text("f.json", text, strlen(text), &bad));
+  assert_non_null(strstr(tx_error(), "stereo_mode"));
 }
 
 // in real time the step never waits: each tick gives a frame or counts a dropped one
 static void real_time_hand_over(void** state) {
   (void)state;
-  char dir[] = "/tmp/tx_view_XXXXXX", err[1024], text[2048], path[4200];
+  char dir[] = "/tmp/tx_view_XXXXXX", text[2048], path[4200];
   assert_non_null(mkdtemp(dir));
   snprintf(text, sizeof text, wall_scene, view_json);
   tx_load_options o = {.view = "png", .stereo = "sbs"};
-  tx_scenario* sc = tx_scenario_load_text("wall-view", text, strlen(text), &o, err, sizeof err);
-  if (!sc) fail_msg("%s", err);
+  tx_scenario* sc = tx_scenario_load_text("wall-view", text, strlen(text), &o);
+  if (!sc) fail_msg("%s", tx_error());
   tx_run_options ro = {.duration_s = 1.0, .out_dir = dir};
   tx_run_result r;
-  if (tx_system_run(sc->system, &ro, &r, err, sizeof err)) fail_msg("%s", err);
+  if (tx_system_run(sc->system, &ro, &r)) fail_msg("%s", tx_error());
   for (int i = 0; i < tx_system_count(sc->system); i++)
     if (strcmp(tx_system_name(sc->system, i), "view") == 0) {
       tx_controller_stats st = tx_system_stats(sc->system, i);
