@@ -18,6 +18,9 @@ int tx_cmd_export(int argc, char** argv);
 // a run replaying recordings ends with the longest of them (s); 0 when no
 // device replays or a --set gives duration_s
 double tx_replay_duration(const char* const* devices, int ndevices, const char* const* sets, int nsets);
+// a replay device's recording cut short (a killed run) plays its whole blocks:
+// one warning line each, once the scenario has taken them (devices print nothing)
+void tx_replay_warn(tx_system* sys);
 
 // the program name that starts every error line: "tactus" or "tactus-device"
 extern const char* tx_program;

@@ -217,6 +217,7 @@ int tx_cmd_run(int argc, char** argv) {
 
   tx_scenario* sc = tx_load_for_command_view(cfg.scenario, sets, nsets, devices, ndevices, view, stereo_mode, cfg.lockstep);
   if (!sc) return TX_EXIT_BAD_INPUT;
+  tx_replay_warn(sc->system);
   int rc = tx_run_scenario(sc, &cfg, NULL);
   tx_scenario_free(sc);
   return rc;

@@ -64,7 +64,7 @@ static const char* shown(const char* s, size_t len, char* out, size_t cap) {
   return out;
 }
 
-bool tx_sim_device_parse(const char* spec, tx_sim_device_def* d, char* hand, size_t hand_size, char* err, size_t n) {
+bool tx_sim_device_parse(const char* spec, tx_sim_device_def* d, char* hand, size_t hand_size) {
   struct {
     const char* key;
     double* field;
@@ -87,25 +87,25 @@ bool tx_sim_device_parse(const char* spec, tx_sim_device_def* d, char* hand, siz
     }
     char key[65]; // as written, for the message
     shown(kv, klen, key, sizeof key);
-    if (klen == len) return snprintf(err, n, "%s: expected key=value", key), false;
+    if (klen == len) return tx_set_error("%s: expected key=value", key), false;
     size_t k = 0;
     while (k < KEYS && !(strlen(keys[k].key) == klen && strncmp(kv, keys[k].key, klen) == 0)) k++;
     if (k == KEYS)
-      return snprintf(err, n, "%s: unknown key (known: mass, damping, quantum, max_force, hand_stiffness, "
+      return tx_set_error("%s: unknown key (known: mass, damping, quantum, max_force, hand_stiffness, "
                               "hand_damping, hand)", key), false;
     // the second of two values would silently win
-    if (seen[k]) return snprintf(err, n, "%s: given twice", keys[k].key), false;
+    if (seen[k]) return tx_set_error("%s: given twice", keys[k].key), false;
     seen[k] = true;
     const char* value = kv + klen + 1;
     size_t vlen = len - klen - 1;
     if (!keys[k].field) {
-      if (vlen == 0) return snprintf(err, n, "hand: expected a scripted motion or a .csv file"), false;
-      if (vlen >= hand_size) return snprintf(err, n, "hand: too long"), false;
+      if (vlen == 0) return tx_set_error("hand: expected a scripted motion or a .csv file"), false;
+      if (vlen >= hand_size) return tx_set_error("hand: too long"), false;
       memcpy(hand, value, vlen);
       hand[vlen] = 0;
     } else {
       char num[64], text[64];
-      if (vlen == 0 || vlen >= sizeof num) return snprintf(err, n, "%s: expected a number", keys[k].key), false;
+      if (vlen == 0 || vlen >= sizeof num) return tx_set_error("%s: expected a number", keys[k].key), false;
       memcpy(num, value, vlen);
       num[vlen] = 0;
       shown(num, vlen, text, sizeof text);
@@ -113,14 +113,14 @@ bool tx_sim_device_parse(const char* spec, tx_sim_device_def* d, char* hand, siz
       errno = 0;
       double v = strtod(num, &end);
       if (*end || end == num || isspace((unsigned char)num[0]))
-        return snprintf(err, n, "%s: expected a number, got '%s'", keys[k].key, text), false;
-      if (errno == ERANGE) return snprintf(err, n, "%s: %s is out of range", keys[k].key, text), false;
+        return tx_set_error("%s: expected a number, got '%s'", keys[k].key, text), false;
+      if (errno == ERANGE) return tx_set_error("%s: %s is out of range", keys[k].key, text), false;
       *keys[k].field = v;
     }
     kv = next;
   }
   const char* bad = tx_sim_device_def_check(d);
-  if (bad) return snprintf(err, n, "%s", bad), false;
+  if (bad) return tx_set_error("%s", bad), false;
   return true;
 }
 

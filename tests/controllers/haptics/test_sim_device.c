@@ -6,6 +6,7 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
+#include "model/error.h"
 #include "controllers/haptics/sim_device.h"
 #include "tactus/model.h"
 
@@ -257,13 +258,13 @@ static void runs_are_deterministic(void** state) {
 static void the_spec_is_parsed_and_checked(void** state) {
   (void)state;
   tx_sim_device_def d = tx_sim_device_def_default();
-  char hand[32] = "pierce-down", err[256];
-  assert_true(tx_sim_device_parse("", &d, hand, sizeof hand, err, sizeof err));
+  char hand[32] = "pierce-down";
+  assert_true(tx_sim_device_parse("", &d, hand, sizeof hand));
   tx_sim_device_def defaults = tx_sim_device_def_default();
   assert_memory_equal(&d, &defaults, sizeof d);
   assert_true(tx_sim_device_parse("mass=0.1,damping=0.5,quantum=0,max_force=7,hand_stiffness=300,hand_damping=3,"
                                   "hand=slide-x-over",
-                                  &d, hand, sizeof hand, err, sizeof err));
+                                  &d, hand, sizeof hand));
   assert_true(d.mass == 0.1 && d.damping == 0.5 && d.quantum == 0 && d.max_force == 7 && d.hand_stiffness == 300 &&
               d.hand_damping == 3);
   assert_string_equal(hand, "slide-x-over");
@@ -291,15 +292,14 @@ static void the_spec_is_parsed_and_checked(void** state) {
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     d = tx_sim_device_def_default();
-    err[0] = 0;
-    if (tx_sim_device_parse(bad[i].spec, &d, hand, sizeof hand, err, sizeof err)) fail_msg("'%s' accepted", bad[i].spec);
-    if (!strstr(err, bad[i].names) || strchr(err, '\n')) fail_msg("'%s': %s", bad[i].spec, err);
+    tx_set_error("%s", "");
+    if (tx_sim_device_parse(bad[i].spec, &d, hand, sizeof hand)) fail_msg("'%s' accepted", bad[i].spec);
+    if (!strstr(tx_error(), bad[i].names) || strchr(tx_error(), '\n')) fail_msg("'%s': %s", bad[i].spec, tx_error());
   }
   // the lightest device the check takes, with the stiffest hand and no damping, at the longest
   // period, integrates stably: the state stays bounded under a bounded force
   d = tx_sim_device_def_default();
-  assert_true(tx_sim_device_parse("mass=0.001,damping=0,hand_damping=0,hand_stiffness=1e6", &d, hand, sizeof hand, err,
-                                  sizeof err));
+  assert_true(tx_sim_device_parse("mass=0.001,damping=0,hand_damping=0,hand_stiffness=1e6", &d, hand, sizeof hand));
   d.period = 0.1;
   tx_sim_device dev;
   assert_true(tx_sim_device_init(&dev, &d));
