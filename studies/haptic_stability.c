@@ -53,8 +53,7 @@ static int apply(tx_wall_case* c, const tx_study_args* a, double* periods, int* 
   }
   for (int p = 0; p < *nperiods; p++) {
     c->device.period = periods[p];
-    const char* bad = tx_wall_case_check(c);
-    if (bad) return tx_bad_input("--set: %s", bad);
+    if (tx_wall_case_check(c)) return tx_bad_input("--set: %s", tx_error());
   }
   return 0;
 }

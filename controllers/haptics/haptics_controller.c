@@ -111,8 +111,7 @@ static int configure(tx_setup* s, void** self) {
   h->limits.model_timeout_s = lowered(s, "model_timeout_s", d.model_timeout_s);
   h->limits.device_timeout_s = lowered(s, "device_timeout_s", d.device_timeout_s);
   h->limits.ramp_s = lowered(s, "ramp_s", d.ramp_s);
-  const char* bad = tx_safety_limits_check(&h->limits);
-  if (bad) return tx_setup_fail(s, NULL, "safety limits: %s", bad);
+  if (tx_safety_limits_check(&h->limits)) return tx_setup_fail(s, NULL, "safety limits: %s", tx_error());
   tx_haptic_path_init(&h->path, &h->limits, control, ref, info.damping);
 
   if (h->device.backend->input) h->input = TX_READ_EXPECT(s, h->device.backend->input, tx_pointer);

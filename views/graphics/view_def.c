@@ -117,8 +117,7 @@ static int read_camera(const json_t* cam, tx_view_def* d) {
   double dx = c->target[0] - c->eye[0], dy = c->target[1] - c->eye[1], dz = c->target[2] - c->eye[2];
   c->convergence = sqrt(dx * dx + dy * dy + dz * dz); // the target is on the zero-parallax plane unless told otherwise
   d->auto_camera = false;
-  const char* problem = tx_camera_check(c);
-  if (problem) return bad("camera", "%s", problem);
+  if (tx_camera_check(c)) return bad("camera", "%s", tx_error());
   return 0;
 }
 

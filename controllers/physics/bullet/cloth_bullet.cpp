@@ -102,7 +102,7 @@ extern "C" tx_cloth_def tx_cloth_def_default(void) {
 
 static const char* range(const char* name, double v, double lo, bool open_lo, double hi, bool open_hi,
                          const char* units) {
-  return tx_check_range("skin", name, v, lo, open_lo, hi, open_hi, units);
+  return tx_check_range_msg("skin", name, v, lo, open_lo, hi, open_hi, units);
 }
 
 extern "C" const char* tx_cloth_def_check(const tx_cloth_def* d) {
@@ -112,7 +112,7 @@ extern "C" const char* tx_cloth_def_check(const tx_cloth_def* d) {
   const char* e;
   for (int a = 0; a < 2; a++) {
     if ((e = range(size_name[a], d->size[a], 1e-3, false, 10, false, "m"))) return e;
-    if ((e = tx_check_count("skin", res_name[a], d->res[a], 2, 1024))) return e;
+    if ((e = tx_check_count_msg("skin", res_name[a], d->res[a], 2, 1024))) return e;
   }
   for (int a = 0; a < 3; a++)
     if ((e = range(center_name[a], d->center[a], -10, false, 10, false, "m"))) return e;
@@ -123,7 +123,7 @@ extern "C" const char* tx_cloth_def_check(const tx_cloth_def* d) {
   if ((e = range("damping", d->damping, 0, false, 1e4, false, "1/s"))) return e;
   if ((e = range("gravity", d->gravity, 0, false, 100, false, "m/s^2"))) return e;
   if ((e = range("rupture_strain", d->rupture_strain, 0, false, 100, false, "(strain)"))) return e;
-  if ((e = tx_check_count("skin", "iterations", d->iterations, 1, 200))) return e;
+  if ((e = tx_check_count_msg("skin", "iterations", d->iterations, 1, 200))) return e;
   if ((e = range("max_substep", d->max_substep, 1e-5, false, 0.1, false, "s"))) return e;
   if ((e = range("max_speed", d->max_speed, 0, true, 1e4, false, "m/s"))) return e;
   if ((e = range("settle_time", d->settle_time, 0, false, 10, false, "s"))) return e;

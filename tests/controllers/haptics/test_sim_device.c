@@ -18,7 +18,7 @@
 static void defaults_are_of_the_class(void** state) {
   (void)state;
   tx_sim_device_def d = tx_sim_device_def_default();
-  assert_null(tx_sim_device_def_check(&d));
+  assert_int_equal(tx_sim_device_def_check(&d), 0);
   assert_true(d.max_force == 3.3);
   assert_true(d.nominal_stiffness >= 400 && d.nominal_stiffness <= 700);
   assert_true(d.period == 1e-3);
@@ -64,7 +64,7 @@ static void bad_fields_are_refused(void** state) {
       if (bad[b] == -1 && !strcmp(fields[f].name, "workspace_min")) continue; // a box may start below zero
       tx_sim_device_def d = good;
       memcpy((char*)&d + fields[f].offset, &bad[b], sizeof(double));
-      const char* msg = tx_sim_device_def_check(&d);
+      const char* msg = tx_sim_device_def_check(&d) ? tx_error() : NULL;
       assert_non_null(msg);
       assert_non_null(strstr(msg, fields[f].name));
       assert_false(tx_sim_device_init(&dev, &d));
@@ -75,14 +75,15 @@ static void bad_fields_are_refused(void** state) {
   // zero is invalid where it would divide, valid where it means "none"
   tx_sim_device_def d = good;
   d.mass = 0;
-  assert_non_null(tx_sim_device_def_check(&d));
+  assert_int_equal(tx_sim_device_def_check(&d), -1);
   d = good, d.period = 0;
-  assert_non_null(tx_sim_device_def_check(&d));
+  assert_int_equal(tx_sim_device_def_check(&d), -1);
   d = good, d.quantum = 0, d.damping = 0, d.hand_stiffness = 0, d.hand_damping = 0;
-  assert_null(tx_sim_device_def_check(&d));
+  assert_int_equal(tx_sim_device_def_check(&d), 0);
   // an empty workspace
   d = good, d.workspace_min[0] = d.workspace_max[0];
-  assert_non_null(strstr(tx_sim_device_def_check(&d), "workspace"));
+  assert_int_equal(tx_sim_device_def_check(&d), -1);
+  assert_non_null(strstr(tx_error(), "workspace"));
 }
 
 // a free damped mass under a held force: x(t) = (F/b)(t - tau (1 - e^(-t/tau))), tau = m/b

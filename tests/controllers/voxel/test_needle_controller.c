@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #ifndef TX_SOURCE_DIR
@@ -137,10 +138,35 @@ static void bad_params_named(void** state) {
   }
 }
 
+// the recording is written in finish: one that cannot be (its temporary file
+// is taken by a folder here) stops the run with the file's name
+static void a_recording_that_cannot_be_written_stops_the_run(void** state) {
+  (void)state;
+  char dir[] = "/tmp/tx-needle-XXXXXX", taken[128];
+  assert_non_null(mkdtemp(dir));
+  snprintf(taken, sizeof taken, "%s/needle-recording.csv.tmp", dir);
+  assert_int_equal(mkdir(taken, 0755), 0);
+  tx_scenario* s = tx_scenario_load(TX_SOURCE_DIR "/scenarios/needle-voxel/needle-voxel.json", NULL);
+  if (!s) fail_msg("%s", tx_error());
+  tx_run_options o = {.duration_s = 0.1, .lockstep = true, .record_dir = dir};
+  tx_run_result r;
+  assert_int_equal(tx_system_run(s->system, &o, &r), 0);
+  tx_scenario_free(s);
+  print_message("  %s\n", r.halt_reason);
+  assert_true(r.halted);
+  char want[256];
+  snprintf(want, sizeof want, "%s/needle-recording.csv: Is a directory", dir);
+  if (!strstr(r.halt_reason, want)) fail_msg("'%s' lacks '%s'", r.halt_reason, want);
+  char cmd[256];
+  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+  assert_int_equal(system(cmd), 0);
+}
+
 int main(void) {
   tx_register_builtin();
   const struct CMUnitTest tests[] = {cmocka_unit_test(shipped_scenario_inserts),
                                      cmocka_unit_test(recording_follows_the_reference),
+                                     cmocka_unit_test(a_recording_that_cannot_be_written_stops_the_run),
                                      cmocka_unit_test(bad_params_named)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
