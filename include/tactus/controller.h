@@ -37,6 +37,13 @@
 //     const tx_controller_class demo = {.type = "demo.counter", .configure = configure, .step = step,
 //                                       .params = params, .nparams = TX_PARAMS_COUNT(params)};
 //
+// Errors: a controller never prints. configure fails with tx_setup_fail (the
+// loader names the file and key, exit 2); at run time tx_warn counts what was
+// recovered, and tx_stop_run ends the run for what cannot be (in init the run
+// fails with that reason; in a step or finish the report is still written and
+// the run exits 1 naming it). The library calls below return -1, NULL or an
+// invalid id with one line in tx_error() (tactus/model.h).
+//
 // Plugins: a shared library named in a scenario's "plugins" exports
 // TX_PLUGIN_ENTRY, which calls tx_register_controller for each class.
 #ifndef TACTUS_CONTROLLER_H
