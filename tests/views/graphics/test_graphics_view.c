@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <cmocka.h>
 
@@ -85,6 +86,42 @@ static void png_frames_every_nth_and_last(void** state) {
   // the tool starts 1 cm above the wall, waits half a second, then goes down: it moves down the image
   assert_true(first > 0 && first == mid);
   assert_true(last > first + 10);
+  tx_scenario_free(sc);
+  char cmd[4300];
+  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+  assert_int_equal(system(cmd), 0);
+}
+
+static uint64_t warning(tx_system* s, const char* key) {
+  for (int w = 0; w < tx_system_warnings(s); w++)
+    if (strcmp(tx_system_warning_key(s, w), key) == 0) return tx_system_warning_count(s, w);
+  return UINT64_MAX;
+}
+
+// a frame that cannot be written is counted and the run goes on; the contact
+// sheet, written at the end, stops the run naming the file (here each file's
+// temporary name is taken by a folder)
+static void files_that_cannot_be_written(void** state) {
+  (void)state;
+  char dir[] = "/tmp/tx_view_XXXXXX", path[4200];
+  assert_non_null(mkdtemp(dir));
+  const char* taken[] = {"frames", "frames/frame_000000.png.tmp", "frames/contact_sheet.png.tmp"};
+  for (size_t i = 0; i < sizeof taken / sizeof taken[0]; i++) {
+    snprintf(path, sizeof path, "%s/%s", dir, taken[i]);
+    assert_int_equal(mkdir(path, 0755), 0);
+  }
+  tx_scenario* sc = load("png", "mono", true);
+  if (!sc) fail_msg("%s", tx_error());
+  tx_run_options o = {.duration_s = 1.0, .lockstep = true, .out_dir = dir};
+  tx_run_result r;
+  if (tx_system_run(sc->system, &o, &r)) fail_msg("%s", tx_error());
+  print_message("  %s at t = %.3f s\n", r.halt_reason, r.halt_t_s);
+  assert_int_equal(warning(sc->system, "view.frame_not_written"), 1);
+  assert_true(r.halted);
+  snprintf(path, sizeof path, "view: %s/frames/contact_sheet.png: ", dir);
+  if (strncmp(r.halt_reason, path, strlen(path)) != 0) fail_msg("'%s' does not start with '%s'", r.halt_reason, path);
+  snprintf(path, sizeof path, "%s/frames/frame_000008.png", dir);
+  assert_int_equal(access(path, R_OK), 0); // the frames after the one lost
   tx_scenario_free(sc);
   char cmd[4300];
   snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
@@ -196,6 +233,7 @@ static void real_time_hand_over(void** state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(png_frames_every_nth_and_last),
+      cmocka_unit_test(files_that_cannot_be_written),
       cmocka_unit_test(stereo_files_and_sizes),
       cmocka_unit_test(automatic_draw_list),
       cmocka_unit_test(draw_errors_name_the_view),
