@@ -65,11 +65,11 @@ typedef struct tx_device_server_stats {
 typedef struct tx_device_server tx_device_server;
 
 tx_device_server_def tx_device_server_def_default(void);
-// open the device and bind; NULL with a one-line message naming what is wrong
+// open the device and bind; NULL with a one-line message in tx_error() naming what is wrong
 tx_device_server* tx_device_server_open(const tx_device_server_def* def);
 uint16_t tx_device_server_port(const tx_device_server* s); // as bound
 // serve until *stop is non-zero (a signal handler or another thread may set
-// it) or the duration has passed; 0, or -1 with a message on a socket error
+// it) or the duration has passed; 0, or -1 with the message in tx_error() on a socket error
 int tx_device_server_run(tx_device_server* s, const atomic_int* stop);
 void tx_device_server_get_stats(const tx_device_server* s, tx_device_server_stats* out);
 void tx_device_server_close(tx_device_server* s);
