@@ -15,18 +15,16 @@ static port* port_of(tx_ctx* c, tx_port p, bool write) {
 
 // a write to a port the instance never declared: a bug in the controller.
 // Counted and the run stopped with the reason, never a silent NULL; no
-// allocation here (snprintf into the stack), so the haptic path stays safe.
+// allocation here (tx_stop_run formats on the stack), so the haptic path stays safe.
 static port* write_port(tx_ctx* c, tx_port p, const char* call) {
   port* pt = port_of(c, p, true);
   if (pt) return pt;
   tx_warn(c, c->in->bad_port);
-  char why[TX_NAME_MAX + 160];
   if (p.id >= 1 && p.id <= c->in->nports)
-    snprintf(why, sizeof why, "%s on port %u ('%s'), which it declared as a read, not a write", call, p.id,
-             c->in->ports[p.id - 1].name);
+    tx_stop_run(c, "%s on port %u ('%s'), which it declared as a read, not a write", call, p.id,
+                c->in->ports[p.id - 1].name);
   else
-    snprintf(why, sizeof why, "%s on port %u, which it never declared (it has %d ports)", call, p.id, c->in->nports);
-  tx_stop_run(c, "%s", why);
+    tx_stop_run(c, "%s on port %u, which it never declared (it has %d ports)", call, p.id, c->in->nports);
   return NULL;
 }
 
@@ -54,10 +52,7 @@ void tx_write_rows(tx_ctx* c, tx_port p, uint32_t rows) {
   if (!pt) return;
   if (rows > pt->def.rows) { // the rest would be lost without a word
     tx_warn(c, c->in->rows_clamped);
-    char why[TX_NAME_MAX + 160];
-    snprintf(why, sizeof why, "tx_write_rows(%u) on '%s', beyond its capacity of %u rows", rows, pt->name,
-             pt->def.rows);
-    tx_stop_run(c, "%s", why);
+    tx_stop_run(c, "tx_write_rows(%u) on '%s', beyond its capacity of %u rows", rows, pt->name, pt->def.rows);
   }
   tx_model_set_rows(c->sys->model, pt->comp, rows); // still clamped, so no reader looks past the buffer
 }
@@ -115,10 +110,8 @@ static void trace_publish(tx_system* s, const instance* in, const port* pt) {
 static port* event_port(tx_ctx* c, tx_port p, port_kind kind, const char* call) {
   if (p.id >= 1 && p.id <= c->in->nports && c->in->ports[p.id - 1].kind == kind) return &c->in->ports[p.id - 1];
   tx_warn(c, c->in->bad_port);
-  char why[TX_NAME_MAX + 160];
-  snprintf(why, sizeof why, "%s on port %u, which it did not declare with %s", call, p.id,
-           kind == PORT_EMIT ? "tx_setup_emit" : "tx_setup_listen");
-  tx_stop_run(c, "%s", why);
+  tx_stop_run(c, "%s on port %u, which it did not declare with %s", call, p.id,
+              kind == PORT_EMIT ? "tx_setup_emit" : "tx_setup_listen");
   return NULL;
 }
 
