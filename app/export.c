@@ -37,11 +37,11 @@ int tx_cmd_export(int argc, char** argv) {
   else if (len > 4 && strcmp(bin + len - 4, ".bin") == 0) snprintf(csv, sizeof csv, "%.*s.csv", (int)(len - 4), bin);
   else snprintf(csv, sizeof csv, "%s.csv", bin);
   if (strcmp(csv, bin) == 0) return tx_bad_input("export: --out %s is the recording itself", out);
-  char warn[512], err[1024];
-  int rc = tx_record_export_csv(bin, csv, warn, sizeof warn, err, sizeof err);
-  if (rc == -1) return tx_bad_input("%s", err); // the recording is not one
-  if (rc) return fprintf(stderr, "tactus: %s\n", err), 1;
-  if (*warn) fprintf(stderr, "tactus: warning: %s\n", warn);
+  tx_record_file read;
+  int rc = tx_record_export_csv(bin, csv, &read);
+  if (rc == -1) return tx_bad_input("%s", tx_error()); // the recording is not one
+  if (rc) return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
+  if (*read.cut_short) fprintf(stderr, "tactus: warning: %s\n", read.cut_short);
   printf("wrote %s\n", csv);
   return 0;
 }
@@ -52,11 +52,11 @@ double tx_replay_duration(const char* const* devices, int ndevices, const char* 
   double longest = 0;
   for (int i = 0; i < ndevices; i++) {
     if (strncmp(devices[i], "replay:", 7) != 0) continue;
-    tx_record_header h;
-    tx_record* recs;
-    size_t count;
-    char warn[512], err[1024];
-    if (tx_record_load(devices[i] + 7, &h, &recs, &count, warn, sizeof warn, err, sizeof err)) continue; // the loader says why
+    tx_record_file rf;
+    if (tx_record_load(devices[i] + 7, &rf)) continue; // the loader says why
+    tx_record_header h = rf.header;
+    tx_record* recs = rf.records;
+    size_t count = rf.count;
     // a replay plays record k at tick k after the first record's time (a
     // real-time recording may skip late ticks): the run covers every record
     double end = recs[0].t_s + (double)count / h.rate_hz;
@@ -64,4 +64,14 @@ double tx_replay_duration(const char* const* devices, int ndevices, const char* 
     free(recs);
   }
   return longest;
+}
+
+void tx_replay_warn(tx_system* sys) {
+  for (int i = 0; i < tx_system_count(sys); i++) {
+    const char* spec = json_string_value(json_object_get(tx_system_params(sys, i), "device"));
+    if (!spec || strncmp(spec, "replay:", 7) != 0) continue;
+    tx_record_file rf;
+    if (tx_record_load(spec + 7, &rf) == 0 && *rf.cut_short) fprintf(stderr, "tactus: warning: %s\n", rf.cut_short);
+    free(rf.records);
+  }
 }

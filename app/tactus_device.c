@@ -115,15 +115,14 @@ int main(int argc, char** argv) {
                         "tactus-device serves scripted:, replay: and sim devices", def.spec);
   // a replay plays one record per tick, so it is served at its recorded rate:
   // that rate unless --rate says otherwise, and a --rate that differs names the fix
+  char cut_short[sizeof ((tx_record_file*)0)->cut_short] = "";
   if (strncmp(def.spec, "replay:", 7) == 0) {
-    tx_record_header h;
-    tx_record* records = NULL;
-    size_t count = 0;
-    char ignored[512], warn[512];
-    // a file that does not load, or loads with a warning, is reported by the server's open below, once
-    if (tx_record_load(def.spec + 7, &h, &records, &count, warn, sizeof warn, ignored, sizeof ignored) == 0) {
-      free(records);
-      double recorded = h.rate_hz;
+    tx_record_file rf;
+    // a file that does not load is reported by the server's open below, once
+    if (tx_record_load(def.spec + 7, &rf) == 0) {
+      free(rf.records);
+      snprintf(cut_short, sizeof cut_short, "%s", rf.cut_short);
+      double recorded = rf.header.rate_hz;
       if (rate_given && fabs(recorded - def.rate_hz) > 1e-9 * recorded)
         return tx_bad_input("--rate %g: %s was recorded at %g Hz; serve it with --rate %g (or leave --rate out)",
                             def.rate_hz, def.spec + 7, recorded, recorded);
@@ -131,9 +130,9 @@ int main(int argc, char** argv) {
     }
   }
 
-  char err[1024];
-  tx_device_server* s = tx_device_server_open(&def, err, sizeof err);
-  if (!s) return tx_bad_input("%s", err);
+  tx_device_server* s = tx_device_server_open(&def);
+  if (!s) return tx_bad_input("%s", tx_error());
+  if (*cut_short) fprintf(stderr, "tactus-device: warning: %s\n", cut_short); // once the server has taken it
 
   struct sigaction sa = {0};
   sa.sa_handler = on_stop; // no SA_RESTART: a signal wakes the wait at once
@@ -145,8 +144,8 @@ int main(int argc, char** argv) {
   printf("tactus-device: serving %s on %s at %g Hz\n", def.spec, tx_dp_addr_text(&bound, where, sizeof where),
          def.rate_hz);
 
-  int rc = tx_device_server_run(s, &stop_requested, err, sizeof err);
-  if (rc) fprintf(stderr, "tactus-device: %s\n", err);
+  int rc = tx_device_server_run(s, &stop_requested);
+  if (rc) fprintf(stderr, "tactus-device: %s\n", tx_error());
   tx_device_server_stats stats;
   tx_device_server_get_stats(s, &stats);
   tx_device_server_close(s);

@@ -3,6 +3,8 @@
 
 #include <errno.h>
 #include <inttypes.h>
+#include <stdarg.h>
+#include <stdio.h>
 #include <string.h>
 
 static port* port_of(tx_ctx* c, tx_port p, bool write) {
@@ -13,18 +15,16 @@ static port* port_of(tx_ctx* c, tx_port p, bool write) {
 
 // a write to a port the instance never declared: a bug in the controller.
 // Counted and the run stopped with the reason, never a silent NULL; no
-// allocation here (snprintf into the stack), so the haptic path stays safe.
+// allocation here (tx_stop_run formats on the stack), so the haptic path stays safe.
 static port* write_port(tx_ctx* c, tx_port p, const char* call) {
   port* pt = port_of(c, p, true);
   if (pt) return pt;
   tx_warn(c, c->in->bad_port);
-  char why[TX_NAME_MAX + 160];
   if (p.id >= 1 && p.id <= c->in->nports)
-    snprintf(why, sizeof why, "%s on port %u ('%s'), which it declared as a read, not a write", call, p.id,
-             c->in->ports[p.id - 1].name);
+    tx_stop_run(c, "%s on port %u ('%s'), which it declared as a read, not a write", call, p.id,
+                c->in->ports[p.id - 1].name);
   else
-    snprintf(why, sizeof why, "%s on port %u, which it never declared (it has %d ports)", call, p.id, c->in->nports);
-  tx_stop_run(c, why);
+    tx_stop_run(c, "%s on port %u, which it never declared (it has %d ports)", call, p.id, c->in->nports);
   return NULL;
 }
 
@@ -52,10 +52,7 @@ void tx_write_rows(tx_ctx* c, tx_port p, uint32_t rows) {
   if (!pt) return;
   if (rows > pt->def.rows) { // the rest would be lost without a word
     tx_warn(c, c->in->rows_clamped);
-    char why[TX_NAME_MAX + 160];
-    snprintf(why, sizeof why, "tx_write_rows(%u) on '%s', beyond its capacity of %u rows", rows, pt->name,
-             pt->def.rows);
-    tx_stop_run(c, why);
+    tx_stop_run(c, "tx_write_rows(%u) on '%s', beyond its capacity of %u rows", rows, pt->name, pt->def.rows);
   }
   tx_model_set_rows(c->sys->model, pt->comp, rows); // still clamped, so no reader looks past the buffer
 }
@@ -85,7 +82,15 @@ static void stop_run(tx_system* s, int64_t sim_ns, const char* who, const char* 
   atomic_store_explicit(&s->halt, true, memory_order_release);
 }
 
-void tx_stop_run(tx_ctx* c, const char* reason) { stop_run(c->sys, c->sim_ns, c->in->name, reason); }
+void tx_stop_run(tx_ctx* c, const char* fmt, ...) {
+  if (atomic_load_explicit(&c->sys->halt_claim, memory_order_relaxed)) return; // the first reason wins
+  char reason[sizeof c->sys->halt_reason - TX_NAME_MAX - 2]; // room for "INSTANCE: "
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(reason, sizeof reason, fmt, ap);
+  va_end(ap);
+  stop_run(c->sys, c->sim_ns, c->in->name, reason);
+}
 
 static void trace_publish(tx_system* s, const instance* in, const port* pt) {
   tx_snapshot snap = tx_model_latest(s->model, pt->comp);
@@ -105,10 +110,8 @@ static void trace_publish(tx_system* s, const instance* in, const port* pt) {
 static port* event_port(tx_ctx* c, tx_port p, port_kind kind, const char* call) {
   if (p.id >= 1 && p.id <= c->in->nports && c->in->ports[p.id - 1].kind == kind) return &c->in->ports[p.id - 1];
   tx_warn(c, c->in->bad_port);
-  char why[TX_NAME_MAX + 160];
-  snprintf(why, sizeof why, "%s on port %u, which it did not declare with %s", call, p.id,
-           kind == PORT_EMIT ? "tx_setup_emit" : "tx_setup_listen");
-  tx_stop_run(c, why);
+  tx_stop_run(c, "%s on port %u, which it did not declare with %s", call, p.id,
+              kind == PORT_EMIT ? "tx_setup_emit" : "tx_setup_listen");
   return NULL;
 }
 
@@ -163,14 +166,14 @@ void tx_instance_finish(instance* in) {
   if (in->cls->finish) in->cls->finish(&in->ctx, in->self);
 }
 
-int tx_instance_init(tx_system* s, instance* in, char* err, size_t n) {
+int tx_instance_init(tx_system* s, instance* in) {
   in->ctx.sim_ns = 0;
   in->ctx.step = 0;
   if (!in->cls->init) return 0;
   if (in->cls->init(&in->ctx, in->self) != 0) {
     // a reason given with tx_stop_run is the one to report
-    if (tx_system_halted(s)) return snprintf(err, n, "%s", s->halt_reason), -1;
-    return snprintf(err, n, "controller '%s' failed to initialise", in->name), -1;
+    if (tx_system_halted(s)) return tx_set_error("%s", s->halt_reason), -1;
+    return tx_set_error("controller '%s' failed to initialise", in->name), -1;
   }
   publish_written(s, in, 0); // what init wrote is the first publish, at time 0
   return 0;

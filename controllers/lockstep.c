@@ -10,16 +10,16 @@
 
 #include <stdlib.h>
 
-int tx_run_lockstep(tx_system* s, const tx_run_options* o, tx_run_result* r, char* err, size_t n) {
+int tx_run_lockstep(tx_system* s, const tx_run_options* o, tx_run_result* r) {
   s->tracing = true;
   s->trace = o->trace;
   s->trace_name = o->trace_name;
   s->trace_hash = TX_HASH_SEED;
   int rc = 0;
-  for (int i = 0; i < s->count && rc == 0; i++) rc = tx_instance_init(s, s->inst[i], err, n);
+  for (int i = 0; i < s->count && rc == 0; i++) rc = tx_instance_init(s, s->inst[i]);
 
   uint64_t* next = calloc(s->ngroups, sizeof *next);
-  if (!next && rc == 0) rc = -1, snprintf(err, n, "out of memory");
+  if (!next && rc == 0) rc = -1, tx_set_error("out of memory");
   const int64_t end_ns = (int64_t)(o->duration_s * 1e9);
   int64_t last_progress = 0, last_wall = tx_mono_ns(), reached = end_ns;
   while (rc == 0) {

@@ -41,7 +41,7 @@ typedef struct worker {
   int fifo_error; // errno of the refusal, 0 if granted
   int pin_error;
   int init_rc;
-  char init_err[256];
+  char init_err[1024]; // the worker thread's tx_error(), for the main thread
 } worker;
 
 static void sleep_until(int64_t ns) {
@@ -72,7 +72,7 @@ static void* worker_main(void* arg) {
   pthread_setname_np(pthread_self(), tname);
   apply_scheduling(w);
   for (int m = 0; m < g->count && w->init_rc == 0; m++)
-    w->init_rc = tx_instance_init(s, s->inst[g->members[m]], w->init_err, sizeof w->init_err);
+    if ((w->init_rc = tx_instance_init(s, s->inst[g->members[m]]))) snprintf(w->init_err, sizeof w->init_err, "%s", tx_error());
   pthread_mutex_lock(&w->gate->mutex);
   w->gate->ready++;
   pthread_cond_broadcast(&w->gate->cond);
@@ -185,13 +185,13 @@ static void describe_scheduling(const worker* w, int n, tx_run_result* r) {
     snprintf(r->scheduler + len, sizeof r->scheduler - len, "; %d CPUs kept awake", r->awake_cpus);
 }
 
-int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r, char* err, size_t n) {
+int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r) {
   const int ng = s->nthreads;
   worker* w = calloc(ng, sizeof *w);
   pthread_t* th = calloc(ng, sizeof *th);
   if (!w || !th) {
     free(w), free(th);
-    return snprintf(err, n, "out of memory"), -1;
+    return tx_set_error("out of memory"), -1;
   }
   gate gt = {.mutex = PTHREAD_MUTEX_INITIALIZER, .cond = PTHREAD_COND_INITIALIZER};
   _Atomic bool stop = false;
@@ -219,7 +219,7 @@ int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r, cha
                     .priority = o->realtime_priority ? (prio < prio_min ? prio_min : prio) : 0};
     if (pthread_create(&th[g], NULL, worker_main, &w[g]) != 0) {
       rc = -1;
-      snprintf(err, n, "could not start thread %d of %d", g + 1, ng);
+      tx_set_error("could not start thread %d of %d", g + 1, ng);
       break;
     }
     started++;
@@ -229,7 +229,7 @@ int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r, cha
   pthread_mutex_lock(&gt.mutex);
   while (gt.ready < started) pthread_cond_wait(&gt.cond, &gt.mutex);
   for (int g = 0; g < started && rc == 0; g++)
-    if (w[g].init_rc) rc = -1, snprintf(err, n, "%s", w[g].init_err);
+    if (w[g].init_rc) rc = -1, tx_set_error("%s", w[g].init_err);
   if (rc) atomic_store(&stop, true), gt.failed = true;
   // every first release lies in the future; spun-up CPUs get time to be
   // running on the host before the first tick

@@ -8,16 +8,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int fault(tx_fault* f, const char* key, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
-static int fault(tx_fault* f, const char* key, const char* fmt, ...) {
-  if (!f) return -1;
-  snprintf(f->key, sizeof f->key, "%s", key ? key : "");
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(f->message, sizeof f->message, fmt, ap);
-  va_end(ap);
-  return -1;
-}
+// a configuration error at KEY: tx_error() and tx_error_key(), and -1
+#define fault(key, ...) (tx_set_error_at(key, __VA_ARGS__), -1)
+// an instance's first tx_setup_fail, as the error of the call that configured it
+#define setup_fault(in) (tx_set_error_at((in)->fault.key, "%s", (in)->fault.message), -1)
 
 tx_system* tx_system_create(void) { return calloc(1, sizeof(tx_system)); }
 
@@ -51,11 +45,11 @@ static const tx_component_def* declared(const tx_system* s, const char* name) {
   return NULL;
 }
 
-int tx_system_declare(tx_system* s, const tx_component_def* def, tx_fault* f) {
-  if (!def->name || !*def->name || strlen(def->name) >= TX_NAME_MAX) return fault(f, "name", "empty or too long");
-  if (declared(s, def->name)) return fault(f, "name", "component '%s' is declared twice", def->name);
+int tx_system_declare(tx_system* s, const tx_component_def* def) {
+  if (!def->name || !*def->name || strlen(def->name) >= TX_NAME_MAX) return fault("name", "empty or too long");
+  if (declared(s, def->name)) return fault("name", "component '%s' is declared twice", def->name);
   const char* units = def->units ? def->units : "1";
-  if (strlen(units) >= TX_UNITS_MAX) return fault(f, "units", "'%s' is too long", units);
+  if (strlen(units) >= TX_UNITS_MAX) return fault("units", "'%s' is too long", units);
   int n = s->ndeclared + 1;
   tx_component_def* d = realloc(s->declared, n * sizeof *d);
   if (d) s->declared = d;
@@ -63,7 +57,7 @@ int tx_system_declare(tx_system* s, const tx_component_def* def, tx_fault* f) {
   if (names) s->declared_names = names;
   char(*units_)[TX_UNITS_MAX] = realloc(s->declared_units, n * sizeof *units_);
   if (units_) s->declared_units = units_;
-  if (!d || !names || !units_) return fault(f, "", "out of memory");
+  if (!d || !names || !units_) return fault("", "out of memory");
   strcpy(s->declared_names[s->ndeclared], def->name);
   strcpy(s->declared_units[s->ndeclared], units);
   s->ndeclared = n;
@@ -79,21 +73,21 @@ static bool valid_instance_name(const char* s) {
   return true;
 }
 
-int tx_system_add(tx_system* s, const char* name, const char* type, double rate_hz, json_t* params, tx_fault* f) {
-  if (!valid_instance_name(name)) return fault(f, "name", "'%s' must be 1-%d characters of a-z 0-9 _ -", name ? name : "", TX_NAME_MAX - 1);
+int tx_system_add(tx_system* s, const char* name, const char* type, double rate_hz, json_t* params) {
+  if (!valid_instance_name(name)) return fault("name", "'%s' must be 1-%d characters of a-z 0-9 _ -", name ? name : "", TX_NAME_MAX - 1);
   for (int i = 0; i < s->count; i++)
-    if (strcmp(s->inst[i]->name, name) == 0) return fault(f, "name", "a controller named '%s' already exists", name);
+    if (strcmp(s->inst[i]->name, name) == 0) return fault("name", "a controller named '%s' already exists", name);
   const tx_controller_class* cls = tx_find_controller(type);
-  if (!cls) return fault(f, "type", "unknown controller type '%s'", type ? type : "");
+  if (!cls) return fault("type", "unknown controller type '%s'", type ? type : "");
   if (!(rate_hz >= TX_RATE_MIN_HZ && rate_hz <= TX_RATE_MAX_HZ))
-    return fault(f, "rate_hz", "%g Hz is out of range [%g, %g]", rate_hz, TX_RATE_MIN_HZ, TX_RATE_MAX_HZ);
-  if (params && !json_is_object(params)) return fault(f, "params", "expected an object");
+    return fault("rate_hz", "%g Hz is out of range [%g, %g]", rate_hz, TX_RATE_MIN_HZ, TX_RATE_MAX_HZ);
+  if (params && !json_is_object(params)) return fault("params", "expected an object");
 
   instance** grown = realloc(s->inst, (s->count + 1) * sizeof *grown);
-  if (!grown) return fault(f, "", "out of memory");
+  if (!grown) return fault("", "out of memory");
   s->inst = grown;
   instance* in = calloc(1, sizeof *in);
-  if (!in) return fault(f, "", "out of memory");
+  if (!in) return fault("", "out of memory");
   s->inst[s->count++] = in;
   strcpy(in->name, name);
   in->cls = cls;
@@ -103,7 +97,7 @@ int tx_system_add(tx_system* s, const char* name, const char* type, double rate_
   in->strings = json_array();
   in->setup = (tx_setup){s, in};
   in->ctx = (tx_ctx){s, in, 0, 0};
-  if (!in->used || !in->strings) return fault(f, "", "out of memory");
+  if (!in->used || !in->strings) return fault("", "out of memory");
 
   const char* key;
   json_t* value;
@@ -116,18 +110,18 @@ int tx_system_add(tx_system* s, const char* name, const char* type, double rate_
       snprintf(known + len, sizeof known - len, "%s%s", k ? ", " : "", cls->params[k].key);
     }
     snprintf(where, sizeof where, "params.%s", key);
-    return fault(f, where, "unknown parameter for %s (valid: %s)", type, cls->nparams ? known : "none");
+    return fault(where, "unknown parameter for %s (valid: %s)", type, cls->nparams ? known : "none");
   }
 
   int rc = cls->configure(&in->setup, &in->self);
   in->configured = true; // fini frees whatever configure made, even on failure
-  if (in->failed) return *f = in->fault, -1;
-  if (rc != 0) return fault(f, "", "controller '%s' (%s) failed to configure", name, type);
+  if (in->failed) return setup_fault(in);
+  if (rc != 0) return fault("", "controller '%s' (%s) failed to configure", name, type);
   // a view only reads: any write it declared is refused, by name
   if (cls->view)
     for (int p = 0; p < in->nports; p++)
       if (in->ports[p].write)
-        return fault(f, "type", "controller '%s' (%s) is a view and may not write '%s'", name, type, in->ports[p].name);
+        return fault("type", "controller '%s' (%s) is a view and may not write '%s'", name, type, in->ports[p].name);
   // without a table, every parameter in the scenario must be one configure asked for
   if (params && !cls->params) json_object_foreach(params, key, value) {
     if (json_object_get(in->used, key)) continue;
@@ -140,7 +134,7 @@ int tx_system_add(tx_system* s, const char* name, const char* type, double rate_
     }
     char where[128];
     snprintf(where, sizeof where, "params.%s", key);
-    return fault(f, where, "unknown parameter for %s (known: %s)", type, *known ? known : "none");
+    return fault(where, "unknown parameter for %s (known: %s)", type, *known ? known : "none");
   }
   return 0;
 }
@@ -149,7 +143,7 @@ bool tx_class_own_thread(const tx_controller_class* cls) {
   return cls->own_thread || strncmp(cls->type, "haptics", 7) == 0;
 }
 
-int tx_system_set_thread(tx_system* s, int i, const char* name, tx_fault* f) {
+int tx_system_set_thread(tx_system* s, int i, const char* name) {
   instance* in = s->inst[i];
   if (!name || !*name || strlen(name) >= TX_THREAD_NAME_MAX) goto bad;
   for (const char* c = name; *c; c++)
@@ -158,10 +152,10 @@ int tx_system_set_thread(tx_system* s, int i, const char* name, tx_fault* f) {
     const instance* o = s->inst[j];
     if (j == i || strcmp(o->thread_name, name) != 0) continue;
     if (o->rate_hz != in->rate_hz)
-      return fault(f, "thread", "'%s' runs %s at %g Hz; %s at %g Hz cannot share it (one thread, one rate)", name,
+      return fault("thread", "'%s' runs %s at %g Hz; %s at %g Hz cannot share it (one thread, one rate)", name,
                    o->name, o->rate_hz, in->name, in->rate_hz);
     if (tx_class_own_thread(o->cls) || tx_class_own_thread(in->cls))
-      return fault(f, "thread", "'%s' is the thread of %s (%s), which runs alone: %s cannot share it", name,
+      return fault("thread", "'%s' is the thread of %s (%s), which runs alone: %s cannot share it", name,
                    tx_class_own_thread(o->cls) ? o->name : in->name,
                    tx_class_own_thread(o->cls) ? o->cls->type : in->cls->type,
                    tx_class_own_thread(o->cls) ? in->name : o->name);
@@ -169,7 +163,7 @@ int tx_system_set_thread(tx_system* s, int i, const char* name, tx_fault* f) {
   snprintf(in->thread_name, sizeof in->thread_name, "%s", name);
   return 0;
 bad:
-  return fault(f, "thread", "'%s' must be 1-%d characters of a-z 0-9 _ -", name ? name : "", TX_THREAD_NAME_MAX - 1);
+  return fault("thread", "'%s' must be 1-%d characters of a-z 0-9 _ -", name ? name : "", TX_THREAD_NAME_MAX - 1);
 }
 
 static const tx_component_def* writer_def(const tx_system* s, const char* name, int* writer) {
@@ -187,7 +181,7 @@ static bool same_schema(const tx_component_def* a, const tx_component_def* b) {
 }
 
 // event streams: one emitter each, and every listen has an emitter
-static int check_streams(tx_system* s, tx_fault* f) {
+static int check_streams(tx_system* s) {
   for (int i = 0; i < s->count; i++) {
     instance* in = s->inst[i];
     for (int p = 0; p < in->nports; p++) {
@@ -197,7 +191,7 @@ static int check_streams(tx_system* s, tx_fault* f) {
       while (k < s->nstreams && strcmp(s->streams[k].name, pt->name) != 0) k++;
       if (k == s->nstreams) {
         sys_stream* grown = realloc(s->streams, (s->nstreams + 1) * sizeof *grown);
-        if (!grown) return fault(f, "", "out of memory");
+        if (!grown) return fault("", "out of memory");
         s->streams = grown;
         s->streams[s->nstreams++] = (sys_stream){.writer = -1};
         strcpy(s->streams[k].name, pt->name);
@@ -206,13 +200,13 @@ static int check_streams(tx_system* s, tx_fault* f) {
       pt->stream = k;
       if (pt->kind == PORT_EMIT) {
         if (st->writer >= 0)
-          return fault(f, in->name, "event stream '%s' has two writers: %s and %s", pt->name, s->inst[st->writer]->name,
+          return fault(in->name, "event stream '%s' has two writers: %s and %s", pt->name, s->inst[st->writer]->name,
                        in->name);
         st->writer = i;
         st->capacity = pt->capacity;
       } else {
         if (st->nreaders == TX_STREAM_READERS_MAX)
-          return fault(f, in->name, "event stream '%s' has more than %d listeners", pt->name, TX_STREAM_READERS_MAX);
+          return fault(in->name, "event stream '%s' has more than %d listeners", pt->name, TX_STREAM_READERS_MAX);
         pt->listener = st->nreaders;
         st->readers[st->nreaders++] = i;
       }
@@ -220,7 +214,7 @@ static int check_streams(tx_system* s, tx_fault* f) {
   }
   for (int k = 0; k < s->nstreams; k++)
     if (s->streams[k].writer < 0)
-      return fault(f, s->inst[s->streams[k].readers[0]]->name, "listens to event stream '%s', which no controller emits",
+      return fault(s->inst[s->streams[k].readers[0]]->name, "listens to event stream '%s', which no controller emits",
                    s->streams[k].name);
   return 0;
 }
@@ -310,9 +304,9 @@ static int build_threads(tx_system* s) {
   return 0;
 }
 
-int tx_system_finalize(tx_system* s, tx_fault* f) {
+int tx_system_finalize(tx_system* s) {
   if (s->model) return 0;
-  if (s->count == 0) return fault(f, "", "no controllers");
+  if (s->count == 0) return fault("", "no controllers");
   for (int d = 0; d < s->ndeclared; d++) {
     s->declared[d].name = s->declared_names[d];
     s->declared[d].units = s->declared_units[d];
@@ -325,10 +319,10 @@ int tx_system_finalize(tx_system* s, tx_fault* f) {
       int w = -1;
       writer_def(s, in->ports[p].name, &w);
       if (w != i)
-        return fault(f, in->name, "'%s' has two writers: %s and %s", in->ports[p].name, s->inst[w]->name, in->name);
+        return fault(in->name, "'%s' has two writers: %s and %s", in->ports[p].name, s->inst[w]->name, in->name);
       const tx_component_def* d = declared(s, in->ports[p].name);
       if (d && !same_schema(d, &in->ports[p].def))
-        return fault(f, in->name, "writes '%s' as %s %ux%u %s, but the model declares %s %ux%u %s", d->name,
+        return fault(in->name, "writes '%s' as %s %ux%u %s, but the model declares %s %ux%u %s", d->name,
                      tx_type_name(in->ports[p].def.type), in->ports[p].def.rows, in->ports[p].def.cols,
                      in->ports[p].def.units, tx_type_name(d->type), d->rows, d->cols, d->units);
     }
@@ -339,8 +333,8 @@ int tx_system_finalize(tx_system* s, tx_fault* f) {
     for (int p = 0; p < in->nports; p++) {
       const char* name = in->ports[p].name;
       if (in->ports[p].kind != PORT_COMPONENT || in->ports[p].write || writer_def(s, name, NULL)) continue;
-      if (declared(s, name)) return fault(f, in->name, "reads '%s', which no controller writes", name);
-      return fault(f, in->name, "reads unknown component '%s'", name);
+      if (declared(s, name)) return fault(in->name, "reads '%s', which no controller writes", name);
+      return fault(in->name, "reads unknown component '%s'", name);
     }
   }
   // a read that needs a schema gets it
@@ -352,36 +346,36 @@ int tx_system_finalize(tx_system* s, tx_fault* f) {
       int w = -1;
       const tx_component_def* d = writer_def(s, pt->name, &w);
       if ((pt->want_type && d->type != pt->want_type) || (pt->want_cols && d->cols != pt->want_cols))
-        return fault(f, in->name, "reads '%s' as %s x %u, but it is written as %s %ux%u", pt->name,
+        return fault(in->name, "reads '%s' as %s x %u, but it is written as %s %ux%u", pt->name,
                      pt->want_type ? tx_type_name(pt->want_type) : "any", pt->want_cols, tx_type_name(d->type), d->rows,
                      d->cols);
       if (*pt->want_units && strcmp(d->units, pt->want_units) != 0)
-        return fault(f, in->name, "%s reads '%s' in units \"%s\", but %s writes it in \"%s\"", in->name, pt->name,
+        return fault(in->name, "%s reads '%s' in units \"%s\", but %s writes it in \"%s\"", in->name, pt->name,
                      pt->want_units, s->inst[w]->name, d->units);
     }
   }
-  if (check_streams(s, f)) return -1;
+  if (check_streams(s)) return -1;
   // declared components need a writer too, or nothing could ever fill them
   for (int d = 0; d < s->ndeclared; d++)
     if (!writer_def(s, s->declared[d].name, NULL))
-      return fault(f, "", "model component '%s' has no writer", s->declared[d].name);
+      return fault("", "model component '%s' has no writer", s->declared[d].name);
 
   // every instance may misuse tx_write or tx_write_rows at run time: counted (context.c)
   for (int i = 0; i < s->count; i++) {
     instance* in = s->inst[i];
     in->bad_port = tx_setup_warning(&in->setup, "bad_port");
     in->rows_clamped = tx_setup_warning(&in->setup, "rows_clamped");
-    if (in->failed) return *f = in->fault, -1;
+    if (in->failed) return setup_fault(in);
   }
 
   s->model = tx_model_create();
-  if (!s->model) return fault(f, "", "out of memory");
+  if (!s->model) return fault("", "out of memory");
   for (int i = 0; i < s->count; i++)
     for (int p = 0; p < s->inst[i]->nports; p++) {
       port* pt = &s->inst[i]->ports[p];
       if (!pt->write) continue;
       pt->comp = tx_model_add(s->model, &pt->def);
-      if (!pt->comp.id) return fault(f, s->inst[i]->name, "%s", tx_error());
+      if (!pt->comp.id) return fault(s->inst[i]->name, "%s", tx_error());
     }
   for (int i = 0; i < s->count; i++)
     for (int p = 0; p < s->inst[i]->nports; p++) {
@@ -389,11 +383,11 @@ int tx_system_finalize(tx_system* s, tx_fault* f) {
       if (pt->write || pt->kind != PORT_COMPONENT) continue;
       pt->comp = tx_model_find(s->model, pt->name);
       pt->reader = tx_model_add_reader(s->model, pt->comp);
-      if (!pt->reader.id) return fault(f, s->inst[i]->name, "%s", tx_error());
+      if (!pt->reader.id) return fault(s->inst[i]->name, "%s", tx_error());
     }
-  if (!tx_model_commit(s->model)) return fault(f, "", "%s", tx_error());
-  if (build_groups(s) || build_threads(s)) return fault(f, "", "out of memory");
-  if (make_streams(s)) return fault(f, "", "%s", tx_error());
+  if (!tx_model_commit(s->model)) return fault("", "%s", tx_error());
+  if (build_groups(s) || build_threads(s)) return fault("", "out of memory");
+  if (make_streams(s)) return fault("", "%s", tx_error());
   return 0;
 }
 
@@ -440,18 +434,18 @@ bool tx_system_prepare_stats(tx_system* s, double duration_s) {
   return true;
 }
 
-int tx_system_run(tx_system* s, const tx_run_options* o, tx_run_result* r, char* err, size_t n) {
+int tx_system_run(tx_system* s, const tx_run_options* o, tx_run_result* r) {
   *r = (tx_run_result){0};
-  if (!s->model) return snprintf(err, n, "the system is not finalized"), -1;
+  if (!s->model) return tx_set_error("the system is not finalized"), -1;
   if (!(o->duration_s >= TX_DURATION_MIN_S && o->duration_s <= TX_DURATION_MAX_S))
-    return snprintf(err, n, "duration %g s is out of range [%g, %g]", o->duration_s, TX_DURATION_MIN_S, TX_DURATION_MAX_S), -1;
-  if (!tx_system_prepare_stats(s, o->duration_s)) return snprintf(err, n, "out of memory for statistics"), -1;
+    return tx_set_error("duration %g s is out of range [%g, %g]", o->duration_s, TX_DURATION_MIN_S, TX_DURATION_MAX_S), -1;
+  if (!tx_system_prepare_stats(s, o->duration_s)) return tx_set_error("out of memory for statistics"), -1;
   s->record_dir = o->record_dir;
   s->out_dir = o->out_dir;
   atomic_store(&s->halt, false);
   atomic_store(&s->halt_claim, 0);
   s->halt_reason[0] = 0;
-  int rc = o->lockstep ? tx_run_lockstep(s, o, r, err, n) : tx_run_realtime(s, o, r, err, n);
+  int rc = o->lockstep ? tx_run_lockstep(s, o, r) : tx_run_realtime(s, o, r);
   if (tx_system_halted(s)) {
     r->halted = true;
     snprintf(r->halt_reason, sizeof r->halt_reason, "%s", s->halt_reason);

@@ -24,13 +24,6 @@
 
 typedef struct tx_system tx_system;
 
-// where a configuration error is: a key relative to the instance
-// ("params.work_us", "rate_hz", "" for the instance as a whole) and a message
-typedef struct tx_fault {
-  char key[128];
-  char message[768]; // room for the valid keys of a large table
-} tx_fault;
-
 typedef struct tx_port_info {
   bool write;
   const char* component;          // name
@@ -94,20 +87,25 @@ const char* tx_json_kind(const json_t* v);
 tx_system* tx_system_create(void);
 void tx_system_destroy(tx_system* s); // runs fini for configured instances
 
+// Errors: each call that can fail returns -1 with the message in tx_error()
+// and the key it belongs to in tx_error_key() (model/error.h): for add and
+// declare a key relative to the instance ("params.work_us", "rate_hz", ""
+// for the instance as a whole), for finalize the name of the instance at fault.
+
 // a component that no controller creates itself (from the scenario's "model")
-int tx_system_declare(tx_system* s, const tx_component_def* def, tx_fault* f);
+int tx_system_declare(tx_system* s, const tx_component_def* def);
 // add and configure one instance; params is borrowed and may be NULL
-int tx_system_add(tx_system* s, const char* name, const char* type, double rate_hz, json_t* params, tx_fault* f);
+int tx_system_add(tx_system* s, const char* name, const char* type, double rate_hz, json_t* params);
 // run instance i (the last added) on the scenario's thread NAME: 1-31
 // characters of a-z 0-9 _ -, shared only by instances of the same rate, and
-// never by a haptics instance; f->key is "thread"
-int tx_system_set_thread(tx_system* s, int i, const char* name, tx_fault* f);
+// never by a haptics instance; the error's key is "thread"
+int tx_system_set_thread(tx_system* s, int i, const char* name);
 // a class that always runs on a thread of its own (own_thread, or a "haptics" type)
 bool tx_class_own_thread(const tx_controller_class* cls);
-// resolve reads, check writers, build and commit the model; f->key names the instance
-int tx_system_finalize(tx_system* s, tx_fault* f);
-// run; on failure (an init failed) returns -1 with a message in err
-int tx_system_run(tx_system* s, const tx_run_options* o, tx_run_result* r, char* err, size_t n);
+// resolve reads, check writers, build and commit the model; the error's key names the instance
+int tx_system_finalize(tx_system* s);
+// run; on failure (an init failed) returns -1 with the message in tx_error()
+int tx_system_run(tx_system* s, const tx_run_options* o, tx_run_result* r);
 
 // the registered classes in order of registration; NULL past the last
 const tx_controller_class* tx_controller_class_at(int i);

@@ -4,6 +4,8 @@
 
 #include "system.h"
 
+#include "../model/error.h"
+
 #include <tactus/events.h>
 
 #include <stdatomic.h>
@@ -64,7 +66,12 @@ struct instance {
   json_t* params;      // own reference, may be NULL
   json_t* used;        // keys configure asked for
   json_t* strings;     // keeps tx_param_str* results alive
-  tx_fault fault;      // first configuration error
+  // first configuration error (tx_setup_fail), kept apart from tx_error(),
+  // which later library calls in configure may overwrite
+  struct {
+    char key[128];
+    char message[1024];
+  } fault;
   bool failed;
   void* self;
   bool configured;
@@ -132,11 +139,11 @@ bool tx_system_prepare_stats(tx_system* s, double duration_s);
 // run one instance's step at sim_ns and publish what it wrote; returns its duration
 int64_t tx_instance_step(tx_system* s, instance* in, int64_t sim_ns);
 // run init of one instance; 0 or -1 with err filled
-int tx_instance_init(tx_system* s, instance* in, char* err, size_t n);
+int tx_instance_init(tx_system* s, instance* in); // -1 with tx_error()
 // after the last step of a run
 void tx_instance_finish(instance* in);
 
-int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r, char* err, size_t n);
-int tx_run_lockstep(tx_system* s, const tx_run_options* o, tx_run_result* r, char* err, size_t n);
+int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r);
+int tx_run_lockstep(tx_system* s, const tx_run_options* o, tx_run_result* r);
 
 #endif

@@ -1,19 +1,39 @@
-// Per-thread last error message, shared by every module.
+// Per-thread last error message and its key, shared by every module.
 #include "error.h"
 
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
-static _Thread_local char last_error[512];
+// room for the valid keys of a large parameter table, with the file in front
+static _Thread_local char last_error[1024];
+static _Thread_local char last_key[128];
 
 const char* tx_error(void) { return last_error; }
+const char* tx_error_key(void) { return last_key; }
 
 void tx_set_error(const char* fmt, ...) {
+  // the message may be built from tx_error() itself: format it apart first
+  char message[sizeof last_error];
   va_list ap;
   va_start(ap, fmt);
-  vsnprintf(last_error, sizeof last_error, fmt, ap);
+  vsnprintf(message, sizeof message, fmt, ap);
   va_end(ap);
+  memcpy(last_error, message, sizeof last_error);
+  last_key[0] = 0;
+}
+
+void tx_set_error_at(const char* key, const char* fmt, ...) {
+  // the message may be built from tx_error() or the key from tx_error_key()
+  char message[sizeof last_error];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(message, sizeof message, fmt, ap);
+  va_end(ap);
+  char k[sizeof last_key];
+  snprintf(k, sizeof k, "%s", key ? key : "");
+  memcpy(last_key, k, sizeof last_key);
+  memcpy(last_error, message, sizeof last_error);
 }
 
 void tx_error_prefix(const char* fmt, ...) {

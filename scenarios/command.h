@@ -18,6 +18,9 @@ int tx_cmd_export(int argc, char** argv);
 // a run replaying recordings ends with the longest of them (s); 0 when no
 // device replays or a --set gives duration_s
 double tx_replay_duration(const char* const* devices, int ndevices, const char* const* sets, int nsets);
+// a replay device's recording cut short (a killed run) plays its whole blocks:
+// one warning line each, once the scenario has taken them (devices print nothing)
+void tx_replay_warn(tx_system* sys);
 
 // the program name that starts every error line: "tactus" or "tactus-device"
 extern const char* tx_program;
@@ -26,7 +29,7 @@ int tx_bad_input(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 // parse a whole number string in [min, max]
 bool tx_parse_num(const char* s, double min, double max, double* out);
 // make the output folder (given, or out/STEM-TIMESTAMP) and check that it takes files
-int tx_out_dir(const char* given, const char* stem, char* dir, size_t n, char* err, size_t en);
+int tx_out_dir(const char* given, const char* stem, char* dir, size_t n);
 // a given --out that already holds files is refused (status 2, one line) unless force
 int tx_out_check(const char* given, bool force);
 
@@ -39,7 +42,7 @@ typedef struct tx_out {
   int nhad;
 } tx_out;
 // tx_out_dir, remembering; on failure nothing made is left
-int tx_out_open(tx_out* o, const char* given, const char* stem, char* err, size_t en);
+int tx_out_open(tx_out* o, const char* given, const char* stem);
 // true when nothing was added since tx_out_open
 bool tx_out_empty(const tx_out* o);
 // remove all that was added since tx_out_open (the folder too, if it was made), then close

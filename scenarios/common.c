@@ -1,6 +1,8 @@
 // What the subcommands share: errors, numbers, output folders, progress.
 #include "command.h"
 
+#include "../model/error.h"
+
 #include <dirent.h>
 #include <errno.h>
 #include <ftw.h>
@@ -85,7 +87,7 @@ int tx_out_check(const char* given, bool force) {
                       first, n > 1 ? ", ..." : "");
 }
 
-int tx_out_open(tx_out* o, const char* given, const char* stem, char* err, size_t en) {
+int tx_out_open(tx_out* o, const char* given, const char* stem) {
   *o = (tx_out){0};
   if (given) {
     snprintf(o->dir, sizeof o->dir, "%s", given);
@@ -97,7 +99,7 @@ int tx_out_open(tx_out* o, const char* given, const char* stem, char* err, size_
     for (int k = 2; access(o->dir, F_OK) == 0 && k < 100; k++) snprintf(o->dir, sizeof o->dir, "out/%s-%s-%d", stem, stamp, k);
   }
   if (make_dirs(o->dir, o->made, sizeof o->made) != 0) {
-    snprintf(err, en, "--out %s: %s", o->dir, strerror(errno));
+    tx_set_error("--out %s: %s", o->dir, strerror(errno));
     return tx_out_discard(o), -1;
   }
   // what it held before (with --force): a failed run removes only what it added
@@ -113,7 +115,7 @@ int tx_out_open(tx_out* o, const char* given, const char* stem, char* err, size_
   snprintf(probe, sizeof probe, "%s/.tactus-probe", o->dir);
   FILE* f = fopen(probe, "w");
   if (!f) {
-    snprintf(err, en, "--out %s: %s", o->dir, strerror(errno));
+    tx_set_error("--out %s: %s", o->dir, strerror(errno));
     return tx_out_discard(o), -1;
   }
   fclose(f);
@@ -163,9 +165,9 @@ bool tx_out_empty(const tx_out* o) {
   return added == 0;
 }
 
-int tx_out_dir(const char* given, const char* stem, char* dir, size_t n, char* err, size_t en) {
+int tx_out_dir(const char* given, const char* stem, char* dir, size_t n) {
   tx_out o;
-  if (tx_out_open(&o, given, stem, err, en)) return -1;
+  if (tx_out_open(&o, given, stem)) return -1;
   snprintf(dir, n, "%s", o.dir);
   tx_out_close(&o);
   return 0;
@@ -178,11 +180,11 @@ tx_scenario* tx_load_for_command(const char* name, const char* const* sets, int 
 
 tx_scenario* tx_load_for_command_view(const char* name, const char* const* sets, int nsets, const char* const* devices,
                                       int ndevices, const char* view, const char* stereo, bool lockstep) {
-  char path[PATH_MAX], err[1024];
-  if (tx_scenario_locate(name, path, sizeof path, err, sizeof err)) return tx_bad_input("%s", err), NULL;
+  char path[PATH_MAX];
+  if (tx_scenario_locate(name, path, sizeof path)) return tx_bad_input("%s", tx_error()), NULL;
   tx_load_options o = {sets, nsets, true, devices, ndevices, view, stereo, lockstep};
-  tx_scenario* s = tx_scenario_load(path, &o, err, sizeof err);
-  if (!s) tx_bad_input("%s", err);
+  tx_scenario* s = tx_scenario_load(path, &o);
+  if (!s) tx_bad_input("%s", tx_error());
   return s;
 }
 

@@ -30,11 +30,12 @@ typedef struct tx_load_options {
 
 // register the built-in controller classes (idempotent)
 void tx_register_builtin(void);
-// a scenario name from `tactus list`, or a path to a .json file, to a path
-int tx_scenario_locate(const char* name_or_path, char* path, size_t size, char* err, size_t n);
-tx_scenario* tx_scenario_load(const char* path, const tx_load_options* o, char* err, size_t n);
-tx_scenario* tx_scenario_load_text(const char* label, const char* text, size_t len, const tx_load_options* o, char* err,
-                                   size_t n);
+// a scenario name from `tactus list`, or a path to a .json file, to a path;
+// -1 with tx_error() when there is none
+int tx_scenario_locate(const char* name_or_path, char* path, size_t size);
+// NULL with the one-line message in tx_error()
+tx_scenario* tx_scenario_load(const char* path, const tx_load_options* o);
+tx_scenario* tx_scenario_load_text(const char* label, const char* text, size_t len, const tx_load_options* o);
 void tx_scenario_free(tx_scenario* s);
 
 // a file a scenario or study names (assets/needle/x.csv): as given when it is

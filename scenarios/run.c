@@ -44,7 +44,7 @@ static bool one_of(const char* s, const char* const* options) {
 static const char* signal_name(int sig) { return sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "a signal"; }
 
 int tx_run_scenario(tx_scenario* sc, const tx_run_config* cfg, json_t** report_out) {
-  char err[1024];
+  char err[1024]; // tx_error(), kept across the clean-up that follows a failure
   double duration = cfg->duration_s > 0 ? cfg->duration_s : sc->duration_s;
   // output is bounded: a lockstep trace that could pass the cap is refused before anything is written
   if (cfg->lockstep) {
@@ -55,10 +55,11 @@ int tx_run_scenario(tx_scenario* sc, const tx_run_config* cfg, json_t** report_o
                           sc->name, duration, bytes * 1e-9, TX_TRACE_MAX_BYTES / (1024.0 * 1024 * 1024));
   }
   tx_out out;
-  if (tx_out_open(&out, cfg->out, sc->name, err, sizeof err)) return tx_bad_input("%s", err);
+  if (tx_out_open(&out, cfg->out, sc->name)) return tx_bad_input("%s", tx_error());
   const char* dir = out.dir;
   // the report's room first: a run that fills the disk still leaves its report
-  if (tx_report_reserve(sc->system, dir, "report.json", err, sizeof err)) {
+  if (tx_report_reserve(sc->system, dir, "report.json")) {
+    snprintf(err, sizeof err, "%s", tx_error());
     tx_out_discard(&out);
     return tx_bad_input("--out %s", err);
   }
@@ -81,9 +82,10 @@ int tx_run_scenario(tx_scenario* sc, const tx_run_config* cfg, json_t** report_o
                       .record_dir = cfg->no_record ? NULL : dir, .out_dir = dir, .progress = tx_progress,
                       .progress_user = &duration};
   tx_run_result r;
-  int rc = tx_system_run(sc->system, &o, &r, err, sizeof err);
+  int rc = tx_system_run(sc->system, &o, &r);
   if (isatty(2)) fprintf(stderr, "\r%40s\r", "");
   if (rc) { // before the first step: nothing of this run is kept
+    snprintf(err, sizeof err, "%s", tx_error());
     if (trace) fclose(trace);
     // fini first, so that no controller writes into the folder after it is cleared
     tx_system_destroy(sc->system);
@@ -104,19 +106,20 @@ int tx_run_scenario(tx_scenario* sc, const tx_run_config* cfg, json_t** report_o
     if (*trace_err) remove(trace_tmp);
   }
   json_t* report = tx_report_json(&(tx_report){sc->name, cfg->lockstep, &r, sc->system});
-  if (!report || tx_report_save(report, dir, "report.json", err, sizeof err)) {
+  if (!report || tx_report_save(report, dir, "report.json")) {
+    snprintf(err, sizeof err, "%s", report ? tx_error() : "out of memory for the report");
     json_decref(report);
     tx_report_unreserve(dir, "report.json");
-    fprintf(stderr, "tactus: run %s: %s\n", sc->name, report ? err : "out of memory for the report");
+    fprintf(stderr, "tactus: run %s: %s\n", sc->name, err);
     return 1;
   }
   // force and position traces of every device recorded in this run; not after a fault, which may be the disk
   for (int hand = 0; hand < 2 && !cfg->no_record && !r.halted; hand++) {
-    char csv[4200], png[4200], perr[1024];
+    char csv[4200], png[4200];
     snprintf(csv, sizeof csv, "%s/device%d.csv", dir, hand);
     snprintf(png, sizeof png, "%s/device%d.png", dir, hand);
-    if (access(csv, R_OK) == 0 && tx_trace_plot_png(csv, png, perr, sizeof perr) != 0 && TX_WITH_PLPLOT)
-      fprintf(stderr, "tactus: %s\n", perr);
+    if (access(csv, R_OK) == 0 && tx_trace_plot_png(csv, png) != 0 && TX_WITH_PLPLOT)
+      fprintf(stderr, "tactus: %s\n", tx_error());
   }
   if (!cfg->quiet) {
     tx_report_print(stdout, report);
@@ -214,6 +217,7 @@ int tx_cmd_run(int argc, char** argv) {
 
   tx_scenario* sc = tx_load_for_command_view(cfg.scenario, sets, nsets, devices, ndevices, view, stereo_mode, cfg.lockstep);
   if (!sc) return TX_EXIT_BAD_INPUT;
+  tx_replay_warn(sc->system);
   int rc = tx_run_scenario(sc, &cfg, NULL);
   tx_scenario_free(sc);
   return rc;

@@ -58,16 +58,16 @@ static const tx_controller_class idle_class = {
 
 // run a one-controller scenario of bench.idle at rate_hz; returns its statistics
 static int run_idle(double rate_hz, const tx_run_options* o, tx_controller_stats* st, tx_run_result* r, double* wall_ns) {
-  char text[256], err[512];
+  char text[256];
   snprintf(text, sizeof text,
            "{\"name\":\"overhead\",\"controllers\":[{\"name\":\"idle\",\"type\":\"bench.idle\",\"rate_hz\":%g}]}",
            rate_hz);
-  tx_scenario* sc = tx_scenario_load_text("overhead", text, strlen(text), NULL, err, sizeof err);
-  if (!sc) return fprintf(stderr, "tactus: %s\n", err), 1;
+  tx_scenario* sc = tx_scenario_load_text("overhead", text, strlen(text), NULL);
+  if (!sc) return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   int64_t t0 = tx_mono_ns();
-  int rc = tx_system_run(sc->system, o, r, err, sizeof err);
+  int rc = tx_system_run(sc->system, o, r);
   *wall_ns = (double)(tx_mono_ns() - t0);
-  if (rc) fprintf(stderr, "tactus: %s\n", err);
+  if (rc) fprintf(stderr, "tactus: %s\n", tx_error());
   else *st = tx_system_stats(sc->system, 0);
   tx_scenario_free(sc);
   return rc ? 1 : 0;
@@ -278,7 +278,7 @@ static int bench_overhead(const bench_args* a) {
 
 // a wall at 60 Hz rendered by haptics at haptics_hz, with or without the rates scenario's load beside it
 static tx_scenario* haptics_scenario(double haptics_hz, bool loaded) {
-  char text[2048], err[512];
+  char text[2048];
   snprintf(text, sizeof text,
            "{\"name\":\"bench-haptics\",\"controllers\":["
            "{\"name\":\"wall\",\"type\":\"collision.wall\",\"rate_hz\":60},"
@@ -289,8 +289,8 @@ static tx_scenario* haptics_scenario(double haptics_hz, bool loaded) {
                     "{\"name\":\"collision\",\"type\":\"rates.worker\",\"rate_hz\":4000,\"params\":{\"work_us\":50}},"
                     "{\"name\":\"graphics\",\"type\":\"rates.worker\",\"rate_hz\":30,\"params\":{\"work_us\":5000}}"
                   : "");
-  tx_scenario* sc = tx_scenario_load_text("bench-haptics", text, strlen(text), NULL, err, sizeof err);
-  if (!sc) fprintf(stderr, "tactus: %s\n", err);
+  tx_scenario* sc = tx_scenario_load_text("bench-haptics", text, strlen(text), NULL);
+  if (!sc) fprintf(stderr, "tactus: %s\n", tx_error());
   return sc;
 }
 
@@ -299,9 +299,8 @@ static int run_haptics(double hz, bool loaded, double seconds, tx_controller_sta
   tx_scenario* sc = haptics_scenario(hz, loaded);
   if (!sc) return 1;
   tx_run_options o = {.duration_s = seconds, .realtime_priority = true, .pin_threads = true, .keep_cpus_awake = true};
-  char err[512];
-  int rc = tx_system_run(sc->system, &o, r, err, sizeof err);
-  if (rc) fprintf(stderr, "tactus: %s\n", err);
+  int rc = tx_system_run(sc->system, &o, r);
+  if (rc) fprintf(stderr, "tactus: %s\n", tx_error());
   for (int i = 0; rc == 0 && i < tx_system_count(sc->system); i++)
     if (strcmp(tx_system_name(sc->system, i), "haptics") == 0) *st = tx_system_stats(sc->system, i);
   tx_scenario_free(sc);

@@ -109,7 +109,7 @@ int tx_bench_cloth(double duration_s) {
   bench_bare = &b;
 
   // the framework's skin and the bare one at the same rate, the bare one first at every tick
-  char text[1024], err[512];
+  char text[1024];
   snprintf(text, sizeof text,
            "{\"name\":\"bench-cloth\",\"controllers\":["
            "{\"name\":\"hip\",\"type\":\"bench.hip_script\",\"rate_hz\":%g},"
@@ -117,10 +117,10 @@ int tx_bench_cloth(double duration_s) {
            "{\"name\":\"skin\",\"type\":\"physics.skin\",\"rate_hz\":%g,"
            "\"params\":{\"spacing_m\":%g,\"hip_radius_m\":%g}}]}",
            RATE_HZ, RATE_HZ, RATE_HZ, SPACING, HIP_RADIUS);
-  tx_scenario* sc = tx_scenario_load_text("bench-cloth", text, strlen(text), NULL, err, sizeof err);
+  tx_scenario* sc = tx_scenario_load_text("bench-cloth", text, strlen(text), NULL);
   int rc = 0;
   if (!sc) {
-    fprintf(stderr, "tactus: %s\n", err);
+    fprintf(stderr, "tactus: %s\n", tx_error());
     rc = 1;
   }
   printf("bench cloth: %d x %d = %d particles (0.1 cm), rupture at %g N/m over %g mm, %d XPBD iterations, HIP r = %g mm\n"
@@ -131,8 +131,8 @@ int tx_bench_cloth(double duration_s) {
   if (rc == 0) {
     tx_run_options o = {.duration_s = seconds, .lockstep = true};
     tx_run_result res;
-    if (tx_system_run(sc->system, &o, &res, err, sizeof err)) {
-      fprintf(stderr, "tactus: bench cloth: %s\n", err);
+    if (tx_system_run(sc->system, &o, &res)) {
+      fprintf(stderr, "tactus: bench cloth: %s\n", tx_error());
       rc = 1;
     }
     for (int i = 0; rc == 0 && i < tx_system_count(sc->system); i++)

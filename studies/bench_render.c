@@ -114,7 +114,7 @@ static double result(tx_system* s, const char* key) {
 }
 
 static int run_case(render_case* rc, const char* dir, double seconds) {
-  char text[2048], err[1024];
+  char text[2048];
   snprintf(text, sizeof text,
            "{\"name\":\"bench-render\",\"controllers\":["
            "{\"name\":\"skin\",\"type\":\"bench.skin\",\"rate_hz\":60,"
@@ -127,20 +127,20 @@ static int run_case(render_case* rc, const char* dir, double seconds) {
            "\"draw\":[{\"mesh\":\"skin\"},{\"spheres\":\"ball\"},{\"tool\":\"device0\",\"show_force\":true}]}}",
            rc->side, rc->spacing, rc->voxels);
   tx_load_options lo = {.view = "png", .stereo = rc->stereo};
-  tx_scenario* sc = tx_scenario_load_text("bench-render", text, strlen(text), &lo, err, sizeof err);
-  if (!sc) return fprintf(stderr, "tactus: %s\n", err), 1;
+  tx_scenario* sc = tx_scenario_load_text("bench-render", text, strlen(text), &lo);
+  if (!sc) return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   char sub[4300];
   snprintf(sub, sizeof sub, "%s/%s", dir, rc->name);
   char made[4400];
-  if (tx_out_dir(sub, "bench-render", made, sizeof made, err, sizeof err)) {
-    tx_scenario_free(sc);
-    return fprintf(stderr, "tactus: %s\n", err), 1;
+  if (tx_out_dir(sub, "bench-render", made, sizeof made)) {
+    fprintf(stderr, "tactus: %s\n", tx_error());
+    return tx_scenario_free(sc), 1;
   }
   tx_run_options o = {.duration_s = seconds, .realtime_priority = true, .pin_threads = true, .keep_cpus_awake = true,
                       .out_dir = made};
   tx_run_result r;
-  int failed = tx_system_run(sc->system, &o, &r, err, sizeof err);
-  if (failed) fprintf(stderr, "tactus: %s\n", err);
+  int failed = tx_system_run(sc->system, &o, &r);
+  if (failed) fprintf(stderr, "tactus: %s\n", tx_error());
   for (int i = 0; !failed && i < tx_system_count(sc->system); i++) {
     if (strcmp(tx_system_name(sc->system, i), "haptics") == 0) rc->haptics = tx_system_stats(sc->system, i);
     if (strcmp(tx_system_name(sc->system, i), "view") == 0) rc->view = tx_system_stats(sc->system, i);
@@ -161,8 +161,8 @@ static int run_case(render_case* rc, const char* dir, double seconds) {
 int tx_bench_render(const char* out, double duration_s) {
   const double seconds = duration_s > 0 ? duration_s : 5;
   if (!tx_find_controller(skin_class.type)) tx_register_controller(&skin_class);
-  char dir[4096], err[1024];
-  if (tx_out_dir(out, "bench-render", dir, sizeof dir, err, sizeof err)) return tx_bad_input("%s", err);
+  char dir[4096];
+  if (tx_out_dir(out, "bench-render", dir, sizeof dir)) return tx_bad_input("%s", tx_error());
   // the camera is the suturing-skin scenario's (the whole patch in view: the
   // cost is mostly per pixel, so a close-up costs more); its default skin (0.25 cm spacing: 42 x 42), the
   // journal paper's densest (0.1 cm: 102 x 102), and blocks of voxels

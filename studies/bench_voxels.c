@@ -31,9 +31,9 @@ static const double paper_b[4] = {3050.4, 1993.4, 1439.8, 1062.4};
 // the shipped needle-voxel scenario (its fitted tissue, 18-gauge needle and
 // scripted:insert) with the block resized and the recordings off
 static tx_scenario* scene(const int c[3]) {
-  char path[4096], err[512], sets[8][64];
-  if (tx_scenario_locate("needle-voxel", path, sizeof path, err, sizeof err)) {
-    fprintf(stderr, "tactus: %s\n", err);
+  char path[4096], sets[8][64];
+  if (tx_scenario_locate("needle-voxel", path, sizeof path)) {
+    fprintf(stderr, "tactus: %s\n", tx_error());
     return NULL;
   }
   static const char* const axis = "xyz";
@@ -46,8 +46,8 @@ static tx_scenario* scene(const int c[3]) {
   const char* list[8];
   for (int k = 0; k < 8; k++) list[k] = sets[k];
   tx_load_options o = {.sets = list, .nsets = 8};
-  tx_scenario* sc = tx_scenario_load(path, &o, err, sizeof err);
-  if (!sc) fprintf(stderr, "tactus: %s\n", err);
+  tx_scenario* sc = tx_scenario_load(path, &o);
+  if (!sc) fprintf(stderr, "tactus: %s\n", tx_error());
   return sc;
 }
 
@@ -56,9 +56,8 @@ static int run(const int c[3], double seconds, bool lockstep, tx_controller_stat
   if (!sc) return 1;
   tx_run_options o = {.duration_s = seconds, .lockstep = lockstep, .realtime_priority = !lockstep,
                       .pin_threads = !lockstep, .keep_cpus_awake = !lockstep};
-  char err[512];
-  int rc = tx_system_run(sc->system, &o, r, err, sizeof err);
-  if (rc) fprintf(stderr, "tactus: %s\n", err);
+  int rc = tx_system_run(sc->system, &o, r);
+  if (rc) fprintf(stderr, "tactus: %s\n", tx_error());
   else *st = tx_system_stats(sc->system, 0); // the needle
   tx_scenario_free(sc);
   return rc ? 1 : 0;

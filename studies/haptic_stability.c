@@ -53,8 +53,7 @@ static int apply(tx_wall_case* c, const tx_study_args* a, double* periods, int* 
   }
   for (int p = 0; p < *nperiods; p++) {
     c->device.period = periods[p];
-    const char* bad = tx_wall_case_check(c);
-    if (bad) return tx_bad_input("--set: %s", bad);
+    if (tx_wall_case_check(c)) return tx_bad_input("--set: %s", tx_error());
   }
   return 0;
 }
@@ -69,7 +68,7 @@ static double largest(tx_wall_case c, tx_wall_pc pc) {
 // a JSON number, or null for a ratio to a bound of 0 (JSON has no infinity)
 static json_t* num(double v) { return isfinite(v) ? json_real(v) : json_null(); }
 
-static int write_plot(const char* dir, const tx_wall_case* c, const row* rows, int n, char* err, size_t en) {
+static int write_plot(const char* dir, const tx_wall_case* c, const row* rows, int n) {
   enum { DENSE = 64 };
   double tx[DENSE], ty[DENSE], px[PERIODS_MAX], measured[PERIODS_MAX], spring[PERIODS_MAX], port[PERIODS_MAX];
   for (int i = 0; i < DENSE; i++) {
@@ -96,7 +95,7 @@ static int write_plot(const char* dir, const tx_wall_case* c, const row* rows, i
            c->device.mass, c->device.damping, c->damping);
   tx_plot p = {title, "servo period T (ms)", "largest stable stiffness K (N/m)", true, true, s, 5};
   snprintf(path, sizeof path, "%s/haptic-stability.png", dir);
-  return tx_plot_png(path, &p, err, en);
+  return tx_plot_png(path, &p);
 }
 
 int tx_study_haptic_stability(const tx_study_args* a) {
@@ -168,7 +167,6 @@ int tx_study_haptic_stability(const tx_study_args* a) {
                                            num(r->spring_pc / r->measured), "k_max_with_port_passivity_control",
                                            r->port_pc, "wall_damping", damping));
   }
-  char err[1024];
   if (fclose(csv) != 0 || rename(tmp, csv_path) != 0) return remove(tmp), fprintf(stderr, "tactus: %s: cannot write\n", csv_path), 1;
   json_t* doc = json_pack("{s:s,s:{s:f,s:f,s:f,s:f},s:f,s:s,s:s,s:o}", "study", "haptic-stability", "device", "mass_kg",
                           c.device.mass, "damping_n_s_m", c.device.damping, "quantum_m", c.device.quantum,
@@ -178,13 +176,13 @@ int tx_study_haptic_stability(const tx_study_args* a) {
                           "spring (the energy at the device port less what the wall's spring holds, plus what the "
                           "device's damping absorbed); port: the energy at the device port",
                           "cases", cases);
-  if (!doc || tx_report_save(doc, a->out_dir, "haptic-stability.json", err, sizeof err)) {
-    json_decref(doc);
-    return fprintf(stderr, "tactus: %s\n", err), 1;
+  if (!doc || tx_report_save(doc, a->out_dir, "haptic-stability.json")) {
+    fprintf(stderr, "tactus: %s\n", doc ? tx_error() : "out of memory");
+    return json_decref(doc), 1;
   }
   json_decref(doc);
-  bool plotted = write_plot(a->out_dir, &c, rows, n, err, sizeof err) == 0;
-  if (!plotted) fprintf(stderr, "tactus: %s\n", err);
+  bool plotted = write_plot(a->out_dir, &c, rows, n) == 0;
+  if (!plotted) fprintf(stderr, "tactus: %s\n", tx_error());
 
   // the exact boundary is what the simulation must find; Colgate's bound is
   // checked where it should hold, B = 0 (the first wall damping above); the

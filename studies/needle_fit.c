@@ -5,6 +5,7 @@
 #include "studies.h"
 
 #include "experiments/needle_fit.h"
+#include "../model/error.h"
 #include "../views/plot.h"
 #include "../views/report.h"
 #include "../scenarios/command.h"
@@ -64,15 +65,14 @@ static bool close_tmp(FILE* f, const char* path, const char* tmp) {
   return true;
 }
 
-static int write_plots(const char* dir, const tx_recording* rec, const double* model, const trace* tr, char* err,
-                       size_t en) {
+static int write_plots(const char* dir, const tx_recording* rec, const double* model, const trace* tr) {
   size_t n = rec->count;
   double* t = malloc(n * sizeof *t);
   double* fr = malloc(n * sizeof *fr);
   double* fm = malloc(n * sizeof *fm);
   if (!t || !fr || !fm) {
     free(t), free(fr), free(fm);
-    snprintf(err, en, "out of memory for the plot");
+    tx_set_error("out of memory for the plot");
     return -1;
   }
   for (size_t k = 0; k < n; k++) t[k] = rec->rows[k].t, fr[k] = rec->rows[k].f[1], fm[k] = model[3 * k + 1];
@@ -81,13 +81,13 @@ static int write_plots(const char* dir, const tx_recording* rec, const double* m
                false, false, s, 2};
   char path[4200];
   snprintf(path, sizeof path, "%s/needle-fit.png", dir);
-  int rc = tx_plot_png(path, &p, err, en);
+  int rc = tx_plot_png(path, &p);
   free(t), free(fr), free(fm);
   if (rc) return rc;
   tx_plot_series c[] = {{"best RMS so far", tr->seconds, tr->rms, tr->n, false, 1}};
   tx_plot q = {"Needle fit: RMS error against run time", "run time (s)", "RMS error (N)", false, true, c, 1};
   snprintf(path, sizeof path, "%s/needle-fit-rms.png", dir);
-  return tx_plot_png(path, &q, err, en);
+  return tx_plot_png(path, &q);
 }
 
 int tx_study_needle_fit(const tx_study_args* a) {
@@ -128,7 +128,7 @@ int tx_study_needle_fit(const tx_study_args* a) {
     free(model), tx_recording_free(&rec);
     return 1;
   }
-  char path[4200], tmp[4300], err[1024];
+  char path[4200], tmp[4300], rms_text[128];
   int status = 0;
   FILE* f = open_tmp(a->out_dir, "needle-fit.csv", path, tmp);
   if (!f) status = 1, fprintf(stderr, "tactus: %s: cannot write\n", path);
@@ -156,17 +156,17 @@ int tx_study_needle_fit(const tx_study_args* a) {
       "damping_ratio", p.damping_ratio, "radius_m", p.radius, "mass_kg", p.mass, "elasticity", p.elasticity,
       "damage_shrink", p.damage_shrink, "rupture_force_n", p.rupture_force, "cutting_force_n", p.cutting_force,
       "friction", p.friction, "target", "RMS <= 10% of the peak recorded force");
-  if (!status && (!doc || tx_report_save(doc, a->out_dir, "needle-fit.json", err, sizeof err)))
-    status = 1, fprintf(stderr, "tactus: %s\n", doc ? err : "out of memory");
+  if (!status && (!doc || tx_report_save(doc, a->out_dir, "needle-fit.json")))
+    status = 1, fprintf(stderr, "tactus: %s\n", doc ? tx_error() : "out of memory");
   json_decref(doc);
-  bool plotted = !status && write_plots(a->out_dir, &rec, model, &tr, err, sizeof err) == 0;
-  if (!status && !plotted) fprintf(stderr, "tactus: %s\n", err);
+  bool plotted = !status && write_plots(a->out_dir, &rec, model, &tr) == 0;
+  if (!status && !plotted) fprintf(stderr, "tactus: %s\n", tx_error());
   printf("\nfitted: k_s %.4g N/m, k_d %.4g N s/m (damping ratio %.3f), radius %.4g m, mass %.4g kg, e %.3f,\n"
          "        damage shrink %.3f, rupture %.4g N, cutting %.4g N, friction %.3f\n",
          p.spring, 2 * p.damping_ratio * sqrt(p.spring * p.mass), p.damping_ratio, p.radius, p.mass, p.elasticity,
          p.damage_shrink, p.rupture_force, p.cutting_force, p.friction);
   printf("\ntargets:\n  %-44s %-26s %-12s %s\n", "RMS error of the fitted model",
-         (snprintf(err, sizeof err, "%.4f N = %.2f%% of %.4f N", rms, 100 * rms / tr.peak, tr.peak), err),
+         (snprintf(rms_text, sizeof rms_text, "%.4f N = %.2f%% of %.4f N", rms, 100 * rms / tr.peak, tr.peak), rms_text),
          "<= 10% peak", met ? "met" : "MISSED");
   if (!status)
     printf("wrote %s/needle-fit.json, .csv, needle-fit-force.csv%s\n", a->out_dir,

@@ -50,12 +50,11 @@ int tx_study_needle_stability(const tx_study_args* a) {
   }
   printf("\n");
   for (int k = 0; k < TX_NEEDLE_STABILITY_CASES; k++) printf("  %-9s %s\n", r[k].name, r[k].what);
-  char err[1024];
   json_t* doc = json_pack("{s:s,s:o,s:s}", "study", "needle-stability", "cases", list, "bound",
                           "energy held <= 2 x the most net work the needle did, plus half k_s (1 nm)^2 per voxel");
-  if (!doc || tx_report_save(doc, a->out_dir, "needle-stability.json", err, sizeof err)) {
-    json_decref(doc);
-    return fprintf(stderr, "tactus: %s\n", err), 1;
+  if (!doc || tx_report_save(doc, a->out_dir, "needle-stability.json")) {
+    fprintf(stderr, "tactus: %s\n", doc ? tx_error() : "out of memory");
+    return json_decref(doc), 1;
   }
   json_decref(doc);
   printf("\ntargets:\n  %-44s %-26s %-12s %s\n", "no NaN out, none left, energy bounded", all ? "every case" : "not every case",

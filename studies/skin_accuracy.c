@@ -233,20 +233,19 @@ static int run_doc(json_t* doc, const char* label, double duration, double* cpu_
   char* text = doc ? json_dumps(doc, JSON_COMPACT) : NULL;
   json_decref(doc);
   if (!text) return fprintf(stderr, "tactus: skin-accuracy: out of memory\n"), 1;
-  char err[1024];
-  tx_scenario* sc = tx_scenario_load_text(label, text, strlen(text), NULL, err, sizeof err);
+  tx_scenario* sc = tx_scenario_load_text(label, text, strlen(text), NULL);
   free(text);
-  if (!sc) return fprintf(stderr, "tactus: %s\n", err), 1;
+  if (!sc) return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   tx_run_options o = {.duration_s = duration, .lockstep = true};
   tx_run_result res;
   int64_t t0 = tx_mono_ns();
   struct timespec c0, c1;
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
-  int rc = tx_system_run(sc->system, &o, &res, err, sizeof err);
+  int rc = tx_system_run(sc->system, &o, &res);
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
   *wall_s = (double)(tx_mono_ns() - t0) * 1e-9;
   *cpu_s = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec);
-  if (rc) fprintf(stderr, "tactus: %s\n", err);
+  if (rc) fprintf(stderr, "tactus: %s\n", tx_error());
   for (int k = 0; rc == 0 && torn && k < tx_system_results(sc->system); k++)
     if (strcmp(tx_system_result_key(sc->system, k), "skin.torn_links") == 0) *torn = (int)tx_system_result(sc->system, k);
   tx_scenario_free(sc);
@@ -279,7 +278,7 @@ static int run_setting(const setting* s, const char* device, double duration, do
   return rc;
 }
 
-static int write_plot(const char* dir, const setting* set, const row* rows, int nlev, char* err, size_t en) {
+static int write_plot(const char* dir, const setting* set, const row* rows, int nlev) {
   // one line per quantity along the path, and the real-time default as points.
   // A zero error (the finest level standing in for a reference that could not
   // be extrapolated, or a quantity that does not change) has no place on a log axis.
@@ -310,7 +309,7 @@ static int write_plot(const char* dir, const setting* set, const row* rows, int 
   snprintf(path, sizeof path, "%s/skin-accuracy.png", dir);
   tx_plot p = {"Skin error vs run time along the refinement path (zero errors not drawn)",
                "run time (CPU s per simulated s)", "error (% of the reference)", true, true, s, ns};
-  return tx_plot_png(path, &p, err, en);
+  return tx_plot_png(path, &p);
 }
 
 // the study's own --set keys
@@ -363,7 +362,7 @@ static void print_row(const setting* s, const row* r) {
 
 static int write_outputs(const char* dir, const setting* set, const row* rows, const curve* curves, int nset,
                          const tx_convergence* conv, const options* o, const char* motion) {
-  char path[4200], tmp[4300], err[1024];
+  char path[4200], tmp[4300];
   // one row per setting
   snprintf(path, sizeof path, "%s/skin-accuracy.csv", dir);
   snprintf(tmp, sizeof tmp, "%s.tmp", path);
@@ -429,9 +428,9 @@ static int write_outputs(const char* dir, const setting* set, const row* rows, c
       "(the finest level when the quantity does not converge: see status)",
       "run_time", "process CPU time of the pierce run (skin, HIP, haptics) per simulated second", "quantities",
       quantities, "settings", list);
-  if (!doc || tx_report_save(doc, dir, "skin-accuracy.json", err, sizeof err)) {
+  if (!doc || tx_report_save(doc, dir, "skin-accuracy.json")) {
     json_decref(doc);
-    return fprintf(stderr, "tactus: %s\n", doc ? err : "skin-accuracy: out of memory"), 1;
+    return fprintf(stderr, "tactus: %s\n", doc ? tx_error() : "skin-accuracy: out of memory"), 1;
   }
   json_decref(doc);
   return 0;
@@ -497,9 +496,8 @@ int tx_study_skin_accuracy(const tx_study_args* a) {
     rc = write_outputs(a->out_dir, set, rows, curves, nset, conv, &o, motion->name);
   }
   if (rc == 0) {
-    char err[1024];
-    bool plotted = write_plot(a->out_dir, set, rows, nlev, err, sizeof err) == 0;
-    if (!plotted) fprintf(stderr, "tactus: %s\n", err);
+    bool plotted = write_plot(a->out_dir, set, rows, nlev) == 0;
+    if (!plotted) fprintf(stderr, "tactus: %s\n", tx_error());
     bool all = true;
     for (int k = 0; k < NQ; k++) all &= conv[k].monotone;
     printf("\n%s\nwrote %s/skin-accuracy.json, .csv, skin-accuracy-curves.csv%s\n",

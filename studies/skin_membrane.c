@@ -47,7 +47,7 @@ int tx_study_skin_membrane(const tx_study_args* a) {
   printf("study skin-membrane: the cloth against closed-form membranes, converged solver (k w h^2 = 1/4, 4 iterations)%s\n\n",
          quick ? ", quick" : "");
 
-  char csv_path[4200], tmp[4300], err[1024];
+  char csv_path[4200], tmp[4300];
   snprintf(csv_path, sizeof csv_path, "%s/skin-membrane.csv", a->out_dir);
   snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
   FILE* csv = fopen(tmp, "w");
@@ -147,9 +147,9 @@ int tx_study_skin_membrane(const tx_study_args* a) {
   json_t* doc = json_pack("{s:s,s:b,s:s,s:o,s:{s:o,s:b},s:o,s:b}", "study", "skin-membrane", "quick", quick, "solver",
                           "XPBD, substep with k w h^2 = 1/4, 4 iterations", "checks", checks, "rupture", "levels", rup,
                           "converged_within_10_percent", converged, "gravity", grav, "all_met", all);
-  if (!doc || tx_report_save(doc, a->out_dir, "skin-membrane.json", err, sizeof err)) {
+  if (!doc || tx_report_save(doc, a->out_dir, "skin-membrane.json")) {
     json_decref(doc);
-    return fprintf(stderr, "tactus: %s\n", err), 1;
+    return fprintf(stderr, "tactus: %s\n", doc ? tx_error() : "skin-membrane: out of memory"), 1;
   }
   json_decref(doc);
 
@@ -159,8 +159,8 @@ int tx_study_skin_membrane(const tx_study_args* a) {
   tx_plot_series s[] = {{"disc load", x[0], y[0], nlevels, true, 1}, {"own weight", x[1], y[1], nlevels, true, 2}};
   tx_plot p = {"Skin membrane against the closed forms", "particle spacing (" TX_PLOT_LENGTH_UNIT ")",
                "error of the centre deflection (%)", true, true, s, 2};
-  bool plotted = tx_plot_png(png, &p, err, sizeof err) == 0;
-  if (!plotted) fprintf(stderr, "tactus: %s\n", err);
+  bool plotted = tx_plot_png(png, &p) == 0;
+  if (!plotted) fprintf(stderr, "tactus: %s\n", tx_error());
   printf("%s\nwrote %s/skin-membrane.json, .csv%s\n", all ? "all targets met" : "some targets MISSED", a->out_dir,
          plotted ? ", .png" : "");
   return 0;

@@ -20,6 +20,7 @@
 #include "studies.h"
 #include "skin_metrics.h"
 
+#include "../model/error.h"
 #include "../scenarios/command.h"
 #include "../controllers/haptics/device_scripted.h"
 #include "../scenarios/run.h"
@@ -213,12 +214,12 @@ static void label_in_plot_unit(const char* in, char* out, size_t n) {
 
 // EXPERIMENT.csv and EXPERIMENT.png from the cases [first, last)
 static int write_experiment(const char* dir, const char* name, run_data* const runs[][NCASES], const char* const* modes,
-                            int nmodes, int first, int last, char* err, size_t en) {
+                            int nmodes, int first, int last) {
   char path[4300], tmp[4400];
   snprintf(path, sizeof path, "%s/%s.csv", dir, name);
   snprintf(tmp, sizeof tmp, "%s.tmp", path);
   FILE* f = fopen(tmp, "w");
-  if (!f) return snprintf(err, en, "%.900s: cannot be written", path), -1;
+  if (!f) return tx_set_error("%s: cannot be written", path), -1;
   fprintf(f, "mode,case,t_s,x_m,y_m,z_m,fx_n,fy_n,fz_n,contacts,pierced,torn\n");
   for (int m = 0; m < nmodes; m++)
     for (int c = first; c < last; c++) {
@@ -228,7 +229,7 @@ static int write_experiment(const char* dir, const char* name, run_data* const r
                 d->pos[0][i], d->pos[1][i], d->pos[2][i], d->f[0][i], d->f[1][i], d->f[2][i], d->contacts[i],
                 d->pierced[i], d->torn[i]);
     }
-  if (fclose(f) != 0 || rename(tmp, path) != 0) return remove(tmp), snprintf(err, en, "%.900s: cannot be written", path), -1;
+  if (fclose(f) != 0 || rename(tmp, path) != 0) return remove(tmp), tx_set_error("%s: cannot be written", path), -1;
   // force against position: along y for piercing; for sliding the tangential force along the slide
   // with two modes each case is drawn twice, its label led by the mode
   tx_plot_series s[8];
@@ -278,9 +279,9 @@ static int write_experiment(const char* dir, const char* name, run_data* const r
   snprintf(path, sizeof path, "%s/%s.png", dir, name);
   if (np == 1) {
     snprintf(titles[0], sizeof titles[0], "skin-paper: %s", name);
-    return tx_plot_png(path, &panels[0], err, en);
+    return tx_plot_png(path, &panels[0]);
   }
-  return tx_plot_png_panels(path, panels, np, 2, err, en);
+  return tx_plot_png_panels(path, panels, np, 2);
 }
 
 // ---------------------------------------------------------------------------
@@ -419,7 +420,7 @@ static int parse_modes(const tx_study_args* a, bool has_param, bool* ran) {
 }
 
 int tx_study_skin_paper(const tx_study_args* a) {
-  char motions_dir[4200], runs_dir[4200], err[1024];
+  char motions_dir[4200], runs_dir[4200];
   bool has_param = class_has_param("collision.hip", "force_mode"), ran[MODES_MAX];
   int bad = parse_modes(a, has_param, ran);
   if (bad) return bad;
@@ -474,9 +475,9 @@ int tx_study_skin_paper(const tx_study_args* a) {
     for (int i = 0; i < NCASES && !rc;) {
       int j = i;
       while (j < NCASES && strcmp(cases[j].experiment, cases[i].experiment) == 0) j++;
-      if (write_experiment(a->out_dir, cases[i].experiment, runs, modes, nmodes, i, j, err, sizeof err)) {
-        fprintf(stderr, "tactus: %s\n", err);
-        if (strstr(err, ".csv")) rc = 1; // a missing plot (no PLplot) leaves the CSV
+      if (write_experiment(a->out_dir, cases[i].experiment, runs, modes, nmodes, i, j)) {
+        fprintf(stderr, "tactus: %s\n", tx_error());
+        if (strstr(tx_error(), ".csv")) rc = 1; // a missing plot (no PLplot) leaves the CSV
       }
       i = j;
     }
@@ -558,8 +559,8 @@ int tx_study_skin_paper(const tx_study_args* a) {
         "largest change of the top-down pierce's force before rupture, over its peak, with stretch_stiffness x1000; "
         "0: the force is a fixed function of the HIP's displacement",
         "change", probe, "findings", flist, "cases", list);
-    if (!doc || tx_report_save(doc, a->out_dir, "skin-paper.json", err, sizeof err))
-      return json_decref(doc), fprintf(stderr, "tactus: %s\n", err), 1;
+    if (!doc || tx_report_save(doc, a->out_dir, "skin-paper.json"))
+      return json_decref(doc), fprintf(stderr, "tactus: %s\n", doc ? tx_error() : "skin-paper: out of memory"), 1;
     json_decref(doc);
   }
   if (!rc) {

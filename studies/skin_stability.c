@@ -12,6 +12,7 @@
 #include "skin_stability.h"
 #include "studies.h"
 
+#include "../model/error.h"
 #include "../scenarios/command.h"
 #include "../views/report.h"
 
@@ -165,14 +166,13 @@ static double result(tx_system* s, const char* key) {
   return NAN;
 }
 
-int tx_skin_stability_run(const tx_skin_stability_case* c, const char* dir, tx_skin_stability_row* row, char* err,
-                          int en) {
+int tx_skin_stability_run(const tx_skin_stability_case* c, const char* dir, tx_skin_stability_row* row) {
   memset(row, 0, sizeof *row);
   const motion* m = find_motion(c->motion);
-  if (!m) return snprintf(err, (size_t)en, "skin-stability: no motion '%s'", c->motion), -1;
+  if (!m) return tx_set_error("skin-stability: no motion '%s'", c->motion), -1;
   char path[4200];
   snprintf(path, sizeof path, "%s/motion-%s.csv", dir, m->name);
-  if (write_motion(m, path)) return snprintf(err, (size_t)en, "%s: cannot be written", path), -1;
+  if (write_motion(m, path)) return tx_set_error("%s: cannot be written", path), -1;
   if (!tx_find_controller(guard_class.type)) tx_register_controller(&guard_class);
 
   // the scenario, built as JSON so that any folder name is quoted right
@@ -191,16 +191,14 @@ int tx_skin_stability_run(const tx_skin_stability_case* c, const char* dir, tx_s
       "name", "guard", "type", "study.skin_guard", "rate_hz", 1000.0);
   char* text = doc ? json_dumps(doc, JSON_COMPACT) : NULL;
   json_decref(doc);
-  if (!text) return snprintf(err, (size_t)en, "skin-stability: out of memory"), -1;
-  char lerr[1024];
-  tx_scenario* sc = tx_scenario_load_text("skin-stability", text, strlen(text), NULL, lerr, sizeof lerr);
+  if (!text) return tx_set_error("skin-stability: out of memory"), -1;
+  tx_scenario* sc = tx_scenario_load_text("skin-stability", text, strlen(text), NULL);
   free(text);
-  if (!sc) return snprintf(err, (size_t)en, "%s", lerr), -1;
+  if (!sc) return -1;
   tx_run_options o = {.duration_s = m->duration, .lockstep = true};
   tx_run_result r;
-  int rc = tx_system_run(sc->system, &o, &r, lerr, sizeof lerr);
+  int rc = tx_system_run(sc->system, &o, &r);
   if (rc) {
-    snprintf(err, (size_t)en, "%s", lerr);
     tx_scenario_free(sc);
     return -1;
   }
@@ -246,7 +244,7 @@ int tx_study_skin_stability(const tx_study_args* a) {
   printf("  %-26s %6s %6s %6s %5s %10s %11s %8s  %-9s\n", "case", "steps", "faults", "torn", "NaN", "max |F| N",
          "max |F0| N", "clamped", "outcome");
   json_t* list = json_array();
-  char csv_path[4200], tmp[4300], err[1024];
+  char csv_path[4200], tmp[4300];
   snprintf(csv_path, sizeof csv_path, "%s/skin-stability.csv", a->out_dir);
   snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
   FILE* csv = fopen(tmp, "w");
@@ -256,11 +254,11 @@ int tx_study_skin_stability(const tx_study_args* a) {
   int failed = 0;
   for (int i = 0; i < n; i++) {
     tx_skin_stability_row r;
-    if (tx_skin_stability_run(&cs[i], a->out_dir, &r, err, sizeof err)) {
+    if (tx_skin_stability_run(&cs[i], a->out_dir, &r)) {
       fclose(csv);
       remove(tmp);
       json_decref(list);
-      return fprintf(stderr, "tactus: %s\n", err), 1;
+      return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
     }
     failed += !r.ok;
     printf("  %-26s %6d %6d %6d %5ld %10.4f %11.4f %8ld  %-9s %s\n", cs[i].name, r.skin_steps, r.faults, r.torn,
@@ -283,9 +281,9 @@ int tx_study_skin_stability(const tx_study_args* a) {
   }
   json_t* doc = json_pack("{s:s,s:f,s:s,s:o}", "study", "skin-stability", "clamp_n", TX_SKIN_STABILITY_CLAMP_N,
                           "units", "stiffness as a factor on 2000 N/m stretch and 20 N/m bend; s, m, N", "cases", list);
-  if (!doc || tx_report_save(doc, a->out_dir, "skin-stability.json", err, sizeof err)) {
+  if (!doc || tx_report_save(doc, a->out_dir, "skin-stability.json")) {
     json_decref(doc);
-    return fprintf(stderr, "tactus: %s\n", err), 1;
+    return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   }
   json_decref(doc);
   printf("\ntargets:\n  every case stable or recovered, no NaN in the model, |F| <= %.1f N: %s (%d of %d failed)\n",

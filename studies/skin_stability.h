@@ -33,8 +33,7 @@ typedef struct tx_skin_stability_row {
 
 // the study's cases, in order
 int tx_skin_stability_cases(const tx_skin_stability_case** cases);
-// runs one case with its scripted hand written into dir; 0, or -1 with err set
-int tx_skin_stability_run(const tx_skin_stability_case* c, const char* dir, tx_skin_stability_row* row, char* err,
-                          int en);
+// runs one case with its scripted hand written into dir; 0, or -1 (and tx_error())
+int tx_skin_stability_run(const tx_skin_stability_case* c, const char* dir, tx_skin_stability_row* row);
 
 #endif

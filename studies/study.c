@@ -70,11 +70,11 @@ int tx_cmd_study(int argc, char** argv) {
     const char* file = optind == argc - 2 ? argv[optind + 1] : NULL;
     if (takes_file(studies[i].name) && !file) return tx_bad_input("study %s: expected a FILE after the name", studies[i].name);
     if (!takes_file(studies[i].name) && file) return tx_bad_input("study %s: unexpected argument '%s'", studies[i].name, file);
-    char path[PATH_MAX], err[1024];
+    char path[PATH_MAX];
     if (file && tx_asset_locate(file, path, sizeof path) == 0) file = path;
     if (tx_out_check(out, force)) return TX_EXIT_BAD_INPUT;
     tx_out o;
-    if (tx_out_open(&o, out, studies[i].name, err, sizeof err)) return tx_bad_input("%s", err);
+    if (tx_out_open(&o, out, studies[i].name)) return tx_bad_input("%s", tx_error());
     tx_study_args a = {o.dir, sets, nsets, file};
     int rc = studies[i].run(&a);
     // bad input keeps nothing; a failed study keeps what it wrote, but never an empty folder

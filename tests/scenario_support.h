@@ -11,8 +11,7 @@
 static inline void run(tx_scenario* s, double seconds) {
   tx_run_options o = {.duration_s = seconds, .lockstep = true};
   tx_run_result r;
-  char err[256];
-  assert_int_equal(tx_system_run(s->system, &o, &r, err, sizeof err), 0);
+  assert_int_equal(tx_system_run(s->system, &o, &r), 0);
 }
 
 // the latest publish of a component; a name the model lacks fails the test

@@ -98,12 +98,12 @@ static void finish(tx_ctx* ctx, void* self) {
   tx_set_result(ctx, c->r_samples, (double)c->n);
   const char* dir = tx_record_dir(ctx);
   if (!dir || c->n == 0) return;
-  char path[4200], tmp[4300], err[512];
+  char path[4200], tmp[4300];
   snprintf(path, sizeof path, "%s/%s.csv", dir, c->file);
   snprintf(tmp, sizeof tmp, "%s.tmp", path);
   FILE* f = fopen(tmp, "w"); // written aside, renamed once whole
   if (!f) {
-    fprintf(stderr, "tactus: %s: cannot be written\n", path);
+    tx_stop_run(ctx, "%s: cannot be written", path); // the run fails: its data would be lost
     return;
   }
   fprintf(f, "t_s,x_m,y_m,z_m,fx_n,fy_n,fz_n,contacts,pierced,torn,skin_t_s\n");
@@ -114,7 +114,7 @@ static void finish(tx_ctx* ctx, void* self) {
   }
   if (fclose(f) != 0 || rename(tmp, path) != 0) {
     remove(tmp);
-    fprintf(stderr, "tactus: %s: cannot be written\n", path);
+    tx_stop_run(ctx, "%s: cannot be written", path);
     return;
   }
   if (!c->png) return;
@@ -123,6 +123,7 @@ static void finish(tx_ctx* ctx, void* self) {
   double* ys = malloc(sizeof(double) * c->n);
   if (!xs || !ys) {
     free(xs), free(ys);
+    tx_stop_run(ctx, "%s.png: out of memory", c->file);
     return;
   }
   for (uint64_t i = 0; i < c->n; i++) {
@@ -135,7 +136,7 @@ static void finish(tx_ctx* ctx, void* self) {
   tx_plot_series s = {"force", xs, ys, (int)(c->n > 2147483647u ? 2147483647u : c->n), false, 1};
   tx_plot p = {"force against displacement", xl, yl, false, false, &s, 1};
   snprintf(path, sizeof path, "%s/%s.png", dir, c->file);
-  if (tx_plot_png(path, &p, err, sizeof err)) fprintf(stderr, "tactus: %s\n", err);
+  if (tx_plot_png(path, &p)) tx_stop_run(ctx, "%s", tx_error());
   free(xs);
   free(ys);
 }

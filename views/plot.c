@@ -1,6 +1,8 @@
 // PNG line plots through PLplot's pngcairo driver.
 #include "plot.h"
 
+#include "../model/error.h"
+
 #include <tactus/config.h>
 
 #include <math.h>
@@ -187,10 +189,10 @@ static void panel(const tx_plot* p, double label_gap) {
            colors, styles, widths, colors, scales, symbol_numbers, symbols);
 }
 
-static int render(const char* path, const tx_plot* panels, int count, int columns, int pw, int ph, char* err, size_t n) {
-  if (count < 1 || columns < 1) return snprintf(err, n, "%s: no panels", path), -1;
+static int render(const char* path, const tx_plot* panels, int count, int columns, int pw, int ph) {
+  if (count < 1 || columns < 1) return tx_set_error("%s: no panels", path), -1;
   FILE* probe = fopen(path, "wb"); // PLplot reports a bad path on stderr only
-  if (!probe) return snprintf(err, n, "%s: cannot be written", path), -1;
+  if (!probe) return tx_set_error("%s: cannot be written", path), -1;
   fclose(probe);
   int cols = count < columns ? count : columns, rows = (count + cols - 1) / cols;
   char geometry[32];
@@ -209,18 +211,18 @@ static int render(const char* path, const tx_plot* panels, int count, int column
   return 0;
 }
 
-int tx_plot_png(const char* path, const tx_plot* p, char* err, size_t n) { return render(path, p, 1, 1, 800, 600, err, n); }
+int tx_plot_png(const char* path, const tx_plot* p) { return render(path, p, 1, 1, 800, 600); }
 
-int tx_plot_png_panels(const char* path, const tx_plot* panels, int count, int columns, char* err, size_t n) {
-  return render(path, panels, count, columns, 640, 480, err, n);
+int tx_plot_png_panels(const char* path, const tx_plot* panels, int count, int columns) {
+  return render(path, panels, count, columns, 640, 480);
 }
 #else
-int tx_plot_png(const char* path, const tx_plot* p, char* err, size_t n) {
+int tx_plot_png(const char* path, const tx_plot* p) {
   (void)p;
-  return snprintf(err, n, "%s: not written: this build has no PLplot (TX_WITH_PLPLOT=OFF)", path), -1;
+  return tx_set_error("%s: not written: this build has no PLplot (TX_WITH_PLPLOT=OFF)", path), -1;
 }
-int tx_plot_png_panels(const char* path, const tx_plot* panels, int count, int columns, char* err, size_t n) {
+int tx_plot_png_panels(const char* path, const tx_plot* panels, int count, int columns) {
   (void)panels, (void)count, (void)columns;
-  return snprintf(err, n, "%s: not written: this build has no PLplot (TX_WITH_PLPLOT=OFF)", path), -1;
+  return tx_set_error("%s: not written: this build has no PLplot (TX_WITH_PLPLOT=OFF)", path), -1;
 }
 #endif

@@ -7,7 +7,7 @@
 //
 //     tx_plot_series s[] = {{"r = 0.05 cm", x, f, n, false, 1}, {"r = 0.1 cm", x2, f2, n2, false, 2}};
 //     tx_plot p = {"(a) piercing", "HIP displacement y (mm)", "force F_y (N)", false, false, s, 2};
-//     tx_plot_png("force.png", &p, err, sizeof err);
+//     if (tx_plot_png("force.png", &p)) ... tx_error() says why
 #ifndef TX_VIEWS_PLOT_H
 #define TX_VIEWS_PLOT_H
 
@@ -46,10 +46,10 @@ typedef struct tx_plot {
   int nseries;
 } tx_plot;
 
-// one panel, 800 x 600 px; 0, or -1 with a message
-int tx_plot_png(const char* path, const tx_plot* p, char* err, size_t n);
-// n panels in rows of `columns`, each 640 x 480 px, one legend per panel; 0, or -1 with a message
-int tx_plot_png_panels(const char* path, const tx_plot* panels, int count, int columns, char* err, size_t n);
+// one panel, 800 x 600 px; 0, or -1 with the message in tx_error()
+int tx_plot_png(const char* path, const tx_plot* p);
+// n panels in rows of `columns`, each 640 x 480 px, one legend per panel; 0, or -1 with the message in tx_error()
+int tx_plot_png_panels(const char* path, const tx_plot* panels, int count, int columns);
 // the palette as RGB 0-255 (index 1-15), for anything drawn to match; every
 // colour has at least 3:1 contrast against the white background
 void tx_plot_color(int index, int rgb[3]);

@@ -1,6 +1,8 @@
 // The run report: per-controller rates, jitter and step times, and warnings.
 #include "report.h"
 
+#include "../model/error.h"
+
 #include <errno.h>
 #include <fcntl.h>
 #include <stdlib.h>
@@ -92,7 +94,7 @@ static long report_bytes(tx_system* s) {
          512L * tx_system_streams(s) + 256L * readers;
 }
 
-int tx_report_reserve(tx_system* s, const char* dir, const char* name, char* err, size_t n) {
+int tx_report_reserve(tx_system* s, const char* dir, const char* name) {
   char tmp[4200];
   snprintf(tmp, sizeof tmp, "%s/%s.tmp", dir, name);
   FILE* f = fopen(tmp, "w");
@@ -100,7 +102,7 @@ int tx_report_reserve(tx_system* s, const char* dir, const char* name, char* err
   if (f && fclose(f) != 0 && !rc) rc = errno;
   if (rc == EOPNOTSUPP || rc == ENOSYS || rc == EINVAL) rc = 0; // a file system without it: no reservation, no fault
   if (rc) {
-    snprintf(err, n, "%s: %s", tmp, strerror(rc));
+    tx_set_error("%s: %s", tmp, strerror(rc));
     remove(tmp);
     return -1;
   }
@@ -113,12 +115,12 @@ void tx_report_unreserve(const char* dir, const char* name) {
   remove(tmp);
 }
 
-int tx_report_save(const json_t* json, const char* dir, const char* name, char* err, size_t n) {
+int tx_report_save(const json_t* json, const char* dir, const char* name) {
   char path[4096], tmp[4200];
   snprintf(path, sizeof path, "%s/%s", dir, name);
   snprintf(tmp, sizeof tmp, "%s.tmp", path);
   char* text = json_dumps(json, JSON_INDENT(2) | JSON_REAL_PRECISION(10));
-  if (!text) return snprintf(err, n, "%s: out of memory", path), -1;
+  if (!text) return tx_set_error("%s: out of memory", path), -1;
   size_t len = strlen(text);
   // into the space tx_report_reserve set aside, if any: a full disk still takes the report
   FILE* f = fopen(tmp, "r+");
@@ -130,7 +132,7 @@ int tx_report_save(const json_t* json, const char* dir, const char* name, char* 
   free(text);
   if (!ok || rename(tmp, path) != 0) {
     if (ok) e = errno;
-    snprintf(err, n, "%s: %s", path, strerror(e ? e : EIO));
+    tx_set_error("%s: %s", path, strerror(e ? e : EIO));
     remove(tmp);
     return -1;
   }

@@ -16,11 +16,11 @@ typedef struct tx_report {
 // the report as JSON (new reference): scenario, mode, duration_s, controllers, warnings, scheduler
 json_t* tx_report_json(const tx_report* r);
 // write json to DIR/NAME through a temporary file, so that it is whole or absent
-int tx_report_save(const json_t* json, const char* dir, const char* name, char* err, size_t n);
+int tx_report_save(const json_t* json, const char* dir, const char* name);
 // set aside room for the report of s in DIR/NAME.tmp before a run, so that a
 // disk the run fills still takes it (tx_report_save writes there); fails when
 // the disk cannot hold even that
-int tx_report_reserve(tx_system* s, const char* dir, const char* name, char* err, size_t n);
+int tx_report_reserve(tx_system* s, const char* dir, const char* name);
 // give the room back, for a run that writes no report
 void tx_report_unreserve(const char* dir, const char* name);
 // the summary table of a report made by tx_report_json

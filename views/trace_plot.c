@@ -1,5 +1,7 @@
 // Device traces: CSV columns by name, three PLplot panels.
 #include "trace_plot.h"
+
+#include "../model/error.h"
 #include "plot.h"
 
 #include <errno.h>
@@ -14,10 +16,10 @@ void tx_trace_free(tx_trace* t) {
   *t = (tx_trace){0};
 }
 
-int tx_trace_load(const char* csv, tx_trace* t, char* err, size_t n) {
+int tx_trace_load(const char* csv, tx_trace* t) {
   *t = (tx_trace){0};
   FILE* f = fopen(csv, "r");
-  if (!f) return snprintf(err, n, "%s: %s", csv, strerror(errno)), -1;
+  if (!f) return tx_set_error("%s: %s", csv, strerror(errno)), -1;
   static const char* const names[7] = {"t_s", "px_m", "py_m", "pz_m", "fx_n", "fy_n", "fz_n"};
   int col[7] = {-1, -1, -1, -1, -1, -1, -1}, ncols = 0;
   char* line = NULL;
@@ -25,7 +27,7 @@ int tx_trace_load(const char* csv, tx_trace* t, char* err, size_t n) {
   long lineno = 1;
   int rc = -1, size = 0;
   if (getline(&line, &cap, f) < 0) {
-    snprintf(err, n, "%s:1: empty file, expected a header", csv);
+    tx_set_error("%s:1: empty file, expected a header", csv);
     goto done;
   }
   line[strcspn(line, "\r\n")] = 0;
@@ -34,7 +36,7 @@ int tx_trace_load(const char* csv, tx_trace* t, char* err, size_t n) {
       if (strcmp(tok, names[k]) == 0) col[k] = ncols;
   for (int k = 0; k < 7; k++)
     if (col[k] < 0) {
-      snprintf(err, n, "%s:1: no column '%s'", csv, names[k]);
+      tx_set_error("%s:1: no column '%s'", csv, names[k]);
       goto done;
     }
   while (getline(&line, &cap, f) >= 0) {
@@ -47,7 +49,7 @@ int tx_trace_load(const char* csv, tx_trace* t, char* err, size_t n) {
         grown[k] = realloc(*fields[k], sizeof(double) * (size_t)size);
         if (grown[k]) *fields[k] = grown[k];
         else {
-          snprintf(err, n, "%s: out of memory", csv);
+          tx_set_error("%s: out of memory", csv);
           goto done;
         }
       }
@@ -63,11 +65,11 @@ int tx_trace_load(const char* csv, tx_trace* t, char* err, size_t n) {
           // subnormal is no error, only an overflow (not finite) is
           v[k] = strtod(p, &end);
           if (end == p || (*end != ',' && *end != '\n' && *end != '\r' && *end)) {
-            snprintf(err, n, "%s:%ld: column %s: not a number", csv, lineno, names[k]);
+            tx_set_error("%s:%ld: column %s: not a number", csv, lineno, names[k]);
             goto done;
           }
           if (!isfinite(v[k])) {
-            snprintf(err, n, "%s:%ld: column %s: not a finite number", csv, lineno, names[k]);
+            tx_set_error("%s:%ld: column %s: not a finite number", csv, lineno, names[k]);
             goto done;
           }
           got++;
@@ -76,7 +78,7 @@ int tx_trace_load(const char* csv, tx_trace* t, char* err, size_t n) {
       if (p) p++;
     }
     if (got != 7) {
-      snprintf(err, n, "%s:%ld: expected %d columns", csv, lineno, ncols);
+      tx_set_error("%s:%ld: expected %d columns", csv, lineno, ncols);
       goto done;
     }
     t->t[t->n] = v[0];
@@ -84,7 +86,7 @@ int tx_trace_load(const char* csv, tx_trace* t, char* err, size_t n) {
     t->n++;
   }
   if (!t->n) {
-    snprintf(err, n, "%s:2: no samples", csv);
+    tx_set_error("%s:2: no samples", csv);
     goto done;
   }
   rc = 0;
@@ -95,14 +97,14 @@ done:
   return rc;
 }
 
-int tx_trace_plot_png(const char* csv, const char* png, char* err, size_t n) {
+int tx_trace_plot_png(const char* csv, const char* png) {
   tx_trace t;
-  if (tx_trace_load(csv, &t, err, n)) return -1;
+  if (tx_trace_load(csv, &t)) return -1;
   int rc = -1;
   double *mag = malloc(sizeof(double) * (size_t)t.n), *mm[3] = {0}, *disp = malloc(sizeof(double) * (size_t)t.n);
   for (int k = 0; k < 3; k++) mm[k] = malloc(sizeof(double) * (size_t)t.n);
   if (!mag || !disp || !mm[0] || !mm[1] || !mm[2]) {
-    snprintf(err, n, "%s: out of memory", png);
+    tx_set_error("%s: out of memory", png);
     goto done;
   }
   // the axis along which the tool travelled furthest from its start
@@ -133,7 +135,7 @@ int tx_trace_plot_png(const char* csv, const char* png, char* err, size_t n) {
   tx_plot panels[3] = {{"(a) force sent to the device", "time t (s)", "force (N)", false, false, force, 4},
                        {"(b) tool position", "time t (s)", "position (" TX_PLOT_LENGTH_UNIT ")", false, false, pos, 3},
                        {ftitle, dlabel, ylabel, false, false, fd, 1}};
-  rc = tx_plot_png_panels(png, panels, 3, 3, err, n);
+  rc = tx_plot_png_panels(png, panels, 3, 3);
 done:
   free(mag);
   free(disp);

@@ -15,10 +15,10 @@ typedef struct tx_trace {
   int n;
 } tx_trace;
 
-// read t_s, px_m..pz_m, fx_n..fz_n from a device CSV; 0, or -1 with "FILE:LINE: message"
-int tx_trace_load(const char* csv, tx_trace* t, char* err, size_t n);
+// read t_s, px_m..pz_m, fx_n..fz_n from a device CSV; 0, or -1 with "FILE:LINE: message" in tx_error()
+int tx_trace_load(const char* csv, tx_trace* t);
 void tx_trace_free(tx_trace* t);
-// the three-panel PNG of a device CSV; 0, or -1 with a message
-int tx_trace_plot_png(const char* csv, const char* png, char* err, size_t n);
+// the three-panel PNG of a device CSV; 0, or -1 with the message in tx_error()
+int tx_trace_plot_png(const char* csv, const char* png);
 
 #endif

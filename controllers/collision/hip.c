@@ -22,16 +22,15 @@ tx_hip_def tx_hip_def_default(void) {
   };
 }
 
-const char* tx_hip_def_check(const tx_hip_def* d) {
-  const char* e;
-  if ((e = tx_check_range("hip", "radius", d->radius, 0, true, 0.05, false, "m"))) return e;
+int tx_hip_def_check(const tx_hip_def* d) {
+  if (tx_check_range("hip", "radius", d->radius, 0, true, 0.05, false, "m")) return -1;
   if (d->rays != 26 && d->rays != 98) return tx_check_fail("hip: rays = %d, must be 26 or 98", d->rays);
-  if ((e = tx_check_range("hip", "alpha", d->alpha, 0, false, 1e6, false, "N/m"))) return e;
-  if ((e = tx_check_range("hip", "k", d->k, 0, false, 1, true, "1"))) return e;
-  if ((e = tx_check_range("hip", "slide_max", d->slide_max, 0, true, 1, false, "m"))) return e;
-  if ((e = tx_check_range("hip", "pierce_range", d->pierce_range, 0, true, 1, false, "m"))) return e;
-  if ((e = tx_check_range("hip", "hold", d->hold, 0, false, 0.01, false, "m"))) return e;
-  return NULL;
+  if (tx_check_range("hip", "alpha", d->alpha, 0, false, 1e6, false, "N/m")) return -1;
+  if (tx_check_range("hip", "k", d->k, 0, false, 1, true, "1")) return -1;
+  if (tx_check_range("hip", "slide_max", d->slide_max, 0, true, 1, false, "m")) return -1;
+  if (tx_check_range("hip", "pierce_range", d->pierce_range, 0, true, 1, false, "m")) return -1;
+  if (tx_check_range("hip", "hold", d->hold, 0, false, 0.01, false, "m")) return -1;
+  return 0;
 }
 
 void tx_hip_init(tx_hip* h, const tx_hip_def* def) {

@@ -63,8 +63,8 @@ typedef struct tx_hip_def {
 } tx_hip_def;
 
 tx_hip_def tx_hip_def_default(void);
-// NULL when every field is valid, else one line naming the field
-const char* tx_hip_def_check(const tx_hip_def* d);
+// 0 when every field is valid, else -1 and tx_error() names the field
+int tx_hip_def_check(const tx_hip_def* d);
 
 typedef struct tx_hip {
   tx_hip_def def;

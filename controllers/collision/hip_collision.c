@@ -89,8 +89,7 @@ static int configure(tx_setup* s, void** self) {
     return tx_setup_fail(s, "force_mode", "expected \"mechanics\" or \"paper\", got \"%s\"", mode);
   h->mechanics = strcmp(mode, "mechanics") == 0;
   if (def.rays != 26 && def.rays != 98) return tx_setup_fail(s, "rays", "must be 26 or 98, got %d", def.rays);
-  const char* err = tx_hip_def_check(&def);
-  if (err) return tx_setup_fail(s, NULL, "%s", err);
+  if (tx_hip_def_check(&def)) return tx_setup_fail(s, NULL, "%s", tx_error());
   tx_hip_init(&h->hip, &def);
   const char* pose = tx_table_str(s, "pose");
   const char* skin = tx_table_str(s, "skin");

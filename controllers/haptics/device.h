@@ -16,8 +16,8 @@ typedef struct tx_device tx_device;
 typedef struct tx_device_backend {
   const char* scheme; // the spec up to the first ':'
   // open with the rest of the spec; period_s is the haptics tick. NULL and a
-  // one-line message on failure
-  tx_device* (*open)(const char* arg, double period_s, char* err, size_t n);
+  // one-line message in tx_error() on failure
+  tx_device* (*open)(const char* arg, double period_s);
   void (*info)(const tx_device* d, tx_device_info* out);
   // the state at time t_s from the start; false if the device had nothing new
   bool (*read)(tx_device* d, double t_s, tx_device_state* out);
@@ -35,8 +35,8 @@ typedef struct tx_device_handle {
   tx_device* device;
 } tx_device_handle;
 
-// open a spec; returns -1 with a message naming the spec when it is bad
-int tx_device_open(const char* spec, double period_s, tx_device_handle* h, char* err, size_t n);
+// open a spec; returns -1 with the message in tx_error() naming the spec when it is bad
+int tx_device_open(const char* spec, double period_s, tx_device_handle* h);
 void tx_device_close(tx_device_handle* h);
 
 extern const tx_device_backend tx_device_scripted;

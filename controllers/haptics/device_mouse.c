@@ -3,6 +3,8 @@
 // window draws deviceN.force). Its input is window.pointer, fed by the
 // haptics controller each tick (device_mouse.h).
 #include "device.h"
+
+#include "../../model/error.h"
 #include "device_mouse.h"
 
 #include <stdio.h>
@@ -17,10 +19,10 @@ struct tx_device {
   bool have_last;
 };
 
-static tx_device* open_mouse(const char* arg, double period_s, char* err, size_t n) {
-  if (*arg) return snprintf(err, n, "device 'mouse:%s': takes no options", arg), NULL;
+static tx_device* open_mouse(const char* arg, double period_s) {
+  if (*arg) return tx_set_error("device 'mouse:%s': takes no options", arg), NULL;
   tx_device* d = calloc(1, sizeof *d);
-  if (!d) return snprintf(err, n, "out of memory"), NULL;
+  if (!d) return tx_set_error("out of memory"), NULL;
   d->period = period_s;
   d->pos[1] = TX_MOUSE_START_Y_M; // above the origin until the window moves it
   return d;

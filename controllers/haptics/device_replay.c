@@ -8,6 +8,8 @@
 #include "device.h"
 #include "recorder.h"
 
+#include "../../model/error.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,21 +19,23 @@ struct tx_device {
   tx_record* records;
   size_t count;
 };
+// a recording cut short is not refused; the command that names it (tactus
+// run) shows tx_record_file.cut_short as a warning: a device prints nothing
 
-static tx_device* open_replay(const char* path, double period_s, char* err, size_t n) {
+static tx_device* open_replay(const char* path, double period_s) {
   tx_device* d = calloc(1, sizeof *d);
-  if (!d) return snprintf(err, n, "out of memory"), NULL;
-  char warn[512];
-  if (tx_record_load(path, &d->header, &d->records, &d->count, warn, sizeof warn, err, n)) return free(d), NULL;
+  if (!d) return tx_set_error("out of memory"), NULL;
+  tx_record_file rf;
+  if (tx_record_load(path, &rf)) return free(d), NULL;
+  d->header = rf.header, d->records = rf.records, d->count = rf.count;
   double rate = 1.0 / period_s;
   if (fabs(d->header.rate_hz - rate) > 1e-9 * rate) {
-    snprintf(err, n, "%s: recorded at %g Hz, replayed at %g Hz: set the haptics rate_hz to match", path,
+    tx_set_error("%s: recorded at %g Hz, replayed at %g Hz: set the haptics rate_hz to match", path,
              d->header.rate_hz, rate);
     free(d->records);
     free(d);
     return NULL;
   }
-  if (*warn) fprintf(stderr, "tactus: warning: %s\n", warn); // only once the recording is taken
   return d;
 }
 

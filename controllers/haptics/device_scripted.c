@@ -8,6 +8,8 @@
 // last row the device holds still. Lines starting with '#' and a first line
 // of column names are skipped. Forces written to it are ignored.
 #include "device.h"
+
+#include "../../model/error.h"
 #include "device_scripted.h"
 
 #include <errno.h>
@@ -108,7 +110,7 @@ static const char* parse_row(char* line, waypoint* w) {
   return NULL;
 }
 
-tx_device* tx_scripted_read_csv(FILE* f, const char* path, char* err, size_t n) {
+tx_device* tx_scripted_read_csv(FILE* f, const char* path) {
   size_t cap = 256, count = 0;
   tx_device* d = with_rows(cap);
   char line[1024];
@@ -139,8 +141,8 @@ tx_device* tx_scripted_read_csv(FILE* f, const char* path, char* err, size_t n) 
   }
   if (!problem && d && count == 0) problem = "no waypoints", lineno = 0;
   if (problem || !d) {
-    if (lineno) snprintf(err, n, "%s:%d: %s", path, lineno, problem ? problem : "out of memory");
-    else snprintf(err, n, "%s: %s", path, problem ? problem : "out of memory");
+    if (lineno) tx_set_error("%s:%d: %s", path, lineno, problem ? problem : "out of memory");
+    else tx_set_error("%s: %s", path, problem ? problem : "out of memory");
     if (d) free(d->w);
     free(d);
     return NULL;
@@ -149,15 +151,15 @@ tx_device* tx_scripted_read_csv(FILE* f, const char* path, char* err, size_t n) 
   return d;
 }
 
-static tx_device* open_scripted(const char* arg, double period_s, char* err, size_t n) {
+static tx_device* open_scripted(const char* arg, double period_s) {
   (void)period_s;
   const tx_hand_motion* m = tx_hand_motion_find(arg);
   if (m) return from_motion(m);
   size_t len = strlen(arg);
   if (len > 4 && strcmp(arg + len - 4, ".csv") == 0) {
     FILE* f = fopen(arg, "r");
-    if (!f) return snprintf(err, n, "%s: %s", arg, strerror(errno)), NULL;
-    tx_device* d = tx_scripted_read_csv(f, arg, err, n);
+    if (!f) return tx_set_error("%s: %s", arg, strerror(errno)), NULL;
+    tx_device* d = tx_scripted_read_csv(f, arg);
     fclose(f);
     return d;
   }
@@ -166,7 +168,7 @@ static tx_device* open_scripted(const char* arg, double period_s, char* err, siz
     size_t used = strlen(names);
     snprintf(names + used, sizeof names - used, "%s%s", i ? ", " : "", motions[i].name);
   }
-  snprintf(err, n, "device 'scripted:%s': expected a .csv file or one of %s", arg, names);
+  tx_set_error("device 'scripted:%s': expected a .csv file or one of %s", arg, names);
   return NULL;
 }
 

@@ -9,7 +9,7 @@
 
 // read waypoints from f (not closed); path names it in "PATH:LINE: message".
 // The device it returns is driven through tx_device_scripted's read and close.
-tx_device* tx_scripted_read_csv(FILE* f, const char* path, char* err, size_t n);
+tx_device* tx_scripted_read_csv(FILE* f, const char* path);
 
 // a named hand motion: waypoints t, x, y, z (s, m), the tool moving in straight
 // lines between them. One table holds every motion that a scenario

@@ -1,6 +1,8 @@
 // A device served over UDP; see device_server.h and docs/device-protocol.md.
 #include "device_server.h"
 
+#include "../../model/error.h"
+
 #include "device.h"
 #include "device_protocol.h"
 
@@ -56,21 +58,21 @@ tx_device_server_def tx_device_server_def_default(void) {
   return d;
 }
 
-tx_device_server* tx_device_server_open(const tx_device_server_def* def, char* err, size_t n) {
-  if (!def->spec || !*def->spec) return snprintf(err, n, "no device to serve"), NULL;
+tx_device_server* tx_device_server_open(const tx_device_server_def* def) {
+  if (!def->spec || !*def->spec) return tx_set_error("no device to serve"), NULL;
   if (!(def->rate_hz > 0 && def->rate_hz <= TX_DP_MAX_RATE_HZ))
-    return snprintf(err, n, "rate %g Hz: expected (0, %g]", def->rate_hz, TX_DP_MAX_RATE_HZ), NULL;
-  if (!(def->duration_s >= 0 && def->duration_s <= 1e7)) return snprintf(err, n, "duration: out of range"), NULL;
+    return tx_set_error("rate %g Hz: expected (0, %g]", def->rate_hz, TX_DP_MAX_RATE_HZ), NULL;
+  if (!(def->duration_s >= 0 && def->duration_s <= 1e7)) return tx_set_error("duration: out of range"), NULL;
   if (!(def->force_timeout_s > 0 && def->force_timeout_s <= 10))
-    return snprintf(err, n, "force timeout: expected (0, 10] s"), NULL;
+    return tx_set_error("force timeout: expected (0, 10] s"), NULL;
   if (!(def->client_timeout_s > 0 && def->client_timeout_s <= 60))
-    return snprintf(err, n, "client timeout: expected (0, 60] s"), NULL;
-  if (!(def->ramp_s >= 0 && def->ramp_s <= 1)) return snprintf(err, n, "ramp: expected [0, 1] s"), NULL;
+    return tx_set_error("client timeout: expected (0, 60] s"), NULL;
+  if (!(def->ramp_s >= 0 && def->ramp_s <= 1)) return tx_set_error("ramp: expected [0, 1] s"), NULL;
   tx_device_server* s = calloc(1, sizeof *s);
-  if (!s) return snprintf(err, n, "out of memory"), NULL;
+  if (!s) return tx_set_error("out of memory"), NULL;
   s->def = *def;
   s->fd = -1;
-  if (tx_device_open(def->spec, 1 / def->rate_hz, &s->dev, err, n)) {
+  if (tx_device_open(def->spec, 1 / def->rate_hz, &s->dev)) {
     tx_device_server_close(s);
     return NULL;
   }
@@ -80,7 +82,7 @@ tx_device_server* tx_device_server_open(const tx_device_server_def* def, char* e
   int on = 1;
   if (s->fd >= 0) setsockopt(s->fd, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on);
   if (s->fd < 0 || bind(s->fd, (const struct sockaddr*)&def->listen, sizeof def->listen) != 0) {
-    snprintf(err, n, "--listen %s: %s", tx_dp_addr_text(&def->listen, where, sizeof where), strerror(errno));
+    tx_set_error("--listen %s: %s", tx_dp_addr_text(&def->listen, where, sizeof where), strerror(errno));
     tx_device_server_close(s);
     return NULL;
   }
@@ -216,7 +218,7 @@ static void consider(tx_device_server* s, const uint8_t* buf, size_t n, const st
   }
 }
 
-static int drain(tx_device_server* s, char* err, size_t n) {
+static int drain(tx_device_server* s) {
   for (int i = 0; i < DRAIN_MAX; i++) {
     uint8_t buf[TX_DP_MAX_SIZE + 1];
     struct sockaddr_in from;
@@ -224,7 +226,7 @@ static int drain(tx_device_server* s, char* err, size_t n) {
     long got = tx_dp_recv(s->fd, buf, sizeof buf, &from, &arrival);
     if (got >= 0) consider(s, buf, (size_t)got, &from, arrival);
     else if (errno == EAGAIN || errno == EWOULDBLOCK) return 0;
-    else if (errno != EINTR && errno != ECONNREFUSED) return snprintf(err, n, "receive: %s", strerror(errno)), -1;
+    else if (errno != EINTR && errno != ECONNREFUSED) return tx_set_error("receive: %s", strerror(errno)), -1;
   }
   return 0;
 }
@@ -245,7 +247,7 @@ static void tick(tx_device_server* s, int64_t now, int64_t period) {
   }
 }
 
-int tx_device_server_run(tx_device_server* s, const atomic_int* stop, char* err, size_t n) {
+int tx_device_server_run(tx_device_server* s, const atomic_int* stop) {
   const int64_t period = (int64_t)llround(1e9 / s->def.rate_hz);
   const int64_t duration = (int64_t)llround(s->def.duration_s * 1e9), force_timeout = (int64_t)llround(s->def.force_timeout_s * 1e9);
   const int64_t client_timeout = (int64_t)llround(s->def.client_timeout_s * 1e9);
@@ -264,10 +266,10 @@ int tx_device_server_run(tx_device_server* s, const atomic_int* stop, char* err,
     struct timespec to = {wait / 1000000000, wait % 1000000000};
     struct pollfd pfd = {s->fd, POLLIN, 0};
     if (ppoll(&pfd, 1, &to, NULL) < 0 && errno != EINTR) {
-      rc = -1, snprintf(err, n, "poll: %s", strerror(errno));
+      rc = -1, tx_set_error("poll: %s", strerror(errno));
       break;
     }
-    if (drain(s, err, n)) {
+    if (drain(s)) {
       rc = -1;
       break;
     }

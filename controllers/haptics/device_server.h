@@ -12,9 +12,9 @@
 //
 //     tx_device_server_def def = tx_device_server_def_default();
 //     def.spec = "scripted:pierce-down";
-//     tx_device_server* s = tx_device_server_open(&def, err, sizeof err);
+//     tx_device_server* s = tx_device_server_open(&def);
 //     printf("port %u\n", tx_device_server_port(s));
-//     tx_device_server_run(s, &stop, err, sizeof err);  // until stop is set or the duration ends
+//     tx_device_server_run(s, &stop);  // until stop is set or the duration ends
 //     tx_device_server_close(s);
 #ifndef TX_CONTROLLERS_HAPTICS_DEVICE_SERVER_H
 #define TX_CONTROLLERS_HAPTICS_DEVICE_SERVER_H
@@ -65,12 +65,12 @@ typedef struct tx_device_server_stats {
 typedef struct tx_device_server tx_device_server;
 
 tx_device_server_def tx_device_server_def_default(void);
-// open the device and bind; NULL with a one-line message naming what is wrong
-tx_device_server* tx_device_server_open(const tx_device_server_def* def, char* err, size_t n);
+// open the device and bind; NULL with a one-line message in tx_error() naming what is wrong
+tx_device_server* tx_device_server_open(const tx_device_server_def* def);
 uint16_t tx_device_server_port(const tx_device_server* s); // as bound
 // serve until *stop is non-zero (a signal handler or another thread may set
-// it) or the duration has passed; 0, or -1 with a message on a socket error
-int tx_device_server_run(tx_device_server* s, const atomic_int* stop, char* err, size_t n);
+// it) or the duration has passed; 0, or -1 with the message in tx_error() on a socket error
+int tx_device_server_run(tx_device_server* s, const atomic_int* stop);
 void tx_device_server_get_stats(const tx_device_server* s, tx_device_server_stats* out);
 void tx_device_server_close(tx_device_server* s);
 

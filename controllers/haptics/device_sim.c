@@ -11,6 +11,8 @@
 // force for one period while the hand pulls toward where the motion will be
 // at the end of it; the next read reports the device as the encoders see it.
 #include "device.h"
+
+#include "../../model/error.h"
 #include "sim_device.h"
 
 #include <tactus/model.h>
@@ -26,20 +28,20 @@ struct tx_device {
   double t;              // s, time of the device's current state
 };
 
-static tx_device* open_sim(const char* arg, double period_s, char* err, size_t n) {
+static tx_device* open_sim(const char* arg, double period_s) {
   tx_sim_device_def def = tx_sim_device_def_default();
   def.period = period_s;
-  char hand[512] = "pierce-down", why[512];
-  if (!tx_sim_device_parse(arg, &def, hand, sizeof hand, why, sizeof why))
-    return snprintf(err, n, "device 'sim:%s': %s", arg, why), NULL;
+  char hand[512] = "pierce-down";
+  if (!tx_sim_device_parse(arg, &def, hand, sizeof hand))
+    return tx_error_prefix("device 'sim:%s'", arg), NULL;
 
   tx_device* d = calloc(1, sizeof *d);
-  if (!d) return snprintf(err, n, "out of memory"), NULL;
+  if (!d) return tx_set_error("out of memory"), NULL;
   char spec[600];
   snprintf(spec, sizeof spec, "scripted:%s", hand);
-  if (tx_device_open(spec, period_s, &d->hand, why, sizeof why) || !tx_sim_device_init(&d->sim, &def)) {
-    if (d->hand.device) snprintf(err, n, "device 'sim:%s': %s", arg, tx_error());
-    else snprintf(err, n, "device 'sim:%s': hand: %s", arg, why);
+  if (tx_device_open(spec, period_s, &d->hand) || !tx_sim_device_init(&d->sim, &def)) {
+    if (d->hand.device) tx_error_prefix("device 'sim:%s'", arg);
+    else tx_error_prefix("device 'sim:%s': hand", arg);
     tx_device_close(&d->hand);
     free(d);
     return NULL;

@@ -9,6 +9,8 @@
 // fades it to zero within about 10 ms of the last state.
 #include "device_udp.h"
 
+#include "../../model/error.h"
+
 #include "device_protocol.h"
 
 #include <arpa/inet.h>
@@ -175,10 +177,10 @@ static void close_udp(tx_device* d) {
   free(d);
 }
 
-static tx_device* fail(tx_device* d, char* err, size_t n, const char* arg, const char* fmt, const char* what) {
+static tx_device* fail(tx_device* d, const char* arg, const char* fmt, const char* what) {
   char why[256];
   snprintf(why, sizeof why, fmt, what);
-  snprintf(err, n, "device 'udp:%s': %s", arg, why);
+  tx_set_error("device 'udp:%s': %s", arg, why);
   if (d) close_udp(d);
   return NULL;
 }
@@ -200,57 +202,57 @@ static bool handshake(tx_device* d) {
   return d->got_info && d->got_state;
 }
 
-static tx_device* open_udp(const char* arg, double period_s, char* err, size_t n) {
+static tx_device* open_udp(const char* arg, double period_s) {
   // HOST:PORT[,bind=ADDR:PORT]
   char peer_s[128], bind_s[128] = "127.0.0.1:0";
   const char* comma = strchr(arg, ',');
   size_t len = comma ? (size_t)(comma - arg) : strlen(arg);
-  if (len >= sizeof peer_s) return fail(NULL, err, n, arg, "%s", "the address is too long");
+  if (len >= sizeof peer_s) return fail(NULL, arg, "%s", "the address is too long");
   memcpy(peer_s, arg, len);
   peer_s[len] = 0;
   if (comma) {
     if (strncmp(comma, ",bind=", 6) != 0 || strlen(comma + 6) >= sizeof bind_s)
-      return fail(NULL, err, n, arg, "%s", "expected udp:HOST:PORT or udp:HOST:PORT,bind=ADDR:PORT");
+      return fail(NULL, arg, "%s", "expected udp:HOST:PORT or udp:HOST:PORT,bind=ADDR:PORT");
     snprintf(bind_s, sizeof bind_s, "%s", comma + 6);
   }
   tx_device* d = calloc(1, sizeof *d);
-  if (!d) return fail(NULL, err, n, arg, "%s", "out of memory");
+  if (!d) return fail(NULL, arg, "%s", "out of memory");
   d->fd = -1;
   snprintf(d->name, sizeof d->name, "udp:%s", peer_s);
   const char* why = NULL;
   struct sockaddr_in local;
-  if (!tx_dp_parse_addr(peer_s, false, &d->peer, &why)) return fail(d, err, n, arg, "%s (udp:HOST:PORT)", why);
-  if (!tx_dp_parse_addr(bind_s, true, &local, &why)) return fail(d, err, n, arg, "bind=: %s", why);
+  if (!tx_dp_parse_addr(peer_s, false, &d->peer, &why)) return fail(d, arg, "%s (udp:HOST:PORT)", why);
+  if (!tx_dp_parse_addr(bind_s, true, &local, &why)) return fail(d, arg, "bind=: %s", why);
   // loopback unless told otherwise: a peer on another machine needs bind= to say which interface
   bool peer_loopback = (ntohl(d->peer.sin_addr.s_addr) >> 24) == 127;
   bool local_loopback = (ntohl(local.sin_addr.s_addr) >> 24) == 127;
   if (!comma && !peer_loopback)
-    return fail(d, err, n, arg, "%s", "the backend binds to loopback: for a device on another machine add ,bind=ADDR:PORT");
+    return fail(d, arg, "%s", "the backend binds to loopback: for a device on another machine add ,bind=ADDR:PORT");
   if (local_loopback && !peer_loopback)
-    return fail(d, err, n, arg, "%s", "a loopback bind= cannot reach a peer on another machine");
+    return fail(d, arg, "%s", "a loopback bind= cannot reach a peer on another machine");
   if (!(period_s > 0 && 1 / period_s <= TX_DP_MAX_RATE_HZ))
-    return fail(d, err, n, arg, "%s", "the haptics rate is out of range");
+    return fail(d, arg, "%s", "the haptics rate is out of range");
   d->rate_hz = 1 / period_s;
   d->session = new_session();
 
   d->fd = socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-  if (d->fd < 0) return fail(d, err, n, arg, "socket: %s", strerror(errno));
+  if (d->fd < 0) return fail(d, arg, "socket: %s", strerror(errno));
   int on = 1;
   setsockopt(d->fd, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on); // arrival stamps; without them, read time
-  if (bind(d->fd, (struct sockaddr*)&local, sizeof local) != 0) return fail(d, err, n, arg, "bind: %s", strerror(errno));
+  if (bind(d->fd, (struct sockaddr*)&local, sizeof local) != 0) return fail(d, arg, "bind: %s", strerror(errno));
   // the kernel then delivers only the peer's datagrams
   if (connect(d->fd, (struct sockaddr*)&d->peer, sizeof d->peer) != 0)
-    return fail(d, err, n, arg, "connect: %s", strerror(errno));
+    return fail(d, arg, "connect: %s", strerror(errno));
   if (!handshake(d)) {
     const char* what = d->got_info ? "the device said hello but sent no state" : "no hello from the device";
     char msg[160];
     snprintf(msg, sizeof msg, "%s within %g s (is tactus-device serving there?)", what, TX_DEVICE_UDP_WAIT_S);
-    return fail(d, err, n, arg, "%s", msg);
+    return fail(d, arg, "%s", msg);
   }
   const tx_device_info* in = &d->info;
   bool usable = in->max_force > 0;
   for (int i = 0; i < 3; i++) usable = usable && in->workspace_min[i] < in->workspace_max[i];
-  if (!usable) return fail(d, err, n, arg, "%s", "the device's hello gave no max force or an empty workspace");
+  if (!usable) return fail(d, arg, "%s", "the device's hello gave no max force or an empty workspace");
   d->last_state_ns = tx_dp_now_ns();
   return d;
 }

@@ -101,8 +101,7 @@ static int configure(tx_setup* s, void** self) {
   else if (strcmp(mode, "sample_hold") == 0) h->mode = TX_RENDER_SAMPLE_HOLD;
   else return tx_setup_fail(s, "mode", "expected \"local\" or \"sample_hold\", got \"%s\"", mode);
 
-  char err[512];
-  if (tx_device_open(spec, period, &h->device, err, sizeof err)) return tx_setup_fail(s, "device", "%s", err);
+  if (tx_device_open(spec, period, &h->device)) return tx_setup_fail(s, "device", "%s", tx_error());
   tx_device_info info;
   h->device.backend->info(h->device.device, &info);
   tx_safety_limits d = tx_safety_limits_from_device(&info);
@@ -112,8 +111,7 @@ static int configure(tx_setup* s, void** self) {
   h->limits.model_timeout_s = lowered(s, "model_timeout_s", d.model_timeout_s);
   h->limits.device_timeout_s = lowered(s, "device_timeout_s", d.device_timeout_s);
   h->limits.ramp_s = lowered(s, "ramp_s", d.ramp_s);
-  const char* bad = tx_safety_limits_check(&h->limits);
-  if (bad) return tx_setup_fail(s, NULL, "safety limits: %s", bad);
+  if (tx_safety_limits_check(&h->limits)) return tx_setup_fail(s, NULL, "safety limits: %s", tx_error());
   tx_haptic_path_init(&h->path, &h->limits, control, ref, info.damping);
 
   if (h->device.backend->input) h->input = TX_READ_EXPECT(s, h->device.backend->input, tx_pointer);
@@ -178,13 +176,12 @@ static int init(tx_ctx* c, void* self) {
   if (!h->device.backend->read(h->device.device, 0, &h->state)) h->state.quat[0] = 1;
   const double zero[3] = {0, 0, 0};
   publish(c, h, zero);
-  char err[512];
   if (h->record && tx_record_dir(c)) {
     tx_device_info info;
     h->device.backend->info(h->device.device, &info);
-    h->recorder = tx_recorder_start(tx_record_dir(c), h->hand, tx_rate(c), &info, err, sizeof err);
+    h->recorder = tx_recorder_start(tx_record_dir(c), h->hand, tx_rate(c), &info);
     if (!h->recorder) {
-      fprintf(stderr, "tactus: recording: %s\n", err);
+      tx_stop_run(c, "recording: %s", tx_error()); // the run fails with this reason
       return -1;
     }
   }
@@ -226,9 +223,7 @@ static void step(tx_ctx* c, void* self) {
     const char* file;
     int e = tx_recorder_error(h->recorder, &file);
     if (e) {
-      char reason[4200];
-      snprintf(reason, sizeof reason, "%s: %s", file, strerror(e));
-      tx_stop_run(c, reason);
+      tx_stop_run(c, "%s: %s", file, strerror(e));
       h->record_failed = true;
     }
   }
@@ -254,24 +249,25 @@ static void step(tx_ctx* c, void* self) {
   }
 }
 
-// the run is over: the recording is made whole (binary and CSV) before the report
+// the run is over: the recording is made whole (binary and CSV) before the
+// report; one that cannot be is a fault that stops the run (exit 1, named)
 static void finish(tx_ctx* c, void* self) {
   haptics* h = self;
   tx_set_result(c, h->energy_result, h->path.passivity.energy);
   tx_set_result(c, h->min_energy_result, h->path.passivity.min_energy);
   tx_set_result(c, h->dissipated_result, h->path.passivity.dissipated);
   tx_set_result(c, h->reference_result, h->path.reference_energy);
-  char err[512];
-  if (tx_recorder_stop(h->recorder, err, sizeof err) && !h->record_failed) // else the run's stop reason says it
-    fprintf(stderr, "tactus: recording: %s\n", err);
+  if (tx_recorder_stop(h->recorder) && !h->record_failed) // else the run's stop reason says it
+    tx_stop_run(c, "recording: %s", tx_error());
   h->recorder = NULL;
 }
 
 static void fini(void* self) {
   haptics* h = self;
   if (!h) return;
-  char err[512];
-  if (tx_recorder_stop(h->recorder, err, sizeof err)) fprintf(stderr, "tactus: recording: %s\n", err); // a failed run's
+  // a run that failed before its first step: its folder is taken back, and the
+  // run's own error is the one to report
+  tx_recorder_stop(h->recorder);
   tx_device_close(&h->device);
   free(h);
 }

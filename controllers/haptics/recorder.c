@@ -3,6 +3,8 @@
 
 #include "device_protocol.h" // tx_dp_crc32: the CRC-32 of zlib, already in the library
 
+#include "../../model/error.h"
+
 #include <tactus/model.h>
 
 #include <errno.h>
@@ -91,10 +93,9 @@ static void* writer_main(void* arg) {
   return NULL;
 }
 
-tx_recorder* tx_recorder_start(const char* dir, int hand, double rate_hz, const tx_device_info* device, char* err,
-                               size_t n) {
+tx_recorder* tx_recorder_start(const char* dir, int hand, double rate_hz, const tx_device_info* device) {
   tx_recorder* r = calloc(1, sizeof *r);
-  if (!r) return snprintf(err, n, "out of memory for the recorder"), NULL;
+  if (!r) return tx_set_error("out of memory for the recorder"), NULL;
   tx_prefault(r->ring, sizeof r->ring); // calloc maps its pages lazily
   snprintf(r->bin, sizeof r->bin, "%s/device%d.bin", dir, hand);
   snprintf(r->csv, sizeof r->csv, "%s/device%d.csv", dir, hand);
@@ -104,13 +105,13 @@ tx_recorder* tx_recorder_start(const char* dir, int hand, double rate_hz, const 
   // the header reaches the file now: a recording is never left without one
   errno = 0;
   if (!r->file || fwrite(&h, sizeof h, 1, r->file) != 1 || fflush(r->file) != 0) {
-    snprintf(err, n, "%s: %s", r->bin, strerror(errno ? errno : EIO));
+    tx_set_error("%s: %s", r->bin, strerror(errno ? errno : EIO));
     if (r->file) fclose(r->file), remove(r->bin);
     free(r);
     return NULL;
   }
   if (pthread_create(&r->writer, NULL, writer_main, r) != 0) {
-    snprintf(err, n, "%s: cannot start the writer thread", r->bin);
+    tx_set_error("%s: cannot start the writer thread", r->bin);
     fclose(r->file);
     remove(r->bin);
     free(r);
@@ -132,15 +133,16 @@ int tx_recorder_error(const tx_recorder* r, const char** file) {
   return atomic_load_explicit(&((tx_recorder*)r)->error, memory_order_relaxed);
 }
 
-int tx_record_export_csv(const char* bin, const char* csv, char* warn, size_t wn, char* err, size_t n) {
-  tx_record_header h;
-  tx_record* recs;
-  size_t count;
-  if (tx_record_load(bin, &h, &recs, &count, warn, wn, err, n)) return -1;
+int tx_record_export_csv(const char* bin, const char* csv, tx_record_file* read) {
+  tx_record_file rf;
+  if (tx_record_load(bin, &rf)) return -1;
+  tx_record* recs = rf.records;
+  size_t count = rf.count;
+  if (read) *read = rf, read->records = NULL;
   char tmp[4200];
   snprintf(tmp, sizeof tmp, "%s.tmp", csv);
   FILE* f = fopen(tmp, "w");
-  if (!f) return free(recs), snprintf(err, n, "%s: %s", tmp, strerror(errno)), -2;
+  if (!f) return free(recs), tx_set_error("%s: %s", tmp, strerror(errno)), -2;
   // %.17g: every double, subnormals included, reads back to the same bits (strtod)
   fprintf(f, "t_s,px_m,py_m,pz_m,fx_n,fy_n,fz_n,vx_m_s,vy_m_s,vz_m_s,qw,qx,qy,qz,grip_rad,buttons,"
              "f0x_n,f0y_n,f0z_n,x0x_m,x0y_m,x0z_m,kxx,kxy,kxz,kyx,kyy,kyz,kzx,kzy,kzz\n");
@@ -156,43 +158,39 @@ int tx_record_export_csv(const char* bin, const char* csv, char* warn, size_t wn
   errno = 0;
   bool bad = ferror(f) != 0;
   if (fclose(f) != 0 || bad || rename(tmp, csv) != 0)
-    return remove(tmp), snprintf(err, n, "%s: %s", csv, strerror(errno ? errno : EIO)), -2;
+    return remove(tmp), tx_set_error("%s: %s", csv, strerror(errno ? errno : EIO)), -2;
   return 0;
 }
 
-int tx_recorder_stop(tx_recorder* r, char* err, size_t n) {
+int tx_recorder_stop(tx_recorder* r) {
   if (!r) return 0;
   atomic_store(&r->stop, true);
   pthread_join(r->writer, NULL);
   errno = 0;
   if (fclose(r->file) != 0) failed(r, errno);
   int e = atomic_load(&r->error), rc = 0;
-  if (e) rc = -1, snprintf(err, n, "%s: %s", r->bin, strerror(e));
-  char warn[512];
-  if (rc == 0) rc = tx_record_export_csv(r->bin, r->csv, warn, sizeof warn, err, n);
+  if (e) rc = -1, tx_set_error("%s: %s", r->bin, strerror(e));
+  if (rc == 0 && tx_record_export_csv(r->bin, r->csv, NULL)) rc = -1;
   free(r);
   return rc;
 }
 
-int tx_record_load(const char* path, tx_record_header* h, tx_record** records, size_t* count, char* warn, size_t wn,
-                   char* err, size_t n) {
-  *records = NULL;
-  *count = 0;
-  if (wn) warn[0] = 0;
+int tx_record_load(const char* path, tx_record_file* out) {
+  memset(out, 0, sizeof *out);
   FILE* f = fopen(path, "rb");
-  if (!f) return snprintf(err, n, "%s: %s", path, strerror(errno)), -1;
+  if (!f) return tx_set_error("%s: %s", path, strerror(errno)), -1;
   unsigned char* data = NULL;
   long size = -1;
   if (fseek(f, 0, SEEK_END) == 0 && (size = ftell(f)) >= 0 && fseek(f, 0, SEEK_SET) == 0 &&
       (data = malloc(size ? (size_t)size : 1)) && fread(data, 1, (size_t)size, f) == (size_t)size) {
     fclose(f);
-    int rc = tx_record_parse(data, (size_t)size, path, h, records, count, warn, wn, err, n);
+    int rc = tx_record_parse(data, (size_t)size, path, out);
     free(data);
     return rc;
   }
   fclose(f);
   free(data);
-  return snprintf(err, n, "%s: %s", path, data || size < 0 ? "cannot be read" : "out of memory"), -1;
+  return tx_set_error("%s: %s", path, data || size < 0 ? "cannot be read" : "out of memory"), -1;
 }
 
 // NULL when the device's limits are finite and sane
@@ -229,14 +227,12 @@ static const char* record_problem(const tx_record* r, const tx_record* prev, con
   return NULL;
 }
 
-int tx_record_parse(const void* bytes, size_t size, const char* name, tx_record_header* h, tx_record** records,
-                    size_t* count, char* warn, size_t wn, char* err, size_t n) {
+int tx_record_parse(const void* bytes, size_t size, const char* name, tx_record_file* out) {
   const unsigned char* data = bytes;
-  *records = NULL;
-  *count = 0;
-  if (wn) warn[0] = 0;
-  if (size < 8 || memcmp(data, TX_RECORD_MAGIC, 8) != 0) return snprintf(err, n, "%s: not a tactus recording", name), -1;
-  if (size < sizeof *h) return snprintf(err, n, "%s: cut short in its header", name), -1;
+  memset(out, 0, sizeof *out);
+  tx_record_header* h = &out->header;
+  if (size < 8 || memcmp(data, TX_RECORD_MAGIC, 8) != 0) return tx_set_error("%s: not a tactus recording", name), -1;
+  if (size < sizeof *h) return tx_set_error("%s: cut short in its header", name), -1;
   memcpy(h, data, sizeof *h);
   const char* problem = NULL;
   if (h->version != 1 && h->version != 2) problem = "its version is neither 1 nor 2 (made by another tactus?)";
@@ -244,18 +240,18 @@ int tx_record_parse(const void* bytes, size_t size, const char* name, tx_record_
   else if (h->record_size != sizeof(tx_record)) problem = "record size does not match this build";
   else if (!(h->rate_hz > 0 && h->rate_hz <= 100000)) problem = "rate out of range";
   else if (h->hand > 1) problem = "hand is neither 0 nor 1";
-  if (problem) return snprintf(err, n, "%s: %s", name, problem), -1;
-  if ((problem = device_problem(&h->device))) return snprintf(err, n, "%s: recorded device: %s", name, problem), -1;
+  if (problem) return tx_set_error("%s: %s", name, problem), -1;
+  if ((problem = device_problem(&h->device))) return tx_set_error("%s: recorded device: %s", name, problem), -1;
 
   size_t off = sizeof *h, most = (size - off) / sizeof(tx_record), total = 0, blk = 0;
   tx_record* recs = malloc((most ? most : 1) * sizeof *recs);
-  if (!recs) return snprintf(err, n, "%s: out of memory", name), -1;
+  if (!recs) return tx_set_error("%s: out of memory", name), -1;
   while (off < size) {
     size_t k;
     if (h->version == 1) { // records straight after the header
       k = (size - off) / sizeof(tx_record);
       if (k == 0) {
-        snprintf(warn, wn, "%s: ends in the middle of a record (a run that did not finish?): using its %zu whole records",
+        snprintf(out->cut_short, sizeof out->cut_short, "%s: ends in the middle of a record (a run that did not finish?): using its %zu whole records",
                  name, total);
         break;
       }
@@ -264,25 +260,25 @@ int tx_record_parse(const void* bytes, size_t size, const char* name, tx_record_
     } else {
       tx_record_block b;
       if (size - off < sizeof b) {
-        snprintf(warn, wn, "%s: cut short in block %zu at byte %zu (a run that did not finish?): using the %zu records before it",
+        snprintf(out->cut_short, sizeof out->cut_short, "%s: cut short in block %zu at byte %zu (a run that did not finish?): using the %zu records before it",
                  name, blk, off, total);
         break;
       }
       memcpy(&b, data + off, sizeof b);
       if (memcmp(b.tag, TX_RECORD_BLOCK_TAG, 4) != 0 || b.count == 0 || b.count > TX_RECORD_BLOCK_MAX || b.first != total) {
-        snprintf(err, n, "%s: block %zu at byte %zu: not a block of records %zu on (the file is corrupt)", name, blk, off,
+        tx_set_error("%s: block %zu at byte %zu: not a block of records %zu on (the file is corrupt)", name, blk, off,
                  total);
         goto bad;
       }
       k = b.count;
       if (size - off - sizeof b < k * sizeof(tx_record)) {
-        snprintf(warn, wn, "%s: cut short in block %zu at byte %zu (a run that did not finish?): using the %zu records before it",
+        snprintf(out->cut_short, sizeof out->cut_short, "%s: cut short in block %zu at byte %zu (a run that did not finish?): using the %zu records before it",
                  name, blk, off, total);
         break;
       }
       uint32_t crc = tx_dp_crc32(data + off + 8, 8 + k * sizeof(tx_record));
       if (crc != b.crc) {
-        snprintf(err, n, "%s: block %zu (records %zu to %zu, at byte %zu): checksum mismatch (the file is corrupt)", name,
+        tx_set_error("%s: block %zu (records %zu to %zu, at byte %zu): checksum mismatch (the file is corrupt)", name,
                  blk, total, total + k - 1, off);
         goto bad;
       }
@@ -291,22 +287,22 @@ int tx_record_parse(const void* bytes, size_t size, const char* name, tx_record_
     }
     for (size_t i = total; i < total + k; i++)
       if ((problem = record_problem(&recs[i], i ? &recs[i - 1] : NULL, h))) {
-        if (h->version == 1) snprintf(err, n, "%s: record %zu: %s", name, i, problem);
-        else snprintf(err, n, "%s: record %zu (block %zu): %s", name, i, blk, problem);
+        if (h->version == 1) tx_set_error("%s: record %zu: %s", name, i, problem);
+        else tx_set_error("%s: record %zu (block %zu): %s", name, i, blk, problem);
         goto bad;
       }
     total += k;
     blk++;
   }
   if (total == 0) {
-    snprintf(err, n, "%s: holds no records", name);
+    tx_set_error("%s: holds no records", name);
     goto bad;
   }
-  *records = recs;
-  *count = total;
+  out->records = recs;
+  out->count = total;
   return 0;
 bad:
-  if (wn) warn[0] = 0;
+  out->cut_short[0] = 0;
   free(recs);
   return -1;
 }

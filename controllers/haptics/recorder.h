@@ -59,29 +59,36 @@ typedef struct tx_record_block {
 
 typedef struct tx_recorder tx_recorder;
 
-// start recording into dir; NULL with a message on failure
-tx_recorder* tx_recorder_start(const char* dir, int hand, double rate_hz, const tx_device_info* device, char* err,
-                               size_t n);
+// Errors: NULL or -1 with one line in tx_error() (tactus/model.h).
+
+// start recording into dir; NULL on failure
+tx_recorder* tx_recorder_start(const char* dir, int hand, double rate_hz, const tx_device_info* device);
 // from the haptics thread: never blocks; false if the ring was full (dropped)
 bool tx_recorder_push(tx_recorder* r, const tx_record* rec);
 // from the haptics thread: 0, or the errno of the first failed write (the
 // recording is then broken and the run should stop); *file is the .bin path
 int tx_recorder_error(const tx_recorder* r, const char** file);
-// drain, close, export the CSV; returns 0 or -1 with a message
-int tx_recorder_stop(tx_recorder* r, char* err, size_t n);
+// drain, close, export the CSV; returns 0 or -1
+int tx_recorder_stop(tx_recorder* r);
 
-// read a recording's header and records (caller frees *records). A file cut
-// short (a killed run) gives its whole blocks and a one-line warning in warn
-// ("" when whole); a corrupt block or an implausible value is an error
-// naming the file, the block and the record.
-int tx_record_load(const char* path, tx_record_header* h, tx_record** records, size_t* count, char* warn, size_t wn,
-                   char* err, size_t n);
+// a recording as read. A file cut short (a killed run) is not an error: it
+// gives its whole blocks, and cut_short says where it ends (data the caller
+// may show as a warning; the reader prints nothing).
+typedef struct tx_record_file {
+  tx_record_header header;
+  tx_record* records;   // count records; the caller frees them (NULL after an error)
+  size_t count;
+  char cut_short[512];  // "" when whole; else one line naming the file and where it ends
+} tx_record_file;
+
+// read a recording; a corrupt block or an implausible value is an error
+// naming the file, the block and the record
+int tx_record_load(const char* path, tx_record_file* out);
 // the same on the bytes of a recording in memory; name is used in messages
-int tx_record_parse(const void* data, size_t size, const char* name, tx_record_header* h, tx_record** records,
-                    size_t* count, char* warn, size_t wn, char* err, size_t n);
+int tx_record_parse(const void* data, size_t size, const char* name, tx_record_file* out);
 // write a recording's CSV (aside, then renamed when whole): 0; -1 when the
-// recording cannot be read, -2 when the CSV cannot be written (err says why);
-// warn as for tx_record_load
-int tx_record_export_csv(const char* bin, const char* csv, char* warn, size_t wn, char* err, size_t n);
+// recording cannot be read, -2 when the CSV cannot be written; read, when not
+// NULL, receives what was read (header, count, cut_short; records NULL)
+int tx_record_export_csv(const char* bin, const char* csv, tx_record_file* read);
 
 #endif

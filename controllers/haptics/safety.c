@@ -1,6 +1,8 @@
 // The force safety chain; see safety.h for the order and why.
 #include "safety.h"
 
+#include "../../model/error.h"
+
 #include <float.h>
 #include <math.h>
 #include <stddef.h>
@@ -20,17 +22,17 @@ tx_safety_limits tx_safety_limits_from_device(const tx_device_info* info) {
   return l;
 }
 
-const char* tx_safety_limits_check(const tx_safety_limits* l) {
-  if (!(isfinite(l->max_force) && l->max_force > 0)) return "max_force: must be a positive number of newtons";
-  if (!(isfinite(l->ramp_s) && l->ramp_s > 0 && l->ramp_s <= 0.010)) return "ramp_s: must be in (0, 0.01] s";
+int tx_safety_limits_check(const tx_safety_limits* l) {
+  if (!(isfinite(l->max_force) && l->max_force > 0)) return tx_set_error("max_force: must be a positive number of newtons"), -1;
+  if (!(isfinite(l->ramp_s) && l->ramp_s > 0 && l->ramp_s <= 0.010)) return tx_set_error("ramp_s: must be in (0, 0.01] s"), -1;
   if (!(isfinite(l->max_force_rate) && l->max_force_rate * l->ramp_s >= l->max_force * (1 - 1e-12)))
-    return "max_force_rate: must be at least max_force / ramp_s, or the ramp to zero would be slowed";
-  if (!(isfinite(l->model_timeout_s) && l->model_timeout_s > 0)) return "model_timeout_s: must be positive";
-  if (!(isfinite(l->device_timeout_s) && l->device_timeout_s > 0)) return "device_timeout_s: must be positive";
+    return tx_set_error("max_force_rate: must be at least max_force / ramp_s, or the ramp to zero would be slowed"), -1;
+  if (!(isfinite(l->model_timeout_s) && l->model_timeout_s > 0)) return tx_set_error("model_timeout_s: must be positive"), -1;
+  if (!(isfinite(l->device_timeout_s) && l->device_timeout_s > 0)) return tx_set_error("device_timeout_s: must be positive"), -1;
   for (int i = 0; i < 3; i++)
     if (!(isfinite(l->workspace_min[i]) && isfinite(l->workspace_max[i]) && l->workspace_min[i] < l->workspace_max[i]))
-      return "workspace: each min must be a number below its max";
-  return NULL;
+      return tx_set_error("workspace: each min must be a number below its max"), -1;
+  return 0;
 }
 
 tx_safety_limits tx_safety_limits_lower(const tx_safety_limits* d, const tx_safety_limits* w) {

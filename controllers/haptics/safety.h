@@ -42,8 +42,8 @@ typedef struct tx_safety {
 // limits from a device: its max force, a 5 ms ramp, 50 ms model and 4 ms device timeouts,
 // so that a device gone silent feels no force 9 ms after its last sample
 tx_safety_limits tx_safety_limits_from_device(const tx_device_info* info);
-// NULL when every field is finite and consistent, else what is wrong ("max_force: ...")
-const char* tx_safety_limits_check(const tx_safety_limits* l);
+// 0 when every field is finite and consistent, else -1 with what is wrong in tx_error() ("max_force: ...")
+int tx_safety_limits_check(const tx_safety_limits* l);
 // the tighter of each limit, so that a scenario can only lower a device's limits
 tx_safety_limits tx_safety_limits_lower(const tx_safety_limits* device, const tx_safety_limits* wanted);
 

@@ -29,31 +29,30 @@ tx_sim_device_def tx_sim_device_def_default(void) {
 }
 
 // NULL if lo <= v <= hi (strictly above lo when open_lo) and finite
-static const char* range(const char* name, double v, double lo, bool open_lo, double hi, const char* units) {
+static int range(const char* name, double v, double lo, bool open_lo, double hi, const char* units) {
   return tx_check_range("sim device", name, v, lo, open_lo, hi, false, units);
 }
 
-const char* tx_sim_device_def_check(const tx_sim_device_def* d) {
-  const char* e;
+int tx_sim_device_def_check(const tx_sim_device_def* d) {
   // the ranges span every device of this kind, from a fingertip to an arm; a
   // mass below a gram would make k T / m and b T / m so large that the
   // transition over one period under- and overflows
-  if ((e = range("mass", d->mass, 1e-3, false, 100, "kg"))) return e;
-  if ((e = range("damping", d->damping, 0, false, 1e3, "N s/m"))) return e;
-  if ((e = range("period", d->period, 1e-5, false, 0.1, "s"))) return e;
-  if ((e = range("quantum", d->quantum, 0, false, 1e-3, "m"))) return e;
-  if ((e = range("max_force", d->max_force, 0, true, 1e3, "N"))) return e;
-  if ((e = range("nominal_stiffness", d->nominal_stiffness, 0, true, 1e6, "N/m"))) return e;
-  if ((e = range("hand_stiffness", d->hand_stiffness, 0, false, 1e6, "N/m"))) return e;
-  if ((e = range("hand_damping", d->hand_damping, 0, false, 1e3, "N s/m"))) return e;
+  if (range("mass", d->mass, 1e-3, false, 100, "kg")) return -1;
+  if (range("damping", d->damping, 0, false, 1e3, "N s/m")) return -1;
+  if (range("period", d->period, 1e-5, false, 0.1, "s")) return -1;
+  if (range("quantum", d->quantum, 0, false, 1e-3, "m")) return -1;
+  if (range("max_force", d->max_force, 0, true, 1e3, "N")) return -1;
+  if (range("nominal_stiffness", d->nominal_stiffness, 0, true, 1e6, "N/m")) return -1;
+  if (range("hand_stiffness", d->hand_stiffness, 0, false, 1e6, "N/m")) return -1;
+  if (range("hand_damping", d->hand_damping, 0, false, 1e3, "N s/m")) return -1;
   for (int i = 0; i < 3; i++) {
-    if ((e = range("workspace_min", d->workspace_min[i], -10, false, 10, "m"))) return e;
-    if ((e = range("workspace_max", d->workspace_max[i], -10, false, 10, "m"))) return e;
+    if (range("workspace_min", d->workspace_min[i], -10, false, 10, "m")) return -1;
+    if (range("workspace_max", d->workspace_max[i], -10, false, 10, "m")) return -1;
     if (!(d->workspace_min[i] < d->workspace_max[i]))
       return tx_check_fail("sim device: workspace_min[%d] = %g m must be below workspace_max[%d] = %g m", i,
                            d->workspace_min[i], i, d->workspace_max[i]);
   }
-  return NULL;
+  return 0;
 }
 
 // at most cap - 1 bytes of s into out, each control byte as '?': a message stays one line
@@ -64,7 +63,7 @@ static const char* shown(const char* s, size_t len, char* out, size_t cap) {
   return out;
 }
 
-bool tx_sim_device_parse(const char* spec, tx_sim_device_def* d, char* hand, size_t hand_size, char* err, size_t n) {
+bool tx_sim_device_parse(const char* spec, tx_sim_device_def* d, char* hand, size_t hand_size) {
   struct {
     const char* key;
     double* field;
@@ -87,25 +86,25 @@ bool tx_sim_device_parse(const char* spec, tx_sim_device_def* d, char* hand, siz
     }
     char key[65]; // as written, for the message
     shown(kv, klen, key, sizeof key);
-    if (klen == len) return snprintf(err, n, "%s: expected key=value", key), false;
+    if (klen == len) return tx_set_error("%s: expected key=value", key), false;
     size_t k = 0;
     while (k < KEYS && !(strlen(keys[k].key) == klen && strncmp(kv, keys[k].key, klen) == 0)) k++;
     if (k == KEYS)
-      return snprintf(err, n, "%s: unknown key (known: mass, damping, quantum, max_force, hand_stiffness, "
+      return tx_set_error("%s: unknown key (known: mass, damping, quantum, max_force, hand_stiffness, "
                               "hand_damping, hand)", key), false;
     // the second of two values would silently win
-    if (seen[k]) return snprintf(err, n, "%s: given twice", keys[k].key), false;
+    if (seen[k]) return tx_set_error("%s: given twice", keys[k].key), false;
     seen[k] = true;
     const char* value = kv + klen + 1;
     size_t vlen = len - klen - 1;
     if (!keys[k].field) {
-      if (vlen == 0) return snprintf(err, n, "hand: expected a scripted motion or a .csv file"), false;
-      if (vlen >= hand_size) return snprintf(err, n, "hand: too long"), false;
+      if (vlen == 0) return tx_set_error("hand: expected a scripted motion or a .csv file"), false;
+      if (vlen >= hand_size) return tx_set_error("hand: too long"), false;
       memcpy(hand, value, vlen);
       hand[vlen] = 0;
     } else {
       char num[64], text[64];
-      if (vlen == 0 || vlen >= sizeof num) return snprintf(err, n, "%s: expected a number", keys[k].key), false;
+      if (vlen == 0 || vlen >= sizeof num) return tx_set_error("%s: expected a number", keys[k].key), false;
       memcpy(num, value, vlen);
       num[vlen] = 0;
       shown(num, vlen, text, sizeof text);
@@ -113,15 +112,13 @@ bool tx_sim_device_parse(const char* spec, tx_sim_device_def* d, char* hand, siz
       errno = 0;
       double v = strtod(num, &end);
       if (*end || end == num || isspace((unsigned char)num[0]))
-        return snprintf(err, n, "%s: expected a number, got '%s'", keys[k].key, text), false;
-      if (errno == ERANGE) return snprintf(err, n, "%s: %s is out of range", keys[k].key, text), false;
+        return tx_set_error("%s: expected a number, got '%s'", keys[k].key, text), false;
+      if (errno == ERANGE) return tx_set_error("%s: %s is out of range", keys[k].key, text), false;
       *keys[k].field = v;
     }
     kv = next;
   }
-  const char* bad = tx_sim_device_def_check(d);
-  if (bad) return snprintf(err, n, "%s", bad), false;
-  return true;
+  return tx_sim_device_def_check(d) == 0;
 }
 
 static void mat3_mul(const double a[9], const double b[9], double out[9]) {
@@ -156,11 +153,7 @@ static void mat3_exp(const double a[9], double out[9]) {
 static double quantize(double x, double q) { return q > 0 ? q * floor(x / q + 0.5) : x; }
 
 bool tx_sim_device_init(tx_sim_device* dev, const tx_sim_device_def* def) {
-  const char* e = tx_sim_device_def_check(def);
-  if (e) {
-    tx_set_error("%s", e);
-    return false;
-  }
+  if (tx_sim_device_def_check(def)) return false;
   // state (x, v, u) with u the held input F + kh xt + bh vt; exp of the
   // augmented matrix gives the transition and the input response at once
   double m = def->mass, T = def->period;

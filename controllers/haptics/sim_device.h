@@ -68,9 +68,9 @@ typedef struct tx_sim_device {
 // the defaults above
 tx_sim_device_def tx_sim_device_def_default(void);
 
-// NULL when every field is finite and in range; otherwise one line naming the
-// field, its value and the allowed range (valid until the next call on this thread)
-const char* tx_sim_device_def_check(const tx_sim_device_def* def);
+// 0 when every field is finite and in range; otherwise -1 with one line in
+// tx_error() naming the field, its value and the allowed range
+int tx_sim_device_def_check(const tx_sim_device_def* def);
 
 // the keys of a "sim:" device spec, "key=value,...", over def (the part after
 // "sim:"; "" keeps def): mass, damping, quantum, max_force, hand_stiffness,
@@ -78,7 +78,7 @@ const char* tx_sim_device_def_check(const tx_sim_device_def* def);
 // hand follows, copied into hand). Each key at most once, and the result must
 // pass tx_sim_device_def_check. false with one line naming the key; def and
 // hand are then unspecified. Nothing here opens a file.
-bool tx_sim_device_parse(const char* spec, tx_sim_device_def* def, char* hand, size_t hand_size, char* err, size_t n);
+bool tx_sim_device_parse(const char* spec, tx_sim_device_def* def, char* hand, size_t hand_size);
 
 // checks def and sets the device at rest at the origin, hand target there too;
 // on bad input returns false, leaves dev unchanged and sets tx_error()

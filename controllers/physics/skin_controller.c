@@ -89,8 +89,7 @@ static int configure(tx_setup* s, void** self) {
   if (res > 1024) return tx_setup_fail(s, "spacing_m", "%g m gives %d particles a side, at most 1024", spacing, res);
   d.size[0] = d.size[1] = (res - 1) * spacing;
   d.res[0] = d.res[1] = res;
-  const char* bad = tx_cloth_def_check(&d);
-  if (bad) return tx_setup_fail(s, NULL, "%s", bad);
+  if (tx_cloth_def_check(&d)) return tx_setup_fail(s, NULL, "%s", tx_error());
   k->cloth = tx_cloth_create(&d);
   if (!k->cloth) return tx_setup_fail(s, NULL, "%s", tx_error());
 

@@ -16,26 +16,24 @@ tx_insertion_motion tx_insertion_motion_default(void) {
   return (tx_insertion_motion){.start_depth = -1e-3, .max_depth = 4e-3, .speed = 3e-3, .wait = 0.2, .rate = 1000};
 }
 
-const char* tx_insertion_model_check(const tx_insertion_model* m) {
-  const char* e;
-  if ((e = tx_check_range("insertion model", "a1", m->a1, -1e6, false, 1e6, false, "N/m"))) return e;
-  if ((e = tx_check_range("insertion model", "a2", m->a2, -1e9, false, 1e9, false, "N/m^2"))) return e;
-  if ((e = tx_check_range("insertion model", "puncture_depth", m->puncture_depth, 0, true, 1, false, "m"))) return e;
-  if ((e = tx_check_range("insertion model", "cutting", m->cutting, 0, false, 1e3, false, "N"))) return e;
-  if ((e = tx_check_range("insertion model", "friction", m->friction, 0, false, 1e6, false, "N/m"))) return e;
-  return NULL;
+int tx_insertion_model_check(const tx_insertion_model* m) {
+  if (tx_check_range("insertion model", "a1", m->a1, -1e6, false, 1e6, false, "N/m")) return -1;
+  if (tx_check_range("insertion model", "a2", m->a2, -1e9, false, 1e9, false, "N/m^2")) return -1;
+  if (tx_check_range("insertion model", "puncture_depth", m->puncture_depth, 0, true, 1, false, "m")) return -1;
+  if (tx_check_range("insertion model", "cutting", m->cutting, 0, false, 1e3, false, "N")) return -1;
+  if (tx_check_range("insertion model", "friction", m->friction, 0, false, 1e6, false, "N/m")) return -1;
+  return 0;
 }
 
-const char* tx_insertion_motion_check(const tx_insertion_motion* m) {
-  const char* e;
-  if ((e = tx_check_range("insertion motion", "start_depth", m->start_depth, -1, false, 0, true, "m"))) return e;
-  if ((e = tx_check_range("insertion motion", "max_depth", m->max_depth, 0, true, 1, false, "m"))) return e;
-  if ((e = tx_check_range("insertion motion", "speed", m->speed, 1e-6, false, 10, false, "m/s"))) return e;
-  if ((e = tx_check_range("insertion motion", "wait", m->wait, 0, false, 60, false, "s"))) return e;
-  if ((e = tx_check_range("insertion motion", "rate", m->rate, 1000, false, 1e5, false, "Hz"))) return e;
+int tx_insertion_motion_check(const tx_insertion_motion* m) {
+  if (tx_check_range("insertion motion", "start_depth", m->start_depth, -1, false, 0, true, "m")) return -1;
+  if (tx_check_range("insertion motion", "max_depth", m->max_depth, 0, true, 1, false, "m")) return -1;
+  if (tx_check_range("insertion motion", "speed", m->speed, 1e-6, false, 10, false, "m/s")) return -1;
+  if (tx_check_range("insertion motion", "wait", m->wait, 0, false, 60, false, "s")) return -1;
+  if (tx_check_range("insertion motion", "rate", m->rate, 1000, false, 1e5, false, "Hz")) return -1;
   double rows = (2 * (m->max_depth - m->start_depth) / m->speed + 2 * m->wait) * m->rate;
   if (rows > TX_RECORDING_MAX_ROWS) return tx_check_fail("insertion motion: %.0f rows, more than %d", rows, TX_RECORDING_MAX_ROWS);
-  return NULL;
+  return 0;
 }
 
 double tx_insertion_force(const tx_insertion_model* m, double z, int dir, bool punctured) {
@@ -48,9 +46,7 @@ double tx_insertion_force(const tx_insertion_model* m, double z, int dir, bool p
 
 bool tx_insertion_generate(const tx_insertion_model* m, const tx_insertion_motion* mo, tx_recording* out) {
   memset(out, 0, sizeof *out);
-  const char* bad = tx_insertion_model_check(m);
-  if (!bad) bad = tx_insertion_motion_check(mo);
-  if (bad) return tx_set_error("%s", bad), false;
+  if (tx_insertion_model_check(m) || tx_insertion_motion_check(mo)) return false;
   const double travel = (mo->max_depth - mo->start_depth) / mo->speed;
   const double t_in = mo->wait, t_turn = t_in + travel, t_out = t_turn + travel, t_end = t_out + mo->wait;
   const size_t rows = (size_t)floor(t_end * mo->rate + 1e-9) + 1;

@@ -36,9 +36,9 @@ typedef struct tx_insertion_motion {
 tx_insertion_model tx_insertion_model_default(void);
 tx_insertion_motion tx_insertion_motion_default(void);
 
-// NULL when valid; otherwise one line naming the field
-const char* tx_insertion_model_check(const tx_insertion_model* m);
-const char* tx_insertion_motion_check(const tx_insertion_motion* m);
+// 0 when valid; otherwise -1 with one line in tx_error() naming the field
+int tx_insertion_model_check(const tx_insertion_model* m);
+int tx_insertion_motion_check(const tx_insertion_motion* m);
 
 // the force resisting the needle (N, positive out of the tissue) at depth z
 // (m) moving into the tissue (dir > 0), out of it (dir < 0) or not (0)

@@ -45,27 +45,25 @@ tx_voxel_needle_def tx_voxel_needle_def_default(void) {
 
 static double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
-const char* tx_voxel_needle_def_check(const tx_voxel_needle_def* d) {
-  const char* e;
-  if ((e = tx_check_count("needle", "gauge", d->gauge, 10, 34))) return e;
+int tx_voxel_needle_def_check(const tx_voxel_needle_def* d) {
+  if (tx_check_count("needle", "gauge", d->gauge, 10, 34)) return -1;
   if ((unsigned)d->tip > TX_NEEDLE_BLUNT) return tx_check_fail("needle: tip = %d, must be conical, bevel or blunt", (int)d->tip);
-  if ((e = tx_check_range("needle", "tip_angle_deg", d->tip_angle_deg, 0, true, 90, true, "degrees"))) return e;
-  if ((e = tx_check_range("needle", "length", d->length, 0, true, 1, false, "m"))) return e;
-  if ((e = tx_check_range("needle", "friction", d->friction, 0, false, 10, false, "(Coulomb coefficient)"))) return e;
-  if ((e = tx_check_range("needle", "rupture_force", d->rupture_force, 0, true, 1e4, false, "N"))) return e;
-  if ((e = tx_check_range("needle", "cutting_force", d->cutting_force, 0, true, 1e4, false, "N"))) return e;
-  if ((e = tx_check_range("needle", "load_time", d->load_time, 0, true, 1, false, "s"))) return e;
+  if (tx_check_range("needle", "tip_angle_deg", d->tip_angle_deg, 0, true, 90, true, "degrees")) return -1;
+  if (tx_check_range("needle", "length", d->length, 0, true, 1, false, "m")) return -1;
+  if (tx_check_range("needle", "friction", d->friction, 0, false, 10, false, "(Coulomb coefficient)")) return -1;
+  if (tx_check_range("needle", "rupture_force", d->rupture_force, 0, true, 1e4, false, "N")) return -1;
+  if (tx_check_range("needle", "cutting_force", d->cutting_force, 0, true, 1e4, false, "N")) return -1;
+  if (tx_check_range("needle", "load_time", d->load_time, 0, true, 1, false, "s")) return -1;
   for (int a = 0; a < 3; a++)
     if (!isfinite(d->axis[a]) || !isfinite(d->side[a])) return tx_check_fail("needle: axis and side must be finite");
   double la = sqrt(dot(d->axis, d->axis)), ls = sqrt(dot(d->side, d->side));
   if (fabs(la - 1) > 1e-6 || fabs(ls - 1) > 1e-6) return tx_check_fail("needle: axis and side must be unit vectors");
   if (fabs(dot(d->axis, d->side)) > 1e-6) return tx_check_fail("needle: side must be normal to axis");
-  return NULL;
+  return 0;
 }
 
 bool tx_voxel_needle_init(tx_voxel_needle* out, const tx_voxel_needle_def* def, const tx_voxel_tissue* t) {
-  const char* e = tx_voxel_needle_def_check(def);
-  if (e) return tx_set_error("%s", e), false;
+  if (tx_voxel_needle_def_check(def)) return false;
   tx_voxel_needle n;
   memset(&n, 0, sizeof n);
   n.def = *def;

@@ -96,8 +96,8 @@ typedef struct tx_voxel_needle {
 // the defaults above
 tx_voxel_needle_def tx_voxel_needle_def_default(void);
 
-// NULL when every field is valid; otherwise one line naming the field
-const char* tx_voxel_needle_def_check(const tx_voxel_needle_def* def);
+// 0 when every field is valid; otherwise -1 with one line in tx_error() naming the field
+int tx_voxel_needle_def_check(const tx_voxel_needle_def* def);
 
 // outer diameter of a gauge, m (ISO 9626 nominal); 0 outside 10 to 34
 double tx_needle_gauge_diameter(int gauge);

@@ -120,9 +120,7 @@ static int configure(tx_setup* s, void** self) {
   if (!tip || !pose || !model) return -1;
   if (!tx_needle_tip_parse(tip, &nd.tip))
     return tx_setup_fail(s, "tip", "expected \"conical\", \"bevel\" or \"blunt\", got \"%s\"", tip);
-  const char* bad = tx_voxel_tissue_def_check(&d);
-  if (!bad) bad = tx_voxel_needle_def_check(&nd);
-  if (bad) return tx_setup_fail(s, NULL, "%s", bad);
+  if (tx_voxel_tissue_def_check(&d) || tx_voxel_needle_def_check(&nd)) return tx_setup_fail(s, NULL, "%s", tx_error());
   if (!tx_voxel_tissue_init(&c->tissue, &d)) return tx_setup_fail(s, NULL, "%s", tx_error());
   if (!tx_voxel_needle_init(&c->needle, &nd, &c->tissue) || !tx_voxel_guard_init(&c->guard, &c->tissue, every)) {
     c->ready = true; // fini frees whatever was made
@@ -188,7 +186,7 @@ static int init(tx_ctx* ctx, void* self) {
   if (c->record && tx_record_dir(ctx)) {
     size_t rows = (size_t)ceil(c->record_max_s * tx_rate(ctx)) + 1;
     if (!tx_recording_alloc(&c->rec, rows)) {
-      fprintf(stderr, "tactus: voxel.needle: %s\n", tx_error());
+      tx_stop_run(ctx, "%s", tx_error()); // the run fails with this reason
       return -1;
     }
   }
@@ -235,7 +233,8 @@ static void finish(tx_ctx* ctx, void* self) {
   if (c->rec.cap && tx_record_dir(ctx)) {
     char path[4200];
     snprintf(path, sizeof path, "%s/needle-recording.csv", tx_record_dir(ctx));
-    if (!tx_recording_write(&c->rec, path)) fprintf(stderr, "tactus: voxel.needle: %s\n", tx_error());
+    // a recording that cannot be written ends the run in a fault (exit 1, named)
+    if (!tx_recording_write(&c->rec, path)) tx_stop_run(ctx, "%s", tx_error());
   }
 }
 

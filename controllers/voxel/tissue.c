@@ -30,38 +30,37 @@ tx_voxel_tissue_def tx_voxel_tissue_def_default(void) {
 }
 
 // NULL if lo <= v <= hi (strictly above lo when open_lo, strictly below hi when open_hi) and finite
-static const char* range(const char* name, double v, double lo, bool open_lo, double hi, bool open_hi,
+static int range(const char* name, double v, double lo, bool open_lo, double hi, bool open_hi,
                          const char* units) {
   return tx_check_range("voxel tissue", name, v, lo, open_lo, hi, open_hi, units);
 }
 
-static const char* irange(const char* name, long long v, long long lo, long long hi) {
+static int irange(const char* name, long long v, long long lo, long long hi) {
   return tx_check_count("voxel tissue", name, v, lo, hi);
 }
 
-const char* tx_voxel_tissue_def_check(const tx_voxel_tissue_def* d) {
+int tx_voxel_tissue_def_check(const tx_voxel_tissue_def* d) {
   static const char* const size_name[3] = {"block_size[0]", "block_size[1]", "block_size[2]"};
   static const char* const origin_name[3] = {"origin[0]", "origin[1]", "origin[2]"};
   static const char* const count_name[3] = {"count[0]", "count[1]", "count[2]"};
-  const char* e;
   // from a single cell to an organ; masses from a cell to a gram-scale lump
   for (int a = 0; a < 3; a++) {
-    if ((e = range(size_name[a], d->block_size[a], 0, true, 1, false, "m"))) return e;
-    if ((e = range(origin_name[a], d->origin[a], -10, false, 10, false, "m"))) return e;
-    if ((e = irange(count_name[a], d->count[a], 1, 1000))) return e;
+    if (range(size_name[a], d->block_size[a], 0, true, 1, false, "m")) return -1;
+    if (range(origin_name[a], d->origin[a], -10, false, 10, false, "m")) return -1;
+    if (irange(count_name[a], d->count[a], 1, 1000)) return -1;
   }
   // a bound on the total keeps every index and list size inside 32 bits
   long long n = (long long)d->count[0] * d->count[1] * d->count[2];
-  if ((e = irange("count[0] * count[1] * count[2]", n, 1, 10000000))) return e;
-  if ((e = range("mass", d->mass, 0, true, 1, false, "kg"))) return e;
-  if ((e = range("elasticity", d->elasticity, 0, false, 1, false, "(e of eq. 5)"))) return e;
-  if ((e = range("spring", d->spring, 0, false, 1e9, false, "N/m"))) return e;
-  if ((e = range("damper", d->damper, 0, false, 1e9, false, "N s/m"))) return e;
-  if ((e = range("radius", d->radius, 0, true, 1, false, "m"))) return e;
-  if ((e = range("damage_shrink", d->damage_shrink, 0, false, 1, true, "(fraction)"))) return e;
-  if ((e = range("recovery_time", d->recovery_time, 0, true, 1e6, false, "s"))) return e;
-  if ((e = range("skin", d->skin, 0, true, 1, false, "m"))) return e;
-  if ((e = irange("max_neighbours", d->max_neighbours, 1, 200))) return e;
+  if (irange("count[0] * count[1] * count[2]", n, 1, 10000000)) return -1;
+  if (range("mass", d->mass, 0, true, 1, false, "kg")) return -1;
+  if (range("elasticity", d->elasticity, 0, false, 1, false, "(e of eq. 5)")) return -1;
+  if (range("spring", d->spring, 0, false, 1e9, false, "N/m")) return -1;
+  if (range("damper", d->damper, 0, false, 1e9, false, "N s/m")) return -1;
+  if (range("radius", d->radius, 0, true, 1, false, "m")) return -1;
+  if (range("damage_shrink", d->damage_shrink, 0, false, 1, true, "(fraction)")) return -1;
+  if (range("recovery_time", d->recovery_time, 0, true, 1e6, false, "s")) return -1;
+  if (range("skin", d->skin, 0, true, 1, false, "m")) return -1;
+  if (irange("max_neighbours", d->max_neighbours, 1, 200)) return -1;
   // voxels packed tighter than this have more neighbours within reach than a
   // lattice point has within two spacings (26): the lists overflow and every
   // search crawls through crowded cells
@@ -70,7 +69,7 @@ const char* tx_voxel_tissue_def_check(const tx_voxel_tissue_def* d) {
   if (2 * d->radius + d->skin > 2 * spacing)
     return tx_check_fail("voxel tissue: 2 radius + skin = %g m, must be at most twice the lattice spacing, %g m",
                          2 * d->radius + d->skin, spacing);
-  return NULL;
+  return 0;
 }
 
 // ---------------------------------------------------------------------------
@@ -188,11 +187,7 @@ static void free_all(tx_voxel_tissue* t) {
 }
 
 bool tx_voxel_tissue_init(tx_voxel_tissue* out, const tx_voxel_tissue_def* def) {
-  const char* e = tx_voxel_tissue_def_check(def);
-  if (e) {
-    tx_set_error("%s", e);
-    return false;
-  }
+  if (tx_voxel_tissue_def_check(def)) return false;
   tx_voxel_tissue t;
   memset(&t, 0, sizeof t);
   t.def = *def;

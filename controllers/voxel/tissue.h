@@ -120,9 +120,9 @@ typedef struct tx_voxel_tissue {
 // the defaults above
 tx_voxel_tissue_def tx_voxel_tissue_def_default(void);
 
-// NULL when every field is finite and in range; otherwise one line naming the
-// field, its value and the allowed range (valid until the next call on this thread)
-const char* tx_voxel_tissue_def_check(const tx_voxel_tissue_def* def);
+// 0 when every field is finite and in range; otherwise -1 with one line in
+// tx_error() naming the field, its value and the allowed range
+int tx_voxel_tissue_def_check(const tx_voxel_tissue_def* def);
 
 // checks def, allocates all storage and puts every voxel at rest on the
 // lattice; on bad input or no memory returns false, leaves t unchanged and

@@ -37,6 +37,13 @@
 //     const tx_controller_class demo = {.type = "demo.counter", .configure = configure, .step = step,
 //                                       .params = params, .nparams = TX_PARAMS_COUNT(params)};
 //
+// Errors: a controller never prints. configure fails with tx_setup_fail (the
+// loader names the file and key, exit 2); at run time tx_warn counts what was
+// recovered, and tx_stop_run ends the run for what cannot be (in init the run
+// fails with that reason; in a step or finish the report is still written and
+// the run exits 1 naming it). The library calls below return -1, NULL or an
+// invalid id with one line in tx_error() (tactus/model.h).
+//
 // Plugins: a shared library named in a scenario's "plugins" exports
 // TX_PLUGIN_ENTRY, which calls tx_register_controller for each class.
 #ifndef TACTUS_CONTROLLER_H
@@ -51,7 +58,8 @@ extern "C" {
 // 2: tx_controller_class gained its parameter table (params, nparams) and
 // own_thread, so a
 // plugin built against version 1 would be read past its end: it must refuse
-#define TX_API_VERSION 2
+// 3: tx_stop_run takes a printf format
+#define TX_API_VERSION 3
 #define TX_RATE_MAX_HZ 100000.0 // no controller runs faster
 // no controller runs slower: one period is 1000 s, so every tick of the longest
 // run (86400 s) is a few 1e13 ns, far inside the int64 ns of the clocks
@@ -188,8 +196,11 @@ const char* tx_output_dir(const tx_ctx* c);          // where this run writes it
 void tx_set_result(tx_ctx* c, tx_result r, double value); // the last value set is reported (set it in finish)
 // end the run at once for a fault the controller cannot recover from (a full
 // disk, a lost file); every thread stops at its next tick, finish still runs,
-// and the report names the first reason given. Lock-free; callable from any thread.
-void tx_stop_run(tx_ctx* c, const char* reason);
+// and the report names the first reason given, printf-style ("%s: cannot be
+// written", path). Lock-free, no allocation; callable from any thread and from
+// init (the run then fails with this reason) or finish (the run still ends
+// with its report, and exits 1 naming the reason).
+void tx_stop_run(tx_ctx* c, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
 // send an event (its seq and sim_ns are set here); returns its seq, or 0 when
 // the slowest listener is a whole ring behind: then it is dropped and counted
 // in the report. Lock-free, no allocation: safe at 1 kHz.

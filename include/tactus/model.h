@@ -16,8 +16,9 @@
 //     tx_model_publish(m, x, sim_ns);             // ... and swap
 //     tx_snapshot s = tx_model_acquire(m, r);     // reader thread: s.data, s.seq
 //
-// Functions that can fail return 0 or an invalid id and leave a message in
-// tx_error().
+// Errors, here and in all of tactus: a function that can fail returns -1,
+// NULL, false or an invalid id and leaves one line in this thread's
+// tx_error(); it never prints and takes no message buffer.
 #ifndef TACTUS_MODEL_H
 #define TACTUS_MODEL_H
 

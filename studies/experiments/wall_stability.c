@@ -28,11 +28,8 @@ tx_wall_case tx_wall_case_default(void) {
   return c;
 }
 
-static _Thread_local char check_msg[200];
-
-const char* tx_wall_case_check(const tx_wall_case* c) {
-  const char* e = tx_sim_device_def_check(&c->device);
-  if (e) return e;
+int tx_wall_case_check(const tx_wall_case* c) {
+  if (tx_sim_device_def_check(&c->device)) return -1;
   const char* name = NULL;
   double v = 0;
   const char* rule = "";
@@ -50,15 +47,13 @@ const char* tx_wall_case_check(const tx_wall_case* c) {
     name = "kick", v = c->kick, rule = "must be in (0, 1): the device starts inside the wall";
   else if (!(isfinite(c->duration) && c->duration >= 8 * c->device.period && c->duration <= 1e3))
     name = "duration", v = c->duration, rule = "s, must be in [8 periods, 1000]";
-  if (!name) return NULL;
-  snprintf(check_msg, sizeof check_msg, "wall case: %s = %g %s", name, v, rule);
-  return check_msg;
+  if (!name) return 0;
+  tx_set_error("wall case: %s = %g %s", name, v, rule);
+  return -1;
 }
 
 bool tx_wall_run(const tx_wall_case* c, tx_wall_result* out) {
-  const char* e = tx_wall_case_check(c);
-  if (e) {
-    tx_set_error("%s", e);
+  if (tx_wall_case_check(c)) {
     return false;
   }
   tx_sim_device dev;

@@ -108,8 +108,8 @@ typedef struct tx_wall_search {
 // damping adds to b and allows a stiffer wall)
 tx_wall_case tx_wall_case_default(void);
 
-// NULL when every field is finite and in range, otherwise one line naming it
-const char* tx_wall_case_check(const tx_wall_case* c);
+// 0 when every field is finite and in range, otherwise -1 with one line in tx_error() naming it
+int tx_wall_case_check(const tx_wall_case* c);
 
 // runs one case for c->duration seconds of simulated time; false (with
 // tx_error() set, *out untouched) on bad input. Allocates nothing.

@@ -5,6 +5,7 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
+#include "model/error.h"
 #include "controllers/system.h"
 #include "controllers/system_internal.h"
 #include "test_support.h"
@@ -27,21 +28,19 @@ static tx_system* chain(void) {
       {"graphics", 30, "{\"read\":\"skin\"}"},
   };
   tx_system* s = tx_system_create();
-  tx_fault f;
   for (size_t i = 0; i < sizeof spec / sizeof spec[0]; i++) {
     json_t* p = json_loads(spec[i].params, 0, NULL);
-    assert_int_equal(tx_system_add(s, spec[i].name, "test.counter", spec[i].rate, p, &f), 0);
+    assert_int_equal(tx_system_add(s, spec[i].name, "test.counter", spec[i].rate, p), 0);
     json_decref(p);
   }
-  assert_int_equal(tx_system_finalize(s, &f), 0);
+  assert_int_equal(tx_system_finalize(s), 0);
   return s;
 }
 
 static uint64_t lockstep(tx_system* s, double seconds, FILE* trace) {
   tx_run_options o = {.duration_s = seconds, .lockstep = true, .trace = trace};
   tx_run_result r;
-  char err[256];
-  assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+  assert_int_equal(tx_system_run(s, &o, &r), 0);
   return r.trace_hash;
 }
 
@@ -110,8 +109,7 @@ static void realtime_runs_every_group_and_moves_data(void** state) {
   tx_system* s = chain();
   tx_run_options o = {.duration_s = 0.5, .realtime_priority = true, .pin_threads = true};
   tx_run_result r;
-  char err[256];
-  assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+  assert_int_equal(tx_system_run(s, &o, &r), 0);
   print_message("  %s\n", r.scheduler);
   assert_true(strlen(r.scheduler) > 0);
   for (int i = 0; i < tx_system_count(s); i++) {
@@ -153,15 +151,13 @@ static void overrun(double sleep_ms, uint64_t want_steps, uint64_t want_missed) 
                                     .step = sleeper_step, .fini = counter_fini};
   if (!tx_find_controller(cls.type)) assert_int_equal(tx_register_controller(&cls), 0);
   tx_system* s = tx_system_create();
-  tx_fault f;
   json_t* p = json_pack("{s:f}", "sleep_ms", sleep_ms);
-  assert_int_equal(tx_system_add(s, "z", "test.sleeper", 5, p, &f), 0);
+  assert_int_equal(tx_system_add(s, "z", "test.sleeper", 5, p), 0);
   json_decref(p);
-  assert_int_equal(tx_system_finalize(s, &f), 0);
+  assert_int_equal(tx_system_finalize(s), 0);
   tx_run_options o = {.duration_s = 1.0};
   tx_run_result r;
-  char err[256];
-  assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+  assert_int_equal(tx_system_run(s, &o, &r), 0);
   tx_controller_stats st = tx_system_stats(s, 0);
   print_message("  sleep %g ms: %llu steps, %llu missed\n", sleep_ms, (unsigned long long)st.steps,
                 (unsigned long long)st.missed);
@@ -192,15 +188,13 @@ static void a_failing_init_stops_the_run_cleanly(void** state) {
   if (!tx_find_controller(bad.type)) assert_int_equal(tx_register_controller(&bad), 0);
   for (int lock = 0; lock < 2; lock++) {
     tx_system* s = tx_system_create();
-    tx_fault f;
-    assert_int_equal(tx_system_add(s, "good", "test.counter", 100, NULL, &f), 0);
-    assert_int_equal(tx_system_add(s, "bad", "test.badinit", 50, NULL, &f), 0);
-    assert_int_equal(tx_system_finalize(s, &f), 0);
+    assert_int_equal(tx_system_add(s, "good", "test.counter", 100, NULL), 0);
+    assert_int_equal(tx_system_add(s, "bad", "test.badinit", 50, NULL), 0);
+    assert_int_equal(tx_system_finalize(s), 0);
     tx_run_options o = {.duration_s = 0.2, .lockstep = lock};
     tx_run_result r;
-    char err[256];
-    assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), -1);
-    assert_non_null(strstr(err, "bad"));
+    assert_int_equal(tx_system_run(s, &o, &r), -1);
+    assert_non_null(strstr(tx_error(), "bad"));
     tx_system_destroy(s);
   }
 }
@@ -212,8 +206,7 @@ static void bad_durations_are_refused(void** state) {
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     tx_run_options o = {.duration_s = bad[i], .lockstep = true};
     tx_run_result r;
-    char err[256];
-    assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), -1);
+    assert_int_equal(tx_system_run(s, &o, &r), -1);
   }
   tx_system_destroy(s);
 }
@@ -223,19 +216,17 @@ static void a_controller_can_stop_the_run(void** state) {
   (void)state;
   for (int lock = 1; lock >= 0; lock--) {
     tx_system* s = tx_system_create();
-    tx_fault f;
     json_t* p = json_loads("{\"write\":\"a\",\"stop_at\":20}", 0, NULL);
-    assert_int_equal(tx_system_add(s, "stopper", "test.counter", 1000, p, &f), 0);
+    assert_int_equal(tx_system_add(s, "stopper", "test.counter", 1000, p), 0);
     json_decref(p);
     p = json_loads("{\"write\":\"b\"}", 0, NULL);
-    assert_int_equal(tx_system_add(s, "other", "test.counter", 100, p, &f), 0);
+    assert_int_equal(tx_system_add(s, "other", "test.counter", 100, p), 0);
     json_decref(p);
-    assert_int_equal(tx_system_finalize(s, &f), 0);
+    assert_int_equal(tx_system_finalize(s), 0);
     tx_run_options o = {.duration_s = 5, .lockstep = lock};
     tx_run_result r;
-    char err[256];
     int64_t t0 = tx_mono_ns();
-    assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+    assert_int_equal(tx_system_run(s, &o, &r), 0);
     assert_true(r.halted);
     assert_string_equal(r.halt_reason, "stopper: disk full");
     // lockstep: exactly at step 20 (t = 20 ms), and no step after it. In real
@@ -262,21 +253,19 @@ static void ticks_saturate_and_the_limits_fit(void** state) {
   assert_true(tx_tick_ns(TX_RATE_MAX_HZ, (uint64_t)(TX_DURATION_MAX_S * TX_RATE_MAX_HZ)) == (int64_t)(TX_DURATION_MAX_S * 1e9));
   // the longest run at the slowest rate: one tick each 1000 s, 0 to 86000 s
   tx_system* s = tx_system_create();
-  tx_fault f;
   json_t* p = json_loads("{\"write\":\"a\"}", 0, NULL);
-  assert_int_equal(tx_system_add(s, "slow", "test.counter", TX_RATE_MIN_HZ, p, &f), 0);
+  assert_int_equal(tx_system_add(s, "slow", "test.counter", TX_RATE_MIN_HZ, p), 0);
   json_decref(p);
-  assert_int_equal(tx_system_finalize(s, &f), 0);
+  assert_int_equal(tx_system_finalize(s), 0);
   tx_run_options o = {.duration_s = TX_DURATION_MAX_S, .lockstep = true};
   tx_run_result r;
-  char err[256];
-  assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+  assert_int_equal(tx_system_run(s, &o, &r), 0);
   assert_int_equal(tx_system_stats(s, 0).steps, 87);
   tx_system_destroy(s);
   // and one below it is refused
   s = tx_system_create();
-  assert_int_equal(tx_system_add(s, "slower", "test.counter", TX_RATE_MIN_HZ / 2, NULL, &f), -1);
-  assert_string_equal(f.key, "rate_hz");
+  assert_int_equal(tx_system_add(s, "slower", "test.counter", TX_RATE_MIN_HZ / 2, NULL), -1);
+  assert_string_equal(tx_error_key(), "rate_hz");
   tx_system_destroy(s);
 }
 
@@ -302,14 +291,12 @@ static void lockstep_hears_a_stop_on_wall_time(void** state) {
                                     .step = slow_step, .fini = counter_fini};
   if (!tx_find_controller(cls.type)) assert_int_equal(tx_register_controller(&cls), 0);
   tx_system* s = tx_system_create();
-  tx_fault f;
-  assert_int_equal(tx_system_add(s, "slow", "test.slow", 1000, NULL, &f), 0);
-  assert_int_equal(tx_system_finalize(s, &f), 0);
+  assert_int_equal(tx_system_add(s, "slow", "test.slow", 1000, NULL), 0);
+  assert_int_equal(tx_system_finalize(s), 0);
   tx_run_options o = {.duration_s = 10, .lockstep = true, .progress = stop_at_once};
   tx_run_result r;
-  char err[256];
   progress_calls = 0;
-  assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+  assert_int_equal(tx_system_run(s, &o, &r), 0);
   assert_true(r.stopped_early);
   assert_int_equal(progress_calls, 1);
   uint64_t steps = tx_system_stats(s, 0).steps;
@@ -329,8 +316,7 @@ static void a_trace_write_error_stops_the_run(void** state) {
   tx_system* s = chain();
   tx_run_options o = {.duration_s = 10, .lockstep = true, .trace = full, .trace_name = "out/trace.csv"};
   tx_run_result r;
-  char err[256];
-  assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+  assert_int_equal(tx_system_run(s, &o, &r), 0);
   assert_true(r.halted);
   char want[256];
   snprintf(want, sizeof want, "out/trace.csv: %s", strerror(ENOSPC));
@@ -362,15 +348,13 @@ static void no_finish_after_a_failed_init(void** state) {
   if (!tx_find_controller(bad.type)) assert_int_equal(tx_register_controller(&bad), 0);
   for (int lock = 0; lock < 2; lock++) {
     tx_system* s = tx_system_create();
-    tx_fault f;
-    assert_int_equal(tx_system_add(s, "good", "test.finisher", 1000, NULL, &f), 0);
-    assert_int_equal(tx_system_add(s, "bad", "test.badinit2", 50, NULL, &f), 0);
-    assert_int_equal(tx_system_finalize(s, &f), 0);
+    assert_int_equal(tx_system_add(s, "good", "test.finisher", 1000, NULL), 0);
+    assert_int_equal(tx_system_add(s, "bad", "test.badinit2", 50, NULL), 0);
+    assert_int_equal(tx_system_finalize(s), 0);
     tx_run_options o = {.duration_s = 0.2, .lockstep = lock};
     tx_run_result r;
-    char err[256];
     finishes = 0;
-    assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), -1);
+    assert_int_equal(tx_system_run(s, &o, &r), -1);
     assert_int_equal(finishes, 0);
     assert_int_equal(tx_system_stats(s, 0).steps, 0);
     tx_system_destroy(s);
@@ -379,17 +363,16 @@ static void no_finish_after_a_failed_init(void** state) {
 
 static tx_system* events_chain(int per_step) {
   tx_system* s = tx_system_create();
-  tx_fault f;
   char text[96];
   snprintf(text, sizeof text, "{\"emit\":\"tool0.events\",\"per_step\":%d}", per_step);
   json_t* w = json_loads(text, 0, NULL);
   json_t* r = json_loads("{\"listen\":\"tool0.events\"}", 0, NULL);
   json_t* c = json_loads("{\"write\":\"x\"}", 0, NULL);
-  assert_int_equal(tx_system_add(s, "writer", "test.events", 1000, w, &f), 0);
-  assert_int_equal(tx_system_add(s, "reader", "test.events", 20, r, &f), 0);
-  assert_int_equal(tx_system_add(s, "count", "test.counter", 100, c, &f), 0);
+  assert_int_equal(tx_system_add(s, "writer", "test.events", 1000, w), 0);
+  assert_int_equal(tx_system_add(s, "reader", "test.events", 20, r), 0);
+  assert_int_equal(tx_system_add(s, "count", "test.counter", 100, c), 0);
   json_decref(w), json_decref(r), json_decref(c);
-  assert_int_equal(tx_system_finalize(s, &f), 0);
+  assert_int_equal(tx_system_finalize(s), 0);
   return s;
 }
 
@@ -421,8 +404,7 @@ static void realtime_events_arrive_whole(void** state) {
   tx_system* s = events_chain(1);
   tx_run_options o = {.duration_s = 0.5};
   tx_run_result r;
-  char err[256];
-  assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+  assert_int_equal(tx_system_run(s, &o, &r), 0);
   tx_stream_info st = tx_system_stream(s, 0);
   eventer *w = s->inst[0]->self, *rd = s->inst[1]->self;
   print_message("  sent %llu, received %llu\n", (unsigned long long)st.sent, (unsigned long long)rd->received);
@@ -453,18 +435,16 @@ static void haptics_keeps_its_rate_beside_an_overrun(void** state) {
                                     .step = hog_step, .fini = counter_fini};
   if (!tx_find_controller(hog.type)) assert_int_equal(tx_register_controller(&hog), 0);
   tx_system* s = tx_system_create();
-  tx_fault f;
   json_t* p = json_pack("{s:f}", "sleep_ms", 3.0);
   json_t* hp = json_loads("{\"write\":\"force\"}", 0, NULL);
-  assert_int_equal(tx_system_add(s, "tissue", "test.hog", 1000, p, &f), 0);
-  assert_int_equal(tx_system_add(s, "haptics", "haptics.test", 1000, hp, &f), 0);
+  assert_int_equal(tx_system_add(s, "tissue", "test.hog", 1000, p), 0);
+  assert_int_equal(tx_system_add(s, "haptics", "haptics.test", 1000, hp), 0);
   json_decref(p), json_decref(hp);
-  assert_int_equal(tx_system_finalize(s, &f), 0);
+  assert_int_equal(tx_system_finalize(s), 0);
   assert_int_not_equal(tx_system_thread(s, 0), tx_system_thread(s, 1));
   tx_run_options o = {.duration_s = 1.0, .realtime_priority = true};
   tx_run_result r;
-  char err[256];
-  assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+  assert_int_equal(tx_system_run(s, &o, &r), 0);
   tx_controller_stats tissue = tx_system_stats(s, 0), hap = tx_system_stats(s, 1);
   print_message("  %s\n  tissue %llu steps %llu missed; haptics %llu steps %llu missed\n", r.scheduler,
                 (unsigned long long)tissue.steps, (unsigned long long)tissue.missed, (unsigned long long)hap.steps,

@@ -81,12 +81,11 @@ static int tableless_configure(tx_setup* s, void** self) {
 static const tx_controller_class tableless = {.type = "test.tableless", .configure = tableless_configure,
                                               .step = probe_step};
 
-static int add(tx_system* sys, const char* type, const char* params, tx_fault* f) {
+static int add(tx_system* sys, const char* type, const char* params) {
   json_t* p = params ? json_loads(params, 0, NULL) : NULL;
   assert_true(!params || p);
-  memset(f, 0, sizeof *f);
   memset(&seen, 0, sizeof seen);
-  int rc = tx_system_add(sys, "c", type, 100, p, f);
+  int rc = tx_system_add(sys, "c", type, 100, p);
   json_decref(p);
   return rc;
 }
@@ -101,8 +100,7 @@ static int setup(void** state) {
 static void defaults_come_from_the_table(void** state) {
   (void)state;
   tx_system* s = tx_system_create();
-  tx_fault f;
-  assert_int_equal(add(s, "test.probe", NULL, &f), 0);
+  assert_int_equal(add(s, "test.probe", NULL), 0);
   assert_true(seen.num == 2.5 + 1000); // the computed default reads as NaN
   assert_int_equal(seen.i, 1);
   assert_true(seen.b);
@@ -114,9 +112,8 @@ static void defaults_come_from_the_table(void** state) {
 static void values_are_read_and_range_checked(void** state) {
   (void)state;
   tx_system* s = tx_system_create();
-  tx_fault f;
   assert_int_equal(add(s, "test.probe", "{\"num\": 7, \"int\": 0, \"flag\": false, \"name\": \"a.b\", "
-                                         "\"names\": [\"p\", \"q\"], \"computed\": 0.5}", &f), 0);
+                                         "\"names\": [\"p\", \"q\"], \"computed\": 0.5}"), 0);
   assert_true(seen.num == 7);
   assert_int_equal(seen.i, 0);
   assert_false(seen.b);
@@ -137,9 +134,9 @@ static void values_are_read_and_range_checked(void** state) {
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     s = tx_system_create();
-    assert_int_equal(add(s, "test.probe", bad[i].params, &f), -1);
-    assert_string_equal(f.key, bad[i].key);
-    assert_non_null(strstr(f.message, bad[i].says));
+    assert_int_equal(add(s, "test.probe", bad[i].params), -1);
+    assert_string_equal(tx_error_key(), bad[i].key);
+    assert_non_null(strstr(tx_error(), bad[i].says));
     tx_system_destroy(s);
   }
 }
@@ -147,10 +144,9 @@ static void values_are_read_and_range_checked(void** state) {
 static void unknown_keys_are_refused_before_configure_naming_the_valid_ones(void** state) {
   (void)state;
   tx_system* s = tx_system_create();
-  tx_fault f;
-  assert_int_equal(add(s, "test.probe", "{\"num\": 1, \"nmu\": 2}", &f), -1);
-  assert_string_equal(f.key, "params.nmu");
-  assert_string_equal(f.message, "unknown parameter for test.probe (valid: num, int, flag, name, names, computed)");
+  assert_int_equal(add(s, "test.probe", "{\"num\": 1, \"nmu\": 2}"), -1);
+  assert_string_equal(tx_error_key(), "params.nmu");
+  assert_string_equal(tx_error(), "unknown parameter for test.probe (valid: num, int, flag, name, names, computed)");
   assert_int_equal(seen.configured, 0);
   tx_system_destroy(s);
 }
@@ -166,23 +162,21 @@ static void misuse_of_the_table_is_a_programming_error(void** state) {
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     tx_system* s = tx_system_create();
-    tx_fault f;
-    assert_int_equal(add(s, "test.probe", bad[i].params, &f), -1);
-    assert_string_equal(f.key, bad[i].key);
-    assert_string_equal(f.message, bad[i].says);
+    assert_int_equal(add(s, "test.probe", bad[i].params), -1);
+    assert_string_equal(tx_error_key(), bad[i].key);
+    assert_string_equal(tx_error(), bad[i].says);
     tx_system_destroy(s);
   }
   // tx_param_num with the table's own default and range reads as before
   tx_system* s = tx_system_create();
-  tx_fault f;
-  assert_int_equal(add(s, "test.probe", "{\"int\": 2, \"num\": 4}", &f), 0);
+  assert_int_equal(add(s, "test.probe", "{\"int\": 2, \"num\": 4}"), 0);
   assert_true(seen.num == 4);
   tx_system_destroy(s);
   // tx_table_* needs a table
   s = tx_system_create();
-  assert_int_equal(add(s, "test.tableless", NULL, &f), -1);
-  assert_string_equal(f.key, "params.x");
-  assert_non_null(strstr(f.message, "test.tableless has no parameter table"));
+  assert_int_equal(add(s, "test.tableless", NULL), -1);
+  assert_string_equal(tx_error_key(), "params.x");
+  assert_non_null(strstr(tx_error(), "test.tableless has no parameter table"));
   tx_system_destroy(s);
 }
 
@@ -190,10 +184,9 @@ static void the_test_counter_names_its_valid_keys(void** state) {
   (void)state;
   register_test_classes(); // classes without a table: test_system's own
   tx_system* s = tx_system_create();
-  tx_fault f;
-  assert_int_equal(add(s, "test.counter", "{\"gian\": 2}", &f), -1);
-  assert_string_equal(f.key, "params.gian");
-  assert_non_null(strstr(f.message, "(valid: gain, stop_at, write, read)"));
+  assert_int_equal(add(s, "test.counter", "{\"gian\": 2}"), -1);
+  assert_string_equal(tx_error_key(), "params.gian");
+  assert_non_null(strstr(tx_error(), "(valid: gain, stop_at, write, read)"));
   tx_system_destroy(s);
 }
 

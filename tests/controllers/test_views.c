@@ -52,42 +52,38 @@ static int setup(void** state) {
   return 0;
 }
 
-static tx_scenario* load(const char* type, bool write, char* err, size_t n) {
+static tx_scenario* load(const char* type, bool write) {
   char text[512];
   snprintf(text, sizeof text,
            "{\"name\":\"v\",\"controllers\":[{\"name\":\"src\",\"type\":\"test_views.source\",\"rate_hz\":10},"
            "{\"name\":\"plot\",\"type\":\"%s\",\"rate_hz\":10,\"params\":{\"write\":%s}}]}",
            type, write ? "true" : "false");
   tx_load_options o = {0};
-  err[0] = 0;
-  return tx_scenario_load_text("views.json", text, strlen(text), &o, err, n);
+  return tx_scenario_load_text("views.json", text, strlen(text), &o);
 }
 
 static void a_view_that_only_reads_loads(void** state) {
   (void)state;
-  char err[1024];
-  tx_scenario* s = load("test_views.view", false, err, sizeof err);
-  if (!s) fail_msg("%s", err);
+  tx_scenario* s = load("test_views.view", false);
+  if (!s) fail_msg("%s", tx_error());
   tx_scenario_free(s);
 }
 
 static void a_view_that_writes_is_refused_in_one_line(void** state) {
   (void)state;
-  char err[1024];
-  tx_scenario* s = load("test_views.view", true, err, sizeof err);
+  tx_scenario* s = load("test_views.view", true);
   if (s) fail_msg("a view that writes view.out was loaded");
-  print_message("%s\n", err);
-  assert_null(strchr(err, '\n'));
+  print_message("%s\n", tx_error());
+  assert_null(strchr(tx_error(), '\n'));
   const char* parts[] = {"views.json", "plot", "test_views.view", "is a view", "view.out"};
   for (size_t i = 0; i < sizeof parts / sizeof parts[0]; i++)
-    if (!strstr(err, parts[i])) fail_msg("'%s' does not mention '%s'", err, parts[i]);
+    if (!strstr(tx_error(), parts[i])) fail_msg("'%s' does not mention '%s'", tx_error(), parts[i]);
 }
 
 static void an_ordinary_controller_may_write(void** state) {
   (void)state;
-  char err[1024];
-  tx_scenario* s = load("test_views.plain", true, err, sizeof err);
-  if (!s) fail_msg("%s", err);
+  tx_scenario* s = load("test_views.plain", true);
+  if (!s) fail_msg("%s", tx_error());
   tx_scenario_free(s);
 }
 
@@ -109,10 +105,9 @@ static void a_structured_parameter_comes_as_json_text(void** state) {
   if (!tx_find_controller(text_class.type)) assert_int_equal(tx_register_controller(&text_class), 0);
   const char* text = "{\"name\":\"t\",\"controllers\":[{\"name\":\"v\",\"type\":\"test_views.text\",\"rate_hz\":10,"
                      "\"params\":{\"view\":{\"width\":640,\"eye\":[0.1,-2.5e-3,1]}}}]}";
-  char err[512] = "";
   tx_load_options o = {0};
-  tx_scenario* sc = tx_scenario_load_text("text.json", text, strlen(text), &o, err, sizeof err);
-  if (!sc) fail_msg("%s", err);
+  tx_scenario* sc = tx_scenario_load_text("text.json", text, strlen(text), &o);
+  if (!sc) fail_msg("%s", tx_error());
   tx_scenario_free(sc);
   // every number as it was (17 digits), and the key counts as used (no "unknown parameter")
   assert_string_equal(seen_text, "{\"width\":640,\"eye\":[0.10000000000000001,-0.0025000000000000001,1]}");

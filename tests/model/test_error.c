@@ -35,7 +35,25 @@ static void a_long_message_is_cut_not_overrun(void** state) {
   big[sizeof big - 1] = 0;
   tx_set_error("%s", big);
   tx_error_prefix("%s", big);
-  assert_int_equal(strlen(tx_error()), 511);
+  assert_int_equal(strlen(tx_error()), 1023);
+}
+
+static void a_key_travels_with_its_message(void** state) {
+  (void)state;
+  tx_set_error_at("params.gain", "%g is out of range", 11.0);
+  assert_string_equal(tx_error_key(), "params.gain");
+  assert_string_equal(tx_error(), "11 is out of range");
+  tx_error_prefix("scene.json"); // context keeps the key
+  assert_string_equal(tx_error_key(), "params.gain");
+  tx_set_error_at(tx_error_key(), "%s", tx_error()); // built from itself
+  assert_string_equal(tx_error_key(), "params.gain");
+  assert_string_equal(tx_error(), "scene.json: 11 is out of range");
+  tx_set_error("%s, again", tx_error()); // no overlap fault either
+  assert_string_equal(tx_error(), "scene.json: 11 is out of range, again");
+  tx_set_error("plain");
+  assert_string_equal(tx_error_key(), ""); // a keyless error clears it
+  tx_set_error_at(NULL, "whole");
+  assert_string_equal(tx_error_key(), "");
 }
 
 static void* other_thread(void* arg) {
@@ -58,6 +76,7 @@ int main(void) {
       cmocka_unit_test(a_prefix_goes_in_front),
       cmocka_unit_test(a_prefix_on_no_message_is_the_context_alone),
       cmocka_unit_test(a_long_message_is_cut_not_overrun),
+      cmocka_unit_test(a_key_travels_with_its_message),
       cmocka_unit_test(each_thread_has_its_own),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -73,13 +73,12 @@ static void check_scenario(const char* name, const char* path, const char* descr
   seen* s = user;
   if (*s->fail) return;
   s->scenarios++;
-  char err[1024] = "";
   tx_load_options o = {0};
-  tx_scenario* sc = tx_scenario_load(path, &o, err, sizeof err);
+  tx_scenario* sc = tx_scenario_load(path, &o);
   if (!sc) {
     // a build without Bullet cannot load the skin; every other failure is a defect
-    if (!TX_WITH_BULLET && strstr(err, "physics.")) return;
-    snprintf(s->fail, sizeof s->fail, "%.100s: %.400s", name, err);
+    if (!TX_WITH_BULLET && strstr(tx_error(), "physics.")) return;
+    snprintf(s->fail, sizeof s->fail, "%.100s: %.400s", name, tx_error());
     return;
   }
   s->loaded++;

@@ -1,5 +1,6 @@
 // Tests of scenarios/loader.c: scenario text and files to a finalized system,
 // and every bad input to one line that names the file and the key path.
+#include "model/error.h"
 #include "scenarios/loader.h"
 
 #include <tactus/config.h>
@@ -22,24 +23,23 @@
 // one worker "a" at 10 Hz that reads and writes nothing
 static const char one_worker[] = "{\"name\":\"t\",\"controllers\":[{\"name\":\"a\"," WORKER ",\"rate_hz\":10}]}";
 
-static char err[1024];
 
 static tx_scenario* load_sets(const char* text, const char* const* sets, int nsets, bool plugins) {
-  err[0] = 0;
+  tx_set_error("%s", ""); // a message left must be this load's
   tx_load_options o = {.sets = sets, .nsets = nsets, .allow_plugins = plugins};
-  return tx_scenario_load_text(LABEL, text, strlen(text), &o, err, sizeof err);
+  return tx_scenario_load_text(LABEL, text, strlen(text), &o);
 }
 
 static tx_scenario* load(const char* text) { return load_sets(text, NULL, 0, false); }
 
 // an error is one line that starts with prefix and holds every further fragment
 static void expect_error(const char* prefix, ...) {
-  if (strncmp(err, prefix, strlen(prefix)) != 0) fail_msg("'%s' does not start with '%s'", err, prefix);
-  assert_null(strchr(err, '\n'));
+  if (strncmp(tx_error(), prefix, strlen(prefix)) != 0) fail_msg("'%s' does not start with '%s'", tx_error(), prefix);
+  assert_null(strchr(tx_error(), '\n'));
   va_list ap;
   va_start(ap, prefix);
   for (const char* part; (part = va_arg(ap, const char*));)
-    if (!strstr(err, part)) fail_msg("'%s' does not mention '%s'", err, part);
+    if (!strstr(tx_error(), part)) fail_msg("'%s' does not mention '%s'", tx_error(), part);
   va_end(ap);
 }
 
@@ -69,7 +69,7 @@ static void minimal_scenario_loads_with_defaults(void** state) {
   (void)state;
   tx_scenario* s = load(one_worker);
   assert_non_null(s);
-  assert_string_equal(err, "");
+  assert_string_equal(tx_error(), "");
   assert_string_equal(s->name, "t");
   assert_string_equal(s->path, LABEL);
   assert_string_equal(s->description, "");
@@ -91,7 +91,7 @@ static void data_flow_through_a_declared_component(void** state) {
                      "{\"name\":\"src\"," WORKER ",\"rate_hz\":100,\"params\":{\"write\":\"t.x\",\"rows\":4,\"cols\":3,\"units\":\"m\"}},"
                      "{\"name\":\"dst\"," WORKER ",\"rate_hz\":1000,\"params\":{\"reads\":[\"t.x\"],\"work_us\":0}}]}";
   tx_scenario* s = load(text);
-  if (!s) fail_msg("%s", err);
+  if (!s) fail_msg("%s", tx_error());
   assert_string_equal(s->description, "two workers");
   assert_true(s->duration_s == 2.5);
   assert_int_equal(tx_system_threads(s->system), 2);
@@ -113,11 +113,11 @@ static void data_flow_through_a_declared_component(void** state) {
 static void rate_at_the_upper_limit_is_accepted(void** state) {
   (void)state;
   tx_scenario* s = load("{\"name\":\"t\",\"controllers\":[{\"name\":\"a\"," WORKER ",\"rate_hz\":100000}]}");
-  if (!s) fail_msg("%s", err);
+  if (!s) fail_msg("%s", tx_error());
   assert_true(tx_system_rate(s->system, 0) == TX_RATE_MAX_HZ);
   tx_scenario_free(s);
   s = load("{\"name\":\"t\",\"controllers\":[{\"name\":\"a\"," WORKER ",\"rate_hz\":0.001}]}");
-  if (!s) fail_msg("%s", err);
+  if (!s) fail_msg("%s", tx_error());
   tx_scenario_free(s);
 }
 
@@ -189,7 +189,7 @@ static void thread_names(void** state) {
   tx_scenario* s = load("{\"name\":\"t\",\"controllers\":[{\"name\":\"a\"," WORKER ",\"rate_hz\":10,\"thread\":\"x\"},"
                         "{\"name\":\"b\"," WORKER ",\"rate_hz\":10},{\"name\":\"c\"," WORKER
                         ",\"rate_hz\":10,\"thread\":\"x\"}]}");
-  if (!s) fail_msg("%s", err);
+  if (!s) fail_msg("%s", tx_error());
   int a = find(s, "a"), b = find(s, "b"), c = find(s, "c");
   assert_int_equal(tx_system_threads(s->system), 2);
   assert_int_equal(tx_system_thread(s->system, a), tx_system_thread(s->system, c));
@@ -330,8 +330,8 @@ static void plugins_rejected_when_not_allowed(void** state) {
   assert_null(load_sets(text, NULL, 0, false));
   expect_error(LABEL ": plugins[0]: ", "not allowed", NULL);
   // and with no options at all, as the fuzzer and the benches pass
-  err[0] = 0;
-  assert_null(tx_scenario_load_text(LABEL, text, strlen(text), NULL, err, sizeof err));
+  tx_set_error("%s", ""); // a message left must be this load's
+  assert_null(tx_scenario_load_text(LABEL, text, strlen(text), NULL));
   expect_error(LABEL ": plugins[0]: ", "not allowed", NULL);
   expect_text_error("{\"name\":\"t\",\"plugins\":\"x.so\",\"controllers\":[]}", LABEL ": plugins: ", "array");
 }
@@ -345,7 +345,7 @@ static void set_overrides_are_applied(void** state) {
                      "{\"name\":\"b\"," WORKER ",\"rate_hz\":10,\"params\":{\"reads\":[\"t.x\"]}}]}";
   const char* sets[] = {"a.rate_hz=50", "a.rows=7", "a.units=N", "b.work_us=0", "duration_s=0.25"};
   tx_scenario* s = load_sets(text, sets, 5, false);
-  if (!s) fail_msg("%s", err);
+  if (!s) fail_msg("%s", tx_error());
   int a = find(s, "a"), b = find(s, "b");
   assert_true(tx_system_rate(s->system, a) == 50);
   assert_true(tx_system_rate(s->system, b) == 10);
@@ -358,8 +358,7 @@ static void set_overrides_are_applied(void** state) {
   // and the run sees the new rate: 50 Hz for 0.25 s of virtual time
   tx_run_options o = {.duration_s = s->duration_s, .lockstep = true};
   tx_run_result res;
-  char run_err[256] = "";
-  assert_int_equal(tx_system_run(s->system, &o, &res, run_err, sizeof run_err), 0);
+  assert_int_equal(tx_system_run(s->system, &o, &res), 0);
   assert_int_equal(tx_system_stats(s->system, a).steps, 13); // ticks at 0, 20, ..., 240 ms
   assert_int_equal(tx_system_stats(s->system, b).steps, 3);  // ticks at 0, 100, 200 ms
   tx_scenario_free(s);
@@ -369,7 +368,7 @@ static void set_adds_params_to_a_controller_without_any(void** state) {
   (void)state;
   const char* sets[] = {"a.work_us=5", "a.reads=[]"};
   tx_scenario* s = load_sets(one_worker, sets, 2, false);
-  if (!s) fail_msg("%s", err);
+  if (!s) fail_msg("%s", tx_error());
   tx_scenario_free(s);
 }
 
@@ -377,7 +376,7 @@ static void set_the_last_one_wins(void** state) {
   (void)state;
   const char* sets[] = {"a.rate_hz=0", "a.rate_hz=25"};
   tx_scenario* s = load_sets(one_worker, sets, 2, false);
-  if (!s) fail_msg("%s", err);
+  if (!s) fail_msg("%s", tx_error());
   assert_true(tx_system_rate(s->system, 0) == 25);
   tx_scenario_free(s);
 }
@@ -473,22 +472,22 @@ static void files_load_and_errors_name_the_path(void** state) {
   write_file(bad, "{\n\"name\": \"t\",\n\"controllers\": [ {\"name\": \"a\" \"type\": 1} ]\n}\n");
 
   tx_load_options o = {.allow_plugins = false};
-  tx_scenario* s = tx_scenario_load(good, &o, err, sizeof err);
-  if (!s) fail_msg("%s", err);
+  tx_scenario* s = tx_scenario_load(good, &o);
+  if (!s) fail_msg("%s", tx_error());
   assert_string_equal(s->path, good);
   tx_scenario_free(s);
 
-  assert_null(tx_scenario_load(bad, &o, err, sizeof err));
+  assert_null(tx_scenario_load(bad, &o));
   snprintf(prefix, sizeof prefix, "%s:3:", bad);
   expect_error(prefix, NULL);
 
   char missing[128];
   snprintf(missing, sizeof missing, "%s/missing.json", dir);
-  assert_null(tx_scenario_load(missing, &o, err, sizeof err));
+  assert_null(tx_scenario_load(missing, &o));
   snprintf(prefix, sizeof prefix, "%s: ", missing);
   expect_error(prefix, "No such file", NULL);
 
-  assert_null(tx_scenario_load(dir, &o, err, sizeof err));
+  assert_null(tx_scenario_load(dir, &o));
   snprintf(prefix, sizeof prefix, "%s: ", dir);
   expect_error(prefix, "not a regular file", NULL);
 
@@ -496,7 +495,7 @@ static void files_load_and_errors_name_the_path(void** state) {
   char unknown[128];
   snprintf(unknown, sizeof unknown, "%s/unknown.json", dir);
   write_file(unknown, "{\"name\":\"t\",\"controllers\":[{\"name\":\"a\",\"type\":\"no.such\",\"rate_hz\":1}]}");
-  assert_null(tx_scenario_load(unknown, &o, err, sizeof err));
+  assert_null(tx_scenario_load(unknown, &o));
   snprintf(prefix, sizeof prefix, "%s: controllers[0].type: ", unknown);
   expect_error(prefix, "no.such", NULL);
 }
@@ -507,24 +506,24 @@ static void plugin_paths_resolve_beside_the_file(void** state) {
   snprintf(path, sizeof path, "%s/with_plugin.json", dir);
   write_file(path, "{\"name\":\"t\",\"plugins\":[\"libnone.so\"],\"controllers\":[{\"name\":\"a\"," WORKER ",\"rate_hz\":1}]}");
   tx_load_options o = {.allow_plugins = true};
-  assert_null(tx_scenario_load(path, &o, err, sizeof err));
+  assert_null(tx_scenario_load(path, &o));
   snprintf(prefix, sizeof prefix, "%s: plugins[0]: ", path);
   snprintf(beside, sizeof beside, "%s/libnone.so", dir);
   expect_error(prefix, beside, "No such file", NULL);
 
   // a file that is there but no shared library
   write_file(beside, "not an ELF file");
-  assert_null(tx_scenario_load(path, &o, err, sizeof err));
+  assert_null(tx_scenario_load(path, &o));
   expect_error(prefix, "libnone.so", NULL);
 }
 
 static void the_shipped_rates_scenario_loads(void** state) {
   (void)state;
   char path[512];
-  assert_int_equal(tx_scenario_locate("rates", path, sizeof path, err, sizeof err), 0);
+  assert_int_equal(tx_scenario_locate("rates", path, sizeof path), 0);
   assert_string_equal(path, TX_SCENARIO_DIR "/rates/rates.json");
-  tx_scenario* s = tx_scenario_load(path, NULL, err, sizeof err);
-  if (!s) fail_msg("%s", err);
+  tx_scenario* s = tx_scenario_load(path, NULL);
+  if (!s) fail_msg("%s", tx_error());
   assert_string_equal(s->name, "rates");
   assert_int_equal(tx_system_count(s->system), 4);
   assert_int_equal(tx_system_threads(s->system), 4);
@@ -535,9 +534,9 @@ static void the_shipped_rates_scenario_loads(void** state) {
 static void locate_unknown_names_and_missing_files(void** state) {
   (void)state;
   char path[512];
-  assert_int_not_equal(tx_scenario_locate("no_such_scenario", path, sizeof path, err, sizeof err), 0);
+  assert_int_not_equal(tx_scenario_locate("no_such_scenario", path, sizeof path), 0);
   expect_error("no_such_scenario: ", "unknown scenario", NULL);
-  assert_int_not_equal(tx_scenario_locate("/nonexistent/x.json", path, sizeof path, err, sizeof err), 0);
+  assert_int_not_equal(tx_scenario_locate("/nonexistent/x.json", path, sizeof path), 0);
   expect_error("/nonexistent/x.json: ", "No such file", NULL);
 }
 

@@ -35,8 +35,7 @@ static tx_skin_stability_row run_case(const char* name) {
   for (int i = 0; i < n; i++) {
     if (strcmp(cs[i].name, name) != 0) continue;
     tx_skin_stability_row r;
-    char err[1024];
-    if (tx_skin_stability_run(&cs[i], dir, &r, err, sizeof err)) fail_msg("%s: %s", name, err);
+    if (tx_skin_stability_run(&cs[i], dir, &r)) fail_msg("%s: %s", name, tx_error());
     print_message("  %-28s steps %4d faults %3d torn %4d NaN %ld max |F| %.4f N  %s\n", name, r.skin_steps, r.faults,
                   r.torn, r.nan_values, r.max_force, r.outcome);
     return r;

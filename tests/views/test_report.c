@@ -6,6 +6,7 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
+#include "model/error.h"
 #include "views/report.h"
 #include "tests/controllers/test_support.h"
 
@@ -36,14 +37,12 @@ static void haptic_stalls_are_warnings(void** state) {
   if (!tx_find_controller(stall_haptics.type)) assert_int_equal(tx_register_controller(&stall_haptics), 0);
   if (!tx_find_controller(stall_other.type)) assert_int_equal(tx_register_controller(&stall_other), 0);
   tx_system* s = tx_system_create();
-  tx_fault f;
-  assert_int_equal(tx_system_add(s, "hand", "haptics.test_stall", 5, NULL, &f), 0);
-  assert_int_equal(tx_system_add(s, "physics", "test.stall", 4, NULL, &f), 0);
-  assert_int_equal(tx_system_finalize(s, &f), 0);
+  assert_int_equal(tx_system_add(s, "hand", "haptics.test_stall", 5, NULL), 0);
+  assert_int_equal(tx_system_add(s, "physics", "test.stall", 4, NULL), 0);
+  assert_int_equal(tx_system_finalize(s), 0);
   tx_run_options o = {.duration_s = 1.0};
   tx_run_result r;
-  char err[256];
-  assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+  assert_int_equal(tx_system_run(s, &o, &r), 0);
   uint64_t missed = tx_system_stats(s, 0).missed;
   assert_true(missed >= 1);
   assert_true(tx_system_stats(s, 1).missed >= 1);
@@ -80,7 +79,6 @@ static void streams_are_reported(void** state) {
   (void)state;
   register_test_classes();
   tx_system* s = tx_system_create();
-  tx_fault f;
   static const struct { const char* name; double rate; const char* params; } spec[] = {
       {"hand", 1000, "{\"emit\":\"tool0.events\",\"capacity\":16}"},
       {"physics", 20, "{\"listen\":\"tool0.events\"}"},
@@ -89,14 +87,13 @@ static void streams_are_reported(void** state) {
   };
   for (int i = 0; i < 4; i++) {
     json_t* p = json_loads(spec[i].params, 0, NULL);
-    assert_int_equal(tx_system_add(s, spec[i].name, "test.events", spec[i].rate, p, &f), 0);
+    assert_int_equal(tx_system_add(s, spec[i].name, "test.events", spec[i].rate, p), 0);
     json_decref(p);
   }
-  assert_int_equal(tx_system_finalize(s, &f), 0);
+  assert_int_equal(tx_system_finalize(s), 0);
   tx_run_options o = {.duration_s = 1.0, .lockstep = true};
   tx_run_result r;
-  char err[256];
-  assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+  assert_int_equal(tx_system_run(s, &o, &r), 0);
   json_t* report = tx_report_json(&(tx_report){"t", true, &r, s});
   json_t* full = json_object_get(json_object_get(report, "streams"), "tool0.events");
   json_t* clean = json_object_get(json_object_get(report, "streams"), "tool1.events");

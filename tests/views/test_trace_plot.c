@@ -1,5 +1,6 @@
 // Device traces: CSV columns found by name, bad rows named by line, and the
 // three-panel PNG written where PLplot is built.
+#include "model/error.h"
 #include "views/trace_plot.h"
 
 #include <tactus/config.h>
@@ -33,14 +34,13 @@ static void loads_columns_by_name(void** state) {
                    "1,0.000,9,0.1,0.2,0.3,2,3\n"
                    "-1,0.001,9,0.1,0.19,0.3,2.5,3\n");
   tx_trace t;
-  char err[256];
-  assert_int_equal(tx_trace_load(path, &t, err, sizeof err), 0);
+  assert_int_equal(tx_trace_load(path, &t), 0);
   assert_int_equal(t.n, 2);
   assert_true(t.t[1] == 0.001 && t.f[0][0] == 1 && t.f[0][1] == -1 && t.p[1][1] == 0.19 && t.f[1][1] == 2.5);
   tx_trace_free(&t);
   char png[300];
   snprintf(png, sizeof png, "%s.png", path);
-  int rc = tx_trace_plot_png(path, png, err, sizeof err);
+  int rc = tx_trace_plot_png(path, png);
   struct stat st;
   if (TX_WITH_PLPLOT) {
     assert_int_equal(rc, 0);
@@ -48,7 +48,7 @@ static void loads_columns_by_name(void** state) {
     assert_true(st.st_size > 1000);
   } else {
     assert_int_equal(rc, -1);
-    assert_non_null(strstr(err, "PLplot"));
+    assert_non_null(strstr(tx_error(), "PLplot"));
   }
   remove(png);
   remove(path);
@@ -59,10 +59,10 @@ static void expect_bad(const char* text, const char* fragment) {
   close(mkstemp(path));
   write_file(path, text);
   tx_trace t;
-  char err[256], want[300];
-  assert_int_equal(tx_trace_load(path, &t, err, sizeof err), -1);
+  char want[300];
+  assert_int_equal(tx_trace_load(path, &t), -1);
   snprintf(want, sizeof want, "%s%s", path, fragment);
-  if (!strstr(err, want)) fail_msg("'%s' lacks '%s'", err, want);
+  if (!strstr(tx_error(), want)) fail_msg("'%s' lacks '%s'", tx_error(), want);
   remove(path);
 }
 
@@ -74,9 +74,8 @@ static void bad_files_name_the_line(void** state) {
   expect_bad("t_s,px_m,py_m,pz_m,fx_n,fy_n,fz_n\n0,0,0\n", ":2: expected 7 columns");
   expect_bad("t_s,px_m,py_m,pz_m,fx_n,fy_n,fz_n\n", ":2: no samples");
   tx_trace t;
-  char err[256];
-  assert_int_equal(tx_trace_load("/nonexistent/device0.csv", &t, err, sizeof err), -1);
-  assert_non_null(strstr(err, "/nonexistent/device0.csv: "));
+  assert_int_equal(tx_trace_load("/nonexistent/device0.csv", &t), -1);
+  assert_non_null(strstr(tx_error(), "/nonexistent/device0.csv: "));
 }
 
 // every finite double that the recorder's %.17g writes reads back to the same
@@ -94,8 +93,7 @@ static void every_finite_double_reads_back(void** state) {
     for (int c = 0; c < 7; c++) fprintf(f, "%.17g%s", v[(i + c) % nv], c < 6 ? "," : "\n");
   fclose(f);
   tx_trace t;
-  char err[256];
-  if (tx_trace_load(path, &t, err, sizeof err)) fail_msg("%s", err);
+  if (tx_trace_load(path, &t)) fail_msg("%s", tx_error());
   assert_int_equal(t.n, nv);
   for (int i = 0; i < nv; i++) {
     double* got[7] = {&t.t[i], &t.p[0][i], &t.p[1][i], &t.p[2][i], &t.f[0][i], &t.f[1][i], &t.f[2][i]};

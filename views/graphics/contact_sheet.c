@@ -1,5 +1,7 @@
 // Contact sheets: box-filtered thumbnails in a grid.
 #include "contact_sheet.h"
+
+#include "../../model/error.h"
 #include "png_writer.h"
 
 #include <stdio.h>
@@ -56,13 +58,13 @@ void tx_contact_sheet_add(tx_contact_sheet* s, const uint8_t* rgba, int w, int h
   shrink(s, rgba, w, h, s->pixels + one * (size_t)s->count++);
 }
 
-int tx_contact_sheet_write(const tx_contact_sheet* s, const char* path, int columns, char* err, size_t n) {
-  if (!s->count) return snprintf(err, n, "%s: no frames to show", path), -1;
+int tx_contact_sheet_write(const tx_contact_sheet* s, const char* path, int columns) {
+  if (!s->count) return tx_set_error("%s: no frames to show", path), -1;
   const int gap = 4;
   int cols = s->count < columns ? s->count : columns, rows = (s->count + cols - 1) / cols;
   int W = cols * (s->thumb_w + gap) + gap, H = rows * (s->thumb_h + gap) + gap;
   uint8_t* sheet = malloc((size_t)W * (size_t)H * 4);
-  if (!sheet) return snprintf(err, n, "%s: out of memory", path), -1;
+  if (!sheet) return tx_set_error("%s: out of memory", path), -1;
   for (size_t i = 0; i < (size_t)W * H; i++) sheet[4 * i] = sheet[4 * i + 1] = sheet[4 * i + 2] = 32, sheet[4 * i + 3] = 255;
   size_t one = (size_t)s->thumb_w * (size_t)s->thumb_h * 4;
   for (int k = 0; k < s->count; k++) {
@@ -71,7 +73,7 @@ int tx_contact_sheet_write(const tx_contact_sheet* s, const char* path, int colu
       memcpy(sheet + 4 * ((size_t)(oy + y) * W + ox), s->pixels + one * k + (size_t)y * s->thumb_w * 4,
              (size_t)s->thumb_w * 4);
   }
-  int rc = tx_png_write(path, sheet, W, H, false, err, n);
+  int rc = tx_png_write(path, sheet, W, H, false);
   free(sheet);
   return rc;
 }

@@ -23,7 +23,7 @@ bool tx_contact_sheet_init(tx_contact_sheet* s, int frame_w, int frame_h, int th
 void tx_contact_sheet_free(tx_contact_sheet* s);
 // offer a frame (RGBA, bottom row first); `last` always keeps it, replacing the newest if full
 void tx_contact_sheet_add(tx_contact_sheet* s, const uint8_t* rgba, int w, int h, bool last);
-// write the kept thumbnails in rows of `columns`; 0 or -1 with a message
-int tx_contact_sheet_write(const tx_contact_sheet* s, const char* path, int columns, char* err, size_t n);
+// write the kept thumbnails in rows of `columns`; 0 or -1 with the message in tx_error()
+int tx_contact_sheet_write(const tx_contact_sheet* s, const char* path, int columns);
 
 #endif

@@ -2,6 +2,8 @@
 // mouse and keyboard input for the `mouse` device (through window_input.h).
 #include "glfw_window.h"
 
+#include "../../model/error.h"
+
 #include "window_input.h"
 
 #include <tactus/components.h>
@@ -98,29 +100,29 @@ static GLFWwindow* make(int width, int height, bool quad, bool visible) {
   return glfwCreateWindow(width, height, "tactus", NULL, NULL);
 }
 
-tx_window_lack tx_window_probe(bool need_quad, char* err, size_t n) {
+tx_window_lack tx_window_probe(bool need_quad) {
   glfwSetErrorCallback(on_error);
   glfw_error[0] = 0;
-  if (!glfwInit()) return snprintf(err, n, "cannot open the display (GLFW: %s)", glfw_error), TX_WINDOW_NO_DISPLAY;
+  if (!glfwInit()) return tx_set_error("cannot open the display (GLFW: %s)", glfw_error), TX_WINDOW_NO_DISPLAY;
   if (!need_quad) return TX_WINDOW_OK;
   // a hidden window with quad buffers, made and closed at once: the answer is the driver's
   GLFWwindow* w = make(16, 16, true, false);
-  if (!w) return snprintf(err, n, "the display's GL has no quad-buffered stereo (GLFW: %s)", glfw_error), TX_WINDOW_NO_QUAD;
+  if (!w) return tx_set_error("the display's GL has no quad-buffered stereo (GLFW: %s)", glfw_error), TX_WINDOW_NO_QUAD;
   glfwDestroyWindow(w);
   return TX_WINDOW_OK;
 }
 
-tx_window* tx_window_open(int width, int height, bool want_quad, char* err, size_t n) {
+tx_window* tx_window_open(int width, int height, bool want_quad) {
   glfwSetErrorCallback(on_error);
-  if (!glfwInit()) return snprintf(err, n, "no window: GLFW: %s", glfw_error), NULL;
+  if (!glfwInit()) return tx_set_error("no window: GLFW: %s", glfw_error), NULL;
   tx_window* t = calloc(1, sizeof *t);
-  if (!t) return snprintf(err, n, "out of memory"), NULL;
+  if (!t) return tx_set_error("out of memory"), NULL;
   // quad buffers where the driver has them; otherwise the chosen mode in a plain window
   if (want_quad && (t->w = make(width, height, true, true))) t->quad = true;
   else t->w = make(width, height, false, true);
   if (!t->w) {
     free(t);
-    return snprintf(err, n, "no window: GLFW: %s", glfw_error), NULL;
+    return tx_set_error("no window: GLFW: %s", glfw_error), NULL;
   }
   glfwMakeContextCurrent(t->w);
   glfwSwapInterval(0); // the view's rate paces frames, not the display

@@ -19,11 +19,11 @@ typedef struct tx_window tx_window;
 
 typedef enum tx_window_lack { TX_WINDOW_OK, TX_WINDOW_NO_DISPLAY, TX_WINDOW_NO_QUAD } tx_window_lack;
 // at load time, before the run writes anything: whether the display opens and,
-// with need_quad, offers a quad-buffered GL context; a message when not.
+// with need_quad, offers a quad-buffered GL context; the reason in tx_error() when not.
 // GLFW stays initialised, as after tx_window_open.
-tx_window_lack tx_window_probe(bool need_quad, char* err, size_t n);
-// NULL and a one-line message when no window can be made
-tx_window* tx_window_open(int width, int height, bool want_quad, char* err, size_t n);
+tx_window_lack tx_window_probe(bool need_quad);
+// NULL with a one-line message in tx_error() when no window can be made
+tx_window* tx_window_open(int width, int height, bool want_quad);
 void tx_window_close(tx_window* w);
 bool tx_window_is_quad(const tx_window* w);
 tx_gl_proc tx_window_proc(const char* name);

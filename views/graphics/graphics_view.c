@@ -58,10 +58,11 @@ typedef struct view {
   bool sems_ready;                      // the semaphores were made (init got that far)
   atomic_bool quit;
   bool setup_failed;
-  char setup_error[512];
+  char setup_error[512];                // the rendering thread's tx_error(), for init
+  char finish_error[1024];              // a file of the last frames that cannot be written, for finish
   char frames_dir[4200];
   // the rendering thread's own
-  uint64_t rendered, written, dropped, write_errors;
+  uint64_t rendered, written, dropped;
   uint64_t timed;                       // frames in frame_ns (all but the first)
   double first_frame_ms;                // ms, the first frame (shader compilation included)
   tx_hist frame_ns;                     // render + read-back time of every frame, ns
@@ -119,9 +120,7 @@ static int configure(tx_setup* s, void** self) {
   if (!tx_stereo_mode_from_name(stereo, &v->stereo))
     return tx_setup_fail(s, "stereo_mode", "expected mono, sbs, tb, anaglyph or lr, got \"%s\"", stereo);
   if (vj) {
-    char key[128], msg[300];
-    if (tx_view_def_from_text(vj, &v->def, key, sizeof key, msg, sizeof msg))
-      return tx_setup_fail(s, "view", "%s: %s", key, msg);
+    if (tx_view_def_from_text(vj, &v->def)) return tx_setup_fail(s, "view", "%s", tx_error());
   }
   if (v->def.nitems == 0 && tx_view_def_auto_draw(&v->def, avail, navail) == 0)
     return tx_setup_fail(s, "view", "nothing to draw: no component follows the naming conventions (docs/views.md)");
@@ -138,11 +137,11 @@ static int configure(tx_setup* s, void** self) {
   // image; lr's two need GL_BACK_LEFT and GL_BACK_RIGHT), is bad input found at load,
   // before the run has made a folder or a recording
   if (v->target == TARGET_WINDOW) {
-    char why[300];
-    tx_window_lack lack = tx_window_probe(v->stereo == TX_STEREO_LR, why, sizeof why);
-    if (lack == TX_WINDOW_NO_DISPLAY) return tx_setup_fail(s, "target", "--view window: %s", why);
+    tx_window_lack lack = tx_window_probe(v->stereo == TX_STEREO_LR);
+    if (lack == TX_WINDOW_NO_DISPLAY) return tx_setup_fail(s, "target", "--view window: %s", tx_error());
     if (lack == TX_WINDOW_NO_QUAD)
-      return tx_setup_fail(s, "stereo_mode", "--stereo lr in a window: %s; use sbs, tb or anaglyph, or --view png for lr files", why);
+      return tx_setup_fail(s, "stereo_mode", "--stereo lr in a window: %s; use sbs, tb or anaglyph, or --view png for lr files",
+                           tx_error());
   }
 #endif
   (void)threads;
@@ -243,21 +242,21 @@ static const uint8_t* target_pixels(render_state* rs) {
   return NULL;
 }
 
+// a frame that cannot be written is counted (frame_not_written) and the run goes on
 static void write_frame(view* v, render_state* rs, uint64_t index) {
-  char path[4400], err[600];
+  char path[4400];
   const uint8_t* px = target_pixels(rs);
   int rc = 0;
   if (v->stereo == TX_STEREO_LR) {
     frame_path(v, path, sizeof path, index, "_left");
-    rc = tx_png_write(path, rs->left, rs->img_w, rs->img_h, true, err, sizeof err);
+    rc = tx_png_write(path, rs->left, rs->img_w, rs->img_h, true);
     frame_path(v, path, sizeof path, index, "_right");
-    if (!rc) rc = tx_png_write(path, px, rs->img_w, rs->img_h, true, err, sizeof err);
+    if (!rc) rc = tx_png_write(path, px, rs->img_w, rs->img_h, true);
   } else {
     frame_path(v, path, sizeof path, index, "");
-    rc = tx_png_write(path, px, rs->img_w, rs->img_h, true, err, sizeof err);
+    rc = tx_png_write(path, px, rs->img_w, rs->img_h, true);
   }
   if (rc) {
-    if (!v->write_errors++) fprintf(stderr, "tactus: view: %s\n", err);
     tx_warn(v->ctx, v->w_write);
     return;
   }
@@ -315,31 +314,37 @@ static void draw_overlay(view* v, render_state* rs, int w, int h) {
 }
 #endif
 
-static int setup_target(view* v, render_state* rs, char* err, size_t n) {
+// -1 with the reason in v->setup_error (a library call's tx_error(), or the view's own)
+static int setup_failed(view* v, const char* why) {
+  snprintf(v->setup_error, sizeof v->setup_error, "%s", why ? why : tx_error());
+  return -1;
+}
+
+static int setup_target(view* v, render_state* rs) {
   tx_stereo_image_size(v->stereo, v->def.width, v->def.height, &rs->img_w, &rs->img_h);
   if (v->target == TARGET_PNG) {
 #if TX_WITH_OSMESA
-    if (!(rs->osm = tx_osmesa_create(rs->img_w, rs->img_h, err, n))) return -1;
-    if (!(rs->r = tx_renderer_create(tx_osmesa_proc, err, n))) return -1;
+    if (!(rs->osm = tx_osmesa_create(rs->img_w, rs->img_h))) return setup_failed(v, NULL);
+    if (!(rs->r = tx_renderer_create(tx_osmesa_proc))) return setup_failed(v, NULL);
 #endif
   } else {
 #if TX_WITH_GLFW
-    if (!(rs->win = tx_window_open(rs->img_w, rs->img_h, v->stereo != TX_STEREO_MONO, err, n))) return -1;
+    if (!(rs->win = tx_window_open(rs->img_w, rs->img_h, v->stereo != TX_STEREO_MONO))) return setup_failed(v, NULL);
     if (tx_window_is_quad(rs->win)) { // each eye has the whole window
       v->stereo = TX_STEREO_QUAD;
       tx_stereo_image_size(v->stereo, v->def.width, v->def.height, &rs->img_w, &rs->img_h);
       tx_window_resize(rs->win, rs->img_w, rs->img_h);
     }
     if (v->stereo == TX_STEREO_LR) // the probe at load found quad buffers: this window must have them too
-      return snprintf(err, n, "--stereo lr in a window: the window has no quad-buffered stereo"), -1;
-    if (!(rs->r = tx_renderer_create(tx_window_proc, err, n))) return -1;
+      return setup_failed(v, "--stereo lr in a window: the window has no quad-buffered stereo");
+    if (!(rs->r = tx_renderer_create(tx_window_proc))) return setup_failed(v, NULL);
     rs->overlay = tx_overlay_create(tx_renderer_gl(rs->r));
 #endif
   }
-  if (!rs->r) return snprintf(err, n, "no graphics target in this build"), -1;
+  if (!rs->r) return setup_failed(v, "no graphics target in this build");
   if (v->stereo == TX_STEREO_LR && !(rs->left = malloc((size_t)rs->img_w * rs->img_h * 4)))
-    return snprintf(err, n, "out of memory"), -1;
-  if (!tx_contact_sheet_init(&rs->sheet, rs->img_w, rs->img_h, 240, SHEET_THUMBS)) return snprintf(err, n, "out of memory"), -1;
+    return setup_failed(v, "out of memory");
+  if (!tx_contact_sheet_init(&rs->sheet, rs->img_w, rs->img_h, 240, SHEET_THUMBS)) return setup_failed(v, "out of memory");
   return 0;
 }
 
@@ -401,9 +406,10 @@ static void render_frame(view* v, render_state* rs) {
   }
 }
 
-// the last frame of the run, and the contact sheet
+// the last frame of the run, and the contact sheet; a file that cannot be
+// written is kept in finish_error, for finish to stop the run with
 static void finish_frames(view* v, render_state* rs) {
-  char path[4400], err[600];
+  char path[4400];
   if (v->rendered == 0) return;
 #if TX_WITH_GLFW
   if (rs->win) { // a screenshot of the last frame: drawn once more and read from the back buffer
@@ -419,7 +425,7 @@ static void finish_frames(view* v, render_state* rs) {
       gl->PixelStorei(GL_PACK_ALIGNMENT, 1);
       gl->ReadPixels(0, 0, fw, fh, GL_RGBA, GL_UNSIGNED_BYTE, px);
       snprintf(path, sizeof path, "%s/window.png", v->frames_dir);
-      if (tx_png_write(path, px, fw, fh, true, err, sizeof err)) fprintf(stderr, "tactus: view: %s\n", err);
+      if (tx_png_write(path, px, fw, fh, true)) snprintf(v->finish_error, sizeof v->finish_error, "%s", tx_error());
       else v->written++;
     }
     free(px);
@@ -432,15 +438,13 @@ static void finish_frames(view* v, render_state* rs) {
     tx_contact_sheet_add(&rs->sheet, v->stereo == TX_STEREO_LR ? rs->left : target_pixels(rs), rs->img_w, rs->img_h, true);
   }
   snprintf(path, sizeof path, "%s/contact_sheet.png", v->frames_dir);
-  if (tx_contact_sheet_write(&rs->sheet, path, 6, err, sizeof err)) fprintf(stderr, "tactus: view: %s\n", err);
+  if (tx_contact_sheet_write(&rs->sheet, path, 6)) snprintf(v->finish_error, sizeof v->finish_error, "%s", tx_error());
 }
 
 static void* render_main(void* arg) {
   view* v = arg;
   render_state rs = {0};
-  char err[512] = "";
-  if (setup_target(v, &rs, err, sizeof err)) {
-    snprintf(v->setup_error, sizeof v->setup_error, "%s", err);
+  if (setup_target(v, &rs)) {
     v->setup_failed = true;
     teardown(&rs);
     sem_post(&v->started);
@@ -493,7 +497,7 @@ static int init(tx_ctx* c, void* self) {
   if (!out) out = ".";
   snprintf(v->frames_dir, sizeof v->frames_dir, "%s/frames", out);
   if (mkdir(v->frames_dir, 0755) != 0 && errno != EEXIST) {
-    fprintf(stderr, "tactus: view: %s: %s\n", v->frames_dir, strerror(errno));
+    tx_stop_run(c, "%s: %s", v->frames_dir, strerror(errno));
     return -1;
   }
   sem_init(&v->go, 0, 0);
@@ -501,7 +505,7 @@ static int init(tx_ctx* c, void* self) {
   sem_init(&v->started, 0, 0);
   v->sems_ready = true;
   if (start_thread(v) != 0) {
-    fprintf(stderr, "tactus: view: cannot start the rendering thread\n");
+    tx_stop_run(c, "cannot start the rendering thread");
     return -1;
   }
   v->thread_running = true;
@@ -509,7 +513,7 @@ static int init(tx_ctx* c, void* self) {
   if (v->setup_failed) {
     pthread_join(v->thread, NULL);
     v->thread_running = false;
-    fprintf(stderr, "tactus: view: %s\n", v->setup_error);
+    tx_stop_run(c, "%s", v->setup_error);
     return -1;
   }
   return 0;
@@ -553,6 +557,7 @@ static void finish(tx_ctx* c, void* self) {
   view* v = self;
   v->ctx = c;
   stop_thread(v);
+  if (*v->finish_error) tx_stop_run(c, "%s", v->finish_error); // the run exits 1, naming the file
   tx_set_result(c, v->r_frames, (double)v->rendered);
   tx_set_result(c, v->r_written, (double)v->written);
   tx_set_result(c, v->r_dropped, (double)v->dropped);

@@ -1,6 +1,8 @@
 // OSMesa: a core-profile context drawing into a buffer we own.
 #include "osmesa_target.h"
 
+#include "../../model/error.h"
+
 #include <GL/osmesa.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,12 +28,12 @@ int tx_osmesa_bound_threads(int wanted) {
   return wanted;
 }
 
-tx_osmesa* tx_osmesa_create(int width, int height, char* err, size_t n) {
+tx_osmesa* tx_osmesa_create(int width, int height) {
   tx_osmesa* o = calloc(1, sizeof *o);
   if (o) o->pixels = malloc((size_t)width * (size_t)height * 4);
   if (!o || !o->pixels) {
     if (o) free(o);
-    return snprintf(err, n, "out of memory for a %dx%d image", width, height), NULL;
+    return tx_set_error("out of memory for a %dx%d image", width, height), NULL;
   }
   const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 24, OSMESA_STENCIL_BITS, 0,
                          OSMESA_PROFILE, OSMESA_CORE_PROFILE, OSMESA_CONTEXT_MAJOR_VERSION, 3,
@@ -40,11 +42,11 @@ tx_osmesa* tx_osmesa_create(int width, int height, char* err, size_t n) {
   if (!o->ctx) {
     free(o->pixels);
     free(o);
-    return snprintf(err, n, "OSMesa could not make a GL 3.3 core context"), NULL;
+    return tx_set_error("OSMesa could not make a GL 3.3 core context"), NULL;
   }
   if (!OSMesaMakeCurrent(o->ctx, o->pixels, GL_UNSIGNED_BYTE, width, height)) {
     tx_osmesa_destroy(o);
-    return snprintf(err, n, "OSMesa could not make its context current"), NULL;
+    return tx_set_error("OSMesa could not make its context current"), NULL;
   }
   o->width = width;
   o->height = height;

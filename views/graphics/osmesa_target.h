@@ -15,8 +15,8 @@ typedef struct tx_osmesa tx_osmesa;
 // the rasteriser threads llvmpipe will use: `wanted` (< 0: CPUs - 2, at most 8),
 // unless LP_NUM_THREADS is already set, which wins; call before any thread starts
 int tx_osmesa_bound_threads(int wanted);
-// a current context with a width x height RGBA buffer; NULL and a message on failure
-tx_osmesa* tx_osmesa_create(int width, int height, char* err, size_t n);
+// a current context with a width x height RGBA buffer; NULL with the message in tx_error() on failure
+tx_osmesa* tx_osmesa_create(int width, int height);
 void tx_osmesa_destroy(tx_osmesa* o);
 // the proc-address function for tx_gl_load
 tx_gl_proc tx_osmesa_proc(const char* name);

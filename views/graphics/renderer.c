@@ -1,6 +1,8 @@
 // GL 3.3 core drawing of meshes, spheres, cylinders, tools and planes.
 #include "renderer.h"
 
+#include "../../model/error.h"
+
 #include <tactus/components.h>
 
 #include <math.h>
@@ -136,7 +138,7 @@ static const char* const cyl_vs =
     "  gl_Position = u_proj * u_view * vec4(p, 1.0);\n"
     "}\n";
 
-static GLuint compile(tx_gl* gl, GLenum kind, const char* src, char* err, size_t n) {
+static GLuint compile(tx_gl* gl, GLenum kind, const char* src) {
   GLuint s = gl->CreateShader(kind);
   gl->ShaderSource(s, 1, &src, NULL);
   gl->CompileShader(s);
@@ -147,15 +149,15 @@ static GLuint compile(tx_gl* gl, GLenum kind, const char* src, char* err, size_t
     gl->GetShaderInfoLog(s, sizeof log, NULL, log);
     for (char* c = log; *c; c++)
       if (*c == '\n') *c = ' ';
-    snprintf(err, n, "shader does not compile: %s", log);
+    tx_set_error("shader does not compile: %s", log);
     gl->DeleteShader(s);
     return 0;
   }
   return s;
 }
 
-static GLuint program(tx_gl* gl, const char* vs, const char* fs, char* err, size_t n) {
-  GLuint v = compile(gl, GL_VERTEX_SHADER, vs, err, n), f = v ? compile(gl, GL_FRAGMENT_SHADER, fs, err, n) : 0;
+static GLuint program(tx_gl* gl, const char* vs, const char* fs) {
+  GLuint v = compile(gl, GL_VERTEX_SHADER, vs), f = v ? compile(gl, GL_FRAGMENT_SHADER, fs) : 0;
   if (!v || !f) return 0;
   GLuint p = gl->CreateProgram();
   gl->AttachShader(p, v);
@@ -168,7 +170,7 @@ static GLuint program(tx_gl* gl, const char* vs, const char* fs, char* err, size
   if (!ok) {
     char log[512] = "";
     gl->GetProgramInfoLog(p, sizeof log, NULL, log);
-    snprintf(err, n, "shaders do not link: %s", log);
+    tx_set_error("shaders do not link: %s", log);
     gl->DeleteProgram(p);
     return 0;
   }
@@ -281,18 +283,18 @@ static void make_cylinder(tx_renderer* r) {
   gl->BindVertexArray(0);
 }
 
-tx_renderer* tx_renderer_create(tx_gl_loader load, char* err, size_t n) {
+tx_renderer* tx_renderer_create(tx_gl_loader load) {
   tx_renderer* r = calloc(1, sizeof *r);
-  if (!r) return snprintf(err, n, "out of memory"), NULL;
+  if (!r) return tx_set_error("out of memory"), NULL;
   const char* missing = NULL;
   if (!tx_gl_load(&r->gl, load, &missing)) {
-    snprintf(err, n, "the GL context lacks %s (GL 3.3 core is needed)", missing);
+    tx_set_error("the GL context lacks %s (GL 3.3 core is needed)", missing);
     free(r);
     return NULL;
   }
   tx_gl* gl = &r->gl;
-  if (!(r->mesh_prog = program(gl, mesh_vs, fs_src, err, n)) || !(r->sphere_prog = program(gl, sphere_vs, sphere_fs, err, n)) ||
-      !(r->cyl_prog = program(gl, cyl_vs, fs_src, err, n))) {
+  if (!(r->mesh_prog = program(gl, mesh_vs, fs_src)) || !(r->sphere_prog = program(gl, sphere_vs, sphere_fs)) ||
+      !(r->cyl_prog = program(gl, cyl_vs, fs_src))) {
     tx_renderer_destroy(r);
     return NULL;
   }
@@ -301,7 +303,7 @@ tx_renderer* tx_renderer_create(tx_gl_loader load, char* err, size_t n) {
   uint8_t* tex = malloc(SKIN_TEX * SKIN_TEX * 3);
   if (!tex) {
     tx_renderer_destroy(r);
-    return snprintf(err, n, "out of memory"), NULL;
+    return tx_set_error("out of memory"), NULL;
   }
   tx_skin_texture(tex, SKIN_TEX);
   gl->GenTextures(1, &r->skin_tex);
@@ -316,7 +318,7 @@ tx_renderer* tx_renderer_create(tx_gl_loader load, char* err, size_t n) {
   free(tex);
   if (gl->GetError() != GL_NO_ERROR) {
     tx_renderer_destroy(r);
-    return snprintf(err, n, "GL error while setting up the renderer"), NULL;
+    return tx_set_error("GL error while setting up the renderer"), NULL;
   }
   return r;
 }

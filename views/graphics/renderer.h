@@ -4,7 +4,7 @@
 // cylinders, tools, planes; per-pixel Blinn-Phong lighting from one
 // directional light, two-sided. Needs a current context; one renderer per context.
 //
-//     tx_renderer* r = tx_renderer_create(loader, err, sizeof err);
+//     tx_renderer* r = tx_renderer_create(loader);
 //     tx_renderer_upload(r, &def, &scene);                  // once per frame
 //     tx_renderer_draw(r, &def, &def.camera, TX_EYE_LEFT, 0, 0, w, h, GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
 //     tx_renderer_draw(r, &def, &def.camera, TX_EYE_RIGHT, w, 0, w, h, 0);  // the eyes tile the image
@@ -37,7 +37,7 @@ typedef struct tx_scene {
 
 typedef struct tx_renderer tx_renderer;
 
-tx_renderer* tx_renderer_create(tx_gl_loader load, char* err, size_t n);
+tx_renderer* tx_renderer_create(tx_gl_loader load);
 void tx_renderer_destroy(tx_renderer* r);
 const tx_gl* tx_renderer_gl(const tx_renderer* r);
 // take one frame's geometry (shared by both eyes); rows that are not finite or

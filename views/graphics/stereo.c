@@ -1,6 +1,8 @@
 // Off-axis stereo: parallel eyes, asymmetric frusta meeting at the convergence plane.
 #include "stereo.h"
 
+#include "../../model/error.h"
+
 #include <math.h>
 #include <string.h>
 
@@ -25,19 +27,19 @@ static bool normalise(double v[3]) {
   return true;
 }
 
-const char* tx_camera_check(const tx_camera* c) {
+int tx_camera_check(const tx_camera* c) {
   for (int i = 0; i < 3; i++)
-    if (!isfinite(c->eye[i]) || !isfinite(c->target[i]) || !isfinite(c->up[i])) return "eye, target and up must be finite";
+    if (!isfinite(c->eye[i]) || !isfinite(c->target[i]) || !isfinite(c->up[i])) return tx_set_error("eye, target and up must be finite"), -1;
   double f[3], r[3];
   sub(c->target, c->eye, f);
-  if (!normalise(f)) return "eye and target must differ";
+  if (!normalise(f)) return tx_set_error("eye and target must differ"), -1;
   cross(f, c->up, r);
-  if (!normalise(r)) return "up must not be parallel to the viewing direction";
-  if (!(c->fov_y > 0 && c->fov_y < M_PI)) return "fov must be in (0, 180) degrees";
-  if (!(c->near_m > 0) || !(c->far_m > c->near_m) || !isfinite(c->far_m)) return "need 0 < near < far";
-  if (!(c->interaxial >= 0) || !isfinite(c->interaxial)) return "interaxial distance must be >= 0";
-  if (!(c->convergence > 0) || !isfinite(c->convergence)) return "convergence distance must be > 0";
-  return NULL;
+  if (!normalise(r)) return tx_set_error("up must not be parallel to the viewing direction"), -1;
+  if (!(c->fov_y > 0 && c->fov_y < M_PI)) return tx_set_error("fov must be in (0, 180) degrees"), -1;
+  if (!(c->near_m > 0) || !(c->far_m > c->near_m) || !isfinite(c->far_m)) return tx_set_error("need 0 < near < far"), -1;
+  if (!(c->interaxial >= 0) || !isfinite(c->interaxial)) return tx_set_error("interaxial distance must be >= 0"), -1;
+  if (!(c->convergence > 0) || !isfinite(c->convergence)) return tx_set_error("convergence distance must be > 0"), -1;
+  return 0;
 }
 
 // the camera's orthonormal frame: right r, true up u, forward f

@@ -32,8 +32,8 @@ typedef struct tx_camera {
 
 // eye at (0, 0.2, 0.35) m looking at the origin, 40 degrees, converging at the target, eyes 1/30 of that apart
 tx_camera tx_camera_default(void);
-// NULL, or what is wrong with the camera
-const char* tx_camera_check(const tx_camera* c);
+// 0, or -1 with what is wrong with the camera in tx_error()
+int tx_camera_check(const tx_camera* c);
 // view and projection matrices (column-major) of one eye for a viewport of this width/height
 void tx_camera_matrices(const tx_camera* c, tx_eye eye, double aspect, float view[16], float proj[16]);
 // a world point to normalised device coordinates of one eye; false if it is behind the eye

@@ -2,6 +2,7 @@
 #include "view_def.h"
 
 #include "../../controllers/system.h" // tx_json_kind, shared with the parameter readers
+#include "../../model/error.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -16,24 +17,19 @@ tx_view_def tx_view_def_default(void) {
   return d;
 }
 
-typedef struct where {
-  char* key;
-  size_t kn;
-  char* msg;
-  size_t mn;
-} where;
-
-static int bad(const where* w, const char* key, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
-static int bad(const where* w, const char* key, const char* fmt, ...) {
-  snprintf(w->key, w->kn, "%s", key);
+// the error at KEY (relative to the view): "KEY: message" in tx_error(), KEY in tx_error_key()
+static int bad(const char* key, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
+static int bad(const char* key, const char* fmt, ...) {
+  char msg[512];
   va_list ap;
   va_start(ap, fmt);
-  vsnprintf(w->msg, w->mn, fmt, ap);
+  vsnprintf(msg, sizeof msg, fmt, ap);
   va_end(ap);
+  tx_set_error_at(key, "%s%s%s", key, *key ? ": " : "", msg);
   return -1;
 }
 
-static int check_keys(const where* w, const char* at, const json_t* obj, const char* const* known) {
+static int check_keys(const char* at, const json_t* obj, const char* const* known) {
   const char* k;
   json_t* v;
   json_object_foreach((json_t*)obj, k, v) {
@@ -46,29 +42,29 @@ static int check_keys(const where* w, const char* at, const json_t* obj, const c
       snprintf(list + len, sizeof list - len, "%s%s", len ? ", " : "", *q);
     }
     snprintf(key, sizeof key, "%s%s%s", at, *at ? "." : "", k);
-    return bad(w, key, "unknown key (known: %s)", list);
+    return bad(key, "unknown key (known: %s)", list);
   }
   return 0;
 }
 
 // n finite numbers in [lo, hi]
-static int numbers(const where* w, const char* key, const json_t* v, int n, double lo, double hi, double* out) {
+static int numbers(const char* key, const json_t* v, int n, double lo, double hi, double* out) {
   if (!json_is_array(v) || (int)json_array_size(v) != n)
-    return bad(w, key, "expected an array of %d numbers, got %s", n, tx_json_kind(v));
+    return bad(key, "expected an array of %d numbers, got %s", n, tx_json_kind(v));
   for (int i = 0; i < n; i++) {
     const json_t* e = json_array_get(v, (size_t)i);
     double x = json_number_value(e);
     if (!json_is_number(e) || !isfinite(x) || x < lo || x > hi)
-      return bad(w, key, "entry %d: expected a number in [%g, %g]", i, lo, hi);
+      return bad(key, "entry %d: expected a number in [%g, %g]", i, lo, hi);
     out[i] = x;
   }
   return 0;
 }
 
-static int number(const where* w, const char* key, const json_t* v, double lo, double hi, bool open_lo, double* out) {
+static int number(const char* key, const json_t* v, double lo, double hi, bool open_lo, double* out) {
   double x = json_number_value(v);
   if (!json_is_number(v) || !isfinite(x) || x < lo || x > hi || (open_lo && x == lo))
-    return bad(w, key, "expected a number in %s%g, %g], got %s", open_lo ? "(" : "[", lo, hi,
+    return bad(key, "expected a number in %s%g, %g], got %s", open_lo ? "(" : "[", lo, hi,
                json_is_number(v) ? "an out-of-range number" : tx_json_kind(v));
   *out = x;
   return 0;
@@ -76,22 +72,22 @@ static int number(const where* w, const char* key, const json_t* v, double lo, d
 
 // an object's "point" and unit "normal" (defaults given in p and nrm) into out
 // (6): the point, then the normal scaled to unit length
-static int point_normal(const where* w, const char* key, const json_t* v, double p[3], double nrm[3], float out[6]) {
+static int point_normal(const char* key, const json_t* v, double p[3], double nrm[3], float out[6]) {
   const json_t* q;
   char sub[128];
   snprintf(sub, sizeof sub, "%s.point", key);
-  if ((q = json_object_get(v, "point")) && numbers(w, sub, q, 3, -1e4, 1e4, p)) return -1;
+  if ((q = json_object_get(v, "point")) && numbers(sub, q, 3, -1e4, 1e4, p)) return -1;
   snprintf(sub, sizeof sub, "%s.normal", key);
-  if ((q = json_object_get(v, "normal")) && numbers(w, sub, q, 3, -1e4, 1e4, nrm)) return -1;
+  if ((q = json_object_get(v, "normal")) && numbers(sub, q, 3, -1e4, 1e4, nrm)) return -1;
   double l = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
-  if (!(l > 1e-6)) return bad(w, sub, "expected a non-zero direction");
+  if (!(l > 1e-6)) return bad(sub, "expected a non-zero direction");
   for (int c = 0; c < 3; c++) out[c] = (float)p[c], out[3 + c] = (float)(nrm[c] / l);
   return 0;
 }
 
-static int integer(const where* w, const char* key, const json_t* v, int lo, int hi, int* out) {
+static int integer(const char* key, const json_t* v, int lo, int hi, int* out) {
   if (!json_is_integer(v) || json_integer_value(v) < lo || json_integer_value(v) > hi)
-    return bad(w, key, "expected an integer in [%d, %d]", lo, hi);
+    return bad(key, "expected an integer in [%d, %d]", lo, hi);
   *out = (int)json_integer_value(v);
   return 0;
 }
@@ -104,35 +100,34 @@ static bool plain_name(const char* s) {
   return true;
 }
 
-static int read_camera(const where* w, const json_t* cam, tx_view_def* d) {
+static int read_camera(const json_t* cam, tx_view_def* d) {
   static const char* const keys[] = {"eye", "target", "up", "fov_deg", "near_m", "far_m", NULL};
-  if (!json_is_object(cam)) return bad(w, "camera", "expected an object, got %s", tx_json_kind(cam));
-  if (check_keys(w, "camera", cam, keys)) return -1;
+  if (!json_is_object(cam)) return bad("camera", "expected an object, got %s", tx_json_kind(cam));
+  if (check_keys("camera", cam, keys)) return -1;
   tx_camera* c = &d->camera;
   const json_t* v;
-  if ((v = json_object_get(cam, "eye")) && numbers(w, "camera.eye", v, 3, -1e4, 1e4, c->eye)) return -1;
-  if ((v = json_object_get(cam, "target")) && numbers(w, "camera.target", v, 3, -1e4, 1e4, c->target)) return -1;
-  if ((v = json_object_get(cam, "up")) && numbers(w, "camera.up", v, 3, -1e4, 1e4, c->up)) return -1;
+  if ((v = json_object_get(cam, "eye")) && numbers("camera.eye", v, 3, -1e4, 1e4, c->eye)) return -1;
+  if ((v = json_object_get(cam, "target")) && numbers("camera.target", v, 3, -1e4, 1e4, c->target)) return -1;
+  if ((v = json_object_get(cam, "up")) && numbers("camera.up", v, 3, -1e4, 1e4, c->up)) return -1;
   double deg = c->fov_y * 180 / M_PI;
-  if ((v = json_object_get(cam, "fov_deg")) && number(w, "camera.fov_deg", v, 1, 170, false, &deg)) return -1;
+  if ((v = json_object_get(cam, "fov_deg")) && number("camera.fov_deg", v, 1, 170, false, &deg)) return -1;
   c->fov_y = deg * M_PI / 180;
-  if ((v = json_object_get(cam, "near_m")) && number(w, "camera.near_m", v, 0, 100, true, &c->near_m)) return -1;
-  if ((v = json_object_get(cam, "far_m")) && number(w, "camera.far_m", v, 0, 1e5, true, &c->far_m)) return -1;
+  if ((v = json_object_get(cam, "near_m")) && number("camera.near_m", v, 0, 100, true, &c->near_m)) return -1;
+  if ((v = json_object_get(cam, "far_m")) && number("camera.far_m", v, 0, 1e5, true, &c->far_m)) return -1;
   double dx = c->target[0] - c->eye[0], dy = c->target[1] - c->eye[1], dz = c->target[2] - c->eye[2];
   c->convergence = sqrt(dx * dx + dy * dy + dz * dz); // the target is on the zero-parallax plane unless told otherwise
   d->auto_camera = false;
-  const char* problem = tx_camera_check(c);
-  if (problem) return bad(w, "camera", "%s", problem);
+  if (tx_camera_check(c)) return bad("camera", "%s", tx_error());
   return 0;
 }
 
-static int read_item(const where* w, size_t i, const json_t* e, tx_draw_item* it) {
+static int read_item(size_t i, const json_t* e, tx_draw_item* it) {
   static const char* const keys[] = {"mesh", "spheres", "segments", "tool", "plane", "colour", "colour_by",
                                      "range", "texture", "radius_m", "show_force", "force_scale_m_per_n", "cut", NULL};
   char at[48], key[96];
   snprintf(at, sizeof at, "draw[%zu]", i);
-  if (!json_is_object(e)) return bad(w, at, "expected an object, got %s", tx_json_kind(e));
-  if (check_keys(w, at, e, keys)) return -1;
+  if (!json_is_object(e)) return bad(at, "expected an object, got %s", tx_json_kind(e));
+  if (check_keys(at, e, keys)) return -1;
   static const struct { const char* key; tx_draw_kind kind; } kinds[] = {
       {"mesh", TX_DRAW_MESH}, {"spheres", TX_DRAW_SPHERES}, {"segments", TX_DRAW_SEGMENTS}, {"tool", TX_DRAW_TOOL},
       {"plane", TX_DRAW_PLANE}};
@@ -140,32 +135,32 @@ static int read_item(const where* w, size_t i, const json_t* e, tx_draw_item* it
   for (size_t k = 0; k < sizeof kinds / sizeof kinds[0]; k++) {
     const json_t* v = json_object_get(e, kinds[k].key);
     if (!v) continue;
-    if (it->kind) return bad(w, at, "expected exactly one of mesh, spheres, segments, tool, plane");
+    if (it->kind) return bad(at, "expected exactly one of mesh, spheres, segments, tool, plane");
     it->kind = kinds[k].kind;
     snprintf(key, sizeof key, "%s.%s", at, kinds[k].key);
     if (it->kind == TX_DRAW_PLANE) {
       static const char* const pkeys[] = {"point", "normal", "size_m", NULL};
-      if (!json_is_object(v)) return bad(w, key, "expected an object, got %s", tx_json_kind(v));
-      if (check_keys(w, key, v, pkeys)) return -1;
+      if (!json_is_object(v)) return bad(key, "expected an object, got %s", tx_json_kind(v));
+      if (check_keys(key, v, pkeys)) return -1;
       double p[3] = {0, 0, 0}, nrm[3] = {0, 1, 0}, size = 0.2;
-      if (point_normal(w, key, v, p, nrm, it->plane)) return -1;
+      if (point_normal(key, v, p, nrm, it->plane)) return -1;
       const json_t* q;
       char sub[128];
       snprintf(sub, sizeof sub, "%s.size_m", key);
-      if ((q = json_object_get(v, "size_m")) && number(w, sub, q, 0, 1e4, true, &size)) return -1;
+      if ((q = json_object_get(v, "size_m")) && number(sub, q, 0, 1e4, true, &size)) return -1;
       it->plane[6] = (float)(size / 2);
       continue;
     }
     if (!json_is_string(v) || !plain_name(json_string_value(v)))
-      return bad(w, key, "expected a component prefix of 1-%d characters of a-z 0-9 _ .", TX_NAME_MAX - 10);
+      return bad(key, "expected a component prefix of 1-%d characters of a-z 0-9 _ .", TX_NAME_MAX - 10);
     snprintf(it->name, sizeof it->name, "%s", json_string_value(v));
   }
-  if (!it->kind) return bad(w, at, "expected one of mesh, spheres, segments, tool, plane");
+  if (!it->kind) return bad(at, "expected one of mesh, spheres, segments, tool, plane");
   double tmp[3];
   const json_t* v;
   snprintf(key, sizeof key, "%s.colour", at);
   if ((v = json_object_get(e, "colour"))) {
-    if (numbers(w, key, v, 3, 0, 1, tmp)) return -1;
+    if (numbers(key, v, 3, 0, 1, tmp)) return -1;
     for (int c = 0; c < 3; c++) it->colour[c] = (float)tmp[c];
   } else if (it->kind == TX_DRAW_TOOL) {
     it->colour[0] = 0.85f, it->colour[1] = 0.25f, it->colour[2] = 0.2f;
@@ -175,120 +170,119 @@ static int read_item(const where* w, size_t i, const json_t* e, tx_draw_item* it
   snprintf(key, sizeof key, "%s.colour_by", at);
   if ((v = json_object_get(e, "colour_by"))) {
     if (it->kind != TX_DRAW_SPHERES && it->kind != TX_DRAW_SEGMENTS)
-      return bad(w, key, "only spheres and segments take a colour map");
+      return bad(key, "only spheres and segments take a colour map");
     if (!json_is_string(v) || !plain_name(json_string_value(v)))
-      return bad(w, key, "expected a component name such as tissue.damage");
+      return bad(key, "expected a component name such as tissue.damage");
     snprintf(it->scalar, sizeof it->scalar, "%s", json_string_value(v));
   }
   snprintf(key, sizeof key, "%s.range", at);
   if ((v = json_object_get(e, "range"))) {
-    if (!*it->scalar) return bad(w, key, "a range needs colour_by");
-    if (numbers(w, key, v, 2, -1e30, 1e30, tmp)) return -1;
-    if (!(tmp[1] > tmp[0])) return bad(w, key, "expected [low, high] with low < high");
+    if (!*it->scalar) return bad(key, "a range needs colour_by");
+    if (numbers(key, v, 2, -1e30, 1e30, tmp)) return -1;
+    if (!(tmp[1] > tmp[0])) return bad(key, "expected [low, high] with low < high");
     it->range[0] = (float)tmp[0], it->range[1] = (float)tmp[1];
   }
   snprintf(key, sizeof key, "%s.texture", at);
   it->skin_texture = it->kind == TX_DRAW_MESH && !json_object_get(e, "colour");
   if ((v = json_object_get(e, "texture"))) {
-    if (it->kind != TX_DRAW_MESH) return bad(w, key, "only meshes take a texture");
+    if (it->kind != TX_DRAW_MESH) return bad(key, "only meshes take a texture");
     const char* t = json_string_value(v);
-    if (!t || (strcmp(t, "skin") != 0 && strcmp(t, "none") != 0)) return bad(w, key, "expected \"skin\" or \"none\"");
+    if (!t || (strcmp(t, "skin") != 0 && strcmp(t, "none") != 0)) return bad(key, "expected \"skin\" or \"none\"");
     it->skin_texture = strcmp(t, "skin") == 0;
   }
   double x = 0; // set by number() whenever it returns 0
   snprintf(key, sizeof key, "%s.radius_m", at);
   if ((v = json_object_get(e, "radius_m"))) {
-    if (it->kind != TX_DRAW_TOOL) return bad(w, key, "only tools take a radius");
-    if (number(w, key, v, 0, 1, true, &x)) return -1;
+    if (it->kind != TX_DRAW_TOOL) return bad(key, "only tools take a radius");
+    if (number(key, v, 0, 1, true, &x)) return -1;
     it->radius = (float)x;
   }
   snprintf(key, sizeof key, "%s.show_force", at);
   if ((v = json_object_get(e, "show_force"))) {
-    if (it->kind != TX_DRAW_TOOL) return bad(w, key, "only tools show a force");
-    if (!json_is_boolean(v)) return bad(w, key, "expected true or false, got %s", tx_json_kind(v));
+    if (it->kind != TX_DRAW_TOOL) return bad(key, "only tools show a force");
+    if (!json_is_boolean(v)) return bad(key, "expected true or false, got %s", tx_json_kind(v));
     it->show_force = json_is_true(v);
   }
   snprintf(key, sizeof key, "%s.force_scale_m_per_n", at);
   if ((v = json_object_get(e, "force_scale_m_per_n"))) {
-    if (it->kind != TX_DRAW_TOOL) return bad(w, key, "only tools show a force");
-    if (number(w, key, v, 0, 10, true, &x)) return -1;
+    if (it->kind != TX_DRAW_TOOL) return bad(key, "only tools show a force");
+    if (number(key, v, 0, 10, true, &x)) return -1;
     it->force_scale = (float)x;
   }
   // a cutaway: the inside of a block of voxels, where a needle does its damage
   snprintf(key, sizeof key, "%s.cut", at);
   if ((v = json_object_get(e, "cut"))) {
     static const char* const ckeys[] = {"point", "normal", NULL};
-    if (it->kind != TX_DRAW_SPHERES) return bad(w, key, "only spheres take a cut");
-    if (!json_is_object(v)) return bad(w, key, "expected an object, got %s", tx_json_kind(v));
-    if (check_keys(w, key, v, ckeys)) return -1;
+    if (it->kind != TX_DRAW_SPHERES) return bad(key, "only spheres take a cut");
+    if (!json_is_object(v)) return bad(key, "expected an object, got %s", tx_json_kind(v));
+    if (check_keys(key, v, ckeys)) return -1;
     double p[3] = {0, 0, 0}, nrm[3] = {0, 0, 1};
-    if (point_normal(w, key, v, p, nrm, it->cut)) return -1;
+    if (point_normal(key, v, p, nrm, it->cut)) return -1;
     it->has_cut = true;
   }
   return 0;
 }
 
-int tx_view_def_from_json(const json_t* view, tx_view_def* d, char* key, size_t kn, char* msg, size_t mn) {
-  where w = {key, kn, msg, mn};
+int tx_view_def_from_json(const json_t* view, tx_view_def* d) {
   static const char* const keys[] = {"rate_hz", "width", "height", "frame_every", "camera", "stereo",
                                      "background", "light", "draw", NULL};
-  if (!json_is_object(view)) return bad(&w, "", "expected an object, got %s", tx_json_kind(view));
-  if (check_keys(&w, "", view, keys)) return -1;
+  if (!json_is_object(view)) return bad("", "expected an object, got %s", tx_json_kind(view));
+  if (check_keys("", view, keys)) return -1;
   const json_t* v;
   if ((v = json_object_get(view, "rate_hz"))) {
     double hz;
-    if (number(&w, "rate_hz", v, 0, 1000, true, &hz)) return -1;
+    if (number("rate_hz", v, 0, 1000, true, &hz)) return -1;
   }
-  if ((v = json_object_get(view, "width")) && integer(&w, "width", v, 16, TX_VIEW_SIDE_MAX, &d->width)) return -1;
-  if ((v = json_object_get(view, "height")) && integer(&w, "height", v, 16, TX_VIEW_SIDE_MAX, &d->height)) return -1;
-  if ((v = json_object_get(view, "frame_every")) && integer(&w, "frame_every", v, 1, 1000000, &d->frame_every))
+  if ((v = json_object_get(view, "width")) && integer("width", v, 16, TX_VIEW_SIDE_MAX, &d->width)) return -1;
+  if ((v = json_object_get(view, "height")) && integer("height", v, 16, TX_VIEW_SIDE_MAX, &d->height)) return -1;
+  if ((v = json_object_get(view, "frame_every")) && integer("frame_every", v, 1, 1000000, &d->frame_every))
     return -1;
-  if ((v = json_object_get(view, "camera")) && read_camera(&w, v, d)) return -1;
+  if ((v = json_object_get(view, "camera")) && read_camera(v, d)) return -1;
   if ((v = json_object_get(view, "stereo"))) {
     static const char* const skeys[] = {"interaxial_m", "convergence_m", NULL};
-    if (!json_is_object(v)) return bad(&w, "stereo", "expected an object, got %s", tx_json_kind(v));
-    if (check_keys(&w, "stereo", v, skeys)) return -1;
+    if (!json_is_object(v)) return bad("stereo", "expected an object, got %s", tx_json_kind(v));
+    if (check_keys("stereo", v, skeys)) return -1;
     const json_t* q;
-    if ((q = json_object_get(v, "interaxial_m")) && number(&w, "stereo.interaxial_m", q, 0, 1, false, &d->camera.interaxial))
+    if ((q = json_object_get(v, "interaxial_m")) && number("stereo.interaxial_m", q, 0, 1, false, &d->camera.interaxial))
       return -1;
     d->interaxial_given = q != NULL;
     if ((q = json_object_get(v, "convergence_m")) &&
-        number(&w, "stereo.convergence_m", q, 0, 1e4, true, &d->camera.convergence))
+        number("stereo.convergence_m", q, 0, 1e4, true, &d->camera.convergence))
       return -1;
     d->convergence_given = q != NULL;
   }
   double c[3];
   if ((v = json_object_get(view, "background"))) {
-    if (numbers(&w, "background", v, 3, 0, 1, c)) return -1;
+    if (numbers("background", v, 3, 0, 1, c)) return -1;
     for (int i = 0; i < 3; i++) d->background[i] = (float)c[i];
   }
   if ((v = json_object_get(view, "light"))) {
-    if (numbers(&w, "light", v, 3, -1e4, 1e4, c)) return -1;
+    if (numbers("light", v, 3, -1e4, 1e4, c)) return -1;
     double l = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-    if (!(l > 1e-6)) return bad(&w, "light", "expected a non-zero direction");
+    if (!(l > 1e-6)) return bad("light", "expected a non-zero direction");
     for (int i = 0; i < 3; i++) d->light_dir[i] = (float)(c[i] / l);
   }
   // the 1/30 rule of stereography: comfortable depth for a scene at the convergence distance
   if (!d->interaxial_given) d->camera.interaxial = d->camera.convergence / 30;
   if ((v = json_object_get(view, "draw"))) {
     if (!json_is_array(v) || json_array_size(v) == 0 || json_array_size(v) > TX_DRAW_MAX)
-      return bad(&w, "draw", "expected an array of 1 to %d entries", TX_DRAW_MAX);
+      return bad("draw", "expected an array of 1 to %d entries", TX_DRAW_MAX);
     d->nitems = 0;
     size_t i;
     json_t* e;
     json_array_foreach(v, i, e) {
-      if (read_item(&w, i, e, &d->items[d->nitems])) return -1;
+      if (read_item(i, e, &d->items[d->nitems])) return -1;
       d->nitems++;
     }
   }
   return 0;
 }
 
-int tx_view_def_from_text(const char* text, tx_view_def* d, char* key, size_t kn, char* msg, size_t mn) {
+int tx_view_def_from_text(const char* text, tx_view_def* d) {
   json_error_t e;
   json_t* view = text ? json_loads(text, JSON_DECODE_ANY, &e) : NULL;
-  if (!view) return bad(&(where){key, kn, msg, mn}, "", "not JSON: %s", text ? e.text : "no text");
-  int rc = tx_view_def_from_json(view, d, key, kn, msg, mn);
+  if (!view) return bad("", "not JSON: %s", text ? e.text : "no text");
+  int rc = tx_view_def_from_json(view, d);
   json_decref(view);
   return rc;
 }

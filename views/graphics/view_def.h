@@ -57,10 +57,12 @@ typedef struct tx_view_def {
 } tx_view_def;
 
 tx_view_def tx_view_def_default(void);
-// read a "view" object (rate_hz is the caller's); 0, or -1 with the key path (relative to the view) and a message
-int tx_view_def_from_json(const json_t* view, tx_view_def* d, char* key, size_t kn, char* msg, size_t mn);
+// read a "view" object (rate_hz is the caller's); 0, or -1 with "KEY: message"
+// in tx_error() (KEY relative to the view; none for the whole view) and KEY
+// alone in tx_error_key() (model/error.h)
+int tx_view_def_from_json(const json_t* view, tx_view_def* d);
 // the same from the object's JSON text (tx_param_json_text)
-int tx_view_def_from_text(const char* text, tx_view_def* d, char* key, size_t kn, char* msg, size_t mn);
+int tx_view_def_from_text(const char* text, tx_view_def* d);
 // draw entries for every component that follows the naming conventions, from the names written in a model
 int tx_view_def_auto_draw(tx_view_def* d, const char* const* written, int count);
 // the components an item reads, in order; returns how many (at most 3)

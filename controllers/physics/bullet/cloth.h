@@ -105,9 +105,9 @@ typedef enum tx_cloth_status {
 // the defaults above
 tx_cloth_def tx_cloth_def_default(void);
 
-// NULL when every field is finite and in range; otherwise one line naming
-// the field, its value and the range (valid until the next check on this thread)
-const char* tx_cloth_def_check(const tx_cloth_def* def);
+// 0 when every field is finite and in range; otherwise -1, and tx_error()
+// names the field, its value and the range
+int tx_cloth_def_check(const tx_cloth_def* def);
 
 // builds the patch at rest, flat; NULL (and tx_error()) on bad input or no memory
 tx_cloth* tx_cloth_create(const tx_cloth_def* def);

@@ -126,39 +126,38 @@ extern "C" tx_cloth_def tx_cloth_def_default(void) {
   return d;
 }
 
-static const char* range(const char* name, double v, double lo, bool open_lo, double hi, bool open_hi,
-                         const char* units) {
+static int range(const char* name, double v, double lo, bool open_lo, double hi, bool open_hi, const char* units) {
   return tx_check_range("skin", name, v, lo, open_lo, hi, open_hi, units);
 }
 
-extern "C" const char* tx_cloth_def_check(const tx_cloth_def* d) {
+extern "C" int tx_cloth_def_check(const tx_cloth_def* d) {
   static const char* const size_name[2] = {"size[0]", "size[1]"};
   static const char* const res_name[2] = {"res[0]", "res[1]"};
   static const char* const center_name[3] = {"center[0]", "center[1]", "center[2]"};
-  const char* e;
   for (int a = 0; a < 2; a++) {
-    if ((e = range(size_name[a], d->size[a], 1e-3, false, 10, false, "m"))) return e;
-    if ((e = tx_check_count("skin", res_name[a], d->res[a], 2, 1024))) return e;
+    if (range(size_name[a], d->size[a], 1e-3, false, 10, false, "m")) return -1;
+    if (tx_check_count("skin", res_name[a], d->res[a], 2, 1024)) return -1;
   }
   for (int a = 0; a < 3; a++)
-    if ((e = range(center_name[a], d->center[a], -10, false, 10, false, "m"))) return e;
-  if ((e = range("thickness", d->thickness, 0, false, 0.02, false, "m"))) return e;
-  if ((e = range("mass", d->mass, 0, true, 100, false, "kg"))) return e;
-  if ((e = range("stretch_stiffness", d->stretch_stiffness, 0, true, 1e9, false, "N/m"))) return e;
-  if ((e = range("bend_stiffness", d->bend_stiffness, 0, false, 1e9, false, "N/m"))) return e;
-  if ((e = range("damping", d->damping, 0, false, 1e4, false, "1/s"))) return e;
-  if ((e = range("gravity", d->gravity, 0, false, 100, false, "m/s^2"))) return e;
-  if ((e = range("clamp_radius", d->clamp_radius, 0, false, 10, false, "m"))) return e;
+    if (range(center_name[a], d->center[a], -10, false, 10, false, "m")) return -1;
+  if (range("thickness", d->thickness, 0, false, 0.02, false, "m")) return -1;
+  if (range("mass", d->mass, 0, true, 100, false, "kg")) return -1;
+  if (range("stretch_stiffness", d->stretch_stiffness, 0, true, 1e9, false, "N/m")) return -1;
+  if (range("bend_stiffness", d->bend_stiffness, 0, false, 1e9, false, "N/m")) return -1;
+  if (range("damping", d->damping, 0, false, 1e4, false, "1/s")) return -1;
+  if (range("gravity", d->gravity, 0, false, 100, false, "m/s^2")) return -1;
+  if (range("clamp_radius", d->clamp_radius, 0, false, 10, false, "m")) return -1;
   // a prestrain under 50 %: the links stay far from zero length
-  if ((e = range("pretension", d->pretension, 0, false, 0.5 * (3 * d->stretch_stiffness + 4 * d->bend_stiffness), false,
-                 "N/m"))) return e;
-  if ((e = range("rupture_tension", d->rupture_tension, 0, false, 1e7, false, "N/m"))) return e;
-  if ((e = range("rupture_length", d->rupture_length, 1e-4, false, 0.05, false, "m"))) return e;
-  if ((e = tx_check_count("skin", "iterations", d->iterations, 1, 200))) return e;
-  if ((e = range("max_substep", d->max_substep, 1e-6, false, 0.1, false, "s"))) return e;
-  if ((e = range("max_speed", d->max_speed, 0, true, 1e4, false, "m/s"))) return e;
-  if ((e = range("settle_time", d->settle_time, 0, false, 10, false, "s"))) return e;
-  return NULL;
+  if (range("pretension", d->pretension, 0, false, 0.5 * (3 * d->stretch_stiffness + 4 * d->bend_stiffness), false,
+            "N/m"))
+    return -1;
+  if (range("rupture_tension", d->rupture_tension, 0, false, 1e7, false, "N/m")) return -1;
+  if (range("rupture_length", d->rupture_length, 1e-4, false, 0.05, false, "m")) return -1;
+  if (tx_check_count("skin", "iterations", d->iterations, 1, 200)) return -1;
+  if (range("max_substep", d->max_substep, 1e-6, false, 0.1, false, "s")) return -1;
+  if (range("max_speed", d->max_speed, 0, true, 1e4, false, "m/s")) return -1;
+  if (range("settle_time", d->settle_time, 0, false, 10, false, "s")) return -1;
+  return 0;
 }
 
 // ---------------------------------------------------------------------------
@@ -394,11 +393,8 @@ static void take_rest(tx_cloth* c) {
 }
 
 extern "C" tx_cloth* tx_cloth_create(const tx_cloth_def* def) {
-  const char* e = def ? tx_cloth_def_check(def) : "skin: no definition";
-  if (e) {
-    tx_set_error("%s", e);
-    return NULL;
-  }
+  if (!def) return tx_set_error("skin: no definition"), nullptr;
+  if (tx_cloth_def_check(def)) return nullptr;
   tx_cloth* c = new (std::nothrow) tx_cloth();
   if (!c) {
     tx_set_error("skin: out of memory");

@@ -61,7 +61,7 @@ static const tx_controller_class test_skin_class = {
     .type = "test.skin", .summary = "a still flat skin", .configure = skin_configure, .step = skin_step, .fini = skin_fini};
 
 static tx_scenario* load(const char* skin_params) {
-  char text[1024], err[512];
+  char text[1024];
   snprintf(text, sizeof text,
            "{\"name\":\"t\",\"controllers\":["
            "{\"name\":\"skin\",\"type\":\"test.skin\",\"rate_hz\":60,\"params\":{%s}},"
@@ -69,8 +69,8 @@ static tx_scenario* load(const char* skin_params) {
            "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:pierce-down\","
            "\"force_model\":\"tool0.force_model\",\"record\":false}}]}",
            skin_params);
-  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL, err, sizeof err);
-  if (!s) fail_msg("%s", err);
+  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+  if (!s) fail_msg("%s", tx_error());
   return s;
 }
 

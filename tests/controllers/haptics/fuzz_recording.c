@@ -4,6 +4,7 @@
 // messages are one line. Each input is tried as it is and again with the
 // header's and every block's CRC made right, so that the checks behind the
 // CRCs are fuzzed as well.
+#include "model/error.h"
 #include "controllers/haptics/device_protocol.h"
 #include "controllers/haptics/recorder.h"
 
@@ -39,13 +40,15 @@ static void check(const uint8_t* data, size_t size, bool fix) {
   if (!buf) return;
   if (size) memcpy(buf, data, size);
   if (fix) fix_crcs(buf, size);
-  tx_record_header h;
-  tx_record* recs;
-  size_t count;
-  char warn[512], err[512] = "";
-  if (tx_record_parse(buf, size, "fuzz.bin", &h, &recs, &count, warn, sizeof warn, err, sizeof err) == 0) {
-    if (count == 0 || !recs || *err) abort();
-    one_line(warn);
+  tx_record_file rf;
+  tx_set_error("%s", "");
+  int rc = tx_record_parse(buf, size, "fuzz.bin", &rf);
+  const tx_record_header h = rf.header;
+  tx_record* recs = rf.records;
+  size_t count = rf.count;
+  if (rc == 0) {
+    if (count == 0 || !recs || *tx_error()) abort();
+    one_line(rf.cut_short);
     for (size_t i = 0; i < count; i++) {
       const tx_record* r = &recs[i];
       if (i && !(r->t_s > recs[i - 1].t_s)) abort();
@@ -55,8 +58,8 @@ static void check(const uint8_t* data, size_t size, bool fix) {
     }
     free(recs);
   } else {
-    if (recs || count || !*err || *warn) abort();
-    one_line(err);
+    if (recs || count || !*tx_error() || *rf.cut_short) abort();
+    one_line(tx_error());
   }
   free(buf);
 }

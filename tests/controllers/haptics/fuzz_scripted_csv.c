@@ -2,6 +2,7 @@
 // (`--device scripted:FILE.csv`): whatever the text, it returns an error of
 // one line naming the file, or a device whose every reading, before, between
 // and after the waypoints, is finite, within 10 m, with a unit quaternion.
+#include "model/error.h"
 #include "controllers/haptics/device_scripted.h"
 
 #include <math.h>
@@ -16,12 +17,11 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   memcpy(buf, data, size);
   FILE* f = fmemopen(buf, size, "r");
   if (!f) return free(buf), 0;
-  char err[512] = "";
-  tx_device* d = tx_scripted_read_csv(f, "fuzz.csv", err, sizeof err);
+  tx_device* d = tx_scripted_read_csv(f, "fuzz.csv");
   fclose(f);
   free(buf);
   if (!d) {
-    if (strncmp(err, "fuzz.csv", 8) != 0 || strchr(err, '\n')) abort();
+    if (strncmp(tx_error(), "fuzz.csv", 8) != 0 || strchr(tx_error(), '\n')) abort();
     return 0;
   }
   // t from before the start to past the end, by uneven steps

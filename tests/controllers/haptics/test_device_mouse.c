@@ -1,5 +1,6 @@
 // The mouse device: it reads what it is fed from window.pointer (the model),
 // clamped to its workspace, and keeps its start until the first input.
+#include "model/error.h"
 #include "controllers/haptics/device.h"
 #include "controllers/haptics/device_mouse.h"
 
@@ -14,8 +15,7 @@
 static void reads_what_it_is_fed(void** state) {
   (void)state;
   tx_device_handle h;
-  char err[256];
-  assert_int_equal(tx_device_open("mouse", 0.001, &h, err, sizeof err), 0);
+  assert_int_equal(tx_device_open("mouse", 0.001, &h), 0);
   // its input is a model component of the pointer's layout, fed by the haptics controller
   assert_string_equal(h.backend->input, "window.pointer");
   assert_non_null(h.backend->feed);
@@ -45,16 +45,15 @@ static void reads_what_it_is_fed(void** state) {
   const double f[3] = {0.5, -1, 2};
   h.backend->write(h.device, f); // no motors: accepted and shown through deviceN.force
   tx_device_close(&h);
-  assert_int_equal(tx_device_open("mouse:fast", 0.001, &h, err, sizeof err), -1);
-  assert_non_null(strstr(err, "mouse:fast"));
+  assert_int_equal(tx_device_open("mouse:fast", 0.001, &h), -1);
+  assert_non_null(strstr(tx_error(), "mouse:fast"));
 }
 
 // the other devices take no input from the model
 static void other_devices_have_no_model_input(void** state) {
   (void)state;
   tx_device_handle h;
-  char err[256];
-  assert_int_equal(tx_device_open("sim", 0.001, &h, err, sizeof err), 0);
+  assert_int_equal(tx_device_open("sim", 0.001, &h), 0);
   assert_null(h.backend->input);
   tx_device_close(&h);
 }

@@ -5,6 +5,7 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
+#include "model/error.h"
 #include "controllers/haptics/device.h"
 #include "controllers/haptics/device_scripted.h"
 
@@ -25,8 +26,7 @@ static tx_device_state at(tx_device_handle* h, double t) {
 static void pierce_down_moves_down_through_the_skin(void** state) {
   (void)state;
   tx_device_handle h;
-  char err[256];
-  assert_int_equal(tx_device_open("scripted:pierce-down", 1e-3, &h, err, sizeof err), 0);
+  assert_int_equal(tx_device_open("scripted:pierce-down", 1e-3, &h), 0);
   assert_true(at(&h, 0).pos[1] == 0.010);
   tx_device_state mid = at(&h, 2.5);
   assert_true(fabs(mid.pos[1]) < 1e-12); // through the mid-plane half-way
@@ -43,8 +43,7 @@ static void pierce_down_moves_down_through_the_skin(void** state) {
 static void insert_goes_in_and_out_at_3_mm_per_s(void** state) {
   (void)state;
   tx_device_handle h;
-  char err[256];
-  assert_int_equal(tx_device_open("scripted:insert", 1e-3, &h, err, sizeof err), 0);
+  assert_int_equal(tx_device_open("scripted:insert", 1e-3, &h), 0);
   assert_true(at(&h, 0).pos[1] == 0.001 && at(&h, 0).vel[1] == 0);
   tx_device_state down = at(&h, 1.0), up = at(&h, 2.5);
   assert_true(fabs(down.vel[1] + 0.003) < 1e-12 && fabs(up.vel[1] - 0.003) < 1e-12);
@@ -59,10 +58,10 @@ static void every_named_motion_opens(void** state) {
   (void)state;
   const char* names[] = {"pierce-down", "pierce-up", "slide-x-over", "slide-x-under", "slide-z-over", "slide-z-under"};
   for (size_t i = 0; i < 6; i++) {
-    char spec[64], err[256];
+    char spec[64];
     snprintf(spec, sizeof spec, "scripted:%s", names[i]);
     tx_device_handle h;
-    assert_int_equal(tx_device_open(spec, 1e-3, &h, err, sizeof err), 0);
+    assert_int_equal(tx_device_open(spec, 1e-3, &h), 0);
     tx_device_state s = at(&h, 4.0);
     double sign = strstr(names[i], "under") || strstr(names[i], "up") ? -1 : 1;
     if (strstr(names[i], "slide")) assert_true(fabs(s.pos[1] - sign * 0.002) < 1e-12); // sliding in contact
@@ -90,23 +89,22 @@ static void one_table_of_hand_motions(void** state) {
   assert_null(tx_hand_motion_find("pierce-sideways"));
 
   tx_device_handle h;
-  char err[512];
-  assert_int_equal(tx_device_open("scripted:paper-pierce-down", 1e-3, &h, err, sizeof err), 0);
+  assert_int_equal(tx_device_open("scripted:paper-pierce-down", 1e-3, &h), 0);
   assert_true(fabs(at(&h, 9.2).pos[1] + 0.015) < 1e-12);
   tx_device_close(&h);
-  assert_int_not_equal(tx_device_open("scripted:pierce-sideways", 1e-3, &h, err, sizeof err), 0);
-  assert_non_null(strstr(err, "pierce-down, pierce-up, slide-x-over"));
-  assert_non_null(strstr(err, "insert, paper-pierce-up, paper-pierce-up-hanging, paper-pierce-down, accuracy-pierce-down"));
+  assert_int_not_equal(tx_device_open("scripted:pierce-sideways", 1e-3, &h), 0);
+  assert_non_null(strstr(tx_error(), "pierce-down, pierce-up, slide-x-over"));
+  assert_non_null(strstr(tx_error(), "insert, paper-pierce-up, paper-pierce-up-hanging, paper-pierce-down, accuracy-pierce-down"));
 }
 
 static void waypoint_file_is_interpolated(void** state) {
   (void)state;
   char* path = write_file("t_s,x_m,y_m,z_m,qw,qx,qy,qz,grip_rad\n# a comment\n0,0,0,0,1,0,0,0,0\n"
                           "2,0.02,0,0,0,0,0,1,0.4\n\n3,0.02,0,0.01,-1,0,0,0,0\n");
-  char spec[128], err[256];
+  char spec[128];
   snprintf(spec, sizeof spec, "scripted:%s", path);
   tx_device_handle h;
-  assert_int_equal(tx_device_open(spec, 1e-3, &h, err, sizeof err), 0);
+  assert_int_equal(tx_device_open(spec, 1e-3, &h), 0);
   tx_device_state s = at(&h, 1.0);
   assert_true(fabs(s.pos[0] - 0.01) < 1e-12);
   assert_true(fabs(s.vel[0] - 0.01) < 1e-12);
@@ -140,21 +138,20 @@ static void bad_files_name_the_line(void** state) {
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     char* path = write_file(bad[i].text);
-    char spec[128], err[512] = "";
+    char spec[128];
     snprintf(spec, sizeof spec, "scripted:%s", path);
     tx_device_handle h;
-    assert_int_equal(tx_device_open(spec, 1e-3, &h, err, sizeof err), -1);
-    if (!strstr(err, bad[i].want) || !strstr(err, path)) fail_msg("case %zu: '%s' lacks '%s'", i, err, bad[i].want);
+    assert_int_equal(tx_device_open(spec, 1e-3, &h), -1);
+    if (!strstr(tx_error(), bad[i].want) || !strstr(tx_error(), path)) fail_msg("case %zu: '%s' lacks '%s'", i, tx_error(), bad[i].want);
     unlink(path);
   }
-  char err[256];
   tx_device_handle h;
-  assert_int_equal(tx_device_open("scripted:/no/such/file.csv", 1e-3, &h, err, sizeof err), -1);
-  assert_non_null(strstr(err, "/no/such/file.csv"));
-  assert_int_equal(tx_device_open("scripted:wiggle", 1e-3, &h, err, sizeof err), -1);
-  assert_non_null(strstr(err, "pierce-down"));
-  assert_int_equal(tx_device_open("phantom", 1e-3, &h, err, sizeof err), -1);
-  assert_non_null(strstr(err, "unknown kind"));
+  assert_int_equal(tx_device_open("scripted:/no/such/file.csv", 1e-3, &h), -1);
+  assert_non_null(strstr(tx_error(), "/no/such/file.csv"));
+  assert_int_equal(tx_device_open("scripted:wiggle", 1e-3, &h), -1);
+  assert_non_null(strstr(tx_error(), "pierce-down"));
+  assert_int_equal(tx_device_open("phantom", 1e-3, &h), -1);
+  assert_non_null(strstr(tx_error(), "unknown kind"));
 }
 
 int main(void) {

@@ -6,6 +6,7 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
+#include "model/error.h"
 #include "scenarios/loader.h"
 #include "tests/scenario_support.h"
 
@@ -16,9 +17,8 @@
 #include <unistd.h>
 
 static tx_scenario* load_text(const char* text) {
-  char err[512];
-  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL, err, sizeof err);
-  if (!s) fail_msg("%s", err);
+  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+  if (!s) fail_msg("%s", tx_error());
   return s;
 }
 
@@ -157,11 +157,11 @@ static void configuration_mistakes_are_refused(void** state) {
        "passivity_reference: expected \"port\" or \"spring\", got \"energy\""},
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-    char text[1024], err[512] = "";
+    char text[1024];
     snprintf(text, sizeof text, "{\"name\":\"t\",\"controllers\":[%s]}", bad[i].controllers);
-    tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL, err, sizeof err);
+    tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
     assert_null(s);
-    if (!strstr(err, bad[i].want)) fail_msg("case %zu: '%s' lacks '%s'", i, err, bad[i].want);
+    if (!strstr(tx_error(), bad[i].want)) fail_msg("case %zu: '%s' lacks '%s'", i, tx_error(), bad[i].want);
   }
 }
 
@@ -201,8 +201,7 @@ static const char* run_recorded(tx_scenario* s, double seconds) {
   assert_non_null(mkdtemp(dir));
   tx_run_options o = {.duration_s = seconds, .lockstep = true, .record_dir = dir};
   tx_run_result r;
-  char err[256];
-  assert_int_equal(tx_system_run(s->system, &o, &r, err, sizeof err), 0);
+  assert_int_equal(tx_system_run(s->system, &o, &r), 0);
   return dir;
 }
 
@@ -397,10 +396,9 @@ static void a_force_model_in_other_units_is_refused(void** state) {
                      "{\"name\":\"cm\",\"type\":\"test.cm\",\"rate_hz\":100},"
                      "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{"
                      "\"device\":\"sim\",\"force_model\":\"tool0.force_model\"}}]}";
-  char err[512] = "";
-  assert_null(tx_scenario_load_text("test", text, strlen(text), NULL, err, sizeof err));
-  if (!strstr(err, "haptics reads 'tool0.force_model' in units \"N, m, N/m\", but cm writes it in \"N, cm, N/cm\""))
-    fail_msg("%s", err);
+  assert_null(tx_scenario_load_text("test", text, strlen(text), NULL));
+  if (!strstr(tx_error(), "haptics reads 'tool0.force_model' in units \"N, m, N/m\", but cm writes it in \"N, cm, N/cm\""))
+    fail_msg("%s", tx_error());
 }
 
 int main(void) {

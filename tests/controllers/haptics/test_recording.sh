@@ -2,7 +2,7 @@
 # Device recordings through the command: a run killed with SIGKILL leaves its
 # records on disk, and they replay; a file cut short replays with one warning
 # and exports its CSV; a replay ends with its recording; a corrupt recording
-# is refused in one line.
+# is refused in one line; a CSV that cannot be written at the end stops the run.
 # Usage: test_recording.sh TACTUS
 set -u
 tactus=$1
@@ -75,5 +75,16 @@ for args in "" "$work/none.bin" "$work/rec/device0.bin --out" "$work/rec/device0
 done
 [ -e "$work/none.csv" ] && fail "export of a missing recording left none.csv"
 
+# 6. a CSV that cannot be written when the run ends (its temporary file is
+# taken by a folder): the run stops there, writes its report, says why in one
+# line naming the file, and exits 1
+mkdir -p "$work/fin/device0.csv.tmp"
+"$tactus" run haptics-wall --lockstep --duration 0.2 --out "$work/fin" --force --quiet >/dev/null 2>"$work/err"
+rc=$?
+[ $rc -eq 1 ] && [ "$(grep -c '' "$work/err")" -eq 1 ] &&
+  grep -q "stopped at t = 0.199 s: haptics: recording: $work/fin/device0.csv.tmp: Is a directory" "$work/err" ||
+  fail "a recording that cannot be finished: exit $rc, $(cat "$work/err")"
+[ -s "$work/fin/report.json" ] || fail "a recording that cannot be finished: no report"
+
 [ $failures -eq 0 ] || exit 1
-echo "recordings: killed, cut short, replayed to their end, corrupt: all as expected"
+echo "recordings: killed, cut short, replayed to their end, corrupt, unfinishable: all as expected"

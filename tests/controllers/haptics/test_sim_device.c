@@ -6,6 +6,7 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
+#include "model/error.h"
 #include "controllers/haptics/sim_device.h"
 #include "tactus/model.h"
 
@@ -17,7 +18,7 @@
 static void defaults_are_of_the_class(void** state) {
   (void)state;
   tx_sim_device_def d = tx_sim_device_def_default();
-  assert_null(tx_sim_device_def_check(&d));
+  assert_int_equal(tx_sim_device_def_check(&d), 0);
   assert_true(d.max_force == 3.3);
   assert_true(d.nominal_stiffness >= 400 && d.nominal_stiffness <= 700);
   assert_true(d.period == 1e-3);
@@ -63,7 +64,7 @@ static void bad_fields_are_refused(void** state) {
       if (bad[b] == -1 && !strcmp(fields[f].name, "workspace_min")) continue; // a box may start below zero
       tx_sim_device_def d = good;
       memcpy((char*)&d + fields[f].offset, &bad[b], sizeof(double));
-      const char* msg = tx_sim_device_def_check(&d);
+      const char* msg = tx_sim_device_def_check(&d) ? tx_error() : NULL;
       assert_non_null(msg);
       assert_non_null(strstr(msg, fields[f].name));
       assert_false(tx_sim_device_init(&dev, &d));
@@ -74,14 +75,15 @@ static void bad_fields_are_refused(void** state) {
   // zero is invalid where it would divide, valid where it means "none"
   tx_sim_device_def d = good;
   d.mass = 0;
-  assert_non_null(tx_sim_device_def_check(&d));
+  assert_int_equal(tx_sim_device_def_check(&d), -1);
   d = good, d.period = 0;
-  assert_non_null(tx_sim_device_def_check(&d));
+  assert_int_equal(tx_sim_device_def_check(&d), -1);
   d = good, d.quantum = 0, d.damping = 0, d.hand_stiffness = 0, d.hand_damping = 0;
-  assert_null(tx_sim_device_def_check(&d));
+  assert_int_equal(tx_sim_device_def_check(&d), 0);
   // an empty workspace
   d = good, d.workspace_min[0] = d.workspace_max[0];
-  assert_non_null(strstr(tx_sim_device_def_check(&d), "workspace"));
+  assert_int_equal(tx_sim_device_def_check(&d), -1);
+  assert_non_null(strstr(tx_error(), "workspace"));
 }
 
 // a free damped mass under a held force: x(t) = (F/b)(t - tau (1 - e^(-t/tau))), tau = m/b
@@ -257,13 +259,13 @@ static void runs_are_deterministic(void** state) {
 static void the_spec_is_parsed_and_checked(void** state) {
   (void)state;
   tx_sim_device_def d = tx_sim_device_def_default();
-  char hand[32] = "pierce-down", err[256];
-  assert_true(tx_sim_device_parse("", &d, hand, sizeof hand, err, sizeof err));
+  char hand[32] = "pierce-down";
+  assert_true(tx_sim_device_parse("", &d, hand, sizeof hand));
   tx_sim_device_def defaults = tx_sim_device_def_default();
   assert_memory_equal(&d, &defaults, sizeof d);
   assert_true(tx_sim_device_parse("mass=0.1,damping=0.5,quantum=0,max_force=7,hand_stiffness=300,hand_damping=3,"
                                   "hand=slide-x-over",
-                                  &d, hand, sizeof hand, err, sizeof err));
+                                  &d, hand, sizeof hand));
   assert_true(d.mass == 0.1 && d.damping == 0.5 && d.quantum == 0 && d.max_force == 7 && d.hand_stiffness == 300 &&
               d.hand_damping == 3);
   assert_string_equal(hand, "slide-x-over");
@@ -291,15 +293,14 @@ static void the_spec_is_parsed_and_checked(void** state) {
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     d = tx_sim_device_def_default();
-    err[0] = 0;
-    if (tx_sim_device_parse(bad[i].spec, &d, hand, sizeof hand, err, sizeof err)) fail_msg("'%s' accepted", bad[i].spec);
-    if (!strstr(err, bad[i].names) || strchr(err, '\n')) fail_msg("'%s': %s", bad[i].spec, err);
+    tx_set_error("%s", "");
+    if (tx_sim_device_parse(bad[i].spec, &d, hand, sizeof hand)) fail_msg("'%s' accepted", bad[i].spec);
+    if (!strstr(tx_error(), bad[i].names) || strchr(tx_error(), '\n')) fail_msg("'%s': %s", bad[i].spec, tx_error());
   }
   // the lightest device the check takes, with the stiffest hand and no damping, at the longest
   // period, integrates stably: the state stays bounded under a bounded force
   d = tx_sim_device_def_default();
-  assert_true(tx_sim_device_parse("mass=0.001,damping=0,hand_damping=0,hand_stiffness=1e6", &d, hand, sizeof hand, err,
-                                  sizeof err));
+  assert_true(tx_sim_device_parse("mass=0.001,damping=0,hand_damping=0,hand_stiffness=1e6", &d, hand, sizeof hand));
   d.period = 0.1;
   tx_sim_device dev;
   assert_true(tx_sim_device_init(&dev, &d));

@@ -16,22 +16,21 @@
 #include <stdio.h>
 #include <string.h>
 
-static tx_scenario* load(const char* skin_params, double rate, char* err, size_t en) {
+static tx_scenario* load(const char* skin_params, double rate) {
   char text[2048];
   snprintf(text, sizeof text,
            "{\"name\":\"t\",\"controllers\":["
            "{\"name\":\"skin\",\"type\":\"physics.skin\",\"rate_hz\":%g,\"params\":{%s}},"
            "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:pierce-down\"}}]}",
            rate, skin_params);
-  return tx_scenario_load_text("test", text, strlen(text), NULL, err, en);
+  return tx_scenario_load_text("test", text, strlen(text), NULL);
 }
 
 // the papers' two densities, published whole at 60 Hz
 static void publishes_the_skin(void** state) {
   (void)state;
-  char err[512];
-  tx_scenario* s = load("", 60, err, sizeof err);
-  if (!s) fail_msg("%s", err);
+  tx_scenario* s = load("", 60);
+  if (!s) fail_msg("%s", tx_error());
   run(s, 0.5);
   tx_snapshot x = latest_snapshot(s, "skin.x"), tri = latest_snapshot(s, "skin.tri"), h = latest_snapshot(s, "skin.thickness"),
               torn = latest_snapshot(s, "skin.torn");
@@ -48,8 +47,8 @@ static void publishes_the_skin(void** state) {
   assert_float_equal(p[3] - p[0], 0.0025, 1e-6);
   tx_scenario_free(s);
 
-  s = load("\"spacing_m\":0.001", 60, err, sizeof err);
-  if (!s) fail_msg("%s", err);
+  s = load("\"spacing_m\":0.001", 60);
+  if (!s) fail_msg("%s", tx_error());
   run(s, 1.0 / 60);
   assert_int_equal(latest_snapshot(s, "skin.x").rows, 10404);
   assert_int_equal(latest_snapshot(s, "skin.tri").rows, 2 * 101 * 101);
@@ -60,9 +59,8 @@ static void publishes_the_skin(void** state) {
 // skin goes down under it, tears, and the HIP ends below a hole
 static void hip_follows_the_device_and_pierces(void** state) {
   (void)state;
-  char err[512];
-  tx_scenario* s = load("\"hip_radius_m\":0.0005", 60, err, sizeof err);
-  if (!s) fail_msg("%s", err);
+  tx_scenario* s = load("\"hip_radius_m\":0.0005", 60);
+  if (!s) fail_msg("%s", tx_error());
   run(s, 2.6); // the HIP at 0.5 mm, the skin's surface 2.5 mm below it
   const float* x = latest_snapshot(s, "skin.x").data;
   float low = 1;
@@ -72,7 +70,7 @@ static void hip_follows_the_device_and_pierces(void** state) {
   assert_true(low < -0.001);
   assert_int_equal(((const int*)latest_snapshot(s, "skin.torn").data)[0], 0);
   tx_scenario_free(s);
-  s = load("\"hip_radius_m\":0.0005", 60, err, sizeof err); // a run starts the script again
+  s = load("\"hip_radius_m\":0.0005", 60); // a run starts the script again
   run(s, 5.0); // on to -1 cm: through
   int torn = ((const int*)latest_snapshot(s, "skin.torn").data)[0];
   tx_snapshot tri = latest_snapshot(s, "skin.tri");
@@ -93,14 +91,13 @@ static void hip_follows_the_device_and_pierces(void** state) {
 // a tangent stiffness between |f|/w and 3|f|/w (a membrane's p in |f| ~ w^p, 1 to 3)
 static void publishes_the_contact(void** state) {
   (void)state;
-  char err[512];
-  tx_scenario* s = load("\"hip_radius_m\":0.0005", 60, err, sizeof err);
-  if (!s) fail_msg("%s", err);
+  tx_scenario* s = load("\"hip_radius_m\":0.0005", 60);
+  if (!s) fail_msg("%s", tx_error());
   run(s, 1.0); // the HIP at 7.5 mm, out of reach (2.5 mm)
   const tx_skin_contact* k = latest_snapshot(s, "skin.contact").data;
   assert_true(k->touching == 0 && k->f[0] == 0 && k->f[1] == 0 && k->f[2] == 0 && k->k == 0);
   tx_scenario_free(s);
-  s = load("\"hip_radius_m\":0.0005", 60, err, sizeof err);
+  s = load("\"hip_radius_m\":0.0005", 60);
   run(s, 2.6); // the HIP at -0.5 mm: 3 mm past first touch
   tx_snapshot ks = latest_snapshot(s, "skin.contact");
   k = ks.data;
@@ -121,7 +118,6 @@ static void publishes_the_contact(void** state) {
 // parameters out of range name themselves; rates outside 20-120 Hz are refused
 static void bad_parameters_are_named(void** state) {
   (void)state;
-  char err[512];
   struct {
     const char* params;
     double rate;
@@ -137,10 +133,10 @@ static void bad_parameters_are_named(void** state) {
       {"", 240, "20 to 120 Hz"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-    tx_scenario* s = load(cases[i].params, cases[i].rate, err, sizeof err);
+    tx_scenario* s = load(cases[i].params, cases[i].rate);
     if (s) fail_msg("case %zu loaded", i);
-    if (!strstr(err, cases[i].expect)) fail_msg("case %zu: '%s' does not name %s", i, err, cases[i].expect);
-    assert_null(strchr(err, '\n'));
+    if (!strstr(tx_error(), cases[i].expect)) fail_msg("case %zu: '%s' does not name %s", i, tx_error(), cases[i].expect);
+    assert_null(strchr(tx_error(), '\n'));
   }
 }
 

@@ -5,6 +5,7 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
+#include "model/error.h"
 #include "controllers/voxel/insertion_model.h"
 #include "tactus/model.h"
 
@@ -14,7 +15,7 @@
 static void force_pieces(void** state) {
   (void)state;
   tx_insertion_model m = tx_insertion_model_default();
-  assert_null(tx_insertion_model_check(&m));
+  assert_int_equal(tx_insertion_model_check(&m), 0);
   assert_true(tx_insertion_force(&m, -1e-3, 1, false) == 0);
   double z = 1.5e-3;
   assert_true(fabs(tx_insertion_force(&m, z, 1, false) - (m.a1 * z + m.a2 * z * z)) < 1e-15);
@@ -22,10 +23,12 @@ static void force_pieces(void** state) {
   assert_true(fabs(tx_insertion_force(&m, 3e-3, -1, true) + m.friction * 3e-3) < 1e-15);
   assert_true(tx_insertion_force(&m, 3e-3, 0, true) == 0);
   m.puncture_depth = 0;
-  assert_non_null(strstr(tx_insertion_model_check(&m), "puncture_depth"));
+  assert_int_equal(tx_insertion_model_check(&m), -1);
+  assert_non_null(strstr(tx_error(), "puncture_depth"));
   tx_insertion_motion mo = tx_insertion_motion_default();
   mo.rate = 500;
-  assert_non_null(strstr(tx_insertion_motion_check(&mo), "rate"));
+  assert_int_equal(tx_insertion_motion_check(&mo), -1);
+  assert_non_null(strstr(tx_error(), "rate"));
 }
 
 static void generated_curve(void** state) {

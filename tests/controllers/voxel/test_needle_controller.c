@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #ifndef TX_SOURCE_DIR
@@ -33,9 +34,8 @@ static const void* latest_rows(tx_scenario* s, const char* name, uint32_t* rows)
 // so it sees the pose of one tick, 3 um, earlier)
 static void shipped_scenario_inserts(void** state) {
   (void)state;
-  char err[512];
-  tx_scenario* s = tx_scenario_load(TX_SOURCE_DIR "/scenarios/needle-voxel/needle-voxel.json", NULL, err, sizeof err);
-  if (!s) fail_msg("%s", err);
+  tx_scenario* s = tx_scenario_load(TX_SOURCE_DIR "/scenarios/needle-voxel/needle-voxel.json", NULL);
+  if (!s) fail_msg("%s", tx_error());
   run(s, 1.6);
   const double* pose = latest_rows(s, "device0.pose", NULL);
   const double tick = 3e-6 + 1e-9; // m the hand moves in 1 ms
@@ -78,13 +78,13 @@ static void shipped_scenario_inserts(void** state) {
 // was fitted to within 10% of its peak, row by row
 static void recording_follows_the_reference(void** state) {
   (void)state;
-  char dir[] = "/tmp/tx-needle-XXXXXX", err[512], path[128];
+  char dir[] = "/tmp/tx-needle-XXXXXX", path[128];
   assert_non_null(mkdtemp(dir));
-  tx_scenario* s = tx_scenario_load(TX_SOURCE_DIR "/scenarios/needle-voxel/needle-voxel.json", NULL, err, sizeof err);
-  if (!s) fail_msg("%s", err);
+  tx_scenario* s = tx_scenario_load(TX_SOURCE_DIR "/scenarios/needle-voxel/needle-voxel.json", NULL);
+  if (!s) fail_msg("%s", tx_error());
   tx_run_options o = {.duration_s = 3.8, .lockstep = true, .record_dir = dir};
   tx_run_result r;
-  assert_int_equal(tx_system_run(s->system, &o, &r, err, sizeof err), 0);
+  assert_int_equal(tx_system_run(s->system, &o, &r), 0);
   tx_scenario_free(s);
   snprintf(path, sizeof path, "%s/needle-recording.csv", dir);
   tx_recording got, ref;
@@ -125,23 +125,48 @@ static void bad_params_named(void** state) {
       {"\"bogus\":1", "params.bogus"},
   };
   for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
-    char text[512], err[512];
+    char text[512];
     snprintf(text, sizeof text,
              "{\"name\":\"t\",\"controllers\":[{\"name\":\"needle\",\"type\":\"voxel.needle\",\"rate_hz\":1000,"
              "\"params\":{%s}},{\"name\":\"h\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":"
              "\"scripted:insert\",\"force_model\":\"tool0.force_model\"}}]}",
              cases[k].params);
-    tx_scenario* s = tx_scenario_load_text("t.json", text, strlen(text), NULL, err, sizeof err);
+    tx_scenario* s = tx_scenario_load_text("t.json", text, strlen(text), NULL);
     if (s) fail_msg("case %zu loaded", k);
-    if (!strstr(err, cases[k].key)) fail_msg("case %zu: '%s' lacks '%s'", k, err, cases[k].key);
-    assert_null(strchr(err, '\n'));
+    if (!strstr(tx_error(), cases[k].key)) fail_msg("case %zu: '%s' lacks '%s'", k, tx_error(), cases[k].key);
+    assert_null(strchr(tx_error(), '\n'));
   }
+}
+
+// the recording is written in finish: one that cannot be (its temporary file
+// is taken by a folder here) stops the run with the file's name
+static void a_recording_that_cannot_be_written_stops_the_run(void** state) {
+  (void)state;
+  char dir[] = "/tmp/tx-needle-XXXXXX", taken[128];
+  assert_non_null(mkdtemp(dir));
+  snprintf(taken, sizeof taken, "%s/needle-recording.csv.tmp", dir);
+  assert_int_equal(mkdir(taken, 0755), 0);
+  tx_scenario* s = tx_scenario_load(TX_SOURCE_DIR "/scenarios/needle-voxel/needle-voxel.json", NULL);
+  if (!s) fail_msg("%s", tx_error());
+  tx_run_options o = {.duration_s = 0.1, .lockstep = true, .record_dir = dir};
+  tx_run_result r;
+  assert_int_equal(tx_system_run(s->system, &o, &r), 0);
+  tx_scenario_free(s);
+  print_message("  %s\n", r.halt_reason);
+  assert_true(r.halted);
+  char want[256];
+  snprintf(want, sizeof want, "%s/needle-recording.csv: Is a directory", dir);
+  if (!strstr(r.halt_reason, want)) fail_msg("'%s' lacks '%s'", r.halt_reason, want);
+  char cmd[256];
+  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+  assert_int_equal(system(cmd), 0);
 }
 
 int main(void) {
   tx_register_builtin();
   const struct CMUnitTest tests[] = {cmocka_unit_test(shipped_scenario_inserts),
                                      cmocka_unit_test(recording_follows_the_reference),
+                                     cmocka_unit_test(a_recording_that_cannot_be_written_stops_the_run),
                                      cmocka_unit_test(bad_params_named)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -8,6 +8,7 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
+#include "model/error.h"
 #include "controllers/voxel/tissue.h"
 #include "tactus/model.h"
 
@@ -52,7 +53,7 @@ static void momentum_energy(const tx_voxel_tissue* t, double mom[3], double* ke)
 static void defaults_rest(void** state) {
   (void)state;
   tx_voxel_tissue_def d = tx_voxel_tissue_def_default();
-  assert_null(tx_voxel_tissue_def_check(&d));
+  assert_int_equal(tx_voxel_tissue_def_check(&d), 0);
   tx_voxel_tissue t;
   assert_true(tx_voxel_tissue_init(&t, &d));
   assert_int_equal(t.n, 1000);
@@ -396,7 +397,7 @@ static void bad_input_refused(void** state) {
       if (origin && bad[b] == -1) continue; // a valid corner
       tx_voxel_tissue_def d = good;
       memcpy((char*)&d + fields[f].offset, &bad[b], sizeof(double));
-      const char* msg = tx_voxel_tissue_def_check(&d);
+      const char* msg = tx_voxel_tissue_def_check(&d) ? tx_error() : NULL;
       assert_non_null(msg);
       assert_non_null(strstr(msg, fields[f].name));
       assert_false(tx_voxel_tissue_init(&t, &d));
@@ -408,18 +409,22 @@ static void bad_input_refused(void** state) {
     for (size_t b = 0; b < 3; b++) {
       tx_voxel_tissue_def d = good;
       d.count[a] = bad_counts[b];
-      assert_non_null(strstr(tx_voxel_tissue_def_check(&d), "count["));
+      assert_int_equal(tx_voxel_tissue_def_check(&d), -1);
+      assert_non_null(strstr(tx_error(), "count["));
     }
   tx_voxel_tissue_def d = good;
   d.max_neighbours = 0;
-  assert_non_null(strstr(tx_voxel_tissue_def_check(&d), "max_neighbours"));
+  assert_int_equal(tx_voxel_tissue_def_check(&d), -1);
+  assert_non_null(strstr(tx_error(), "max_neighbours"));
   d = good;
   d.elasticity = 1.01;
-  assert_non_null(strstr(tx_voxel_tissue_def_check(&d), "elasticity"));
+  assert_int_equal(tx_voxel_tissue_def_check(&d), -1);
+  assert_non_null(strstr(tx_error(), "elasticity"));
   // packed so tight that the lists would overflow: refused
   d = good;
   d.count[0] = 100;
-  assert_non_null(strstr(tx_voxel_tissue_def_check(&d), "twice the lattice spacing"));
+  assert_int_equal(tx_voxel_tissue_def_check(&d), -1);
+  assert_non_null(strstr(tx_error(), "twice the lattice spacing"));
 
   // steps of no length, negative, NaN or Inf: refused, nothing moves
   assert_true(tx_voxel_tissue_init(&t, &good));

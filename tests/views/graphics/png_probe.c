@@ -3,6 +3,7 @@
 // window mode. Given a region (px, from the top-left), it also prints SHADE:
 // the pixels in it of the window overlay's backing colour (0.05, 0.05, 0.08),
 // which nothing else in a frame has, to find the overlay in each eye.
+#include "model/error.h"
 #include "views/graphics/png_writer.h"
 
 #include <stdio.h>
@@ -14,8 +15,7 @@ int main(int argc, char** argv) {
   if (argc != 2 && argc != 6) return fprintf(stderr, "usage: png_probe FILE [X Y W H]\n"), 2;
   uint8_t* img;
   int w, h;
-  char err[512];
-  if (tx_png_read(argv[1], &img, &w, &h, err, sizeof err)) return fprintf(stderr, "png_probe: %s\n", err), 1;
+  if (tx_png_read(argv[1], &img, &w, &h)) return fprintf(stderr, "png_probe: %s\n", tx_error()), 1;
   long red = 0;
   for (long i = 0; i < (long)w * h; i++)
     if (img[4 * i] > 120 && img[4 * i + 1] < 90 && img[4 * i + 2] < 90) red++;

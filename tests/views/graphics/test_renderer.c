@@ -2,6 +2,7 @@
 // and the lighting model say: the silhouette of a sphere, the colour of a lit
 // sphere at its centre, the eyes' disparity in each stereo layout, meshes
 // with bad rows, and PNG files read back.
+#include "model/error.h"
 #include "views/graphics/osmesa_target.h"
 #include "views/graphics/png_writer.h"
 #include "views/graphics/renderer.h"
@@ -42,12 +43,11 @@ static tx_view_def scene_def(void) {
 
 // render a scene of spheres (x y z r each) in a stereo mode into f
 static void render(frame* f, tx_view_def* d, tx_stereo_mode mode, tx_scene* s) {
-  char err[256];
   tx_stereo_image_size(mode, d->width, d->height, &f->w, &f->h);
-  f->osm = tx_osmesa_create(f->w, f->h, err, sizeof err);
-  if (!f->osm) fail_msg("%s", err);
-  f->r = tx_renderer_create(tx_osmesa_proc, err, sizeof err);
-  if (!f->r) fail_msg("%s", err);
+  f->osm = tx_osmesa_create(f->w, f->h);
+  if (!f->osm) fail_msg("%s", tx_error());
+  f->r = tx_renderer_create(tx_osmesa_proc);
+  if (!f->r) fail_msg("%s", tx_error());
   tx_renderer_upload(f->r, s);
   tx_stereo_draw(f->r, d, &d->camera, mode, 0, d->width, d->height);
   tx_renderer_gl(f->r)->Finish();
@@ -267,19 +267,18 @@ static void colour_map_and_png(void** state) {
   int fd = mkstemp(path);
   assert_true(fd >= 0);
   close(fd);
-  char err[256];
-  assert_int_equal(tx_png_write(path, img, 3, 2, true, err, sizeof err), 0);
+  assert_int_equal(tx_png_write(path, img, 3, 2, true), 0);
   uint8_t* back;
   int w, h;
-  assert_int_equal(tx_png_read(path, &back, &w, &h, err, sizeof err), 0);
+  assert_int_equal(tx_png_read(path, &back, &w, &h), 0);
   assert_int_equal(w, 3);
   assert_int_equal(h, 2);
   assert_memory_equal(back, img + 12, 12); // the bottom row of the buffer is the file's top row
   assert_memory_equal(back + 12, img, 12);
   free(back);
   remove(path);
-  assert_int_equal(tx_png_write("/nonexistent/dir/x.png", img, 3, 2, true, err, sizeof err), -1);
-  assert_non_null(strstr(err, "/nonexistent/dir/x.png"));
+  assert_int_equal(tx_png_write("/nonexistent/dir/x.png", img, 3, 2, true), -1);
+  assert_non_null(strstr(tx_error(), "/nonexistent/dir/x.png"));
 }
 
 // impostor depth: a small near sphere (red on the map) is drawn over a big far

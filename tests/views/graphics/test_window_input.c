@@ -2,6 +2,7 @@
 // view, which only reads): what the window sets is published whole as
 // window.pointer, and the mouse device, fed by the haptics controller, puts
 // the tool there.
+#include "model/error.h"
 #include "scenarios/loader.h"
 #include "views/graphics/window_input.h"
 
@@ -71,17 +72,17 @@ static tx_scenario* load(const char* view) {
       "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"mouse\",\"record\":false}}]}";
   tx_load_options o = {.view = view};
   load_err[0] = 0;
-  return tx_scenario_load_text("window.json", text, strlen(text), &o, load_err, sizeof load_err);
+  return tx_scenario_load_text("window.json", text, strlen(text), &o);
 }
 
 static void the_mouse_goes_through_the_model(void** state) {
   (void)state;
   // without a window nothing writes window.pointer: the mouse device cannot be loaded
   assert_null(load(NULL));
-  assert_non_null(strstr(load_err, "window.pointer"));
+  assert_non_null(strstr(tx_error(), "window.pointer"));
   // "none" checks the view but adds nothing: no window, no pointer either
   assert_null(load("none"));
-  assert_non_null(strstr(load_err, "window.pointer"));
+  assert_non_null(strstr(tx_error(), "window.pointer"));
 }
 
 // with a window: input.window is added, publishes window.pointer once the window has
@@ -95,18 +96,16 @@ static void the_pointer_moves_the_tool(void** state) {
   assert_false(in->view); // it writes: an ordinary controller, not a view
   // a system with the input, the hand and haptics, as the loader builds it for --view window
   tx_system* s = tx_system_create();
-  tx_fault f;
   if (!tx_find_controller(hand_class.type)) assert_int_equal(tx_register_controller(&hand_class), 0);
   json_t* hp = json_pack("{s:s, s:b}", "device", "mouse", "record", 0);
-  assert_int_equal(tx_system_add(s, "window_input", "input.window", TX_WINDOW_INPUT_HZ, NULL, &f), 0);
-  assert_int_equal(tx_system_add(s, "hand", "test.window_hand", 1000, NULL, &f), 0);
-  if (tx_system_add(s, "haptics", "haptics", 1000, hp, &f)) fail_msg("%s: %s", f.key, f.message);
+  assert_int_equal(tx_system_add(s, "window_input", "input.window", TX_WINDOW_INPUT_HZ, NULL), 0);
+  assert_int_equal(tx_system_add(s, "hand", "test.window_hand", 1000, NULL), 0);
+  if (tx_system_add(s, "haptics", "haptics", 1000, hp)) fail_msg("%s: %s", tx_error_key(), tx_error());
   json_decref(hp);
-  if (tx_system_finalize(s, &f)) fail_msg("%s: %s", f.key, f.message);
+  if (tx_system_finalize(s)) fail_msg("%s: %s", tx_error_key(), tx_error());
   tx_run_options o = {.duration_s = 0.1, .lockstep = true};
   tx_run_result r;
-  char err[256];
-  assert_int_equal(tx_system_run(s, &o, &r, err, sizeof err), 0);
+  assert_int_equal(tx_system_run(s, &o, &r), 0);
   tx_model* m = tx_system_model(s);
   tx_snapshot p = tx_model_latest(m, tx_model_find(m, "window.pointer"));
   assert_true(p.seq > 0);
