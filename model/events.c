@@ -11,7 +11,10 @@
 // the writer's line, since readers look at it only at their own slower rate;
 // the writer keeps the smallest tail it last saw and reads the readers' lines
 // only when that bound says the ring may be full; and it prefetches the next
-// slot.
+// slot. The stream, its tails and its ring are one block on huge pages where
+// the system grants them (2 MiB a stream at least): after a millisecond of
+// other work the TLB is cold too, and a page walk under a hypervisor costs
+// more than the misses themselves; on one huge page the push takes one walk.
 #include "error.h"
 
 #include <tactus/events.h>
@@ -19,8 +22,10 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 
 #define CACHE_LINE 64
+#define HUGE_PAGE (2u << 20)
 
 typedef struct tail {
   _Alignas(CACHE_LINE) _Atomic uint64_t next; // next event this reader takes
@@ -45,16 +50,16 @@ tx_stream* tx_stream_create(const char* name, uint32_t capacity) {
   if (!name || !*name || strlen(name) >= TX_NAME_MAX) return tx_set_error("stream name: empty or too long"), NULL;
   if (capacity < 2 || capacity > TX_STREAM_CAPACITY_MAX || (capacity & (capacity - 1)))
     return tx_set_error("%s: capacity %u is not a power of two in [2, %u]", name, capacity, TX_STREAM_CAPACITY_MAX), NULL;
-  tx_stream* s = aligned_alloc(CACHE_LINE, sizeof *s);
-  tx_event* ring = aligned_alloc(CACHE_LINE, (size_t)capacity * sizeof *ring);
-  tail* tails = aligned_alloc(CACHE_LINE, TX_STREAM_READERS_MAX * sizeof *tails);
-  if (!s || !ring || !tails) {
-    free(s), free(ring), free(tails);
-    return tx_set_error("%s: out of memory", name), NULL;
-  }
-  memset(s, 0, sizeof *s);
-  memset(ring, 0, (size_t)capacity * sizeof *ring); // touched now, not in a 1 kHz push
-  memset(tails, 0, TX_STREAM_READERS_MAX * sizeof *tails);
+  // one block: the stream, the tails, the ring, in whole huge pages
+  size_t tails_at = sizeof(tx_stream), ring_at = tails_at + TX_STREAM_READERS_MAX * sizeof(tail);
+  size_t bytes = (ring_at + (size_t)capacity * sizeof(tx_event) + HUGE_PAGE - 1) / HUGE_PAGE * HUGE_PAGE;
+  char* block = aligned_alloc(HUGE_PAGE, bytes);
+  if (!block) return tx_set_error("%s: out of memory", name), NULL;
+  madvise(block, bytes, MADV_HUGEPAGE); // a hint: without huge pages the stream still works
+  memset(block, 0, bytes);              // touched now, not in a 1 kHz push
+  tx_stream* s = (tx_stream*)block;
+  tx_event* ring = (tx_event*)(block + ring_at);
+  tail* tails = (tail*)(block + tails_at);
   strcpy(s->name, name);
   s->mask = capacity - 1;
   s->ring = ring;
@@ -63,10 +68,7 @@ tx_stream* tx_stream_create(const char* name, uint32_t capacity) {
 }
 
 void tx_stream_destroy(tx_stream* s) {
-  if (!s) return;
-  free(s->ring);
-  free(s->tails);
-  free(s);
+  free(s); // the whole block
 }
 
 const char* tx_stream_name(const tx_stream* s) { return s->name; }
