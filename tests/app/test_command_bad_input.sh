@@ -252,8 +252,13 @@ if "$TACTUS" describe suturing-skin >/dev/null 2>&1; then
   expect_bad "skin rate out of range" "suturing-skin.json" "controllers[0]" "20 to 120 Hz" -- run suturing-skin --set skin.rate_hz=500
   expect_bad "skin gravity not a boolean" "--set skin.gravity=9.81" -- run suturing-skin --set skin.gravity=9.81
   expect_bad "skin unknown parameter" "--set skin.stiffnes=1" "unknown parameter" -- run suturing-skin --set skin.stiffnes=1
+  expect_bad "skin pretension negative" "--set skin.pretension_n_per_m=-1" "out of range" -- run suturing-skin --set skin.pretension_n_per_m=-1
+  expect_bad "skin pretension past half the modulus" "suturing-skin.json" "controllers[0]" "pretension" -- run suturing-skin --set skin.pretension_n_per_m=1e9
+  expect_bad "skin rupture tension negative" "--set skin.rupture_tension_n_per_m=-1" "out of range" -- run suturing-skin --set skin.rupture_tension_n_per_m=-1
+  expect_bad "skin rupture length zero" "--set skin.rupture_length_m=0" "out of range" -- run suturing-skin --set skin.rupture_length_m=0
+  expect_bad "hip force mode unknown" "--set hip.force_mode=sideways" "mechanics" -- run suturing-skin --set hip.force_mode=sideways
   expect_bad "skin-stability takes no --set" "--set skin.iterations=3" -- study skin-stability --set skin.iterations=3 --out "$WORK/ss"
-  expect_bad "skin-accuracy takes no --set" "--set skin.iterations=3" -- study skin-accuracy --set skin.iterations=3 --out "$WORK/sa"
+  expect_bad "skin-accuracy refuses a skin key" "--set skin.iterations=3" -- study skin-accuracy --set skin.iterations=3 --out "$WORK/sa"
   expect_bad "skin-stability unwritable --out" "--out /dev/null/x" -- study skin-stability --out /dev/null/x
 else
   expect_bad "skin-paper without Bullet" "physics.skin" -- study skin-paper --out "$WORK/sp"
