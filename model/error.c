@@ -12,28 +12,27 @@ static _Thread_local char last_key[128];
 const char* tx_error(void) { return last_error; }
 const char* tx_error_key(void) { return last_key; }
 
-void tx_set_error(const char* fmt, ...) {
-  // the message may be built from tx_error() itself: format it apart first
-  char message[sizeof last_error];
-  va_list ap;
-  va_start(ap, fmt);
+// the message may be built from tx_error(), the key from tx_error_key(): both are formatted apart first
+static void set(const char* key, const char* fmt, va_list ap) {
+  char message[sizeof last_error], k[sizeof last_key];
   vsnprintf(message, sizeof message, fmt, ap);
-  va_end(ap);
-  memcpy(last_error, message, sizeof last_error);
-  last_key[0] = 0;
-}
-
-void tx_set_error_at(const char* key, const char* fmt, ...) {
-  // the message may be built from tx_error() or the key from tx_error_key()
-  char message[sizeof last_error];
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(message, sizeof message, fmt, ap);
-  va_end(ap);
-  char k[sizeof last_key];
   snprintf(k, sizeof k, "%s", key ? key : "");
   memcpy(last_key, k, sizeof last_key);
   memcpy(last_error, message, sizeof last_error);
+}
+
+void tx_set_error(const char* fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  set(NULL, fmt, ap);
+  va_end(ap);
+}
+
+void tx_set_error_at(const char* key, const char* fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  set(key, fmt, ap);
+  va_end(ap);
 }
 
 void tx_error_prefix(const char* fmt, ...) {
