@@ -56,6 +56,16 @@
 #define THICKNESS_M 0.004  // suturing-skin's
 #define RADIUS_M 0.0005    // suturing-skin's HIP
 #define SAG_AFTER_S 0.5    // the sag run, after the skin's own settle time
+#define MASS_KG 0.044      // physics.skin's mass_kg (the whole patch), kept at every level
+#define STIFFNESS 2000.0   // physics.skin's stretch_stiffness
+#define KWH2 0.25          // k w h^2 on the path: converged (skin-membrane's)
+#define CELLS0 10          // level 0: 10 cells a side, 1 cm spacing
+#define ITERATIONS 4       // on the path
+#define RATE_HZ 120.0      // physics.skin's rate on the path
+#define RUPTURE_T 150.0    // N/m, the pierce's rupture tension (see below)
+#define RUPTURE_L 0.01     // m, its averaging length: two spacings at level 1, one at level 0
+#define CONTACT_Y (RADIUS_M + 0.5 * THICKNESS_M) // m, the HIP height at first contact with the flat skin
+#define WINDOW_M 0.0005    // m, half the indentation window the force at the indentation is fitted over
 #define NQ 4               // quantities: force at the indentation, rupture force, rupture depth, sag
 
 // ---------------------------------------------------------------------------
@@ -155,20 +165,27 @@ typedef struct row {
 static const char* const q_key[NQ] = {"force_at_indentation_n", "rupture_force_n", "rupture_depth_m", "sag_m"};
 static const char* const q_label[NQ] = {"force at indentation", "rupture force", "rupture depth", "sag"};
 
-// the path: level l of a path starting at (cells0 cells a side, it0 iterations, rate0 Hz)
-static setting level_setting(int l, int cells0, int it0, double rate0) {
-  setting s = {.iterations = it0 << l};
+// the path: level l halves the spacing of level 0 (cells0 cells a side) and
+// takes the substep that keeps k w h^2 = KWH2 (w = 2 / m, m the particle's
+// mass, which falls as the spacing squared, so h halves with the spacing),
+// with ITERATIONS iterations: the range where XPBD converges to the links'
+// true stiffness (docs/skin.md). physics.skin runs at RATE_HZ; h is its step
+// split into whole substeps.
+static setting level_setting(int l, int cells0) {
+  setting s = {.iterations = ITERATIONS, .rate_hz = RATE_HZ};
   snprintf(s.name, sizeof s.name, "level %d", l);
-  s.spacing = EDGE_M / (double)(cells0 << l);
+  int cells = cells0 << l;
+  s.spacing = EDGE_M / (double)cells;
   s.size = EDGE_M - s.spacing;
-  double rate = rate0 * (double)(1 << l);
-  s.rate_hz = rate < 120 ? rate : 120;
-  s.substep = 1 / rate;
+  double m = MASS_KG / ((double)cells * cells);
+  double h = sqrt(KWH2 / (STIFFNESS * 2 / m));
+  s.substep = (1 / RATE_HZ) / ceil((1 / RATE_HZ) / h - 1e-9);
   return s;
 }
 
-// suturing-skin as it ships (scenarios/suturing-skin/suturing-skin.json and the skin's defaults)
-static const setting real_time = {"real time", 0.0025, 0.1, 10, 60, 1.0 / 60};
+// suturing-skin as it ships (scenarios/suturing-skin/suturing-skin.json and
+// the skin's defaults: 1 iteration, ten substeps a 60 Hz step)
+static const setting real_time = {"real time", 0.0025, 0.1, 1, 60, 1.0 / 600};
 
 // the hand: down at 1 cm/s. The full path uses the table's accuracy-pierce-down
 // (1 cm above the mid-plane to 1.5 cm below, 3 s); the quick path a shorter one.
@@ -186,10 +203,17 @@ static int write_motion(const char* path, const tx_hand_motion* m) {
   return 0;
 }
 
-// the pierce's quantities from its ticks: first contact (the first non-zero
-// force), the force `depth` below it (interpolated in HIP height), and the
-// rupture: the largest force before the force collapses (under a tenth of
-// the largest so far) once a link has torn; its depth below first contact
+// the pierce's quantities from its ticks. Indentation is measured from the
+// geometric first contact, CONTACT_Y (the skin lies flat at y = 0 and has no
+// gravity): the first non-zero force comes up to a physics step later, and
+// with a force that grows as the cube of the indentation that step alone is
+// some 10 % at 2 mm. The force at the indentation `depth` is a least-squares
+// quadratic in the indentation over the ticks within WINDOW_M of it, before
+// any tear, taken at `depth`: the force is held for a physics step and
+// jumps with the contact's impulses (some 3 mN rms at 2 mm), which one tick
+// would carry into the error. The rupture: the largest force before the force
+// collapses (under a tenth of the largest so far) once a link has torn; its
+// depth below CONTACT_Y.
 static void measure_pierce(const curve* c, double depth, row* r) {
   int contact = -1;
   for (int i = 0; i < c->n && contact < 0; i++)
@@ -197,20 +221,33 @@ static void measure_pierce(const curve* c, double depth, row* r) {
   r->contact_y = contact >= 0 ? c->y[contact] : NAN;
   r->q[0] = r->q[1] = r->q[2] = NAN;
   if (contact < 0) return;
-  double at = r->contact_y - depth;
-  for (int i = contact + 1; i < c->n; i++)
-    if (c->y[i - 1] >= at && c->y[i] < at) {
-      if (c->torn[i] > c->torn[contact] && fabs(c->f[i]) < 0.1 * fabs(c->f[i - 1])) break; // torn before it
-      double w = (c->y[i - 1] - at) / (c->y[i - 1] - c->y[i]);
-      r->q[0] = fabs(c->f[i - 1] + w * (c->f[i] - c->f[i - 1]));
-      break;
+  // the normal equations of f = a + b u + c u^2, u = indentation - depth
+  double s[5] = {0}, t[3] = {0};
+  int n = 0;
+  for (int i = 0; i < c->n && c->torn[i] == 0; i++) {
+    double u = CONTACT_Y - c->y[i] - depth;
+    if (fabs(u) > WINDOW_M) continue;
+    double f = fabs(c->f[i]), p = 1;
+    for (int k = 0; k < 5; k++, p *= u) {
+      s[k] += p;
+      if (k < 3) t[k] += p * f;
     }
+    n++;
+  }
+  if (n >= 10) { // the window was passed untorn: Cramer's rule for a
+    double m[3][3] = {{s[0], s[1], s[2]}, {s[1], s[2], s[3]}, {s[2], s[3], s[4]}};
+    double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                 m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    double num = t[0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (t[1] * m[2][2] - m[1][2] * t[2]) +
+                 m[0][2] * (t[1] * m[2][1] - m[1][1] * t[2]);
+    if (det != 0) r->q[0] = num / det;
+  }
   int peak = contact;
   for (int i = contact; i < c->n; i++) {
     if (fabs(c->f[i]) > fabs(c->f[peak])) peak = i;
     if (c->torn[i] > c->torn[contact] && fabs(c->f[i]) < 0.1 * fabs(c->f[peak])) {
       r->q[1] = fabs(c->f[peak]);
-      r->q[2] = r->contact_y - c->y[peak];
+      r->q[2] = CONTACT_Y - c->y[peak];
       return;
     }
   }
@@ -225,6 +262,10 @@ static json_t* skin_params(const setting* s, bool gravity, double hip_radius) {
                         THICKNESS_M, "hip_radius_m", hip_radius, "iterations", s->iterations, "max_substep_s",
                         s->substep, "gravity", gravity);
   if (p && gravity) no_rupture(p);
+  else if (p) {
+    json_object_set_new(p, "rupture_tension_n_per_m", json_real(RUPTURE_T));
+    json_object_set_new(p, "rupture_length_m", json_real(RUPTURE_L));
+  }
   return p;
 }
 
@@ -345,10 +386,9 @@ static int parse_options(const tx_study_args* a, options* o) {
       return tx_bad_input("--set %s: skin-accuracy takes path, levels and indentation_m", s);
   }
   if (!o->levels) o->levels = o->quick ? 3 : 4;
-  // the finest level must stay within physics.skin's spacing (>= 0.5 mm) and iterations (<= 200)
-  int cells0 = 20, it0 = o->quick ? 3 : 5;
-  if ((cells0 << (o->levels - 1)) > 200 || (it0 << (o->levels - 1)) > 200)
-    return tx_bad_input("--set levels: %d levels of the %s path go past 0.5 mm spacing or 200 iterations", o->levels,
+  // the finest level must stay within physics.skin's spacing (>= 0.5 mm)
+  if ((CELLS0 << (o->levels - 1)) > 200)
+    return tx_bad_input("--set levels: %d levels of the %s path go past 0.5 mm spacing", o->levels,
                         o->quick ? "quick" : "full");
   return 0;
 }
@@ -453,7 +493,7 @@ int tx_study_skin_accuracy(const tx_study_args* a) {
   // the path, then the real-time default
   int nlev = o.levels, nset = nlev + 1;
   setting set[LEVELS_MAX + 1];
-  for (int l = 0; l < nlev; l++) set[l] = o.quick ? level_setting(l, 20, 3, 20) : level_setting(l, 20, 5, 30);
+  for (int l = 0; l < nlev; l++) set[l] = level_setting(l, CELLS0);
   set[nlev] = real_time;
   curve* curves = calloc((size_t)nset, sizeof *curves);
   row rows[LEVELS_MAX + 1];
