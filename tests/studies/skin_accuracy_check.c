@@ -5,7 +5,8 @@
 //
 // Whole: the documented keys, one row per level and the real-time default,
 // every row with its CPU time, the levels refining by 2 (spacing halves,
-// iterations double, time step halves). Converges: for each quantity the
+// the substep halves with it keeping k w h^2 at the path's value, at most
+// 1/4, the iterations stay). Converges: for each quantity the
 // status is "converging", the order p and the reference are finite, and the
 // error falls at every level of the path. Exit status 0, or 1 with one line
 // per failure on stderr.
@@ -44,7 +45,10 @@ int main(int argc, char** argv) {
       json_array_size(settings) != (size_t)levels + 1)
     return fprintf(stderr, "skin_accuracy_check: %s: expected settings (levels + 1), quantities, refinement.levels\n",
                    path), 1;
-  // the path and the real-time default
+  // the path and the real-time default; the path converges: k w h^2 <= 1/4
+  double kwh2 = num(json_object_get(doc, "refinement"), "k_w_h2");
+  if (!(kwh2 > 0 && kwh2 <= 0.25))
+    return fprintf(stderr, "skin_accuracy_check: %s: refinement.k_w_h2 %g is not in (0, 1/4]\n", path, kwh2), 1;
   for (int i = 0; i <= levels; i++) {
     json_t* r = json_array_get(settings, (size_t)i);
     char what[96];
@@ -54,12 +58,18 @@ int main(int argc, char** argv) {
     if (i == 0 || i == levels) continue;
     json_t* p = json_array_get(settings, (size_t)i - 1);
     expect(fabs(num(p, "spacing_m") / num(r, "spacing_m") - 2) < 1e-9, what, "spacing does not halve");
-    expect(num(r, "iterations") == 2 * num(p, "iterations"), what, "iterations do not double");
-    expect(fabs(num(p, "time_step_s") / num(r, "time_step_s") - 2) < 1e-9, what, "time step does not halve");
+    expect(num(r, "iterations") == num(p, "iterations"), what, "iterations change along the path");
+    // whole substeps of a 120 Hz step: within a few % of half
+    expect(fabs(num(p, "time_step_s") / num(r, "time_step_s") - 2) < 0.05, what, "time step does not halve");
+    expect(num(r, "k_w_h2") <= kwh2 * (1 + 1e-9) && num(r, "k_w_h2") > 0.9 * kwh2, what,
+           "k w h^2 is not the path's");
     expect(fabs(num(p, "edge_m") - num(r, "edge_m")) < 1e-12, what, "the patch's edge changes along the path");
   }
   expect(strcmp(json_string_value(json_object_get(json_array_get(settings, (size_t)levels), "setting")), "real time") == 0,
          "the last setting", "is not the real-time default");
+  json_t* rt = json_array_get(settings, (size_t)levels);
+  expect(num(rt, "iterations") == 1 && fabs(num(rt, "time_step_s") * 600 - 1) < 1e-9, "the real-time default",
+         "is not physics.skin's (1 iteration, 1/600 s substeps)");
   for (int k = 0; k < 4; k++) {
     json_t* q = json_object_get(quantities, keys[k]);
     const char* status = json_string_value(json_object_get(q, "status"));
