@@ -19,15 +19,18 @@ cmp <(cut -d, -f5-8 "$d/p2/force_displacement.csv") <(cut -d, -f5-8 "$d/p6/force
 awk -F, 'NR > 1 && $8 > 0 && n < 10 { s = $6 - f; if (s < 0) s = -s; if (s > m) m = s; n++ } { f = $6 } END { exit !(n == 10 && m <= 2.1e-4) }' \
   "$d/p2/force_displacement.csv" || fail "paper: a force step at first contact"
 
-# mechanics: stiffer (200 vs 2000 N/m) and thicker (0.2 vs 0.8 cm) push back harder at the same HIP height
+# mechanics: stiffer (200 vs 2000 N/m), thicker (0.2 vs 0.8 cm) and pre-tensioned (0 vs 50 N/m)
+# skins push back harder at the same HIP height
 run ms --set duration_s=3 --set skin.stretch_stiffness=200
 run mk --set duration_s=3
 run mt --set duration_s=3 --set skin.thickness_m=0.002
 run mT --set duration_s=3 --set skin.thickness_m=0.008
-a=$(at ms 2.700000) b=$(at mk 2.700000) c=$(at mt 2.700000) e=$(at mT 2.700000)
-echo "mechanics at 2.7 s: stiffness 200 -> $a N, 2000 -> $b N; thickness 0.2 cm -> $c N, 0.8 cm -> $e N"
+run mp --set duration_s=3 --set skin.pretension_n_per_m=50
+a=$(at ms 2.700000) b=$(at mk 2.700000) c=$(at mt 2.700000) e=$(at mT 2.700000) g=$(at mp 2.700000)
+echo "mechanics at 2.7 s: stiffness 200 -> $a N, 2000 -> $b N; thickness 0.2 cm -> $c N, 0.8 cm -> $e N; pretension 0 -> $b N, 50 N/m -> $g N"
 awk -v a="$a" -v b="$b" 'BEGIN { exit !(a > 0 && b > a) }' || fail "mechanics: stiffness"
 awk -v a="$c" -v b="$e" 'BEGIN { exit !(a > 0 && b > a) }' || fail "mechanics: thickness"
+awk -v a="$b" -v b="$g" 'BEGIN { exit !(a > 0 && b > a) }' || fail "mechanics: pretension"
 # a heavier hanging skin (22 vs 88 g, gravity), pushed from below, 50 ms after contact: density
 # acts through the weight the skin hangs by. On a converged solver (0.5 cm spacing, 0.15 ms
 # substeps: k w h^2 < 1), since the real-time default is not converged, and there a heavier
