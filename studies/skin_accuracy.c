@@ -57,6 +57,7 @@
 #include <time.h>
 
 #if TX_WITH_BULLET
+#include "../controllers/physics/bullet/cloth.h"
 
 #define TICKS_MAX 4000 // 3 s at 1 kHz, and room
 #define LEVELS_MAX 6
@@ -186,7 +187,7 @@ static setting level_setting(int l, int cells0) {
   s.spacing = EDGE_M / (double)cells;
   s.size = EDGE_M - s.spacing;
   double m = MASS_KG / ((double)cells * cells);
-  double h = sqrt(KWH2 / (STIFFNESS * 2 / m));
+  double h = tx_cloth_converged_substep(STIFFNESS, m, KWH2);
   s.substep = (1 / RATE_HZ) / ceil((1 / RATE_HZ) / h - 1e-9);
   return s;
 }

@@ -42,34 +42,55 @@ static double inside(double x, double z, double s, double r0) {
   return in / 64.0;
 }
 
-bool tx_membrane_run(const tx_membrane_case* k, double spacing, tx_membrane_result* out) {
-  double cells = k->radius / spacing;
-  if (!(spacing > 0) || fabs(cells - lround(cells)) > 1e-6 * cells || lround(cells) < 4) {
-    tx_set_error("skin-membrane: spacing %g m must divide the radius %g m into at least 4 cells", spacing, k->radius);
-    return false;
-  }
-  // a square of side 2 a + 2 s around the disc, a particle at the centre
-  const int half = (int)lround(cells) + 1, res = 2 * half + 1;
+// A membrane clamped at radius a: a square of side 2 a + 2 s around the disc,
+// a particle at the centre, areal density rho_t (kg/m^2) per cell, no bending
+// links, and the converged solver: the substep makes k w h^2 = 1/4, where one
+// iteration already takes most of a link's stretch, and 4 iterations finish it.
+// half: the particles from the centre to the edge
+static bool disc_patch(double a, double spacing, double rho_t, double stiffness, tx_cloth_def* d, int* half) {
+  double cells = a / spacing;
+  if (!(spacing > 0) || fabs(cells - lround(cells)) > 1e-6 * cells || lround(cells) < 4)
+    return tx_set_error("skin-membrane: spacing %g m must divide the radius %g m into at least 4 cells", spacing, a), false;
+  *half = (int)lround(cells) + 1;
+  const int res = 2 * *half + 1;
   const double size = (res - 1) * spacing;
-  tx_cloth_def d = tx_cloth_def_default();
-  d.size[0] = d.size[1] = size;
-  d.res[0] = d.res[1] = res;
-  d.mass = k->density * size * size * (double)(res * res) / ((double)(res - 1) * (res - 1)); // rho t per cell
-  d.stretch_stiffness = k->stiffness;
-  d.bend_stiffness = 0; // a membrane
-  d.clamp_radius = k->radius;
+  *d = tx_cloth_def_default();
+  d->size[0] = d->size[1] = size;
+  d->res[0] = d->res[1] = res;
+  d->mass = rho_t * size * size * (double)(res * res) / ((double)(res - 1) * (res - 1));
+  d->stretch_stiffness = stiffness;
+  d->bend_stiffness = 0;
+  d->clamp_radius = a;
+  d->max_substep = tx_cloth_converged_substep(stiffness, d->mass / (res * res), 0.25);
+  d->iterations = 4;
+  return true;
+}
+
+// steps c at 60 Hz for time s; the centre particle's sag (m) and its change over the last 10 %
+static bool settle(tx_cloth* c, int centre, double time, double* sag, double* drift) {
+  const int frames = (int)ceil(time * 60), tail = frames / 10 > 0 ? frames / 10 : 1;
+  double p[3], before = 0;
+  for (int f = 0; f < frames; f++) {
+    if (tx_cloth_step(c, 1.0 / 60) != TX_CLOTH_OK) return false;
+    if (f == frames - 1 - tail) tx_cloth_particle(c, centre, p), before = p[1];
+  }
+  tx_cloth_particle(c, centre, p);
+  *sag = -p[1];
+  *drift = fabs(p[1] - before);
+  return true;
+}
+
+bool tx_membrane_run(const tx_membrane_case* k, double spacing, tx_membrane_result* out) {
+  tx_cloth_def d;
+  int half;
+  if (!disc_patch(k->radius, spacing, k->density, k->stiffness, &d, &half)) return false;
+  const int res = d.res[0];
   d.pretension = k->tension;
   d.rupture_tension = 0;
   d.rupture_length = 0.25 * k->radius; // only for the tension it reports
   d.damping = k->damping;
   d.gravity = k->kind == TX_MEMBRANE_SAG ? k->gravity : 0;
   d.settle_time = 0;
-  // converged range: the substep makes k w h^2 = 1/4, where one iteration
-  // already takes most of a link's stretch; 4 iterations finish it
-  const double m = d.mass / (res * res);
-  double h = 0.5 / sqrt(k->stiffness * 2 / m);
-  d.max_substep = h;
-  d.iterations = 4;
   tx_cloth* c = tx_cloth_create(&d);
   if (!c) return false;
   if (k->kind == TX_MEMBRANE_DISC) {
@@ -86,25 +107,17 @@ bool tx_membrane_run(const tx_membrane_case* k, double spacing, tx_membrane_resu
         }
   }
   const int centre = half * res + half;
-  const int frames = (int)ceil(k->time * 60), tail = frames / 10 > 0 ? frames / 10 : 1;
-  double t0 = wall_now(), p[3], before = 0;
-  for (int f = 0; f < frames; f++) {
-    if (tx_cloth_step(c, 1.0 / 60) != TX_CLOTH_OK) {
-      tx_cloth_destroy(c);
-      tx_set_error("skin-membrane: the cloth faulted at %g m spacing", spacing);
-      return false;
-    }
-    if (f == frames - 1 - tail) tx_cloth_particle(c, centre, p), before = p[1];
+  double t0 = wall_now();
+  if (!settle(c, centre, k->time, &out->measured, &out->drift)) {
+    tx_cloth_destroy(c);
+    return tx_set_error("skin-membrane: the cloth faulted at %g m spacing", spacing), false;
   }
-  tx_cloth_particle(c, centre, p);
   out->spacing = spacing;
   out->particles = res * res;
-  out->substep = (1.0 / 60) / ceil((1.0 / 60) / h - 1e-9);
+  out->substep = (1.0 / 60) / ceil((1.0 / 60) / d.max_substep - 1e-9);
   out->iterations = d.iterations;
-  out->measured = -p[1];
   out->exact = tx_membrane_exact(k);
   out->error = fabs(out->measured - out->exact) / out->exact;
-  out->drift = fabs(p[1] - before);
   out->tension = tx_cloth_membrane_tension(c, centre);
   out->seconds = wall_now() - t0;
   tx_cloth_destroy(c);
@@ -131,28 +144,15 @@ static double clamp_force(const tx_cloth* c, const unsigned char* fixed) {
 
 bool tx_membrane_rupture_run(double spacing, tx_membrane_rupture* out) {
   const double a = 0.015, r = 0.0005, thickness = 0.004, rc = r + 0.5 * thickness, speed = 0.02;
-  double cells = a / spacing;
-  if (!(spacing > 0) || fabs(cells - lround(cells)) > 1e-6 * cells || lround(cells) < 4) {
-    tx_set_error("skin-membrane: spacing %g m must divide the radius %g m into at least 4 cells", spacing, a);
-    return false;
-  }
-  const int half = (int)lround(cells) + 1, res = 2 * half + 1;
-  const double size = (res - 1) * spacing;
-  tx_cloth_def d = tx_cloth_def_default();
-  d.size[0] = d.size[1] = size;
-  d.res[0] = d.res[1] = res;
+  tx_cloth_def d;
+  int half;
+  if (!disc_patch(a, spacing, 100 * 4.4, 2000, &d, &half)) return false;
+  const int res = d.res[0];
   d.thickness = thickness;
-  d.mass = 100 * 4.4 * size * size * (double)(res * res) / ((double)(res - 1) * (res - 1));
-  d.stretch_stiffness = 2000;
-  d.bend_stiffness = 0;
-  d.clamp_radius = a;
   d.pretension = 50;
   d.rupture_tension = 150;
   d.rupture_length = 0.002;
   d.damping = 5;
-  const double m = d.mass / (res * res);
-  d.max_substep = 0.5 / sqrt(d.stretch_stiffness * 2 / m);
-  d.iterations = 4;
   unsigned char* fixed = calloc((size_t)(res * res), 1);
   tx_cloth* c = fixed ? tx_cloth_create(&d) : NULL;
   if (!c) return free(fixed), false;
@@ -195,21 +195,9 @@ bool tx_membrane_rupture_run(double spacing, tx_membrane_rupture* out) {
 static bool hang(const tx_cloth_def* d, double time, double* sag, double* drift) {
   tx_cloth* c = tx_cloth_create(d);
   if (!c) return false;
-  const int centre = (d->res[1] / 2) * d->res[0] + d->res[0] / 2;
-  const int frames = (int)ceil(time * 60), tail = frames / 10 > 0 ? frames / 10 : 1;
-  double p[3], before = 0;
-  for (int f = 0; f < frames; f++) {
-    if (tx_cloth_step(c, 1.0 / 60) != TX_CLOTH_OK) {
-      tx_cloth_destroy(c);
-      return tx_set_error("skin-membrane: the hanging cloth faulted"), false;
-    }
-    if (f == frames - 1 - tail) tx_cloth_particle(c, centre, p), before = p[1];
-  }
-  tx_cloth_particle(c, centre, p);
-  *sag = -p[1];
-  *drift = fabs(p[1] - before);
+  bool ok = settle(c, (d->res[1] / 2) * d->res[0] + d->res[0] / 2, time, sag, drift);
   tx_cloth_destroy(c);
-  return true;
+  return ok || (tx_set_error("skin-membrane: the hanging cloth faulted"), false);
 }
 
 bool tx_membrane_gravity_run(int res, tx_membrane_sag* out) {
@@ -223,7 +211,7 @@ bool tx_membrane_gravity_run(int res, tx_membrane_sag* out) {
   double t0 = wall_now(), drift;
   if (!hang(&d, 3, &out->realtime, &drift)) return false; // the real-time default, as it comes
   d.damping = 50; // to rest sooner; the rest state does not depend on it
-  d.max_substep = 0.5 / sqrt(d.stretch_stiffness * 2 / (d.mass / (res * res)));
+  d.max_substep = tx_cloth_converged_substep(d.stretch_stiffness, d.mass / (res * res), 0.25);
   d.iterations = 4;
   if (!hang(&d, 0.5, &out->converged, &out->drift)) return false;
   out->res = res;

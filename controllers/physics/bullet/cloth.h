@@ -169,6 +169,10 @@ double tx_cloth_membrane_tension(const tx_cloth* c, int i);
 double tx_cloth_peak_tension(const tx_cloth* c);
 // faults found and recovered so far
 int tx_cloth_faults(const tx_cloth* c);
+// the substep (s) at which k w h^2 = kwh2 for links of stiffness k (N/m) between
+// particles of mass m (kg), w = 2 / m: XPBD reaches the links' true stiffness for
+// kwh2 up to about 1/4 with a few iterations (docs/skin.md)
+double tx_cloth_converged_substep(double stiffness, double particle_mass, double kwh2);
 
 // the state after the last good step: saved by every good step, and put
 // back by a fault or by restore

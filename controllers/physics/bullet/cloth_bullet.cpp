@@ -1110,3 +1110,7 @@ extern "C" double tx_cloth_membrane_tension(const tx_cloth* c, int i) {
 }
 
 extern "C" double tx_cloth_peak_tension(const tx_cloth* c) { return c->peak_tension; }
+
+extern "C" double tx_cloth_converged_substep(double stiffness, double particle_mass, double kwh2) {
+  return std::sqrt(kwh2 / (stiffness * 2 / particle_mass));
+}
