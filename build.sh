@@ -66,7 +66,7 @@ case "$target" in
     TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$PWD/tests/tsan.supp" tsan ctest --test-dir build-tsan --output-on-failure -L tsan
 
     say "core only: every optional part off"
-    build_variant build-core -DCMAKE_BUILD_TYPE=Release -DTX_WITH_BULLET=OFF -DTX_WITH_ODE=OFF \
+    build_variant build-core -DCMAKE_BUILD_TYPE=Release -DTX_WITH_BULLET=OFF -DTX_WITH_ODE=OFF -DTX_WITH_ASSIMP=OFF -DTX_WITH_URDFDOM=OFF \
       -DTX_WITH_OSMESA=OFF -DTX_WITH_GLFW=OFF -DTX_WITH_DDS=OFF -DTX_WITH_PLPLOT=OFF
     test_variant build-core
 

@@ -17,6 +17,7 @@ static const char usage[] =
     "                             with its value\n"
     "  describe --class TYPE      a controller class's parameter table, as Markdown (docs/ holds it)\n"
     "  describe --classes         the controller types built in\n"
+    "  describe --instrument FILE an instrument description (URDF): links, masses, shapes, meshes, jaws\n"
     "  run SCENARIO [OPTIONS]     run it; writes OUT/report.json (tactus run --help)\n"
     "  bench NAME [--out DIR]     a benchmark table (tactus bench lists them)\n"
     "  study NAME [--out DIR]     a study with plots (tactus study lists them)\n"
@@ -214,7 +215,7 @@ static int version(void) {
   printf("tactus %s (%s%s%s)\noptional parts:", TX_VERSION, TX_BUILD_TYPE, *TX_SANITIZE ? ", sanitize=" : "",
          TX_SANITIZE);
   const struct { const char* name; int on; } parts[] = {
-      {"bullet", TX_WITH_BULLET}, {"ode", TX_WITH_ODE}, {"osmesa", TX_WITH_OSMESA}, {"glfw", TX_WITH_GLFW},
+      {"bullet", TX_WITH_BULLET}, {"ode", TX_WITH_ODE}, {"assimp", TX_WITH_ASSIMP}, {"urdfdom", TX_WITH_URDFDOM}, {"osmesa", TX_WITH_OSMESA}, {"glfw", TX_WITH_GLFW},
       {"dds", TX_WITH_DDS}, {"plplot", TX_WITH_PLPLOT}};
   for (size_t i = 0; i < sizeof parts / sizeof parts[0]; i++) printf(" %s=%s", parts[i].name, parts[i].on ? "on" : "off");
   printf("\n");
@@ -229,6 +230,9 @@ int main(int argc, char** argv) {
   if (!strcmp(cmd, "-h") || !strcmp(cmd, "--help") || !strcmp(cmd, "help")) return fputs(usage, stdout), 0;
   if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) return version();
   if (!strcmp(cmd, "list")) return tx_cmd_list(argc - 1, argv + 1);
+  if (!strcmp(cmd, "describe") && argc >= 3 && !strcmp(argv[2], "--instrument"))
+    return argc == 4 ? tx_cmd_describe_instrument(argv[3])
+                     : tx_bad_input("describe --instrument: expected one FILE.urdf (assets/instruments/)");
   if (!strcmp(cmd, "describe")) return tx_cmd_describe(argc - 1, argv + 1);
   if (!strcmp(cmd, "run")) return tx_cmd_run(argc - 1, argv + 1);
   if (!strcmp(cmd, "bench")) return tx_cmd_bench(argc - 1, argv + 1);

@@ -11,6 +11,7 @@
 
 int tx_cmd_list(int argc, char** argv);
 int tx_cmd_describe(int argc, char** argv);
+int tx_cmd_describe_instrument(const char* path); // app/describe_instrument.c
 int tx_cmd_run(int argc, char** argv);
 int tx_cmd_bench(int argc, char** argv);
 int tx_cmd_study(int argc, char** argv);

@@ -6,7 +6,7 @@ set -euo pipefail
 core=(build-essential cmake pkg-config git
       libjansson-dev libcmocka-dev
       clang libclang-rt-14-dev)        # clang: libFuzzer target of the scenario loader
-optional=(libbullet-dev libode-dev libassimp-dev liburdfdom-dev
+optional=(libbullet-dev libode-dev libassimp-dev liburdfdom-dev libtinyxml-dev
           libosmesa6-dev libglfw3-dev libpng-dev
           libplplot-dev plplot-driver-cairo
           xvfb xauth                   # xvfb-run: the window-mode screenshot test
