@@ -1,0 +1,364 @@
+// The instruments' ODE world (instrument_sim.h).
+#include "instrument_sim.h"
+
+#include "../../model/error.h"
+
+#include <math.h>
+#include <ode/ode.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_CONTACTS 8 // per geom pair
+#define TX_JAW_STOP_GUARD 0.02 // rad
+
+typedef struct instrument {
+  const tx_urdf* urdf;
+  dBodyID body[TX_INSTRUMENT_LINKS_MAX];
+  dJointID joint[TX_INSTRUMENT_LINKS_MAX]; // joint j of the URDF
+  dJointID orient; // the angular motor of the root
+  double hand_force[3];
+  double start[3];
+} instrument;
+
+struct tx_instrument_world {
+  tx_instrument_sim_params p;
+  dWorldID world;
+  dSpaceID space;
+  dJointGroupID contacts;
+  instrument ins[TX_INSTRUMENTS_MAX];
+  int n, ncontacts, resets, bad_inputs;
+  double depth; // deepest contact of the last step, m
+};
+
+tx_instrument_sim_params tx_instrument_sim_defaults(void) {
+  return (tx_instrument_sim_params){.coupling_k = 200,
+                                    .coupling_b = 1,
+                                    .orient_rate = 50,
+                                    .orient_torque = 0.2,
+                                    .max_force = 3.3,
+                                    .jaw_gain = 40,
+                                    .gravity = {0, -9.81, 0},
+                                    .table_height = -0.05,
+                                    .friction = 0.5,
+                                    .erp = 0.2,
+                                    .cfm = 1e-7};
+}
+
+// ---- poses: position and unit quaternion (w, x, y, z)
+
+static void qmul(const double a[4], const double b[4], double o[4]) {
+  double r[4] = {a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+                 a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+                 a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+                 a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0]};
+  memcpy(o, r, sizeof r);
+}
+static void qrot(const double q[4], const double v[3], double o[3]) {
+  double t[3] = {2 * (q[2] * v[2] - q[3] * v[1]), 2 * (q[3] * v[0] - q[1] * v[2]), 2 * (q[1] * v[1] - q[2] * v[0])};
+  double r[3] = {v[0] + q[0] * t[0] + q[2] * t[2] - q[3] * t[1], v[1] + q[0] * t[1] + q[3] * t[0] - q[1] * t[2],
+                 v[2] + q[0] * t[2] + q[1] * t[1] - q[2] * t[0]};
+  memcpy(o, r, sizeof r);
+}
+// a * b for poses (p, q)
+static void compose(const double pa[3], const double qa[4], const double pb[3], const double qb[4], double po[3],
+                    double qo[4]) {
+  double r[3];
+  qrot(qa, pb, r);
+  for (int k = 0; k < 3; k++) po[k] = pa[k] + r[k];
+  qmul(qa, qb, qo);
+}
+
+// ---- contacts
+
+static void near(void* data, dGeomID a, dGeomID b) {
+  tx_instrument_world* w = data;
+  dBodyID ba = dGeomGetBody(a), bb = dGeomGetBody(b);
+  if (!ba && !bb) return;
+  // the links of one instrument do not touch each other: a jaw and its root
+  // overlap at the pivot by design, and two jaws at their closed stop lie
+  // face to face at zero depth, where a box-box test has no separating
+  // direction to push along; the stop (lower limit 0) is where they meet
+  if (ba && bb && dGeomGetData(a) == dGeomGetData(b)) return;
+  dContactGeom cg[MAX_CONTACTS];
+  int n = dCollide(a, b, MAX_CONTACTS, cg, sizeof cg[0]);
+  for (int i = 0; i < n; i++) {
+    dContact c = {0};
+    c.geom = cg[i];
+    // friction bounded by mu x the normal force, so touching faces at zero depth hold nothing
+    c.surface.mode = dContactApprox1 | dContactSoftERP | dContactSoftCFM;
+    c.surface.mu = w->p.friction;
+    c.surface.soft_erp = w->p.erp;
+    c.surface.soft_cfm = w->p.cfm;
+    dJointID j = dJointCreateContact(w->world, w->contacts, &c);
+    dJointAttach(j, ba, bb);
+    w->ncontacts++;
+    w->depth = fmax(w->depth, cg[i].depth);
+  }
+}
+
+// ---- building
+
+static void place(tx_instrument_world* w, instrument* in) {
+  const tx_urdf* u = in->urdf;
+  double lp[TX_INSTRUMENT_LINKS_MAX][3], lq[TX_INSTRUMENT_LINKS_MAX][4];
+  memcpy(lp[0], in->start, sizeof lp[0]);
+  lq[0][0] = 1, lq[0][1] = lq[0][2] = lq[0][3] = 0;
+  for (int j = 0; j < u->njoints; j++) { // a joint's parent comes first (urdf.h)
+    const tx_urdf_joint* jt = &u->joints[j];
+    compose(lp[jt->parent], lq[jt->parent], jt->origin.p, jt->origin.q, lp[jt->child], lq[jt->child]);
+  }
+  for (int l = 0; l < u->nlinks; l++) {
+    const tx_urdf_link* link = &u->links[l];
+    double bp[3], bq[4];
+    compose(lp[l], lq[l], link->com.p, link->com.q, bp, bq);
+    dBodyID b = in->body[l];
+    dBodySetPosition(b, bp[0], bp[1], bp[2]);
+    dQuaternion q = {bq[0], bq[1], bq[2], bq[3]};
+    dBodySetQuaternion(b, q);
+    dBodySetLinearVel(b, 0, 0, 0);
+    dBodySetAngularVel(b, 0, 0, 0);
+  }
+}
+
+static bool build(tx_instrument_world* w, instrument* in) {
+  const tx_urdf* u = in->urdf;
+  for (int l = 0; l < u->nlinks; l++) {
+    const tx_urdf_link* link = &u->links[l];
+    dBodyID b = in->body[l] = dBodyCreate(w->world);
+    dMass m;
+    // the inertia is about the centre of mass in the inertial frame, which is the body's frame
+    dMassSetParameters(&m, link->mass, 0, 0, 0, link->inertia[0], link->inertia[3], link->inertia[5], link->inertia[1],
+                       link->inertia[2], link->inertia[4]);
+    if (!dMassCheck(&m)) return tx_set_error("%s: link '%s': ODE refuses its mass", u->name, link->name), false;
+    dBodySetMass(b, &m);
+  }
+  place(w, in);
+  // geoms: where the URDF puts them in the link frame, offset from the body
+  for (int l = 0; l < u->nlinks; l++) {
+    const tx_urdf_link* link = &u->links[l];
+    const dReal* bp = dBodyGetPosition(in->body[l]);
+    const dReal* bq = dBodyGetQuaternion(in->body[l]);
+    // the link frame from the body: body * com^-1
+    double cq[4] = {link->com.q[0], -link->com.q[1], -link->com.q[2], -link->com.q[3]};
+    double q[4] = {bq[0], bq[1], bq[2], bq[3]}, lq[4], lp[3], r[3];
+    qmul(q, cq, lq);
+    qrot(lq, link->com.p, r);
+    for (int k = 0; k < 3; k++) lp[k] = bp[k] - r[k];
+    for (int s = 0; s < link->nshapes; s++) {
+      const tx_urdf_shape* sh = &link->shapes[s];
+      // a long cylinder is a capsule of the same length: ODE's cylinder
+      // against cylinder gives one contact point, on which two shafts roll
+      double rad = sh->size[0], len = sh->size[1];
+      dGeomID g = sh->kind == TX_URDF_BOX ? dCreateBox(w->space, sh->size[0], sh->size[1], sh->size[2])
+                  : sh->kind == TX_URDF_CYLINDER && len > 4 * rad ? dCreateCapsule(w->space, rad, len - 2 * rad)
+                  : sh->kind == TX_URDF_CYLINDER               ? dCreateCylinder(w->space, rad, len)
+                                                               : dCreateSphere(w->space, rad);
+      double gp[3], gq[4];
+      compose(lp, lq, sh->pose.p, sh->pose.q, gp, gq);
+      dGeomSetBody(g, in->body[l]);
+      dGeomSetData(g, in); // which instrument it belongs to
+      dGeomSetOffsetWorldPosition(g, gp[0], gp[1], gp[2]);
+      dQuaternion dq = {gq[0], gq[1], gq[2], gq[3]};
+      dGeomSetOffsetWorldQuaternion(g, dq);
+    }
+  }
+  in->orient = dJointCreateAMotor(w->world, 0);
+  dJointAttach(in->orient, in->body[0], 0);
+  dJointSetAMotorMode(in->orient, dAMotorUser);
+  dJointSetAMotorNumAxes(in->orient, 3);
+  for (int k = 0; k < 3; k++) { // world axes
+    dJointSetAMotorAxis(in->orient, k, 0, k == 0, k == 1, k == 2);
+    dJointSetAMotorParam(in->orient, dParamFMax + k * dParamGroup, w->p.orient_torque);
+  }
+  // hinges at the jaw pivots, zero angle = as built (closed)
+  for (int j = 0; j < u->njoints; j++) {
+    const tx_urdf_joint* jt = &u->joints[j];
+    dBodyID child = in->body[jt->child], parent = in->body[jt->parent];
+    if (jt->fixed) {
+      in->joint[j] = dJointCreateFixed(w->world, 0);
+      dJointAttach(in->joint[j], child, parent);
+      dJointSetFixed(in->joint[j]);
+      continue;
+    }
+    // the joint frame in the world: the child's link frame at angle 0
+    double pp[3], pq[4], jp[3], jq[4], axis[3];
+    const dReal* bp = dBodyGetPosition(parent);
+    const dReal* bq = dBodyGetQuaternion(parent);
+    const tx_urdf_link* pl = &u->links[jt->parent];
+    double q[4] = {bq[0], bq[1], bq[2], bq[3]}, cq[4] = {pl->com.q[0], -pl->com.q[1], -pl->com.q[2], -pl->com.q[3]}, r[3];
+    qmul(q, cq, pq);
+    qrot(pq, pl->com.p, r);
+    for (int k = 0; k < 3; k++) pp[k] = bp[k] - r[k];
+    compose(pp, pq, jt->origin.p, jt->origin.q, jp, jq);
+    qrot(jq, jt->axis, axis);
+    dJointID h = in->joint[j] = dJointCreateHinge(w->world, 0);
+    // body 1 is the child: the angle is the child's turn about the axis
+    dJointAttach(h, child, parent);
+    dJointSetHingeAnchor(h, jp[0], jp[1], jp[2]);
+    dJointSetHingeAxis(h, axis[0], axis[1], axis[2]);
+    // The motor's target stays inside [lower, upper]; ODE's stops sit a
+    // guard outside it, for what pushes harder than the motor. At a stop ODE
+    // drives a motor pulling away with a fudged torque applied directly,
+    // which flings a jaw of a gram; never starting at a stop avoids it.
+    dJointSetHingeParam(h, dParamLoStop, jt->lower - TX_JAW_STOP_GUARD);
+    dJointSetHingeParam(h, dParamHiStop, jt->upper + TX_JAW_STOP_GUARD);
+    dJointSetHingeParam(h, dParamFMax, jt->effort);
+    dJointSetHingeParam(h, dParamVel, 0);
+  }
+  return true;
+}
+
+tx_instrument_world* tx_instrument_world_create(const tx_instrument_sim_params* p, const tx_urdf* const* urdfs, int n,
+                                                const double (*start)[3]) {
+  if (n < 0 || n > TX_INSTRUMENTS_MAX) return tx_set_error("at most %d instruments", TX_INSTRUMENTS_MAX), NULL;
+  for (int i = 0; i < n; i++)
+    if (urdfs[i]->nlinks > TX_INSTRUMENT_LINKS_MAX)
+      return tx_set_error("%s: more than %d links", urdfs[i]->name, TX_INSTRUMENT_LINKS_MAX), NULL;
+  if (!dInitODE2(0) || !dAllocateODEDataForThread(dAllocateMaskAll))
+    return tx_set_error("ODE cannot be started"), NULL;
+  tx_instrument_world* w = calloc(1, sizeof *w);
+  if (!w) {
+    dCloseODE();
+    return tx_set_error("out of memory"), NULL;
+  }
+  w->p = *p;
+  w->world = dWorldCreate();
+  w->space = dSimpleSpaceCreate(0); // a dozen geoms: every pair is cheaper than a hash
+  w->contacts = dJointGroupCreate(0);
+  dWorldSetGravity(w->world, p->gravity[0], p->gravity[1], p->gravity[2]);
+  dWorldSetERP(w->world, p->erp);
+  dWorldSetCFM(w->world, p->cfm);
+  dCreatePlane(w->space, 0, 1, 0, p->table_height);
+  w->n = n;
+  for (int i = 0; i < n; i++) {
+    w->ins[i].urdf = urdfs[i];
+    memcpy(w->ins[i].start, start[i], sizeof w->ins[i].start);
+    if (!build(w, &w->ins[i])) {
+      tx_instrument_world_destroy(w);
+      return NULL;
+    }
+  }
+  return w;
+}
+
+void tx_instrument_world_destroy(tx_instrument_world* w) {
+  if (!w) return;
+  dJointGroupDestroy(w->contacts);
+  dSpaceDestroy(w->space); // and its geoms
+  dWorldDestroy(w->world); // and its bodies and joints
+  free(w);
+  dCloseODE();
+}
+
+void tx_instrument_world_link(const tx_instrument_world* w, int i, int l, double pos[3], double quat[4]) {
+  const tx_urdf_link* link = &w->ins[i].urdf->links[l];
+  const dReal* bp = dBodyGetPosition(w->ins[i].body[l]);
+  const dReal* bq = dBodyGetQuaternion(w->ins[i].body[l]);
+  double q[4] = {bq[0], bq[1], bq[2], bq[3]}, cq[4] = {link->com.q[0], -link->com.q[1], -link->com.q[2], -link->com.q[3]};
+  double r[3];
+  qmul(q, cq, quat);
+  qrot(quat, link->com.p, r);
+  for (int k = 0; k < 3; k++) pos[k] = bp[k] - r[k];
+}
+
+double tx_instrument_world_joint(const tx_instrument_world* w, int i, int j) {
+  const instrument* in = &w->ins[i];
+  return in->urdf->joints[j].fixed ? 0 : dJointGetHingeAngle(in->joint[j]);
+}
+
+void tx_instrument_world_hand_force(const tx_instrument_world* w, int i, double f[3]) {
+  memcpy(f, w->ins[i].hand_force, 3 * sizeof *f);
+}
+int tx_instrument_world_contacts(const tx_instrument_world* w) { return w->ncontacts; }
+int tx_instrument_world_resets(const tx_instrument_world* w) { return w->resets; }
+int tx_instrument_world_bad_inputs(const tx_instrument_world* w) { return w->bad_inputs; }
+double tx_instrument_world_depth(const tx_instrument_world* w) { return w->depth; }
+
+static bool finite_input(const tx_instrument_input* d) {
+  for (int k = 0; k < 3; k++)
+    if (!isfinite(d->pos[k]) || !isfinite(d->vel[k])) return false;
+  for (int k = 0; k < 4; k++)
+    if (!isfinite(d->quat[k])) return false;
+  return true; // a grip that is not finite closes the jaws (drive_jaws)
+}
+
+static void couple(tx_instrument_world* w, instrument* in, const tx_instrument_input* d) {
+  if (!finite_input(d)) { // a device gone wrong pulls on nothing: the instrument stays where it is
+    memset(in->hand_force, 0, sizeof in->hand_force);
+    for (int k = 0; k < 3; k++) dJointSetAMotorParam(in->orient, dParamVel + k * dParamGroup, 0);
+    w->bad_inputs++;
+    return;
+  }
+  double x[3], q[4];
+  tx_instrument_world_link(w, (int)(in - w->ins), 0, x, q);
+  dVector3 v;
+  dBodyGetPointVel(in->body[0], x[0], x[1], x[2], v);
+  double f[3], n2 = 0;
+  for (int k = 0; k < 3; k++) {
+    f[k] = w->p.coupling_k * (d->pos[k] - x[k]) + w->p.coupling_b * (d->vel[k] - v[k]);
+    n2 += f[k] * f[k];
+  }
+  double n = sqrt(n2);
+  if (n > w->p.max_force) // the hand cannot push harder than the device can push back
+    for (int k = 0; k < 3; k++) f[k] *= w->p.max_force / n;
+  dBodyAddForceAtPos(in->body[0], f[0], f[1], f[2], x[0], x[1], x[2]);
+  for (int k = 0; k < 3; k++) in->hand_force[k] = -f[k];
+  // orientation: the angular motor turns the root towards the device's
+  // orientation at orient_rate x the angle left, with at most orient_torque.
+  // A motor is solved with the step (implicitly): an explicit torque spring
+  // is unstable about a 5 mm shaft's axis, whose inertia is 1e-7 kg m^2.
+  double qc[4] = {q[0], -q[1], -q[2], -q[3]}, e[4];
+  qmul(d->quat, qc, e);
+  double s = e[0] < 0 ? -1 : 1, vn = sqrt(e[1] * e[1] + e[2] * e[2] + e[3] * e[3]);
+  double angle = isfinite(vn) ? 2 * atan2(vn, s * e[0]) : 0;
+  for (int k = 0; k < 3; k++) {
+    double omega = vn > 1e-12 && isfinite(vn) ? w->p.orient_rate * angle * s * e[k + 1] / vn : 0;
+    dJointSetAMotorParam(in->orient, dParamVel + k * dParamGroup, omega);
+  }
+}
+
+static void drive_jaws(tx_instrument_world* w, instrument* in, double grip) {
+  int revolute = 0;
+  for (int j = 0; j < in->urdf->njoints; j++) revolute += !in->urdf->joints[j].fixed;
+  for (int j = 0; j < in->urdf->njoints; j++) {
+    const tx_urdf_joint* jt = &in->urdf->joints[j];
+    if (jt->fixed) continue;
+    // the grip is the angle between the jaws: each of two opens by half of it
+    double target = isfinite(grip) ? grip / (revolute > 1 ? 2 : 1) : jt->lower;
+    target = fmin(fmax(target, jt->lower), jt->upper);
+    double speed = w->p.jaw_gain * (target - dJointGetHingeAngle(in->joint[j]));
+    dJointSetHingeParam(in->joint[j], dParamVel, fmin(fmax(speed, -jt->velocity), jt->velocity));
+  }
+}
+
+static bool finite_state(const instrument* in) {
+  for (int l = 0; l < in->urdf->nlinks; l++) {
+    const dReal* p = dBodyGetPosition(in->body[l]);
+    const dReal* v = dBodyGetLinearVel(in->body[l]);
+    const dReal* o = dBodyGetAngularVel(in->body[l]);
+    for (int k = 0; k < 3; k++)
+      if (!isfinite(p[k]) || !isfinite(v[k]) || !isfinite(o[k])) return false;
+  }
+  return true;
+}
+
+void tx_instrument_world_step(tx_instrument_world* w, const tx_instrument_input* in, double dt) {
+  for (int i = 0; i < w->n; i++) {
+    couple(w, &w->ins[i], &in[i]);
+    drive_jaws(w, &w->ins[i], in[i].grip);
+  }
+  w->ncontacts = 0;
+  w->depth = 0;
+  dSpaceCollide(w->space, w, near);
+  dWorldStep(w->world, dt);
+  dJointGroupEmpty(w->contacts);
+  for (int i = 0; i < w->n; i++)
+    if (!finite_state(&w->ins[i])) { // start over at the device, jaws closed
+      memcpy(w->ins[i].start, in[i].pos, sizeof w->ins[i].start);
+      if (!isfinite(in[i].pos[0]) || !isfinite(in[i].pos[1]) || !isfinite(in[i].pos[2]))
+        memset(w->ins[i].start, 0, sizeof w->ins[i].start);
+      place(w, &w->ins[i]);
+      memset(w->ins[i].hand_force, 0, sizeof w->ins[i].hand_force);
+      w->resets++;
+    }
+}

@@ -1,0 +1,71 @@
+// Articulated instruments on ODE: each instrument of a tx_urdf is a root body
+// and jaw bodies on hinge joints, in one ODE world with a table plane (the
+// rigid scene). Its root follows a device through a virtual coupling (a
+// spring-damper); what the hand feels is the coupling's reaction. Its jaws'
+// hinge motors follow the device's grip angle within the joint limits. ODE
+// contacts: jaw with jaw, instrument with instrument, instrument with the
+// table. Built with TX_WITH_ODE (and the readers: TX_WITH_URDFDOM, TX_WITH_ASSIMP).
+//
+// ODE wants each body's centre of mass at its origin: a link's body is placed
+// at the link frame times its inertial origin, and its geoms are offset from
+// it to where the URDF puts them in the link frame.
+#ifndef TX_CONTROLLERS_INSTRUMENTS_INSTRUMENT_SIM_H
+#define TX_CONTROLLERS_INSTRUMENTS_INSTRUMENT_SIM_H
+
+#include "urdf.h"
+
+#include <stdbool.h>
+
+#define TX_INSTRUMENTS_MAX 2 // one per hand
+#define TX_INSTRUMENT_LINKS_MAX 8
+
+typedef struct tx_instrument_sim_params {
+  double coupling_k, coupling_b; // N/m, N s/m: the virtual coupling's spring and damper
+  double orient_rate; // 1/s: the root turns towards the device's orientation at this rate x the angle left
+  double orient_torque; // N m: with at most this torque
+  double max_force; // N: the coupling force is clamped to this (the device's limit)
+  double jaw_gain; // 1/s: a jaw motor's speed is gain x its angle error, within the joint's velocity
+  double gravity[3]; // m/s^2
+  double table_height; // m: the table is the half-space y < table_height
+  double friction; // Coulomb coefficient of every contact
+  double erp, cfm; // ODE's error reduction and constraint force mixing
+} tx_instrument_sim_params;
+
+tx_instrument_sim_params tx_instrument_sim_defaults(void);
+
+// one instrument's device this step
+typedef struct tx_instrument_input {
+  double pos[3], quat[4]; // the tool point's target pose: m, unit (w, x, y, z)
+  double vel[3]; // m/s
+  double grip; // rad, the angle wanted between the jaws
+} tx_instrument_input;
+
+typedef struct tx_instrument_world tx_instrument_world;
+
+// n instruments (at most TX_INSTRUMENTS_MAX), instrument i with its root at
+// start[i] (identity orientation), jaws closed. The caller keeps the urdfs
+// alive while the world lives. NULL with tx_error() set when ODE cannot be
+// started or a description has more than TX_INSTRUMENT_LINKS_MAX links.
+// ODE keeps per-thread data: create, step and destroy on one thread.
+tx_instrument_world* tx_instrument_world_create(const tx_instrument_sim_params* p, const tx_urdf* const* urdfs, int n,
+                                                const double (*start)[3]);
+void tx_instrument_world_destroy(tx_instrument_world* w);
+
+// one ODE step of dt seconds: couplings, jaw motors, contacts, integration
+void tx_instrument_world_step(tx_instrument_world* w, const tx_instrument_input* in, double dt);
+
+// after a step: a link frame's pose in the world (the URDF's link frame, not
+// the body's centre of mass), the jaw joint angles, and the coupling force on
+// the hand (N, clamped to max_force)
+void tx_instrument_world_link(const tx_instrument_world* w, int instrument, int link, double pos[3], double quat[4]);
+double tx_instrument_world_joint(const tx_instrument_world* w, int instrument, int joint);
+void tx_instrument_world_hand_force(const tx_instrument_world* w, int instrument, double f[3]);
+// contacts made in the last step (all pairs), and steps whose state went non-finite (then reset)
+int tx_instrument_world_contacts(const tx_instrument_world* w);
+int tx_instrument_world_resets(const tx_instrument_world* w);
+// steps whose device input was not finite (the coupling then pulls on nothing),
+// and the deepest contact of the last step (m)
+int tx_instrument_world_bad_inputs(const tx_instrument_world* w);
+double tx_instrument_world_depth(const tx_instrument_world* w);
+
+#endif
