@@ -31,6 +31,7 @@ typedef struct haptics {
   tx_haptic_path path;           // passivity and safety: the force path the stability study measures
   tx_port model;                 // the force model read, 0 for none
   tx_port tool;                  // virtual coupling: the simulated tool's pose, 0 for none
+  tx_port grip;                  // deviceN.grip: the gripper angle and buttons
   tx_port input;                 // the device's input in the model (the mouse's window.pointer), 0 for none
   double coupling_k, coupling_b; // N/m, N s/m
   tx_port pose, velocity, force, energy;
@@ -124,6 +125,8 @@ static int configure(tx_setup* s, void** self) {
   h->velocity = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_velocity, 1));
   snprintf(name, sizeof name, "device%d.force", hand);
   h->force = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_force, 1)); // what was sent
+  snprintf(name, sizeof name, "device%d.grip", hand);
+  h->grip = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_device_grip, 1));
   snprintf(name, sizeof name, "device%d.energy", hand);
   h->energy = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_device_energy, 1));
   static const char* const keys[W_COUNT] = {"force_non_finite", "force_clamped", "force_rate_limited",
@@ -163,6 +166,9 @@ static void publish(tx_ctx* c, haptics* h, const double force[3]) {
   memcpy(vel->v, h->state.vel, sizeof vel->v);
   tx_force* sent = tx_write(c, h->force);
   memcpy(sent->f, force, sizeof sent->f);
+  tx_device_grip* g = tx_write(c, h->grip);
+  g->grip = h->state.grip;
+  g->buttons = h->state.buttons;
   tx_device_energy* e = tx_write(c, h->energy);
   e->observed = h->path.passivity.energy;
   e->dissipated = h->path.passivity.dissipated;

@@ -240,6 +240,24 @@ typedef struct tx_instrument_pose {
 #define tx_instrument_pose_UNITS "m, 1, rad"
 TX_LAYOUT_ASSERT(tx_instrument_pose, double);
 
+// DEVICE.grip (1 row), written by haptics, read by physics.instruments: what
+// the hand does with the instrument's handle
+typedef struct tx_device_grip {
+  double grip;    // rad, the gripper angle (tx_device_state.grip): the angle wanted between the jaws
+  double buttons; // the device's buttons, one bit each, as a number
+} tx_device_grip;
+#define tx_device_grip_TYPE TX_F64
+#define tx_device_grip_COLS 2u
+#define tx_device_grip_UNITS "rad, 1"
+TX_LAYOUT_ASSERT(tx_device_grip, double);
+
+// physics.instruments writes, for instrument N (held by deviceN):
+//   INSTRUMENT.pose (1 row, tx_instrument_pose): the root link frame (the
+//     pivot of the jaws) and the angle between the jaws, rad
+//   INSTRUMENT.links (one row per URDF link, root first, tx_pose): each link frame
+//   INSTRUMENT.force_model (1 row, tx_force_model): the virtual coupling as the
+//     hand feels it, for the haptics controller to render (docs/instruments.md)
+
 #ifdef __cplusplus
 }
 #endif
