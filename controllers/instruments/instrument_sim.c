@@ -10,6 +10,8 @@
 
 #define MAX_CONTACTS 8 // per geom pair
 #define TX_JAW_STOP_GUARD 0.02 // rad
+#define TX_NEEDLE_RELEASE_RAD 0.02 // a jaw asked to open this much past where it is lets the needle go
+#define STEEL_DENSITY 7900.0 // kg/m^3
 
 typedef struct instrument {
   const tx_urdf* urdf;
@@ -18,7 +20,14 @@ typedef struct instrument {
   dJointID orient; // the angular motor of the root
   double hand_force[3];
   double start[3];
+  double target[TX_INSTRUMENT_LINKS_MAX]; // the jaw motors' target angles this step
+  bool touch[TX_INSTRUMENT_LINKS_MAX]; // links that touched the needle this step
+  double touch_sum[3]; // the needle's contact points with it this step, summed
+  int touch_n;
 } instrument;
+
+#define NEEDLE_SEGMENTS 8 // capsules along the arc
+#define NEEDLE_MASS_POINTS 512 // for its mass properties
 
 struct tx_instrument_world {
   tx_instrument_sim_params p;
@@ -27,11 +36,29 @@ struct tx_instrument_world {
   dJointGroupID contacts;
   instrument ins[TX_INSTRUMENTS_MAX];
   int n, ncontacts, resets, bad_inputs;
+  dBodyID needle; // NULL without a needle
+  double needle_com[3]; // in the needle frame
+  dJointID hold; // the needle's fixed joint to its holder, or NULL
+  int held_by, grasps, releases;
+  double grasp_point[3]; // the mean contact point of the last grasp
+  double pull[3]; // N at the swage, this step
   double depth; // deepest contact of the last step, m
 };
 
+static char needle_tag; // the needle's geoms carry its address
+
+tx_needle_params tx_needle_defaults(void) {
+  // 19 mm along the arc over 3/8 of a circle: radius 19 mm / (0.75 pi)
+  return (tx_needle_params){.enabled = false,
+                            .radius = 0.019 / (0.75 * M_PI),
+                            .wire_diameter = 0.0006,
+                            .arc = 0.75 * M_PI,
+                            .pos = {0.03, -0.05 + 0.0003, 0},
+                            .quat = {M_SQRT1_2, -M_SQRT1_2, 0, 0}}; // arc plane flat on the table, normal up
+}
+
 tx_instrument_sim_params tx_instrument_sim_defaults(void) {
-  return (tx_instrument_sim_params){.coupling_k = 200,
+  return (tx_instrument_sim_params){.needle = tx_needle_defaults(),.coupling_k = 200,
                                     .coupling_b = 1,
                                     .orient_rate = 50,
                                     .orient_torque = 0.2,
@@ -79,6 +106,10 @@ static void near(void* data, dGeomID a, dGeomID b) {
   // face to face at zero depth, where a box-box test has no separating
   // direction to push along; the stop (lower limit 0) is where they meet
   if (ba && bb && dGeomGetData(a) == dGeomGetData(b)) return;
+  // which instrument touches the needle (a held needle still touches its
+  // holder's jaws: they stay closed on the wire, not through it)
+  instrument* other = dGeomGetData(a) == &needle_tag ? dGeomGetData(b) : dGeomGetData(b) == &needle_tag ? dGeomGetData(a) : NULL;
+  dBodyID other_body = dGeomGetData(a) == &needle_tag ? bb : ba;
   dContactGeom cg[MAX_CONTACTS];
   int n = dCollide(a, b, MAX_CONTACTS, cg, sizeof cg[0]);
   for (int i = 0; i < n; i++) {
@@ -94,6 +125,11 @@ static void near(void* data, dGeomID a, dGeomID b) {
     w->ncontacts++;
     w->depth = fmax(w->depth, cg[i].depth);
   }
+  if (n > 0 && other)
+    for (int l = 0; l < other->urdf->nlinks; l++)
+      if (other->body[l] == other_body) other->touch[l] = true;
+  for (int i = 0; other && i < n; i++, other->touch_n++)
+    for (int k = 0; k < 3; k++) other->touch_sum[k] += cg[i].pos[k];
 }
 
 // ---- building
@@ -208,6 +244,66 @@ static bool build(tx_instrument_world* w, instrument* in) {
   return true;
 }
 
+void tx_needle_mass(const tx_needle_params* n, double* mass, double com[3], double inertia[6]) {
+  // a thin wire: point masses along the arc (midpoint rule), then about their centre
+  double a = n->wire_diameter / 2, m = STEEL_DENSITY * M_PI * a * a * n->radius * n->arc, dm = m / NEEDLE_MASS_POINTS;
+  double c[3] = {0}, I[6] = {0};
+  for (int k = 0; k < NEEDLE_MASS_POINTS; k++) {
+    double phi = (k + 0.5) * n->arc / NEEDLE_MASS_POINTS;
+    c[0] += dm * n->radius * cos(phi) / m, c[1] += dm * n->radius * sin(phi) / m;
+  }
+  for (int k = 0; k < NEEDLE_MASS_POINTS; k++) {
+    double phi = (k + 0.5) * n->arc / NEEDLE_MASS_POINTS;
+    double x = n->radius * cos(phi) - c[0], y = n->radius * sin(phi) - c[1];
+    I[0] += dm * y * y, I[1] -= dm * x * y, I[3] += dm * x * x, I[5] += dm * (x * x + y * y);
+  }
+  // the wire's own section, so that no axis has zero inertia: a rod's m a^2 / 4 across, m a^2 / 2 along
+  I[0] += m * a * a / 4, I[3] += m * a * a / 4, I[5] += m * a * a / 4;
+  *mass = m;
+  memcpy(com, c, sizeof c);
+  memcpy(inertia, I, sizeof I);
+}
+
+static void needle_place(tx_instrument_world* w) {
+  const tx_needle_params* n = &w->p.needle;
+  double bp[3], q[4] = {1, 0, 0, 0};
+  compose(n->pos, n->quat, w->needle_com, q, bp, q);
+  dBodySetPosition(w->needle, bp[0], bp[1], bp[2]);
+  dQuaternion dq = {q[0], q[1], q[2], q[3]};
+  dBodySetQuaternion(w->needle, dq);
+  dBodySetLinearVel(w->needle, 0, 0, 0);
+  dBodySetAngularVel(w->needle, 0, 0, 0);
+}
+
+static void needle_build(tx_instrument_world* w) {
+  const tx_needle_params* n = &w->p.needle;
+  double m, I[6];
+  tx_needle_mass(n, &m, w->needle_com, I);
+  w->needle = dBodyCreate(w->world);
+  dMass dm;
+  dMassSetParameters(&dm, m, 0, 0, 0, I[0], I[3], I[5], I[1], I[2], I[4]);
+  dBodySetMass(w->needle, &dm);
+  needle_place(w);
+  for (int k = 0; k < NEEDLE_SEGMENTS; k++) { // a capsule on each chord of the arc
+    double p0 = k * n->arc / NEEDLE_SEGMENTS, p1 = (k + 1) * n->arc / NEEDLE_SEGMENTS;
+    double a[3] = {n->radius * cos(p0), n->radius * sin(p0), 0}, b[3] = {n->radius * cos(p1), n->radius * sin(p1), 0};
+    double mid[3] = {(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, 0}, u[3] = {b[0] - a[0], b[1] - a[1], 0};
+    double len = sqrt(u[0] * u[0] + u[1] * u[1]);
+    u[0] /= len, u[1] /= len;
+    // the capsule's z onto the chord u (in the arc plane, never -z): q = (1 + z.u, z x u) normalised
+    double sq[4] = {1, -u[1], u[0], 0}, qn = sqrt(1 + u[0] * u[0] + u[1] * u[1]);
+    for (int k2 = 0; k2 < 4; k2++) sq[k2] /= qn;
+    double gp[3], gq[4];
+    compose(n->pos, n->quat, mid, sq, gp, gq);
+    dGeomID g = dCreateCapsule(w->space, n->wire_diameter / 2, len);
+    dGeomSetBody(g, w->needle);
+    dGeomSetData(g, &needle_tag);
+    dGeomSetOffsetWorldPosition(g, gp[0], gp[1], gp[2]);
+    dQuaternion dq = {gq[0], gq[1], gq[2], gq[3]};
+    dGeomSetOffsetWorldQuaternion(g, dq);
+  }
+}
+
 tx_instrument_world* tx_instrument_world_create(const tx_instrument_sim_params* p, const tx_urdf* const* urdfs, int n,
                                                 const double (*start)[3]) {
   if (n < 0 || n > TX_INSTRUMENTS_MAX) return tx_set_error("at most %d instruments", TX_INSTRUMENTS_MAX), NULL;
@@ -230,6 +326,8 @@ tx_instrument_world* tx_instrument_world_create(const tx_instrument_sim_params* 
   dWorldSetCFM(w->world, p->cfm);
   dCreatePlane(w->space, 0, 1, 0, p->table_height);
   w->n = n;
+  w->held_by = -1;
+  if (p->needle.enabled) needle_build(w);
   for (int i = 0; i < n; i++) {
     w->ins[i].urdf = urdfs[i];
     memcpy(w->ins[i].start, start[i], sizeof w->ins[i].start);
@@ -326,8 +424,49 @@ static void drive_jaws(tx_instrument_world* w, instrument* in, double grip) {
     // the grip is the angle between the jaws: each of two opens by half of it
     double target = isfinite(grip) ? grip / (revolute > 1 ? 2 : 1) : jt->lower;
     target = fmin(fmax(target, jt->lower), jt->upper);
+    in->target[j] = target;
     double speed = w->p.jaw_gain * (target - dJointGetHingeAngle(in->joint[j]));
     dJointSetHingeParam(in->joint[j], dParamVel, fmin(fmax(speed, -jt->velocity), jt->velocity));
+  }
+}
+
+// jaws closing (or holding): no jaw's target above its angle
+static bool closing(const instrument* in) {
+  for (int j = 0; j < in->urdf->njoints; j++)
+    if (!in->urdf->joints[j].fixed && in->target[j] > dJointGetHingeAngle(in->joint[j]) + 1e-3) return false;
+  return true;
+}
+// jaws opening: some jaw's target clearly above its angle
+static bool opening(const instrument* in) {
+  for (int j = 0; j < in->urdf->njoints; j++)
+    if (!in->urdf->joints[j].fixed && in->target[j] > dJointGetHingeAngle(in->joint[j]) + TX_NEEDLE_RELEASE_RAD)
+      return true;
+  return false;
+}
+
+static void needle_grasp(tx_instrument_world* w) {
+  if (w->held_by >= 0) {
+    if (opening(&w->ins[w->held_by])) {
+      dJointDestroy(w->hold);
+      w->hold = NULL;
+      w->held_by = -1;
+      w->releases++;
+    }
+    return;
+  }
+  for (int i = 0; i < w->n; i++) {
+    instrument* in = &w->ins[i];
+    int jaws = 0, touching = 0;
+    for (int j = 0; j < in->urdf->njoints; j++)
+      if (!in->urdf->joints[j].fixed) jaws++, touching += in->touch[in->urdf->joints[j].child];
+    if (jaws < 2 || touching < jaws || !closing(in)) continue;
+    w->hold = dJointCreateFixed(w->world, 0);
+    dJointAttach(w->hold, w->needle, in->body[0]);
+    dJointSetFixed(w->hold);
+    w->held_by = i;
+    w->grasps++;
+    for (int k = 0; k < 3; k++) w->grasp_point[k] = in->touch_sum[k] / in->touch_n;
+    return;
   }
 }
 
@@ -349,9 +488,21 @@ void tx_instrument_world_step(tx_instrument_world* w, const tx_instrument_input*
   }
   w->ncontacts = 0;
   w->depth = 0;
+  for (int i = 0; i < w->n; i++) {
+    memset(w->ins[i].touch, 0, sizeof w->ins[i].touch);
+    memset(w->ins[i].touch_sum, 0, sizeof w->ins[i].touch_sum);
+    w->ins[i].touch_n = 0;
+  }
+  if (w->needle) {
+    double sp[3], sq[4];
+    tx_instrument_world_needle_swage(w, sp, sq);
+    dBodyAddForceAtPos(w->needle, w->pull[0], w->pull[1], w->pull[2], sp[0], sp[1], sp[2]);
+    memset(w->pull, 0, sizeof w->pull);
+  }
   dSpaceCollide(w->space, w, near);
   dWorldStep(w->world, dt);
   dJointGroupEmpty(w->contacts);
+  if (w->needle) needle_grasp(w);
   for (int i = 0; i < w->n; i++)
     if (!finite_state(&w->ins[i])) { // start over at the device, jaws closed
       memcpy(w->ins[i].start, in[i].pos, sizeof w->ins[i].start);
@@ -361,4 +512,47 @@ void tx_instrument_world_step(tx_instrument_world* w, const tx_instrument_input*
       memset(w->ins[i].hand_force, 0, sizeof w->ins[i].hand_force);
       w->resets++;
     }
+  if (w->needle) {
+    const dReal* np = dBodyGetPosition(w->needle);
+    const dReal* nv = dBodyGetLinearVel(w->needle);
+    if (!isfinite(np[0] + np[1] + np[2] + nv[0] + nv[1] + nv[2])) {
+      if (w->hold) dJointDestroy(w->hold), w->hold = NULL, w->held_by = -1, w->releases++;
+      needle_place(w);
+      w->resets++;
+    }
+  }
+}
+
+void tx_instrument_world_needle(const tx_instrument_world* w, double pos[3], double quat[4]) {
+  const dReal* bp = dBodyGetPosition(w->needle);
+  const dReal* bq = dBodyGetQuaternion(w->needle);
+  double r[3];
+  for (int k = 0; k < 4; k++) quat[k] = bq[k];
+  qrot(quat, w->needle_com, r);
+  for (int k = 0; k < 3; k++) pos[k] = bp[k] - r[k];
+}
+
+void tx_instrument_world_needle_swage(const tx_instrument_world* w, double pos[3], double quat[4]) {
+  double c[3], swage[3] = {w->p.needle.radius, 0, 0}, r[3];
+  tx_instrument_world_needle(w, c, quat);
+  qrot(quat, swage, r);
+  for (int k = 0; k < 3; k++) pos[k] = c[k] + r[k];
+}
+
+void tx_instrument_world_needle_tip(const tx_instrument_world* w, double pos[3]) {
+  double c[3], q[4], r[3];
+  double tip[3] = {w->p.needle.radius * cos(w->p.needle.arc), w->p.needle.radius * sin(w->p.needle.arc), 0};
+  tx_instrument_world_needle(w, c, q);
+  qrot(q, tip, r);
+  for (int k = 0; k < 3; k++) pos[k] = c[k] + r[k];
+}
+
+int tx_instrument_world_needle_held_by(const tx_instrument_world* w) { return w->held_by; }
+int tx_instrument_world_needle_grasps(const tx_instrument_world* w) { return w->grasps; }
+int tx_instrument_world_needle_releases(const tx_instrument_world* w) { return w->releases; }
+void tx_instrument_world_needle_pull(tx_instrument_world* w, const double f[3]) {
+  for (int k = 0; k < 3; k++) w->pull[k] += isfinite(f[k]) ? f[k] : 0;
+}
+void tx_instrument_world_needle_grasp_point(const tx_instrument_world* w, double p[3]) {
+  memcpy(p, w->grasp_point, 3 * sizeof *p);
 }

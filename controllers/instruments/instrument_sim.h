@@ -19,6 +19,21 @@
 #define TX_INSTRUMENTS_MAX 2 // one per hand
 #define TX_INSTRUMENT_LINKS_MAX 8
 
+// The curved needle: a circular arc of a steel wire, one rigid body. Its
+// frame has the circle's centre at its origin and the arc in its x-y plane,
+// from the swage end at (radius, 0, 0) counter-clockwise about z to the tip.
+typedef struct tx_needle_params {
+  bool enabled;
+  double radius; // m, of the circle the needle is bent on
+  double wire_diameter; // m
+  double arc; // rad: 3/8 circle = 0.75 pi, 1/2 circle = pi
+  double pos[3], quat[4]; // where its frame starts, in the world
+} tx_needle_params;
+
+// the default: a 3/8-circle reverse-cutting skin needle 19 mm long (the
+// common skin-closure size, docs/instruments.md), 0.6 mm wire, lying flat
+tx_needle_params tx_needle_defaults(void);
+
 typedef struct tx_instrument_sim_params {
   double coupling_k, coupling_b; // N/m, N s/m: the virtual coupling's spring and damper
   double orient_rate; // 1/s: the root turns towards the device's orientation at this rate x the angle left
@@ -29,6 +44,7 @@ typedef struct tx_instrument_sim_params {
   double table_height; // m: the table is the half-space y < table_height
   double friction; // Coulomb coefficient of every contact
   double erp, cfm; // ODE's error reduction and constraint force mixing
+  tx_needle_params needle;
 } tx_instrument_sim_params;
 
 tx_instrument_sim_params tx_instrument_sim_defaults(void);
@@ -67,5 +83,24 @@ int tx_instrument_world_resets(const tx_instrument_world* w);
 // and the deepest contact of the last step (m)
 int tx_instrument_world_bad_inputs(const tx_instrument_world* w);
 double tx_instrument_world_depth(const tx_instrument_world* w);
+
+// The needle, when enabled. Its frame's pose; the swage end's pose (the
+// thread's head: at the swage, the needle frame's orientation) and the tip's
+// position. An instrument whose two jaws both touch the needle while they
+// close holds it by a fixed joint; it lets go when its jaws open (the grip
+// asks for more than they have). held_by: the holding instrument, -1 for none.
+// grasps and releases count those events since the world was made.
+void tx_instrument_world_needle(const tx_instrument_world* w, double pos[3], double quat[4]);
+void tx_instrument_world_needle_swage(const tx_instrument_world* w, double pos[3], double quat[4]);
+void tx_instrument_world_needle_tip(const tx_instrument_world* w, double pos[3]);
+int tx_instrument_world_needle_held_by(const tx_instrument_world* w);
+int tx_instrument_world_needle_grasps(const tx_instrument_world* w);
+int tx_instrument_world_needle_releases(const tx_instrument_world* w);
+// where the last grasp held it: the mean of the holder's contact points with it
+void tx_instrument_world_needle_grasp_point(const tx_instrument_world* w, double p[3]);
+// a force (N) on the needle at its swage end during the next step (the thread's pull)
+void tx_instrument_world_needle_pull(tx_instrument_world* w, const double f[3]);
+// the needle's mass (kg) and inertia about its centre of mass, in its frame (ixx ixy ixz iyy iyz izz)
+void tx_needle_mass(const tx_needle_params* n, double* mass, double com[3], double inertia[6]);
 
 #endif

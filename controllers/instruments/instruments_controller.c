@@ -8,6 +8,7 @@
 
 #include <tactus/components.h>
 #include <tactus/config.h>
+#include <tactus/events.h>
 
 #include <math.h>
 #include <stdio.h>
@@ -22,7 +23,9 @@ typedef struct instruments {
   tx_port dev_pose[TX_INSTRUMENTS_MAX], dev_vel[TX_INSTRUMENTS_MAX], dev_grip[TX_INSTRUMENTS_MAX];
   tx_port pose[TX_INSTRUMENTS_MAX], links[TX_INSTRUMENTS_MAX], model[TX_INSTRUMENTS_MAX];
   tx_warning bad_input, reset;
-  tx_result contacts_max, force_max;
+  tx_result contacts_max, force_max, grasps, releases;
+  tx_port needle_pose, needle_swage, events;
+  int grasps_seen, releases_seen, last_holder;
   int bad_seen, resets_seen, contacts_most;
   double force_most;
 } instruments;
@@ -43,6 +46,12 @@ static const tx_param_def params[] = {
     {"gravity_m_s2", TX_PARAM_NUM, "m/s^2", 0, 100, 9.81, NULL, "gravity, down (-y)"},
     {"table_height_m", TX_PARAM_NUM, "m", -10, 10, -0.05, NULL, "the rigid scene: a table filling y < table_height_m"},
     {"friction", TX_PARAM_NUM, "1", 0, 10, 0.5, NULL, "Coulomb friction coefficient of every contact"},
+    {"needle", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "a curved needle lies on the table, for the instruments to take"},
+    {"needle_circle", TX_PARAM_NUM, "1", 0.25, 0.625, 0.375, NULL, "the needle's arc as a fraction of a circle: 3/8 or 1/2"},
+    {"needle_length_m", TX_PARAM_NUM, "m", 0.003, 0.1, 0.019, NULL, "the needle's length along its arc"},
+    {"needle_wire_diameter_m", TX_PARAM_NUM, "m", 5e-5, 0.003, 0.0006, NULL, "the needle's wire diameter"},
+    {"needle_x_m", TX_PARAM_NUM, "m", -10, 10, 0.03, NULL, "where its circle's centre lies on the table, x"},
+    {"needle_z_m", TX_PARAM_NUM, "m", -10, 10, 0, NULL, "where its circle's centre lies on the table, z"},
 };
 
 // a bare name is a shipped instrument; anything else is a path
@@ -67,6 +76,15 @@ static int configure(tx_setup* s, void** self) {
   m->p.gravity[1] = -tx_table_num(s, "gravity_m_s2");
   m->p.table_height = tx_table_num(s, "table_height_m");
   m->p.friction = tx_table_num(s, "friction");
+  tx_needle_params* nd = &m->p.needle;
+  nd->enabled = tx_table_bool(s, "needle");
+  nd->arc = 2 * M_PI * tx_table_num(s, "needle_circle");
+  nd->radius = tx_table_num(s, "needle_length_m") / nd->arc;
+  nd->wire_diameter = tx_table_num(s, "needle_wire_diameter_m");
+  if (nd->wire_diameter > nd->radius) return tx_setup_fail(s, "needle_wire_diameter_m", "thicker than the needle's radius");
+  nd->pos[0] = tx_table_num(s, "needle_x_m");
+  nd->pos[1] = m->p.table_height + nd->wire_diameter / 2;
+  nd->pos[2] = tx_table_num(s, "needle_z_m");
   for (int i = 0; i < TX_INSTRUMENTS_MAX; i++) {
     char key[32], path[2048], name[TX_NAME_MAX];
     snprintf(key, sizeof key, "instrument%d", i);
@@ -96,6 +114,13 @@ static int configure(tx_setup* s, void** self) {
   m->bad_input = tx_setup_warning(s, "device_not_finite");
   m->reset = tx_setup_warning(s, "reset");
   m->contacts_max = tx_setup_result(s, "contacts_max");
+  if (nd->enabled) {
+    m->needle_pose = tx_setup_write(s, &TX_COMPONENT_OF("needle.pose", tx_pose, 1));
+    m->needle_swage = tx_setup_write(s, &TX_COMPONENT_OF("needle.swage", tx_pose, 1));
+    m->events = tx_setup_emit(s, "instruments.events", 64);
+    m->grasps = tx_setup_result(s, "needle_grasps");
+    m->releases = tx_setup_result(s, "needle_releases");
+  }
   m->force_max = tx_setup_result(s, "coupling_force_max_n");
   return 0;
 }
@@ -144,6 +169,25 @@ static void step(tx_ctx* c, void* self) {
   m->bad_seen = tx_instrument_world_bad_inputs(m->world);
   m->resets_seen = tx_instrument_world_resets(m->world);
   if (tx_instrument_world_contacts(m->world) > m->contacts_most) m->contacts_most = tx_instrument_world_contacts(m->world);
+  if (m->p.needle.enabled) {
+    tx_pose* np = tx_write(c, m->needle_pose);
+    tx_instrument_world_needle(m->world, np->pos, np->quat);
+    tx_pose* sw = tx_write(c, m->needle_swage);
+    tx_instrument_world_needle_swage(m->world, sw->pos, sw->quat);
+    int held = tx_instrument_world_needle_held_by(m->world);
+    if (tx_instrument_world_needle_grasps(m->world) > m->grasps_seen) {
+      tx_event e = {.kind = TX_EVENT_GRASP, .source = (uint32_t)held};
+      tx_instrument_world_needle_grasp_point(m->world, e.grasp.point);
+      e.grasp.jaw = 0;
+      for (int j = 0; j < m->desc[held]->urdf->njoints; j++) e.grasp.jaw += tx_instrument_world_joint(m->world, held, j);
+      tx_emit(c, m->events, &e);
+    }
+    if (tx_instrument_world_needle_releases(m->world) > m->releases_seen)
+      tx_emit(c, m->events, &(tx_event){.kind = TX_EVENT_RELEASE, .source = (uint32_t)m->last_holder});
+    if (held >= 0) m->last_holder = held;
+    m->grasps_seen = tx_instrument_world_needle_grasps(m->world);
+    m->releases_seen = tx_instrument_world_needle_releases(m->world);
+  }
   for (int i = 0; i < m->n; i++) {
     const tx_urdf* u = m->desc[i]->urdf;
     tx_pose* links = tx_write(c, m->links[i]);
@@ -169,6 +213,10 @@ static void step(tx_ctx* c, void* self) {
 
 static void finish(tx_ctx* c, void* self) {
   instruments* m = self;
+  if (m->p.needle.enabled) {
+    tx_set_result(c, m->grasps, m->grasps_seen);
+    tx_set_result(c, m->releases, m->releases_seen);
+  }
   tx_set_result(c, m->contacts_max, m->contacts_most);
   tx_set_result(c, m->force_max, m->force_most);
 }

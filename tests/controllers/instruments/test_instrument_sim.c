@@ -218,6 +218,137 @@ static void test_force_clamp_and_nan(void** state) {
   tx_instrument_desc_free(d);
 }
 
+
+// the needle's mass and inertia against the thin arc's closed forms:
+// m = rho pi a^2 R theta, centre of mass R sin(theta/2)/(theta/2) from the
+// circle's centre on the bisector, and about it izz = m (R^2 - c^2) (+ m a^2/4)
+static void test_needle_mass_closed_form(void** state) {
+  (void)state;
+  tx_needle_params n = tx_needle_defaults();
+  double m, c[3], I[6];
+  tx_needle_mass(&n, &m, c, I);
+  double R = n.radius, a = n.wire_diameter / 2, th = n.arc;
+  double mc = 7900 * M_PI * a * a * R * th, cc = R * sin(th / 2) / (th / 2);
+  print_message("  needle: R %.3f mm, %.1f mg; centre of mass %.4f mm from the circle's centre\n", 1e3 * R, 1e6 * m, 1e3 * cc);
+  assert_true(fabs(R * th - 0.019) < 1e-12); // 19 mm along the arc
+  assert_true(fabs(m - mc) < 1e-12 * mc);
+  assert_true(fabs(sqrt(c[0] * c[0] + c[1] * c[1]) - cc) < 1e-6 * cc);
+  assert_true(fabs(atan2(c[1], c[0]) - th / 2) < 1e-9); // on the bisector
+  double izz = m * (R * R - cc * cc) + m * a * a / 4;
+  assert_true(fabs(I[5] - izz) < 1e-5 * izz);
+  assert_true(fabs(I[0] + I[3] - I[5] - m * a * a / 4) < 1e-9 * I[5]); // a plane figure: ixx + iyy = izz
+}
+
+static void step_to(tx_instrument_world* w, tx_instrument_input* in, const double to[3], double grip, double seconds) {
+  double from[3] = {in->pos[0], in->pos[1], in->pos[2]}, g0 = in->grip;
+  int n = (int)lround(seconds * 1000);
+  for (int i = 1; i <= n; i++) {
+    double u = (double)i / n;
+    for (int k = 0; k < 3; k++) in->pos[k] = from[k] + u * (to[k] - from[k]);
+    in->grip = g0 + u * (grip - g0);
+    tx_instrument_world_step(w, in, 1e-3);
+  }
+}
+
+// the swage end in the holder's root frame
+static void swage_in_root(const tx_instrument_world* w, double out[3]) {
+  double sp[3], sq[4], rp[3], rq[4];
+  tx_instrument_world_needle_swage(w, sp, sq);
+  tx_instrument_world_link(w, 0, 0, rp, rq);
+  double d[3] = {sp[0] - rp[0], sp[1] - rp[1], sp[2] - rp[2]}, qc[4] = {rq[0], -rq[1], -rq[2], -rq[3]};
+  double t[3] = {2 * (qc[2] * d[2] - qc[3] * d[1]), 2 * (qc[3] * d[0] - qc[1] * d[2]), 2 * (qc[1] * d[1] - qc[2] * d[0])};
+  out[0] = d[0] + qc[0] * t[0] + qc[2] * t[2] - qc[3] * t[1];
+  out[1] = d[1] + qc[0] * t[1] + qc[3] * t[0] - qc[1] * t[2];
+  out[2] = d[2] + qc[0] * t[2] + qc[1] * t[1] - qc[2] * t[0];
+}
+
+// the needle holder closes on the needle: it is held; lifted, it comes along;
+// pulled with 2 N at its swage it slips less than 0.5 mm; opened, it is let go
+static void test_needle_held_and_released(void** state) {
+  (void)state;
+  tx_instrument_desc* d = load("needle_holder");
+  tx_instrument_sim_params p = tx_instrument_sim_defaults();
+  memset(p.gravity, 0, sizeof p.gravity);
+  p.table_height = -1;
+  p.needle.enabled = true;
+  // the arc upright in the world's x-y plane, turned so that 0.2 rad from the
+  // swage the wire crosses the x axis running along y: across the jaws, as a
+  // needle holder takes a needle
+  double phi = 0.2;
+  p.needle.pos[0] = p.needle.pos[1] = p.needle.pos[2] = 0;
+  double nq[4] = {cos(-phi / 2), 0, 0, sin(-phi / 2)};
+  memcpy(p.needle.quat, nq, sizeof nq);
+  const tx_urdf* u = d->urdf;
+  double R = p.needle.radius;
+  double grasp[3] = {R - 0.03, 0, 0}, start[1][3] = {{R - 0.06, 0, 0}}; // the wire 30 mm from the pivot
+  tx_instrument_world* w = tx_instrument_world_create(&p, &u, 1, start);
+  assert_non_null(w);
+  double sw[3], sq[4];
+  tx_instrument_world_needle_swage(w, sw, sq);
+  assert_true(fabs(sw[0] - R * cos(phi)) < 1e-12 && fabs(sw[1] + R * sin(phi)) < 1e-12 && fabs(sw[2]) < 1e-12);
+  tx_instrument_input in = at(start[0][0], start[0][1], start[0][2], 0);
+  step_to(w, &in, start[0], 0.4, 0.3); // open
+  step_to(w, &in, grasp, 0.4, 0.3); // over the wire
+  assert_int_equal(tx_instrument_world_needle_held_by(w), -1);
+  step_to(w, &in, grasp, 0, 0.3); // close
+  step_to(w, &in, grasp, 0, 0.1);
+  print_message("  closed on the needle: held by %d, jaws at %.4f rad\n", tx_instrument_world_needle_held_by(w),
+                tx_instrument_world_joint(w, 0, 0));
+  assert_int_equal(tx_instrument_world_needle_held_by(w), 0);
+  assert_int_equal(tx_instrument_world_needle_grasps(w), 1);
+  assert_true(tx_instrument_world_joint(w, 0, 0) > 0.002); // the wire keeps the jaws apart
+  double gp[3];
+  tx_instrument_world_needle_grasp_point(w, gp);
+  assert_true(fabs(gp[0] - R) < 0.001 && fabs(gp[1]) < 0.001 && fabs(gp[2]) < 0.001); // where the wire crosses the jaws
+  double lift[3] = {grasp[0], grasp[1] + 0.02, grasp[2]};
+  step_to(w, &in, lift, 0, 0.3);
+  double sw2[3];
+  tx_instrument_world_needle_swage(w, sw2, sq);
+  assert_true(fabs(sw2[1] - sw[1] - 0.02) < 0.001); // it came along
+  double before[3], after[3];
+  swage_in_root(w, before);
+  double most = 0;
+  for (int i = 0; i < 500; i++) {
+    double pull[3] = {2, 0, 0}; // 2 N, out along the swage
+    tx_instrument_world_needle_pull(w, pull);
+    tx_instrument_world_step(w, &in, 1e-3);
+    swage_in_root(w, after);
+    most = fmax(most, sqrt((after[0] - before[0]) * (after[0] - before[0]) + (after[1] - before[1]) * (after[1] - before[1]) +
+                           (after[2] - before[2]) * (after[2] - before[2])));
+  }
+  print_message("  2 N pull for 0.5 s: the needle slips %.2e mm in the jaws (limit 0.5 mm)\n", 1e3 * most);
+  assert_true(most <= 0.0005);
+  assert_int_equal(tx_instrument_world_needle_held_by(w), 0);
+  step_to(w, &in, lift, 0.4, 0.2); // open
+  assert_int_equal(tx_instrument_world_needle_held_by(w), -1);
+  assert_int_equal(tx_instrument_world_needle_releases(w), 1);
+  tx_instrument_world_destroy(w);
+  tx_instrument_desc_free(d);
+}
+
+// on the table the needle lies still, neither sinking nor jumping
+static void test_needle_rests_on_the_table(void** state) {
+  (void)state;
+  tx_instrument_desc* d = load("thumb_forceps");
+  tx_instrument_sim_params p = tx_instrument_sim_defaults();
+  p.needle.enabled = true;
+  const tx_urdf* u = d->urdf;
+  double start[1][3] = {{-0.1, 0, 0}};
+  tx_instrument_world* w = tx_instrument_world_create(&p, &u, 1, start);
+  tx_instrument_input in = at(-0.1, 0, 0, 0);
+  for (int i = 0; i < 1000; i++) tx_instrument_world_step(w, &in, 1e-3);
+  double c[3], q[4], tip[3];
+  tx_instrument_world_needle(w, c, q);
+  tx_instrument_world_needle_tip(w, tip);
+  print_message("  after 1 s: needle frame at y = %.4f mm, tip at y = %.4f mm (wire centre on the table: %.4f mm)\n", 1e3 * c[1],
+                1e3 * tip[1], 1e3 * (p.table_height + p.needle.wire_diameter / 2));
+  assert_true(fabs(c[1] - (p.table_height + p.needle.wire_diameter / 2)) < 1e-4);
+  assert_true(fabs(tip[1] - c[1]) < 1e-4);
+  assert_true(fabs(c[0] - p.needle.pos[0]) < 1e-4 && fabs(c[2] - p.needle.pos[2]) < 1e-4);
+  tx_instrument_world_destroy(w);
+  tx_instrument_desc_free(d);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_links_start_where_the_urdf_puts_them),
@@ -227,6 +358,9 @@ int main(void) {
       cmocka_unit_test(test_table_holds_the_instrument),
       cmocka_unit_test(test_instruments_collide),
       cmocka_unit_test(test_force_clamp_and_nan),
+      cmocka_unit_test(test_needle_mass_closed_form),
+      cmocka_unit_test(test_needle_held_and_released),
+      cmocka_unit_test(test_needle_rests_on_the_table),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -87,10 +87,31 @@ static void test_refuses_what_it_cannot_read(void** state) {
   assert_non_null(strstr(tx_error(), "instrument1"));
 }
 
+// with a needle: it lies on the table where the scenario puts it, and its
+// swage end is published one radius from its circle's centre
+static void test_needle_is_published(void** state) {
+  (void)state;
+  tx_scenario* s = load("\"needle\":true,\"needle_circle\":0.5,\"needle_x_m\":0.05");
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 0.3);
+  const double* np = latest(s, "needle.pose");
+  const double* sw = latest(s, "needle.swage");
+  double R = 0.019 / M_PI; // half a circle 19 mm long
+  double d = sqrt((sw[0] - np[0]) * (sw[0] - np[0]) + (sw[1] - np[1]) * (sw[1] - np[1]) + (sw[2] - np[2]) * (sw[2] - np[2]));
+  print_message("  needle centre (%.4f, %.4f, %.4f) m, swage %.4f mm from it (R = %.4f mm)\n", np[0], np[1], np[2], 1e3 * d, 1e3 * R);
+  assert_true(fabs(np[0] - 0.05) < 1e-4 && fabs(np[1] - (-0.05 + 0.0003)) < 1e-4);
+  assert_true(fabs(d - R) < 1e-9);
+  assert_true(result(s, "instruments.needle_grasps") == 0);
+  tx_scenario_free(s);
+  assert_null(load("\"needle\":true,\"needle_wire_diameter_m\":0.003,\"needle_length_m\":0.003"));
+  assert_non_null(strstr(tx_error(), "needle_wire_diameter_m"));
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_follows_the_hand_and_renders_the_weight),
       cmocka_unit_test(test_refuses_what_it_cannot_read),
+      cmocka_unit_test(test_needle_is_published),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }
