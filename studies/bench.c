@@ -2,6 +2,7 @@
 // percentiles of one run on this machine; they are printed, never asserted.
 #include "bench_cloth.h"
 #include "bench_hip.h"
+#include "bench_instruments.h"
 #include "bench_render.h"
 #include "bench_voxels.h"
 #include "../scenarios/command.h"
@@ -348,6 +349,7 @@ static int bench_haptics(const bench_args* a) {
 
 static int bench_voxels(const bench_args* a) { return tx_bench_voxels(a->duration_s); }
 static int bench_cloth(const bench_args* a) { return tx_bench_cloth(a->duration_s); }
+static int bench_instruments(const bench_args* a) { return tx_bench_instruments(a->duration_s); }
 static int bench_hip(const bench_args* a) {
   (void)a;
   return tx_bench_hip();
@@ -366,6 +368,7 @@ static const struct {
     {"render", bench_render, "graphics view frame times, mono and 2x640x480 stereo, beside 1 kHz haptics"},
     {"cloth", bench_cloth, "skin physics step at 10404 particles with rupture; overhead vs a bare Bullet loop"},
     {"hip", bench_hip, "collision.hip query (98 rays) on 10404 and 102400 particles, and the refit"},
+    {"instruments", bench_instruments, "one 1 kHz ODE step of two articulated instruments and the needle"},
 };
 
 int tx_cmd_bench(int argc, char** argv) {
