@@ -25,6 +25,8 @@ static const struct {
      "the skin under stiffness x1e-3..x1e3, steps 1/20..1/1000 s, a teleporting and a 10 m/s HIP, zero thickness"},
     {"skin-membrane", tx_study_skin_membrane,
      "the skin against closed-form membranes (disc load, own weight), rupture under refinement, gravity sag"},
+    {"instruments-stability", tx_study_instruments_stability,
+     "virtual coupling stiffness bound at 1 kHz vs haptic-stability's; a 10 m/s hand, slammed jaws, a squeezed needle"},
     {"skin-accuracy", tx_study_skin_accuracy,
      "spacing, iterations and step refined together: observed order, Richardson reference, error vs CPU time"},
 };

@@ -4,6 +4,8 @@
 #include "../../model/error.h"
 
 #include <math.h>
+#include <stdarg.h>
+#include <stdatomic.h>
 #include <ode/ode.h>
 #include <stdlib.h>
 #include <string.h>
@@ -46,6 +48,15 @@ struct tx_instrument_world {
 };
 
 static char needle_tag; // the needle's geoms carry its address
+
+// ODE prints its solver's messages (an LCP it could not finish, then
+// recovered) to stderr; they are counted instead
+static atomic_int ode_messages;
+static void count_message(int num, const char* msg, va_list ap) {
+  (void)num, (void)msg, (void)ap;
+  ode_messages++;
+}
+int tx_instrument_ode_messages(void) { return ode_messages; }
 
 tx_needle_params tx_needle_defaults(void) {
   // 19 mm along the arc over 3/8 of a circle: radius 19 mm / (0.75 pi)
@@ -312,6 +323,7 @@ tx_instrument_world* tx_instrument_world_create(const tx_instrument_sim_params* 
       return tx_set_error("%s: more than %d links", urdfs[i]->name, TX_INSTRUMENT_LINKS_MAX), NULL;
   if (!dInitODE2(0) || !dAllocateODEDataForThread(dAllocateMaskAll))
     return tx_set_error("ODE cannot be started"), NULL;
+  dSetMessageHandler(count_message);
   tx_instrument_world* w = calloc(1, sizeof *w);
   if (!w) {
     dCloseODE();

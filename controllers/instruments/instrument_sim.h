@@ -83,6 +83,9 @@ int tx_instrument_world_resets(const tx_instrument_world* w);
 // and the deepest contact of the last step (m)
 int tx_instrument_world_bad_inputs(const tx_instrument_world* w);
 double tx_instrument_world_depth(const tx_instrument_world* w);
+// ODE's solver messages since start (an LCP it could not finish and recovered
+// from); they are counted, not printed
+int tx_instrument_ode_messages(void);
 
 // The needle, when enabled. Its frame's pose; the swage end's pose (the
 // thread's head: at the swage, the needle frame's orientation) and the tip's
