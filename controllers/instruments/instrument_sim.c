@@ -12,7 +12,7 @@
 
 #define MAX_CONTACTS 8 // per geom pair
 #define TX_JAW_STOP_GUARD 0.02 // rad
-#define TX_NEEDLE_RELEASE_RAD 0.02 // a jaw asked to open this much past where it is lets the needle go
+#define TX_NEEDLE_RELEASE_RAD 0.01 // a jaw this much wider than when it took the needle has let it go
 #define STEEL_DENSITY 7900.0 // kg/m^3
 
 typedef struct instrument {
@@ -26,6 +26,7 @@ typedef struct instrument {
   bool touch[TX_INSTRUMENT_LINKS_MAX]; // links that touched the needle this step
   double touch_sum[3]; // the needle's contact points with it this step, summed
   int touch_n;
+  bool was_on; // both jaws were on the needle the step before: a grasp is the step they come on
 } instrument;
 
 #define NEEDLE_SEGMENTS 8 // capsules along the arc
@@ -43,6 +44,7 @@ struct tx_instrument_world {
   dJointID hold; // the needle's fixed joint to its holder, or NULL
   int held_by, grasps, releases;
   double grasp_point[3]; // the mean contact point of the last grasp
+  double hold_angle[TX_INSTRUMENT_LINKS_MAX]; // the holder's jaw angles when it took the needle
   double pull[3]; // N at the swage, this step
   double depth; // deepest contact of the last step, m
 };
@@ -448,37 +450,40 @@ static bool closing(const instrument* in) {
     if (!in->urdf->joints[j].fixed && in->target[j] > dJointGetHingeAngle(in->joint[j]) + 1e-3) return false;
   return true;
 }
-// jaws opening: some jaw's target clearly above its angle
-static bool opening(const instrument* in) {
+// the holder's jaws opened: one is TX_NEEDLE_RELEASE_RAD wider than when it took the needle
+static bool opened(const tx_instrument_world* w, const instrument* in) {
   for (int j = 0; j < in->urdf->njoints; j++)
-    if (!in->urdf->joints[j].fixed && in->target[j] > dJointGetHingeAngle(in->joint[j]) + TX_NEEDLE_RELEASE_RAD)
+    if (!in->urdf->joints[j].fixed && dJointGetHingeAngle(in->joint[j]) > w->hold_angle[j] + TX_NEEDLE_RELEASE_RAD)
       return true;
   return false;
 }
 
 static void needle_grasp(tx_instrument_world* w) {
-  if (w->held_by >= 0) {
-    if (opening(&w->ins[w->held_by])) {
-      dJointDestroy(w->hold);
-      w->hold = NULL;
-      w->held_by = -1;
-      w->releases++;
-    }
-    return;
+  if (w->held_by >= 0 && opened(w, &w->ins[w->held_by])) {
+    dJointDestroy(w->hold);
+    w->hold = NULL;
+    w->held_by = -1;
+    w->releases++;
   }
+  // another instrument closing on a held needle takes it over (a handover):
+  // one holder at a time, so the needle never binds two hands together
   for (int i = 0; i < w->n; i++) {
     instrument* in = &w->ins[i];
     int jaws = 0, touching = 0;
     for (int j = 0; j < in->urdf->njoints; j++)
       if (!in->urdf->joints[j].fixed) jaws++, touching += in->touch[in->urdf->joints[j].child];
-    if (jaws < 2 || touching < jaws || !closing(in)) continue;
+    bool on = jaws >= 2 && touching == jaws, came_on = on && !in->was_on;
+    in->was_on = on;
+    if (i == w->held_by || !came_on || !closing(in)) continue;
+    if (w->hold) dJointDestroy(w->hold); // handed over: no release event, the needle stays held
     w->hold = dJointCreateFixed(w->world, 0);
     dJointAttach(w->hold, w->needle, in->body[0]);
     dJointSetFixed(w->hold);
     w->held_by = i;
     w->grasps++;
+    for (int j = 0; j < in->urdf->njoints; j++)
+      w->hold_angle[j] = in->urdf->joints[j].fixed ? 0 : dJointGetHingeAngle(in->joint[j]);
     for (int k = 0; k < 3; k++) w->grasp_point[k] = in->touch_sum[k] / in->touch_n;
-    return;
   }
 }
 

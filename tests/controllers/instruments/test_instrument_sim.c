@@ -349,6 +349,80 @@ static void test_needle_rests_on_the_table(void** state) {
   tx_instrument_desc_free(d);
 }
 
+// a handover: the needle holder holds the needle; the thumb forceps close on
+// it further along the arc and take it (a grasp, no release); the holder then
+// opens without letting anything go; the forceps open and let it go
+static void test_needle_handover(void** state) {
+  (void)state;
+  tx_instrument_desc* a = load("needle_holder");
+  tx_instrument_desc* b = load("thumb_forceps");
+  tx_instrument_sim_params p = tx_instrument_sim_defaults();
+  memset(p.gravity, 0, sizeof p.gravity);
+  p.table_height = -1;
+  p.needle.enabled = true;
+  double phi = 0.2;
+  memset(p.needle.pos, 0, sizeof p.needle.pos);
+  double nq[4] = {cos(-phi / 2), 0, 0, sin(-phi / 2)};
+  memcpy(p.needle.quat, nq, sizeof nq);
+  double R = p.needle.radius;
+  // the forceps take the wire 0.2 rad from the tip, coming radially from outside, tips 5 mm past it
+  double th = p.needle.arc - 2 * phi, radial[3] = {cos(th), sin(th), 0}, point[3] = {R * cos(th), R * sin(th), 0};
+  double turn = th + M_PI, bq[4] = {cos(turn / 2), 0, 0, sin(turn / 2)};
+  double b_grasp[3], b_start[3];
+  for (int k = 0; k < 3; k++) b_grasp[k] = point[k] + 0.125 * radial[k], b_start[k] = point[k] + 0.16 * radial[k];
+  const tx_urdf* u[2] = {a->urdf, b->urdf};
+  double start[2][3] = {{R - 0.06, 0, 0}, {b_start[0], b_start[1], b_start[2]}};
+  tx_instrument_world* w = tx_instrument_world_create(&p, u, 2, start);
+  assert_non_null(w);
+  double a_grasp[3] = {R - 0.03, 0, 0};
+  tx_instrument_input in[2] = {at(start[0][0], 0, 0, 0), at(b_start[0], b_start[1], b_start[2], 0)};
+  memcpy(in[1].quat, bq, sizeof bq);
+  // the forceps' root starts turned: let the orientation settle while far away
+  for (int i = 0; i < 300; i++) {
+    in[0].grip = 0.4 * i / 300.0, in[1].grip = 0.14 * i / 300.0;
+    tx_instrument_world_step(w, in, 1e-3);
+  }
+  for (int i = 1; i <= 300; i++) { // the holder slides over the wire
+    for (int k = 0; k < 3; k++) in[0].pos[k] = start[0][k] + i / 300.0 * (a_grasp[k] - start[0][k]);
+    tx_instrument_world_step(w, in, 1e-3);
+  }
+  for (int i = 1; i <= 400; i++) { // and closes
+    in[0].grip = 0.4 * fmax(0, 1 - i / 300.0);
+    tx_instrument_world_step(w, in, 1e-3);
+  }
+  assert_int_equal(tx_instrument_world_needle_held_by(w), 0);
+  for (int i = 1; i <= 300; i++) { // the forceps come in, open
+    for (int k = 0; k < 3; k++) in[1].pos[k] = b_start[k] + i / 300.0 * (b_grasp[k] - b_start[k]);
+    tx_instrument_world_step(w, in, 1e-3);
+  }
+  assert_int_equal(tx_instrument_world_needle_held_by(w), 0);
+  for (int i = 1; i <= 400; i++) { // and close on the wire
+    in[1].grip = 0.14 * fmax(0, 1 - i / 300.0);
+    tx_instrument_world_step(w, in, 1e-3);
+  }
+  print_message("  after the forceps close: held by %d, %d grasps, %d releases\n", tx_instrument_world_needle_held_by(w),
+                tx_instrument_world_needle_grasps(w), tx_instrument_world_needle_releases(w));
+  assert_int_equal(tx_instrument_world_needle_held_by(w), 1);
+  assert_int_equal(tx_instrument_world_needle_grasps(w), 2);
+  assert_int_equal(tx_instrument_world_needle_releases(w), 0);
+  for (int i = 1; i <= 200; i++) { // the holder opens: nothing is let go
+    in[0].grip = 0.4 * fmin(1, i / 100.0);
+    tx_instrument_world_step(w, in, 1e-3);
+  }
+  assert_int_equal(tx_instrument_world_needle_held_by(w), 1);
+  assert_int_equal(tx_instrument_world_needle_releases(w), 0);
+  for (int i = 1; i <= 200; i++) { // the forceps open: let go
+    in[1].grip = 0.14 * fmin(1, i / 100.0);
+    tx_instrument_world_step(w, in, 1e-3);
+  }
+  assert_int_equal(tx_instrument_world_needle_held_by(w), -1);
+  assert_int_equal(tx_instrument_world_needle_releases(w), 1);
+  assert_int_equal(tx_instrument_world_needle_grasps(w), 2);
+  tx_instrument_world_destroy(w);
+  tx_instrument_desc_free(a);
+  tx_instrument_desc_free(b);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_links_start_where_the_urdf_puts_them),
@@ -360,6 +434,7 @@ int main(void) {
       cmocka_unit_test(test_force_clamp_and_nan),
       cmocka_unit_test(test_needle_mass_closed_form),
       cmocka_unit_test(test_needle_held_and_released),
+      cmocka_unit_test(test_needle_handover),
       cmocka_unit_test(test_needle_rests_on_the_table),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
