@@ -21,7 +21,7 @@ static const char* names[] = {"thumb_forceps", "needle_holder", "metzenbaum_scis
 
 static char* asset(const char* name) {
   static char path[1024];
-  snprintf(path, sizeof path, "%s/%s.urdf", TX_ASSET_DIR, name);
+  snprintf(path, sizeof path, "%s/%s.urdf", TX_INSTRUMENT_DIR, name);
   return path;
 }
 
@@ -62,7 +62,7 @@ static const char* mutated2(const char* name, const char* from, const char* to, 
   if (!without_meshes) {
     char link[128];
     snprintf(link, sizeof link, "%s/meshes", dir);
-    assert_int_equal(symlink(TX_ASSET_DIR "/meshes", link), 0);
+    assert_int_equal(symlink(TX_INSTRUMENT_DIR "/meshes", link), 0);
   }
   return urdf_path;
 }

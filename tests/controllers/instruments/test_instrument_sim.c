@@ -18,7 +18,7 @@
 
 static tx_instrument_desc* load(const char* name) {
   char path[1024];
-  snprintf(path, sizeof path, "%s/%s.urdf", TX_ASSET_DIR, name);
+  snprintf(path, sizeof path, "%s/%s.urdf", TX_INSTRUMENT_DIR, name);
   tx_instrument_desc* d = tx_instrument_desc_load(path);
   if (!d) fail_msg("%s", tx_error());
   return d;
