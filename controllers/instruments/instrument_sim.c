@@ -359,6 +359,7 @@ void tx_instrument_world_destroy(tx_instrument_world* w) {
   dSpaceDestroy(w->space); // and its geoms
   dWorldDestroy(w->world); // and its bodies and joints
   free(w);
+  dCleanupODEAllDataForThread(); // this thread's ODE data (it may not be the one that made the world)
   dCloseODE();
 }
 

@@ -62,7 +62,8 @@ typedef struct tx_instrument_world tx_instrument_world;
 // start[i] (identity orientation), jaws closed. The caller keeps the urdfs
 // alive while the world lives. NULL with tx_error() set when ODE cannot be
 // started or a description has more than TX_INSTRUMENT_LINKS_MAX links.
-// ODE keeps per-thread data: create, step and destroy on one thread.
+// ODE keeps per-thread data: create, step and destroy on one thread (destroy
+// frees the calling thread's).
 tx_instrument_world* tx_instrument_world_create(const tx_instrument_sim_params* p, const tx_urdf* const* urdfs, int n,
                                                 const double (*start)[3]);
 void tx_instrument_world_destroy(tx_instrument_world* w);

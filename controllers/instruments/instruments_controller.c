@@ -217,6 +217,9 @@ static void finish(tx_ctx* c, void* self) {
     tx_set_result(c, m->grasps, m->grasps_seen);
     tx_set_result(c, m->releases, m->releases_seen);
   }
+  // the world goes on the thread that made and stepped it, with ODE's data for that thread
+  tx_instrument_world_destroy(m->world);
+  m->world = NULL;
   tx_set_result(c, m->contacts_max, m->contacts_most);
   tx_set_result(c, m->force_max, m->force_most);
 }
