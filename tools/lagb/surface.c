@@ -80,6 +80,19 @@ static gint revert(gpointer item, gpointer data) {
   return 0;
 }
 
+// GTS orders its edge collapses by cost in a heap filled in the order of a
+// hash table of pointers: equal costs (a smooth mask on a grid has many)
+// would collapse in an order that changes from run to run. A tiny term from
+// the edge's midpoint makes every cost distinct, and the output reproducible.
+static gdouble cost(gpointer item, gpointer data) {
+  GtsEdge* e = item;
+  GtsPoint *a = GTS_POINT(GTS_SEGMENT(e)->v1), *b = GTS_POINT(GTS_SEGMENT(e)->v2);
+  double h = sin(12.9898 * (a->x + b->x) + 78.233 * (a->y + b->y) + 37.719 * (a->z + b->z)) * 43758.5453;
+  h -= floor(h);
+  gdouble c = gts_volume_optimized_cost(e, data);
+  return c * (1 + 1e-9 * h) + 1e-30 * h;
+}
+
 // decimate: a closed surface of F triangles has 3F/2 edges. The cost is
 // Lindstrom and Turk's (volume and boundary preserved); folds over 1 degree
 // are refused.
@@ -87,23 +100,58 @@ static void coarsen(GtsSurface* s, int faces) {
   if ((int)gts_surface_face_number(s) <= faces) return;
   GtsVolumeOptimizedParams params = {0.5, 0.5, 1e-9};
   guint edges = (guint)(faces / 2 * 3);
-  gts_surface_coarsen(s, (GtsKeyFunc)gts_volume_optimized_cost, &params, (GtsCoarsenFunc)gts_volume_optimized_vertex,
-                      &params, (GtsStopFunc)gts_coarsen_stop_number, &edges, M_PI / 180.0);
+  gts_surface_coarsen(s, cost, &params, (GtsCoarsenFunc)gts_volume_optimized_vertex, &params,
+                      (GtsStopFunc)gts_coarsen_stop_number, &edges, M_PI / 180.0);
 }
 
+static const double* sort_v;  // qsort has no context argument
+static int by_position(const void* a, const void* b) {
+  const double *p = sort_v + 3 * *(const int*)a, *q = sort_v + 3 * *(const int*)b;
+  for (int k = 0; k < 3; k++)
+    if (p[k] != q[k]) return p[k] < q[k] ? -1 : 1;
+  return 0;
+}
+static int by_corners(const void* a, const void* b) {
+  const int *p = a, *q = b;
+  for (int k = 0; k < 3; k++)
+    if (p[k] != q[k]) return p[k] < q[k] ? -1 : 1;
+  return 0;
+}
+
+// the surface out of GTS, numbered in a canonical order (vertices by
+// position, triangles by their vertices), not in GTS's hash-table order
 static bool from_gts(GtsSurface* s, tx_trimesh* out) {
   *out = (tx_trimesh){0};
   int nv = (int)gts_surface_vertex_number(s), nt = (int)gts_surface_face_number(s);
   out->v = malloc((size_t)nv * 3 * sizeof(double));
   out->t = malloc((size_t)nt * 3 * sizeof(int));
-  if (!out->v || !out->t) {
+  int* order = malloc((size_t)(nv > 0 ? nv : 1) * sizeof(int));
+  int* rank = malloc((size_t)(nv > 0 ? nv : 1) * sizeof(int));
+  double* v = malloc((size_t)(nv > 0 ? nv : 1) * 3 * sizeof(double));
+  if (!out->v || !out->t || !order || !rank || !v) {
     tx_trimesh_free(out);
+    free(order), free(rank), free(v);
     tx_set_error("out of memory for a surface of %d triangles", nt);
     return false;
   }
   gts_surface_foreach_vertex(s, number_vertex, out);
   gts_surface_foreach_face(s, take_face, out);
   gts_surface_foreach_vertex(s, clear_reserved, NULL);
+  for (int i = 0; i < nv; i++) order[i] = i;
+  sort_v = out->v;
+  qsort(order, (size_t)nv, sizeof(int), by_position);
+  for (int i = 0; i < nv; i++) rank[order[i]] = i, memcpy(v + 3 * i, out->v + 3 * order[i], 3 * sizeof(double));
+  memcpy(out->v, v, (size_t)nv * 3 * sizeof(double));
+  for (int i = 0; i < nt; i++) {
+    int* t = out->t + 3 * i;
+    int a = rank[t[0]], b = rank[t[1]], c = rank[t[2]];
+    // the smallest first, the orientation kept
+    if (a < b && a < c) t[0] = a, t[1] = b, t[2] = c;
+    else if (b < c) t[0] = b, t[1] = c, t[2] = a;
+    else t[0] = c, t[1] = a, t[2] = b;
+  }
+  qsort(out->t, (size_t)nt, 3 * sizeof(int), by_corners);
+  free(order), free(rank), free(v);
   return true;
 }
 
@@ -255,11 +303,6 @@ bool tx_lagb_tets(const tx_trimesh* surface, int target, const char* prefix, con
     tx_set_error("tets = %d: ask for at least 4", target);
     return false;
   }
-  GtsSurface* full = to_gts(surface);
-  if (!full) {
-    tx_set_error("out of memory for a surface of %d triangles", surface->nt);
-    return false;
-  }
   const char* sw = "-pYq1.6/10zQ";
   snprintf(st->switches, sizeof st->switches, "%s", sw);
   // the count goes about as the triangles of the boundary: scale them by
@@ -268,8 +311,13 @@ bool tx_lagb_tets(const tx_trimesh* surface, int target, const char* prefix, con
   tx_trimesh best_hull = {0};
   bool ok = true;
   for (int run = 0; run < MAX_RUNS && ok; run++) {
-    GtsSurface* s = gts_surface_new(gts_surface_class(), gts_face_class(), gts_edge_class(), gts_vertex_class());
-    gts_surface_copy(s, full);
+    // built afresh each time: a copy would follow a hash table's order
+    GtsSurface* s = to_gts(surface);
+    if (!s) {
+      tx_set_error("out of memory for a surface of %d triangles", surface->nt);
+      ok = false;
+      break;
+    }
     coarsen(s, faces);
     tx_trimesh hull;
     ok = from_gts(s, &hull);
@@ -300,7 +348,6 @@ bool tx_lagb_tets(const tx_trimesh* surface, int target, const char* prefix, con
   if (ok && last != best) ok = tx_lagb_tetgen(&best_hull, prefix, sw, tetgen, &last);
   if (ok) st->tets = best, st->hull_faces = best_hull.nt;
   tx_trimesh_free(&best_hull);
-  gts_object_destroy(GTS_OBJECT(full));
   st->seconds = now() - t0;
   return ok;
 }

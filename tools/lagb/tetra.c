@@ -6,6 +6,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
@@ -39,14 +40,19 @@ static void last_words(const char* log, char* out, size_t n) {
   fclose(f);
 }
 
-// runs tetgen SWITCHES OFF with its output in LOG; its status, or -1
-static int run_tetgen(const char* tetgen, const char* sw, const char* off, const char* log) {
+// runs tetgen SWITCHES surf.off in DIR with its output in DIR/log; its
+// status, or -1. In DIR, so that the comment tetgen writes into its files
+// names surf.off and not a temporary folder: the files are reproducible.
+static int run_tetgen(const char* tetgen, const char* sw, const char* dir) {
+  char exe[PATH_MAX];
+  if (!realpath(tetgen, exe)) return -1;
   pid_t pid = fork();
   if (pid < 0) return -1;
   if (pid == 0) {
-    int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (chdir(dir) != 0) _exit(126);
+    int fd = open("log", O_WRONLY | O_CREAT | O_TRUNC, 0644);
     if (fd >= 0) dup2(fd, 1), dup2(fd, 2), close(fd);
-    execl(tetgen, "tetgen", sw, off, (char*)NULL);
+    execl(exe, "tetgen", sw, "surf.off", (char*)NULL);
     _exit(127);
   }
   // a guard against a run that does not end
@@ -110,7 +116,7 @@ bool tx_lagb_tetgen(const tx_trimesh* s, const char* prefix, const char* switche
     remove_work(dir);
     return false;
   }
-  int rc = run_tetgen(tetgen, switches, off, log);
+  int rc = run_tetgen(tetgen, switches, dir);
   int n = rc == 0 ? ele_count(ele) : -1;
   if (n <= 0) {
     char words[300];
