@@ -27,6 +27,8 @@ static const struct {
      "the skin against closed-form membranes (disc load, own weight), rupture under refinement, gravity sag"},
     {"skin-accuracy", tx_study_skin_accuracy,
      "spacing, iterations and step refined together: observed order, Richardson reference, error vs CPU time"},
+    {"organ-hemisphere", tx_study_organ_hemisphere,
+     "a hemisphere indented at its pole: Bullet FEM and links against Hertz, Richardson, error vs CPU time (Fig. 14)"},
 };
 
 // the studies that take a FILE after their name

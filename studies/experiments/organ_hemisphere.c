@@ -15,9 +15,18 @@ void tx_hemisphere_free(tx_hemisphere_mesh* m) {
 }
 
 bool tx_hemisphere_build(double radius, int n, tx_hemisphere_mesh* m) {
+  return tx_hemisphere_build_graded(radius, n, 1, m);
+}
+
+// t in [-1, 1] (or [0, 1]) pulled toward 0: |t|^grade with its sign
+static double pull(double t, double grade) { return t < 0 ? -pow(-t, grade) : pow(t, grade); }
+
+bool tx_hemisphere_build_graded(double radius, int n, double grade, tx_hemisphere_mesh* m) {
   *m = (tx_hemisphere_mesh){0};
-  if (!(radius > 0 && radius < 10) || n < 1 || n > 64) {
-    tx_set_error("hemisphere: radius %g m and %d cells per radius: need 0 < R < 10 m and 1 to 64 cells", radius, n);
+  if (!(radius > 0 && radius < 10) || n < 1 || n > 64 || !(grade >= 1 && grade <= 3)) {
+    tx_set_error("hemisphere: radius %g m, %d cells per radius, grading %g: need 0 < R < 10 m, 1 to 64 cells, "
+                 "grading 1 to 3",
+                 radius, n, grade);
     return false;
   }
   int nx = 2 * n + 1, ny = n + 1;
@@ -36,7 +45,8 @@ bool tx_hemisphere_build(double radius, int n, tx_hemisphere_mesh* m) {
   for (int k = 0; k < nx; k++)
     for (int j = 0; j < ny; j++)
       for (int i = 0; i < nx; i++) {
-        double x = -1 + (double)i / n, y = (double)j / n, z = -1 + (double)k / n;
+        double x = pull(-1 + (double)i / n, grade), y = 1 - pull(1 - (double)j / n, grade);
+        double z = pull(-1 + (double)k / n, grade);
         double x2 = x * x, y2 = y * y, z2 = z * z;
         int id = (k * ny + j) * nx + i;
         double* p = m->v + 3 * id;

@@ -29,6 +29,10 @@ typedef struct tx_hemisphere_mesh {
 } tx_hemisphere_mesh;
 
 bool tx_hemisphere_build(double radius, int n, tx_hemisphere_mesh* m);
+// the same with the cells graded toward the pole, where the indenter
+// presses: the cube's coordinates pulled toward x = z = 0 and y = 1 as
+// |t|^GRADE (1: uniform); refining n at one grading refines every element alike
+bool tx_hemisphere_build_graded(double radius, int n, double grade, tx_hemisphere_mesh* m);
 void tx_hemisphere_free(tx_hemisphere_mesh* m);
 
 // Hertz: a rigid flat pressed a depth d into an elastic sphere of radius R
