@@ -3,8 +3,8 @@
 //
 // Two models: Bullet's FEM deformables (btDeformableMultiBodyDynamicsWorld
 // with the corotated or the stable Neo-Hookean force, explicit integration:
-// setImplicit(true) diverged at 1-5 ms steps on a small test, explicit was
-// stable), or Bullet's classic soft body (links along the tetrahedra's edges
+// setImplicit(true) has been seen to diverge at 1-5 ms steps on a small test
+// where explicit steps were stable), or Bullet's classic soft body (links along the tetrahedra's edges
 // and volume conservation, solved by iterations: the closest open analogue of
 // the PhysX soft body of the LAGB paper).
 //
