@@ -31,13 +31,13 @@
 #include <string.h>
 #include <time.h>
 
+static json_t* num(double v) { return isfinite(v) ? json_real(v) : json_null(); }
+
+#if TX_WITH_BULLET
 enum { DEPTHS = 5, LEVELS = 3, LINK_RUNS = 4 };
 
 static const double RADIUS = 0.02, YOUNG = 5e3, NU = 0.45, GRADE = 1.5;
 
-static json_t* num(double v) { return isfinite(v) ? json_real(v) : json_null(); }
-
-#if TX_WITH_BULLET
 typedef struct run_result {
   int tets;
   double dt;             // s
