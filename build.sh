@@ -67,7 +67,8 @@ case "$target" in
 
     say "core only: every optional part off"
     build_variant build-core -DCMAKE_BUILD_TYPE=Release -DTX_WITH_BULLET=OFF -DTX_WITH_ODE=OFF -DTX_WITH_ASSIMP=OFF -DTX_WITH_URDFDOM=OFF \
-      -DTX_WITH_OSMESA=OFF -DTX_WITH_GLFW=OFF -DTX_WITH_DDS=OFF -DTX_WITH_PLPLOT=OFF
+      -DTX_WITH_OSMESA=OFF -DTX_WITH_GLFW=OFF -DTX_WITH_DDS=OFF -DTX_WITH_PLPLOT=OFF \
+      -DTX_WITH_GTS=OFF -DTX_WITH_NIFTI=OFF
     test_variant build-core
 
     say "libFuzzer: the scenario loader, the device packet decoder, the recording and waypoint readers and the sim spec, ${fuzz_seconds} s each"

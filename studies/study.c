@@ -29,6 +29,8 @@ static const struct {
      "virtual coupling stiffness bound at 1 kHz vs haptic-stability's; a 10 m/s hand, slammed jaws, a squeezed needle"},
     {"skin-accuracy", tx_study_skin_accuracy,
      "spacing, iterations and step refined together: observed order, Richardson reference, error vs CPU time"},
+    {"organ-hemisphere", tx_study_organ_hemisphere,
+     "a hemisphere indented at its pole: Bullet FEM and links against Hertz, Richardson, error vs CPU time (Fig. 14)"},
 };
 
 // the studies that take a FILE after their name

@@ -1,0 +1,72 @@
+// Internal: a tetrahedral soft body on Bullet, behind a C interface, for the
+// organs (liver, stomach) and the organ-hemisphere check.
+//
+// Two models: Bullet's FEM deformables (btDeformableMultiBodyDynamicsWorld
+// with the corotated or the stable Neo-Hookean force, explicit integration:
+// setImplicit(true) has been seen to diverge at 1-5 ms steps on a small test
+// where explicit steps were stable), or Bullet's classic soft body (links along the tetrahedra's edges
+// and volume conservation, solved by iterations: the closest open analogue of
+// the PhysX soft body of the LAGB paper).
+//
+//   tx_fem_def d = tx_fem_def_default();
+//   tx_fem* b = tx_fem_create(&d, nodes, nv, tets, ne);   // NULL: tx_error() says why
+//   tx_fem_fix(b, i);                                       // a node held where it is
+//   tx_fem_set_plate(b, y);                                 // a frictionless rigid plate above
+//   tx_fem_step(b, 100);
+//   double f = tx_fem_plate_force(b);                       // N, pushing the plate up
+//   tx_fem_destroy(b);
+#ifndef TX_CONTROLLERS_ORGANS_BULLET_FEM_H
+#define TX_CONTROLLERS_ORGANS_BULLET_FEM_H
+
+#include <stdbool.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum tx_fem_model {
+  TX_FEM_COROTATED,   // FEM deformable, corotated linear elasticity
+  TX_FEM_NEOHOOKEAN,  // FEM deformable, stable Neo-Hookean (Smith et al. 2018)
+  TX_FEM_LINKS,       // classic soft body: edge links and volume conservation
+} tx_fem_model;
+
+typedef struct tx_fem_def {
+  tx_fem_model model;
+  double young;        // Young's modulus, Pa (FEM models)
+  double poisson;      // Poisson's ratio, below 0.5 (FEM models)
+  double density;      // kg/m^3
+  double damping;      // mass-proportional velocity damping, 1/s (moves nothing at rest)
+  double dt;           // time step, s; 0: a stable explicit step from the mesh (FEM models)
+  bool mass_scaling;   // quasi-static only: thin elements made heavier, so that the step is set by the
+                       // median element, not the thinnest (a static answer does not depend on the masses)
+  int iterations;      // links: position iterations per step
+  double link_stiffness;  // links: Bullet's kLST, 0 to 1
+  double volume_stiffness;  // links: Bullet's kVC (volume conservation), >= 0
+} tx_fem_def;
+
+tx_fem_def tx_fem_def_default(void);
+
+typedef struct tx_fem tx_fem;
+
+// nodes (nv x 3, m), tets (ne x 4, zero-based, TetGen's orientation)
+tx_fem* tx_fem_create(const tx_fem_def* d, const double* nodes, int nv, const int* tets, int ne);
+void tx_fem_destroy(tx_fem* b);
+
+void tx_fem_fix(tx_fem* b, int node);
+// a rigid frictionless plate whose underside is the plane y = Y: nodes are
+// kept at or below it, and what it takes to keep them is its force
+void tx_fem_set_plate(tx_fem* b, double y);
+// false when a position or velocity stopped being finite
+bool tx_fem_step(tx_fem* b, int steps);
+
+double tx_fem_dt(const tx_fem* b);          // s, the step in use
+double tx_fem_plate_force(const tx_fem* b); // N, upward, averaged over the last tx_fem_step's steps
+double tx_fem_kinetic(const tx_fem* b);     // J
+int tx_fem_plate_contacts(const tx_fem* b); // nodes on the plate
+void tx_fem_positions(const tx_fem* b, double* out);  // (nv x 3), m
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,286 @@
+// tactus study organ-hemisphere: the LAGB paper's check of its soft bodies
+// (its Figure 14). A hemisphere (R = 2 cm, E = 5 kPa, nu = 0.45) with its
+// base fixed is indented at its pole by a rigid frictionless plate, on
+// Bullet's FEM deformables (corotated) at three refinements and on Bullet's
+// classic soft body (links) at several iteration counts. The force against
+// Hertz, F = (4/3) E / (1 - nu^2) sqrt(R) d^(3/2) ((16/9) E sqrt(R) d^(3/2)
+// at nu = 0.5); the force's observed order and Richardson limit; the
+// deformation profile against the finest FEM mesh; error against CPU time.
+// Quasi-static: each depth is held until the body is at rest (mass-scaled
+// explicit steps, damping), so the answers do not depend on density or time.
+// Writes organ-hemisphere.csv, .json and .png.
+#include "studies.h"
+
+#include "experiments/organ_hemisphere.h"
+#include "../scenarios/command.h"
+#include "../views/plot.h"
+#include "../views/report.h"
+#include "../model/error.h"
+
+#include <tactus/config.h>
+#include <tactus/model.h>
+
+#if TX_WITH_BULLET
+#include "../controllers/organs/bullet/fem.h"
+#endif
+
+#include <jansson.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static json_t* num(double v) { return isfinite(v) ? json_real(v) : json_null(); }
+
+#if TX_WITH_BULLET
+enum { DEPTHS = 5, LEVELS = 3, LINK_RUNS = 4 };
+
+static const double RADIUS = 0.02, YOUNG = 5e3, NU = 0.45, GRADE = 1.5;
+
+typedef struct run_result {
+  int tets;
+  double dt;             // s
+  double cpu;            // s
+  double force[DEPTHS];  // N, at d / R = 0.02 .. 0.10
+  double* profile;       // (meridian nodes) vertical displacement at d / R = 0.1, m
+  bool finite;
+} run_result;
+
+static double cpu_now(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+// the meridian in the plane z = 0 from the pole to the base rim: the top
+// face's nodes i = n..2n (j = n), then the side's j = n-1..0 (i = 2n); at
+// refinement n its node s is the coarse mesh's node s / 2 (the grids nest)
+static int meridian(const tx_hemisphere_mesh* m, int* ids) {
+  int n = m->n, nx = 2 * n + 1, ny = n + 1, c = 0;
+  for (int i = n; i <= 2 * n; i++) ids[c++] = (n * ny + n) * nx + i;
+  for (int j = n - 1; j >= 0; j--) ids[c++] = (n * ny + j) * nx + 2 * n;
+  return c;
+}
+
+// indent to each depth in turn, each ramped over half a settling time and
+// then held for one, the force averaged over the last quarter
+static bool indent(const tx_fem_def* d, int n, run_result* r) {
+  tx_hemisphere_mesh m;
+  if (!tx_hemisphere_build_graded(RADIUS, n, GRADE, &m)) return false;
+  tx_fem* b = tx_fem_create(d, m.v, m.nv, m.e, m.ne);
+  if (!b) {
+    tx_hemisphere_free(&m);
+    return false;
+  }
+  for (int i = 0; i < m.nv; i++)
+    if (m.base[i]) tx_fem_fix(b, i);
+  r->tets = m.ne;
+  r->dt = tx_fem_dt(b);
+  r->finite = true;
+  double wave = sqrt(YOUNG * (1 - NU) / ((1 + NU) * (1 - 2 * NU)) / d->density);
+  int settle = (int)ceil(8 * RADIUS / wave / r->dt);
+  if (d->model == TX_FEM_LINKS) settle = 400;
+  double t0 = cpu_now();
+  for (int l = 0; l < DEPTHS && r->finite; l++) {
+    double from = RADIUS - 0.02 * l * RADIUS, to = RADIUS - 0.02 * (l + 1) * RADIUS;
+    for (int s = 1; s <= settle / 2 && r->finite; s++) {
+      tx_fem_set_plate(b, from + (to - from) * s / (settle / 2));
+      r->finite = tx_fem_step(b, 1);
+    }
+    r->finite = r->finite && tx_fem_step(b, settle - settle / 4) && tx_fem_step(b, settle / 4);
+    r->force[l] = tx_fem_plate_force(b);
+  }
+  r->cpu = cpu_now() - t0;
+  int ids[200];
+  int c = meridian(&m, ids);
+  double* x = malloc((size_t)m.nv * 3 * sizeof(double));
+  r->profile = malloc((size_t)c * sizeof(double));
+  if (x && r->profile) {
+    tx_fem_positions(b, x);
+    for (int s = 0; s < c; s++) r->profile[s] = x[3 * ids[s] + 1] - m.v[3 * ids[s] + 1];
+  }
+  free(x);
+  tx_fem_destroy(b);
+  tx_hemisphere_free(&m);
+  if (!r->profile) tx_set_error("organ-hemisphere: out of memory");
+  return r->profile != NULL;
+}
+
+// RMS over the coarse mesh's meridian nodes of the difference to a finer
+// mesh's (at refinement ratio `step`), over the indentation depth
+static double profile_error(const double* coarse, int n_coarse, const double* fine, int step, double depth) {
+  int c = 2 * n_coarse + 1;
+  double s = 0;
+  for (int k = 0; k < c; k++) s += pow(coarse[k] - fine[k * step], 2);
+  return sqrt(s / c) / depth;
+}
+#endif
+
+int tx_study_organ_hemisphere(const tx_study_args* a) {
+  bool quick = false;
+  for (int i = 0; i < a->nsets; i++) {
+    const char* eq = strchr(a->sets[i], '=');
+    double v;
+    if (!eq || (size_t)(eq - a->sets[i]) != 5 || strncmp(a->sets[i], "quick", 5) != 0)
+      return tx_bad_input("--set %s: unknown key (known: quick)", a->sets[i]);
+    if (!tx_parse_num(eq + 1, 0, 1, &v) || (v != 0 && v != 1)) return tx_bad_input("--set %s: expected 0 or 1", a->sets[i]);
+    quick = v == 1;
+  }
+#if !TX_WITH_BULLET
+  (void)num, (void)quick;
+  return tx_bad_input("study organ-hemisphere: this build has no Bullet (configured with TX_WITH_BULLET=OFF)");
+#else
+  // refinements at ratio 2 (cells per radius); quick: the coarsest three
+  const int full_levels[LEVELS] = {2, 4, 8}, quick_levels[LEVELS] = {1, 2, 4};
+  const int* levels = quick ? quick_levels : full_levels;
+  const int link_iterations[LINK_RUNS] = {2, 5, 10, 20};
+  const int link_n = levels[1];
+  printf("study organ-hemisphere: R = %g cm, E = %g kPa, nu = %g, base fixed, a rigid frictionless plate at the pole%s\n\n",
+         RADIUS * 1e2, YOUNG * 1e-3, NU, quick ? ", quick" : "");
+
+  char csv_path[4200], tmp[4300];
+  snprintf(csv_path, sizeof csv_path, "%s/organ-hemisphere.csv", a->out_dir);
+  snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
+  FILE* csv = fopen(tmp, "w");
+  if (!csv) return tx_bad_input("--out %s: cannot write organ-hemisphere.csv", a->out_dir);
+  fprintf(csv, "model,cells_per_radius,tetrahedra,iterations,dt_s,cpu_s,d_over_r,force_n,hertz_n,force_error,profile_error\n");
+
+  run_result fem[LEVELS] = {{0}}, links[LINK_RUNS] = {{0}};
+  tx_fem_def d = tx_fem_def_default();
+  d.young = YOUNG, d.poisson = NU, d.mass_scaling = true;
+  d.damping = 4 * sqrt(YOUNG * (1 - NU) / ((1 + NU) * (1 - 2 * NU)) / d.density) / RADIUS;  // about critical, lowest mode
+  bool ok = true;
+  for (int l = 0; l < LEVELS && ok; l++) {
+    ok = indent(&d, levels[l], &fem[l]);
+    if (ok) printf("  FEM corotated, %2d cells per radius, %6d tetrahedra: %.2f s of CPU\n", levels[l], fem[l].tets, fem[l].cpu);
+    fflush(stdout);
+  }
+  tx_fem_def dl = d;
+  dl.model = TX_FEM_LINKS, dl.dt = 1e-3, dl.damping = 20, dl.mass_scaling = false;
+  for (int k = 0; k < LINK_RUNS && ok; k++) {
+    dl.iterations = link_iterations[k];
+    ok = indent(&dl, link_n, &links[k]);
+  }
+  if (!ok) {
+    fclose(csv), remove(tmp);
+    for (int l = 0; l < LEVELS; l++) free(fem[l].profile);
+    for (int k = 0; k < LINK_RUNS; k++) free(links[k].profile);
+    return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
+  }
+
+  // FEM: force against Hertz at each depth and refinement
+  const int top = LEVELS - 1;
+  double depth_max = 0.1 * RADIUS;
+  printf("\n  force (N) against Hertz; FEM by refinement, and Richardson's limit from the three\n  %6s %10s", "d/R",
+         "Hertz");
+  for (int l = 0; l < LEVELS; l++) printf("   n=%-2d %6s", levels[l], "error");
+  printf(" %6s %9s %6s\n", "order", "limit", "error");
+  bool limits_within = true;
+  bool all_finite = true;
+  json_t* jdepths = json_array();
+  for (int i = 0; i < DEPTHS; i++) {
+    double dd = 0.02 * (i + 1) * RADIUS, h = tx_hertz_force(YOUNG, NU, RADIUS, dd);
+    printf("  %6.2f %10.5f", dd / RADIUS, h);
+    json_t* jl = json_array();
+    for (int l = 0; l < LEVELS; l++) {
+      double e = fem[l].force[i] / h - 1;
+      all_finite &= fem[l].finite && isfinite(fem[l].force[i]);
+      printf(" %8.5f %5.1f%%", fem[l].force[i], 100 * e);
+      json_array_append_new(jl, num(fem[l].force[i]));
+    }
+    double p = tx_observed_order(fem[0].force[i], fem[1].force[i], fem[2].force[i], 2);
+    double lim = isfinite(p) ? tx_richardson(fem[1].force[i], fem[2].force[i], 2, p) : NAN;
+    limits_within &= fabs(lim / h - 1) <= 0.10;
+    printf(" %6.2f %9.5f %5.1f%%\n", p, lim, 100 * (lim / h - 1));
+    json_array_append_new(jdepths, json_pack("{s:f,s:f,s:o,s:o,s:o}", "d_over_r", dd / RADIUS, "hertz_n", h, "fem_force_n",
+                                             jl, "observed_order", num(p), "richardson_limit_n", num(lim)));
+  }
+  // Richardson on the force at d / R = 0.1
+  double f1 = fem[0].force[DEPTHS - 1], f2 = fem[1].force[DEPTHS - 1], f3 = fem[2].force[DEPTHS - 1];
+  double order = tx_observed_order(f1, f2, f3, 2);
+  double limit = isfinite(order) ? tx_richardson(f2, f3, 2, order) : NAN;
+  double hertz_max = tx_hertz_force(YOUNG, NU, RADIUS, depth_max);
+  double finest_error = f3 / hertz_max - 1, limit_error = limit / hertz_max - 1;
+  bool within = fabs(finest_error) <= 0.10;
+  printf("\n  at d/R = 0.1: observed order %.2f, Richardson limit %.5f N (%+.1f%% from Hertz); finest mesh %+.1f%%:"
+         " within 10%%: %s\n  Richardson's limit within 10%% of Hertz at every d/R <= 0.1: %s\n",
+         order, limit, 100 * limit_error, 100 * finest_error, within ? "yes" : "NO", limits_within ? "yes" : "NO");
+
+  // profiles against the finest FEM mesh, and error against CPU time
+  double cpu_x[LEVELS + LINK_RUNS], err_y[LEVELS + LINK_RUNS];
+  printf("\n  error against run time (profile: RMS over the meridian against the finest FEM mesh, over d)\n"
+         "  %-10s %6s %10s %8s %10s %12s %10s\n",
+         "model", "tets", "iterations", "dt us", "CPU s", "force error", "profile");
+  json_t* jruns = json_array();
+  int np = 0;
+  for (int l = 0; l < LEVELS; l++) {
+    double fe = fem[l].force[DEPTHS - 1] / hertz_max - 1;
+    double pe = l < top ? profile_error(fem[l].profile, levels[l], fem[top].profile, levels[top] / levels[l], depth_max) : 0;
+    printf("  %-10s %6d %10s %8.1f %10.3f %11.1f%% %9.2f%%\n", "FEM", fem[l].tets, "-", fem[l].dt * 1e6, fem[l].cpu, 100 * fe,
+           100 * pe);
+    char pe_text[32] = "";  // the finest is the reference: no error of its own
+    if (l < top) snprintf(pe_text, sizeof pe_text, "%.6g", pe);
+    for (int i = 0; i < DEPTHS; i++) {
+      double dd = 0.02 * (i + 1) * RADIUS, h = tx_hertz_force(YOUNG, NU, RADIUS, dd);
+      fprintf(csv, "fem_corotated,%d,%d,,%.6g,%.6g,%.2f,%.9g,%.9g,%.6g,%s\n", levels[l], fem[l].tets, fem[l].dt, fem[l].cpu,
+              dd / RADIUS, fem[l].force[i], h, fem[l].force[i] / h - 1, pe_text);
+    }
+    json_array_append_new(jruns, json_pack("{s:s,s:i,s:i,s:f,s:f,s:o,s:o}", "model", "fem_corotated", "cells_per_radius",
+                                           levels[l], "tetrahedra", fem[l].tets, "dt_s", fem[l].dt, "cpu_s", fem[l].cpu,
+                                           "force_error_at_0_1", num(fe), "profile_error", l < top ? num(pe) : json_null()));
+    if (l < top) cpu_x[np] = fem[l].cpu, err_y[np++] = 100 * pe;
+  }
+  int nfem = np;
+  for (int k = 0; k < LINK_RUNS; k++) {
+    double fe = links[k].force[DEPTHS - 1] / hertz_max - 1;
+    double pe = profile_error(links[k].profile, link_n, fem[top].profile, levels[top] / link_n, depth_max);
+    all_finite &= links[k].finite;
+    printf("  %-10s %6d %10d %8.1f %10.3f %11.1f%% %9.2f%%\n", "links", links[k].tets, link_iterations[k],
+           links[k].dt * 1e6, links[k].cpu, 100 * fe, 100 * pe);
+    for (int i = 0; i < DEPTHS; i++) {
+      double dd = 0.02 * (i + 1) * RADIUS, h = tx_hertz_force(YOUNG, NU, RADIUS, dd);
+      fprintf(csv, "links,%d,%d,%d,%.6g,%.6g,%.2f,%.9g,%.9g,%.6g,%.6g\n", link_n, links[k].tets, link_iterations[k],
+              links[k].dt, links[k].cpu, dd / RADIUS, links[k].force[i], h, links[k].force[i] / h - 1, pe);
+    }
+    json_array_append_new(jruns, json_pack("{s:s,s:i,s:i,s:i,s:f,s:f,s:o,s:o}", "model", "links", "cells_per_radius",
+                                           link_n, "tetrahedra", links[k].tets, "iterations", link_iterations[k], "dt_s",
+                                           links[k].dt, "cpu_s", links[k].cpu, "force_error_at_0_1", num(fe),
+                                           "profile_error", num(pe)));
+    cpu_x[np] = links[k].cpu, err_y[np++] = 100 * pe;
+  }
+  printf("\n  the links body has no E: its force is set by kLST, the iterations and the step, not by the tissue\n");
+  bool falls = fabs(f2 / hertz_max - 1) < fabs(f1 / hertz_max - 1) && fabs(f3 / hertz_max - 1) < fabs(f2 / hertz_max - 1);
+  printf("  FEM force error falls with refinement: %s; never a NaN: %s\n", falls ? "yes" : "NO", all_finite ? "yes" : "NO");
+
+  for (int l = 0; l < LEVELS; l++) free(fem[l].profile);
+  for (int k = 0; k < LINK_RUNS; k++) free(links[k].profile);
+  if (fclose(csv) != 0 || rename(tmp, csv_path) != 0) {
+    remove(tmp), json_decref(jdepths), json_decref(jruns);
+    return fprintf(stderr, "tactus: %s: cannot write\n", csv_path), 1;
+  }
+  json_t* doc = json_pack("{s:s,s:b,s:{s:f,s:f,s:f,s:f,s:s},s:o,s:o,s:{s:o,s:o,s:o,s:f},s:b,s:b,s:b,s:b}", "study",
+                          "organ-hemisphere", "quick", quick, "case", "radius_m", RADIUS, "young_pa", YOUNG, "poisson",
+                          NU, "grading", GRADE, "hertz", "F = 4/3 E / (1 - nu^2) sqrt(R) d^(3/2)", "depths", jdepths,
+                          "runs", jruns, "richardson_at_0_1", "observed_order", num(order), "limit_n", num(limit),
+                          "limit_error", num(limit_error), "finest_error", finest_error, "fem_error_falls", falls,
+                          "hertz_within_10_percent", within, "finite", all_finite,
+                          "richardson_limits_within_10_percent", limits_within);
+  if (!doc || tx_report_save(doc, a->out_dir, "organ-hemisphere.json")) {
+    json_decref(doc);
+    return fprintf(stderr, "tactus: %s\n", doc ? tx_error() : "organ-hemisphere: out of memory"), 1;
+  }
+  json_decref(doc);
+
+  char png[4200];
+  snprintf(png, sizeof png, "%s/organ-hemisphere.png", a->out_dir);
+  tx_plot_series s[] = {{"FEM (corotated), by refinement", cpu_x, err_y, nfem, true, 1},
+                        {"links, by iterations", cpu_x + nfem, err_y + nfem, np - nfem, true, 2}};
+  tx_plot p = {"Hemisphere indented to d/R = 0.1: profile error against run time", "CPU time (s)",
+               "profile error against the finest FEM mesh (% of d)", true, true, s, 2};
+  bool plotted = tx_plot_png(png, &p) == 0;
+  if (!plotted) fprintf(stderr, "tactus: %s\n", tx_error());
+  printf("\nwrote %s/organ-hemisphere.json, .csv%s\n", a->out_dir, plotted ? ", .png" : "");
+  return all_finite ? 0 : 1;
+#endif
+}

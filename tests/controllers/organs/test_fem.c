@@ -1,0 +1,128 @@
+// The Bullet soft body behind controllers/organs/bullet/fem.h on a small
+// hemisphere: at rest it stays at rest; a plate pressed into its pole pushes
+// back with a positive force that grows with the depth, in both models; a
+// frictionless plate holds the pole on it; bad definitions and an inverted
+// tetrahedron are refused with one line.
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include "controllers/organs/bullet/fem.h"
+#include "studies/experiments/organ_hemisphere.h"
+
+#include <tactus/model.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const double R = 0.02;
+
+static tx_fem* hemisphere(const tx_fem_def* d, tx_hemisphere_mesh* m) {
+  assert_true(tx_hemisphere_build(R, 2, m));
+  tx_fem* b = tx_fem_create(d, m->v, m->nv, m->e, m->ne);
+  assert_non_null(b);
+  for (int i = 0; i < m->nv; i++)
+    if (m->base[i]) tx_fem_fix(b, i);
+  return b;
+}
+
+static tx_fem_def quasi_static(tx_fem_model model) {
+  tx_fem_def d = tx_fem_def_default();
+  d.model = model;
+  d.mass_scaling = model != TX_FEM_LINKS;
+  d.damping = model == TX_FEM_LINKS ? 20 : 800;
+  if (model == TX_FEM_LINKS) d.dt = 1e-3;
+  return d;
+}
+
+static void test_rest_stays(void** state) {
+  (void)state;
+  tx_hemisphere_mesh m;
+  tx_fem_def d = quasi_static(TX_FEM_COROTATED);
+  tx_fem* b = hemisphere(&d, &m);
+  assert_true(tx_fem_dt(b) > 0);
+  assert_true(tx_fem_step(b, 200));
+  double* x = malloc((size_t)m.nv * 3 * sizeof(double));
+  tx_fem_positions(b, x);
+  for (int i = 0; i < m.nv * 3; i++) assert_true(fabs(x[i] - m.v[i]) < 1e-9);
+  assert_true(tx_fem_plate_force(b) == 0);
+  assert_true(tx_fem_kinetic(b) < 1e-12);  // J: Bullet holds floats, its rest is at rest to their rounding
+  free(x);
+  tx_fem_destroy(b);
+  tx_hemisphere_free(&m);
+}
+
+// force at depths 1 and 2 mm, each held until the body is at rest
+static void press(tx_fem_model model) {
+  tx_hemisphere_mesh m;
+  tx_fem_def d = quasi_static(model);
+  tx_fem* b = hemisphere(&d, &m);
+  int steps = model == TX_FEM_LINKS ? 400 : (int)(0.03 / tx_fem_dt(b));
+  double f[2];
+  for (int k = 0; k < 2; k++) {
+    tx_fem_set_plate(b, R - 1e-3 * (k + 1));
+    assert_true(tx_fem_step(b, steps));
+    assert_true(tx_fem_step(b, steps / 4));
+    f[k] = tx_fem_plate_force(b);
+    assert_true(tx_fem_plate_contacts(b) >= 1);
+  }
+  assert_true(f[0] > 0);
+  assert_true(f[1] > 1.5 * f[0]);  // Hertz: 2^(3/2) = 2.8; a coarse mesh, stiffer, at least more than linear
+  double* x = malloc((size_t)m.nv * 3 * sizeof(double));
+  tx_fem_positions(b, x);
+  assert_true(fabs(x[3 * m.pole + 1] - (R - 2e-3)) < 1e-8);  // the pole is held on the plate (floats)
+  for (int i = 0; i < m.nv; i++) assert_true(x[3 * i + 1] <= R - 2e-3 + 1e-8);
+  free(x);
+  tx_fem_destroy(b);
+  tx_hemisphere_free(&m);
+}
+
+static void test_press_corotated(void** state) {
+  (void)state;
+  press(TX_FEM_COROTATED);
+}
+static void test_press_neohookean(void** state) {
+  (void)state;
+  press(TX_FEM_NEOHOOKEAN);
+}
+static void test_press_links(void** state) {
+  (void)state;
+  press(TX_FEM_LINKS);
+}
+
+static void test_refused(void** state) {
+  (void)state;
+  tx_hemisphere_mesh m;
+  assert_true(tx_hemisphere_build(R, 1, &m));
+  tx_fem_def d = tx_fem_def_default();
+  d.poisson = 0.5;
+  assert_null(tx_fem_create(&d, m.v, m.nv, m.e, m.ne));
+  assert_non_null(strstr(tx_error(), "nu"));
+  d = tx_fem_def_default();
+  d.young = NAN;
+  assert_null(tx_fem_create(&d, m.v, m.nv, m.e, m.ne));
+  d = tx_fem_def_default();
+  d.density = 0;
+  assert_null(tx_fem_create(&d, m.v, m.nv, m.e, m.ne));
+  d = tx_fem_def_default();
+  int t = m.e[1];
+  m.e[1] = m.e[2], m.e[2] = t;  // the first tetrahedron turned inside out
+  assert_null(tx_fem_create(&d, m.v, m.nv, m.e, m.ne));
+  assert_non_null(strstr(tx_error(), "tetrahedron 0"));
+  m.e[2] = m.e[1], m.e[1] = t;
+  m.e[0] = m.nv;  // a node that is not there
+  assert_null(tx_fem_create(&d, m.v, m.nv, m.e, m.ne));
+  assert_non_null(strstr(tx_error(), "names node"));
+  tx_hemisphere_free(&m);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_rest_stays),      cmocka_unit_test(test_press_corotated),
+      cmocka_unit_test(test_press_neohookean), cmocka_unit_test(test_press_links),
+      cmocka_unit_test(test_refused),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
