@@ -32,6 +32,7 @@ struct tx_thread {
   double* v;                 // (n x 3) velocities, m/s
   double* xs;                // (n x 3) at the start of the step, for a fault
   double* vs;                // (n x 3)
+  double* v0;                // (n x 3) at the start of the substep
   double* w;                 // (n) inverse masses, 1/kg; 0 for pinned nodes
   double* wf;                // (n) inverse masses of the nodes when free
   double* lam;               // (4 nseg) XPBD multipliers, in the rows of the band below
@@ -58,6 +59,7 @@ struct tx_thread {
   double thickness;
   tx_tri_bvh bvh;
   bool have_bvh;
+  bool move_first;           // edge contacts may move a cylinder's first node
   tx_thread_contacts last;
   int faults;
 };
@@ -166,6 +168,7 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   t->v = calloc(3 * (size_t)n, sizeof(double));
   t->xs = malloc(sizeof(double) * 3 * n);
   t->vs = malloc(sizeof(double) * 3 * n);
+  t->v0 = malloc(sizeof(double) * 3 * n);
   t->w = malloc(sizeof(double) * n);
   t->wf = malloc(sizeof(double) * n);
   t->lam = malloc(sizeof(double) * 4 * nseg);
@@ -180,7 +183,7 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   t->pairs = malloc(sizeof(pair) * t->pair_cap);
   t->colliding = calloc((size_t)nseg, 1);
   t->caps = malloc(sizeof(tx_thread_capsule) * (def->max_shapes + 1));
-  if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->w || !t->wf || !t->lam || !t->band || !t->rhs || !t->dir || !t->pinned || !t->pin || !t->cell_start ||
+  if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->v0 || !t->w || !t->wf || !t->lam || !t->band || !t->rhs || !t->dir || !t->pinned || !t->pin || !t->cell_start ||
       !t->cell_item || !t->seg_cell || !t->pairs || !t->colliding || !t->caps)
     goto oom;
   if (def->max_triangles > 0) {
@@ -215,6 +218,7 @@ void tx_thread_destroy(tx_thread* t) {
   free(t->v);
   free(t->xs);
   free(t->vs);
+  free(t->v0);
   free(t->w);
   free(t->wf);
   free(t->lam);
@@ -445,26 +449,18 @@ static void broadphase(tx_thread* t, double margin) {
             tx_seg_closest_points(p, p + 3, x + 3 * j, x + 3 * j + 3, &cl);
             if (cl.dist >= reach) continue;
             if (t->npairs < t->pair_cap) t->pairs[t->npairs++] = (pair){i, j};
+            // held apart at exactly 2 r, touching cylinders stay marked
+            if (cl.dist < 2 * t->def.radius * 1.01) {
+              t->last.self_pairs++;
+              t->colliding[i] = t->colliding[j] = 1;
+            }
           }
         }
   }
 }
 
-static void solve_self(tx_thread* t, bool mark) {
-  double touch = 2 * t->def.radius * 1.01;
-  for (int k = 0; k < t->npairs; k++) {
-    int i = t->pairs[k].i, j = t->pairs[k].j;
-    if (mark) {
-      tx_seg_closest c;
-      tx_seg_closest_points(t->x + 3 * i, t->x + 3 * i + 3, t->x + 3 * j, t->x + 3 * j + 3, &c);
-      // held apart at exactly 2 r, touching cylinders stay marked
-      if (c.dist < touch) {
-        if (!t->colliding[i] || !t->colliding[j]) t->last.self_pairs++;
-        t->colliding[i] = t->colliding[j] = 1;
-      }
-    }
-    solve_self_pair(t, i, j);
-  }
+static void solve_self(tx_thread* t) {
+  for (int k = 0; k < t->npairs; k++) solve_self_pair(t, t->pairs[k].i, t->pairs[k].j);
 }
 
 // every cylinder against every capsule: the thread moves out to r + R
@@ -573,8 +569,88 @@ static void solve_mesh_node(tx_thread* t, int i) {
   }
 }
 
+// the mesh triangles whose boxes meet [lo, hi]: calls fn on each (its 3 corners)
+typedef void (*tri_fn)(tx_thread* t, int i, const double v[3][3]);
+
+static void for_triangles_near(tx_thread* t, const float lo[3], const float hi[3], int i, tri_fn fn) {
+  const tx_tri_bvh* b = &t->bvh;
+  if (b->nnodes == 0) return;
+  uint32_t stack[BVH_STACK];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const tx_bvh_node* nd = &b->nodes[stack[--top]];
+    if (nd->lo[0] > hi[0] || nd->hi[0] < lo[0] || nd->lo[1] > hi[1] || nd->hi[1] < lo[1] || nd->lo[2] > hi[2] ||
+        nd->hi[2] < lo[2])
+      continue;
+    if (nd->count == 0) {
+      if (top + 2 <= BVH_STACK) {
+        stack[top++] = nd->first;
+        stack[top++] = (uint32_t)(nd - b->nodes) + 1;
+      }
+      continue;
+    }
+    for (uint32_t sl = nd->first; sl < nd->first + nd->count; sl++) {
+      if (b->order[sl] == UINT32_MAX) continue;
+      const int32_t* tv = b->tri + 3 * sl;
+      double v[3][3];
+      for (int c = 0; c < 3; c++)
+        for (int a = 0; a < 3; a++) v[c][a] = t->mx[3 * tv[c] + a];
+      fn(t, i, v);
+    }
+  }
+}
+
+// cylinder i against the three edges of a triangle: a cylinder cannot pass
+// across an edge (the skin's border, a fold), so its nodes cannot end up on
+// two sides of the skin without going round it. The side is the one the
+// cylinder was on at the start of the substep.
+static void edge_contacts(tx_thread* t, int i, const double v[3][3]) {
+  double reach = t->def.radius + 0.5 * t->thickness;
+  double* x = t->x;
+  double wi = t->move_first ? t->w[i] : 0, wj = t->w[i + 1];
+  for (int e = 0; e < 3; e++) {
+    const double *va = v[e], *vb = v[(e + 1) % 3];
+    tx_seg_closest c, c0;
+    tx_seg_closest_points(x + 3 * i, x + 3 * i + 3, va, vb, &c);
+    if (c.dist >= reach) continue;
+    tx_seg_closest_points(t->x0 + 3 * i, t->x0 + 3 * i + 3, va, vb, &c0);
+    double n[3], sep[3] = {c.a[0] - c.b[0], c.a[1] - c.b[1], c.a[2] - c.b[2]};
+    double sep0[3] = {c0.a[0] - c0.b[0], c0.a[1] - c0.b[1], c0.a[2] - c0.b[2]};
+    if (c0.dist > 0 && (c.dist <= 1e-12 * reach || dot3(sep, sep0) < 0)) {
+      for (int a = 0; a < 3; a++) n[a] = sep0[a] / c0.dist;
+    } else if (c.dist > 0) {
+      for (int a = 0; a < 3; a++) n[a] = sep[a] / c.dist;
+    } else {
+      continue;
+    }
+    double ga = wi * (1 - c.t), gb = wj * c.t, den = ga * (1 - c.t) + gb * c.t;
+    if (den <= 0) continue;
+    // move A so that it sits reach from the edge along n
+    for (int a = 0; a < 3; a++) {
+      double delta = n[a] * reach - sep[a];
+      x[3 * i + a] += ga / den * delta;
+      x[3 * i + 3 + a] += gb / den * delta;
+    }
+    t->last.mesh_hits++;
+  }
+}
+
+static void solve_mesh_edges(tx_thread* t, int i) {
+  double reach = t->def.radius + 0.5 * t->thickness;
+  float lo[3], hi[3];
+  const double *p = t->x + 3 * i, *p0 = t->x0 + 3 * i;
+  for (int a = 0; a < 3; a++) {
+    lo[a] = (float)(fmin(fmin(p[a], p[a + 3]), fmin(p0[a], p0[a + 3])) - reach) - 1e-6f;
+    hi[a] = (float)(fmax(fmax(p[a], p[a + 3]), fmax(p0[a], p0[a + 3])) + reach) + 1e-6f;
+  }
+  for_triangles_near(t, lo, hi, i, edge_contacts);
+}
+
 static void solve_mesh(tx_thread* t) {
   if (t->mntri == 0) return;
+  t->move_first = true;
+  for (int i = 0; i < t->nseg; i++) solve_mesh_edges(t, i);
   for (int i = 0; i < t->n; i++)
     if (!t->pinned[i]) solve_mesh_node(t, i);
 }
@@ -604,8 +680,18 @@ static void place_after(tx_thread* t, int i, int from, double len) {
   for (int a = 0; a < 3; a++) p[a] = q[a] + d[a] / l * len;
 }
 
+// against a mesh each node is also kept on its side of it (the continuous
+// test from where it was at the start of the substep): where the two
+// disagree, not crossing the skin wins over the exact length
 static void ftl_forward(tx_thread* t) {
-  for (int i = 1; i < t->n; i++) place_after(t, i, i - 1, t->l0);
+  for (int i = 1; i < t->n; i++) {
+    place_after(t, i, i - 1, t->l0);
+    if (t->mntri) {
+      t->move_first = false; // the leader is placed: only this node moves
+      solve_mesh_edges(t, i - 1);
+      solve_mesh_node(t, i);
+    }
+  }
 }
 
 // FABRIK towards the pins behind the head, the last pass from the head
@@ -628,7 +714,7 @@ static void ftl_substep(tx_thread* t, double h, double margin) {
   if (t->def.self_collision && t->nseg > t->skip + 1) {
     broadphase(t, margin);
     for (int it = 0; it < t->def.iterations; it++) {
-      solve_self(t, it == 0);
+      solve_self(t);
       ftl_solve(t);
     }
   }
@@ -787,11 +873,16 @@ static void rod_substep(tx_thread* t, double h, double margin) {
   if (self) broadphase(t, margin);
   for (int it = 0; it < d->iterations; it++) {
     rod_solve(t, h);
-    if (self) solve_self(t, it == 0);
+    solve_capsules(t);
+    if (self) solve_self(t);
   }
   cap_stretch(t);
-  solve_capsules(t);
-  if (self) solve_self(t, false);
+  // a node moved by one cylinder's push can go back into its neighbour's
+  // capsule: a second pass settles the pair
+  for (int pass = 0; pass < 2; pass++) {
+    solve_capsules(t);
+    if (self) solve_self(t);
+  }
   solve_mesh(t);
   for (int i = 0; i < n; i++)
     for (int a = 0; a < 3; a++) v[3 * i + a] = t->pinned[i] ? 0 : (x[3 * i + a] - t->x0[3 * i + a]) / h;
@@ -808,7 +899,8 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
   memcpy(t->vs, t->v, sizeof(double) * 3 * n);
   memset(t->colliding, 0, (size_t)t->nseg);
   memset(&t->last, 0, sizeof t->last);
-  // substeps: no node (the head included) moves more than r / 2 in one
+  // substeps: the head and, by their last velocities, the nodes move no
+  // more than r / 2 in one
   double move = dist3(t->head_from, t->head_to);
   if (d->model == TX_THREAD_ROD) {
     double vmax2 = 0;
@@ -824,19 +916,40 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
   if (need > sub) sub = need;
   if (sub < 1) sub = 1;
   if (sub > d->max_substeps) sub = d->max_substeps;
-  int ns = (int)sub;
-  double h = dt / ns;
-  for (int k = 1; k <= ns; k++) {
-    double f = (double)k / ns;
+  double h = dt / sub, hmin = dt / d->max_substeps, tau = 0;
+  int ns = 0;
+  // a substep in which a free node moved more than r (a kink springing
+  // back, a whip) is taken again at half the length, down to dt /
+  // max_substeps: the contacts' margin of 2 r covers two nodes that each
+  // moved r, so no cylinder jumps across another's 2 r
+  while (tau < dt * (1 - 1e-12)) {
+    if (h > dt - tau) h = dt - tau;
+    double f = (tau + h) / dt;
     memcpy(t->x0, t->x, sizeof(double) * 3 * n);
+    memcpy(t->v0, t->v, sizeof(double) * 3 * n);
     for (int a = 0; a < 3; a++) t->x[a] = t->head_from[a] + f * (t->head_to[a] - t->head_from[a]);
     for (int i = 1; i < n; i++)
       if (t->pinned[i]) memcpy(t->x + 3 * i, t->pin + 3 * i, sizeof(double) * 3);
-    double margin = move / ns + d->radius;
+    double margin = 2 * d->radius + dist3(t->x, t->x0);
     if (d->model == TX_THREAD_FTL)
       ftl_substep(t, h, margin);
     else
       rod_substep(t, h, margin);
+    ns++;
+    double far2 = 0;
+    for (int i = 1; i < n; i++) {
+      double e[3] = {t->x[3 * i] - t->x0[3 * i], t->x[3 * i + 1] - t->x0[3 * i + 1], t->x[3 * i + 2] - t->x0[3 * i + 2]};
+      double s = dot3(e, e);
+      if (s > far2 && !t->pinned[i]) far2 = s;
+    }
+    if (far2 > d->radius * d->radius && h > hmin * (1 + 1e-9) && ns < 4 * d->max_substeps) {
+      memcpy(t->x, t->x0, sizeof(double) * 3 * n);
+      memcpy(t->v, t->v0, sizeof(double) * 3 * n);
+      h = fmax(0.5 * h, hmin);
+      t->last.retries++;
+      continue;
+    }
+    tau += h;
   }
   memcpy(t->head_from, t->head_to, sizeof(double) * 3);
   t->last.substeps = ns;

@@ -26,10 +26,12 @@
 // contact between cylinders (|AB| < 2 r, segment.h) found through a uniform
 // grid, kinematic capsules and spheres, and a triangle mesh (the skin's
 // SKIN.x / SKIN.tri arrays). A step is split into substeps short enough
-// that no node moves more than r / 2 in one, so neither a fast head nor a
-// fast node jumps across a 2 r contact; against triangles each node's move
-// in a substep is also tested as a segment (continuous), so a node never
-// crosses a triangle whatever its speed.
+// that the head and, by its last velocity, every node move no more than
+// r / 2 in one; a substep in which a free node still moved more than r is
+// taken again at half the length (down to dt / max_substeps). So neither a
+// fast head nor a fast node jumps across a 2 r contact. Against triangles
+// each node's move in a substep is also tested as a segment (continuous),
+// so a node never crosses a triangle whatever its speed.
 //
 //     tx_thread_def d = tx_thread_def_default();
 //     d.model = TX_THREAD_ROD;
@@ -141,6 +143,7 @@ typedef struct tx_thread_contacts {
   int mesh_hits;   // node contacts with triangles
   int substeps;    // substeps the step took
   int broad_pairs; // cylinder pairs the grid proposed (the broadphase's work)
+  int retries;     // substeps taken again shorter because a node moved more than r
 } tx_thread_contacts;
 void tx_thread_last_contacts(const tx_thread* t, tx_thread_contacts* out);
 // per cylinder (N - 1 entries): 1 when it touched another cylinder of the
