@@ -13,10 +13,6 @@
 
 #define PI 3.14159265358979323846
 #define BVH_STACK 128
-// the rod's constraints in rows of 4 per segment k: the bend at node k (3
-// rows; none at k = 0) and the distance of segment k. Two rows couple when
-// their constraints share a node, at most 10 rows apart.
-#define BAND 10
 
 typedef struct pair {
   int32_t i, j; // cylinders i < j
@@ -35,9 +31,10 @@ struct tx_thread {
   double* v0;                // (n x 3) at the start of the substep
   double* w;                 // (n) inverse masses, 1/kg; 0 for pinned nodes
   double* wf;                // (n) inverse masses of the nodes when free
-  double* lam;               // (4 nseg) XPBD multipliers, in the rows of the band below
-  double* band;              // (4 nseg x (BAND + 1)) the rod's system, lower band, then its Cholesky factor
-  double* rhs;               // (4 nseg)
+  double* lam;               // (4 nseg) XPBD multipliers: the distances, then 3 per bend
+  double* band;              // (2 nseg) the distances' tridiagonal system, then its Cholesky factor
+  double* bend;              // (3 nseg) the bends' pentadiagonal system, then its factor
+  double* rhs;               // (3 nseg)
   double* dir;               // (nseg x 3) unit segment directions, x[i] - x[i+1]
   uint8_t* pinned;           // (n)
   double* pin;               // (n x 3) where pinned nodes are held, m
@@ -48,6 +45,7 @@ struct tx_thread {
   uint32_t* cell_start;      // (hash size + 1)
   uint32_t* cell_item;       // (nseg) cylinders sorted by cell
   uint32_t* seg_cell;        // (nseg) each cylinder's bucket
+  int64_t* seg_ijk;          // (nseg x 3) each cylinder's cell
   pair* pairs;               // candidate pairs of the substep
   int npairs, pair_cap;
   uint8_t* colliding;        // (nseg)
@@ -90,7 +88,7 @@ tx_thread_def tx_thread_def_default(void) {
   d.density = 1140;
   d.gravity = 9.81;
   d.damping = 1;
-  d.iterations = 4;
+  d.iterations = 2;
   d.max_substep = 1e-3;
   d.max_substeps = 64;
   d.max_stretch = 0.05;
@@ -172,19 +170,21 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   t->w = malloc(sizeof(double) * n);
   t->wf = malloc(sizeof(double) * n);
   t->lam = malloc(sizeof(double) * 4 * nseg);
-  t->band = malloc(sizeof(double) * 4 * nseg * (BAND + 1));
-  t->rhs = malloc(sizeof(double) * 4 * nseg);
+  t->band = malloc(sizeof(double) * 2 * nseg);
+  t->bend = malloc(sizeof(double) * 3 * nseg);
+  t->rhs = malloc(sizeof(double) * 3 * nseg);
   t->dir = malloc(sizeof(double) * 3 * nseg);
   t->pinned = calloc((size_t)n, 1);
   t->pin = calloc(3 * (size_t)n, sizeof(double));
   t->cell_start = malloc(sizeof(uint32_t) * (hsize + 1));
   t->cell_item = malloc(sizeof(uint32_t) * nseg);
   t->seg_cell = malloc(sizeof(uint32_t) * nseg);
+  t->seg_ijk = malloc(sizeof(int64_t) * 3 * nseg);
   t->pairs = malloc(sizeof(pair) * t->pair_cap);
   t->colliding = calloc((size_t)nseg, 1);
   t->caps = malloc(sizeof(tx_thread_capsule) * (def->max_shapes + 1));
-  if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->v0 || !t->w || !t->wf || !t->lam || !t->band || !t->rhs || !t->dir || !t->pinned || !t->pin || !t->cell_start ||
-      !t->cell_item || !t->seg_cell || !t->pairs || !t->colliding || !t->caps)
+  if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->v0 || !t->w || !t->wf || !t->lam || !t->band || !t->bend || !t->rhs || !t->dir || !t->pinned || !t->pin || !t->cell_start ||
+      !t->cell_item || !t->seg_cell || !t->seg_ijk || !t->pairs || !t->colliding || !t->caps)
     goto oom;
   if (def->max_triangles > 0) {
     if (tx_tri_bvh_init(&t->bvh, (uint32_t)def->max_triangles)) goto oom;
@@ -223,6 +223,7 @@ void tx_thread_destroy(tx_thread* t) {
   free(t->wf);
   free(t->lam);
   free(t->band);
+  free(t->bend);
   free(t->rhs);
   free(t->dir);
   free(t->pinned);
@@ -230,6 +231,7 @@ void tx_thread_destroy(tx_thread* t) {
   free(t->cell_start);
   free(t->cell_item);
   free(t->seg_cell);
+  free(t->seg_ijk);
   free(t->pairs);
   free(t->colliding);
   free(t->caps);
@@ -415,8 +417,9 @@ static void broadphase(tx_thread* t, double margin) {
   memset(t->cell_start, 0, sizeof(uint32_t) * (hsize + 1));
   for (int i = 0; i < nseg; i++) {
     const double* p = x + 3 * i;
-    uint32_t h = cell_hash((int64_t)floor((p[0] + p[3]) * 0.5 * inv), (int64_t)floor((p[1] + p[4]) * 0.5 * inv),
-                           (int64_t)floor((p[2] + p[5]) * 0.5 * inv), t->hash_mask);
+    int64_t* c = t->seg_ijk + 3 * i;
+    for (int a = 0; a < 3; a++) c[a] = (int64_t)floor((p[a] + p[a + 3]) * 0.5 * inv);
+    uint32_t h = cell_hash(c[0], c[1], c[2], t->hash_mask);
     t->seg_cell[i] = h;
     t->cell_start[h + 1]++;
   }
@@ -429,21 +432,17 @@ static void broadphase(tx_thread* t, double margin) {
   double reach = 2 * t->def.radius + margin;
   for (int i = 0; i < nseg; i++) {
     const double* p = x + 3 * i;
-    int64_t c[3];
-    for (int a = 0; a < 3; a++) c[a] = (int64_t)floor((p[a] + p[a + 3]) * 0.5 * inv);
-    uint32_t seen[27];
-    int nseen = 0;
+    const int64_t* c = t->seg_ijk + 3 * i;
     for (int dz = -1; dz <= 1; dz++)
       for (int dy = -1; dy <= 1; dy++)
         for (int dx = -1; dx <= 1; dx++) {
-          uint32_t h = cell_hash(c[0] + dx, c[1] + dy, c[2] + dz, t->hash_mask);
-          bool dup = false;
-          for (int k = 0; k < nseen; k++) dup |= seen[k] == h;
-          if (dup) continue;
-          seen[nseen++] = h;
+          int64_t cx = c[0] + dx, cy = c[1] + dy, cz = c[2] + dz;
+          uint32_t h = cell_hash(cx, cy, cz, t->hash_mask);
           for (uint32_t k = t->cell_start[h]; k < t->cell_start[h + 1]; k++) {
             int j = (int)t->cell_item[k];
-            if (j <= i + t->skip) continue;
+            const int64_t* cj = t->seg_ijk + 3 * j;
+            // only the bucket's items of this very cell: each pair once, no hash collisions
+            if (j <= i + t->skip || cj[0] != cx || cj[1] != cy || cj[2] != cz) continue;
             t->last.broad_pairs++;
             tx_seg_closest cl;
             tx_seg_closest_points(p, p + 3, x + 3 * j, x + 3 * j + 3, &cl);
@@ -740,117 +739,116 @@ static void cap_stretch(tx_thread* t) {
     if (!t->pinned[i] && dist3(t->x + 3 * i, t->x + 3 * i - 3) > t->lmax) place_after(t, i, i - 1, t->lmax);
 }
 
-// the gradients of the constraints that move node j: up to two distances
-// and three bends (each bend 3 rows of gradient coef e_c)
-typedef struct grads {
-  int m;
-  int row[11];
-  double g[11][3];
-} grads;
-
-static void node_grads(const tx_thread* t, int j, grads* out) {
-  int n = t->n, nseg = t->nseg, m = 0;
-  if (j >= 1) { // the distance of segment j - 1, whose second node j is
-    out->row[m] = 4 * (j - 1) + 3;
-    for (int a = 0; a < 3; a++) out->g[m][a] = -t->dir[3 * (j - 1) + a];
-    m++;
-  }
-  if (j < nseg) {
-    out->row[m] = 4 * j + 3;
-    for (int a = 0; a < 3; a++) out->g[m][a] = t->dir[3 * j + a];
-    m++;
-  }
-  // the bends at j - 1, j, j + 1 (node j is their i + 1, i, i - 1)
-  for (int k = j - 1; k <= j + 1; k++) {
-    if (k < 1 || k > n - 2) continue;
-    double coef = k == j ? -2 : 1;
-    for (int c = 0; c < 3; c++) {
-      out->row[m] = 4 * k + c;
-      out->g[m][0] = out->g[m][1] = out->g[m][2] = 0;
-      out->g[m][c] = coef;
-      m++;
+// Cholesky of a symmetric banded matrix in place: A[r (bw + 1) + k] holds
+// A(r, r - k), k = 0..bw, and then L(r, r - k), with 1 / L(r, r) on the
+// diagonal (the solves multiply: a chain of divisions is slow)
+static void band_factor(double* A, int rows, int bw) {
+  int w = bw + 1;
+  for (int r = 0; r < rows; r++) {
+    int c0 = r - bw < 0 ? 0 : r - bw;
+    for (int c = c0; c <= r; c++) {
+      double sum = A[r * w + (r - c)];
+      int m0 = c - bw > c0 ? c - bw : c0;
+      for (int m = m0; m < c; m++) sum -= A[r * w + (r - m)] * A[c * w + (c - m)];
+      if (c == r)
+        A[r * w] = 1 / sqrt(sum > 1e-300 ? sum : 1e-300);
+      else
+        A[r * w + (r - c)] = sum * A[c * w];
     }
   }
-  out->m = m;
 }
 
-// one XPBD iteration over every distance and bend at once: the linearised
-// system (J W J^T + alpha / h^2) dlambda = -(C + alpha / h^2 lambda) is
-// banded, and its Cholesky factor costs O(N BAND^2), so a stiff rod
-// converges in a few iterations where Gauss-Seidel sweeps would need O(N^2)
+// solves L L^T y = b in place; stride: the distance between y's entries
+static void band_solve(const double* L, int rows, int bw, double* y, int stride) {
+  int w = bw + 1;
+  for (int r = 0; r < rows; r++) {
+    int m0 = r - bw < 0 ? 0 : r - bw;
+    double sum = y[r * stride];
+    for (int m = m0; m < r; m++) sum -= L[r * w + (r - m)] * y[m * stride];
+    y[r * stride] = sum * L[r * w];
+  }
+  for (int r = rows - 1; r >= 0; r--) {
+    int m1 = r + bw >= rows ? rows - 1 : r + bw;
+    double sum = y[r * stride];
+    for (int m = r + 1; m <= m1; m++) sum -= L[m * w + (m - r)] * y[m * stride];
+    y[r * stride] = sum * L[r * w];
+  }
+}
+
+// the bends' system depends on the masses and h alone: factored once a substep
+static void bend_factor(tx_thread* t, double h) {
+  int nb = t->n - 2;
+  const double* w = t->w;
+  double ab = t->alpha_b / (h * h);
+  double* B = t->bend;
+  for (int k = 0; k < nb; k++) {
+    int i = k + 1;
+    B[k * 3] = w[i - 1] + 4 * w[i] + w[i + 1] + ab;
+    B[k * 3 + 1] = k >= 1 ? -2 * w[i - 1] - 2 * w[i] : 0;
+    B[k * 3 + 2] = k >= 2 ? w[i - 1] : 0;
+  }
+  if (nb > 0) band_factor(B, nb, 2);
+}
+
+// one XPBD iteration, the bends then the distances, each group solved
+// exactly: (J W J^T + alpha / h^2) dlambda = -(C + alpha / h^2 lambda).
+// The bends' gradients are constant (1, -2, 1 on each axis), so their
+// system is one pentadiagonal matrix for the three axes; the distances'
+// is tridiagonal. A stiff rod converges in a few iterations where
+// Gauss-Seidel sweeps would need O(N^2); bends and stretch barely couple
+// (one moves across the rod, the other along it), so alternating the two
+// exact solves converges fast.
 static void rod_solve(tx_thread* t, double h) {
-  int n = t->n, nseg = t->nseg, rows = 4 * nseg;
+  int n = t->n, nseg = t->nseg, nb = n - 2;
   double* x = t->x;
+  const double* w = t->w;
   double ad = t->alpha_d / (h * h), ab = t->alpha_b / (h * h);
   double* A = t->band;
-  memset(A, 0, sizeof(double) * rows * (BAND + 1));
+  double* y = t->rhs;
+  double* lam_d = t->lam;
+  double* lam_b = t->lam + nseg; // 3 per bend
+  if (nb > 0) {
+    // bend k (node k + 1): rows k, k + 1, k + 2 share nodes
+    for (int k = 0; k < nb; k++) {
+      int i = k + 1;
+      for (int c = 0; c < 3; c++)
+        y[3 * k + c] = -(x[3 * i - 3 + c] - 2 * x[3 * i + c] + x[3 * i + 3 + c]) - ab * lam_b[3 * k + c];
+    }
+    for (int c = 0; c < 3; c++) band_solve(t->bend, nb, 2, y + c, 3);
+    for (int k = 0; k < nb; k++) {
+      int i = k + 1;
+      for (int c = 0; c < 3; c++) {
+        double dl = y[3 * k + c];
+        lam_b[3 * k + c] += dl;
+        x[3 * i - 3 + c] += w[i - 1] * dl;
+        x[3 * i + c] -= 2 * w[i] * dl;
+        x[3 * i + 3 + c] += w[i + 1] * dl;
+      }
+    }
+  }
+  // distances: segment k's gradient is +u_k at node k and -u_k at node k + 1
+  double* u = t->dir;
   for (int k = 0; k < nseg; k++) {
     double e[3] = {x[3 * k] - x[3 * k + 3], x[3 * k + 1] - x[3 * k + 4], x[3 * k + 2] - x[3 * k + 5]};
     double l = sqrt(dot3(e, e));
-    int r = 4 * k + 3;
     if (l > 1e-12 * t->l0) {
-      for (int a = 0; a < 3; a++) t->dir[3 * k + a] = e[a] / l;
-      t->rhs[r] = -(l - t->l0) - ad * t->lam[r];
+      for (int a = 0; a < 3; a++) u[3 * k + a] = e[a] / l;
+      y[k] = -(l - t->l0) - ad * lam_d[k];
     } else { // no direction: the segment waits for its neighbours to pull it open
-      t->dir[3 * k] = t->dir[3 * k + 1] = t->dir[3 * k + 2] = 0;
-      t->rhs[r] = 0;
+      u[3 * k] = u[3 * k + 1] = u[3 * k + 2] = 0;
+      y[k] = 0;
     }
-    A[r * (BAND + 1)] = ad;
-    for (int c = 0; c < 3; c++) {
-      r = 4 * k + c;
-      if (k == 0) { // no bend at the head: a unit row
-        A[r * (BAND + 1)] = 1;
-        t->rhs[r] = 0;
-      } else {
-        A[r * (BAND + 1)] = ab;
-        t->rhs[r] = -(x[3 * k - 3 + c] - 2 * x[3 * k + c] + x[3 * k + 3 + c]) - ab * t->lam[r];
-      }
+    A[k * 2] = (w[k] + w[k + 1]) * (l > 1e-12 * t->l0 ? 1 : 0) + ad;
+    A[k * 2 + 1] = k >= 1 ? -w[k] * dot3(u + 3 * k - 3, u + 3 * k) : 0;
+  }
+  band_factor(A, nseg, 1);
+  band_solve(A, nseg, 1, y, 1);
+  for (int k = 0; k < nseg; k++) {
+    lam_d[k] += y[k];
+    for (int a = 0; a < 3; a++) {
+      x[3 * k + a] += w[k] * u[3 * k + a] * y[k];
+      x[3 * k + 3 + a] -= w[k + 1] * u[3 * k + a] * y[k];
     }
-  }
-  grads g;
-  for (int j = 0; j < n; j++) {
-    double wj = t->w[j];
-    if (wj <= 0) continue;
-    node_grads(t, j, &g);
-    for (int p = 0; p < g.m; p++)
-      for (int q = 0; q < g.m; q++) {
-        if (g.row[q] > g.row[p]) continue;
-        A[g.row[p] * (BAND + 1) + (g.row[p] - g.row[q])] += wj * dot3(g.g[p], g.g[q]);
-      }
-  }
-  // Cholesky, in place: L(r, c) at A[r (BAND + 1) + r - c]
-  for (int r = 0; r < rows; r++) {
-    int c0 = r - BAND < 0 ? 0 : r - BAND;
-    for (int c = c0; c <= r; c++) {
-      double sum = A[r * (BAND + 1) + (r - c)];
-      int m0 = c - BAND > c0 ? c - BAND : c0;
-      for (int m = m0; m < c; m++) sum -= A[r * (BAND + 1) + (r - m)] * A[c * (BAND + 1) + (c - m)];
-      if (c == r)
-        A[r * (BAND + 1)] = sqrt(sum > 1e-300 ? sum : 1e-300);
-      else
-        A[r * (BAND + 1) + (r - c)] = sum / A[c * (BAND + 1)];
-    }
-  }
-  double* y = t->rhs;
-  for (int r = 0; r < rows; r++) {
-    int m0 = r - BAND < 0 ? 0 : r - BAND;
-    double sum = y[r];
-    for (int m = m0; m < r; m++) sum -= A[r * (BAND + 1) + (r - m)] * y[m];
-    y[r] = sum / A[r * (BAND + 1)];
-  }
-  for (int r = rows - 1; r >= 0; r--) {
-    int m1 = r + BAND >= rows ? rows - 1 : r + BAND;
-    double sum = y[r];
-    for (int m = r + 1; m <= m1; m++) sum -= A[m * (BAND + 1) + (m - r)] * y[m];
-    y[r] = sum / A[r * (BAND + 1)];
-  }
-  for (int r = 0; r < rows; r++) t->lam[r] += y[r];
-  for (int j = 0; j < n; j++) {
-    double wj = t->w[j];
-    if (wj <= 0) continue;
-    node_grads(t, j, &g);
-    for (int p = 0; p < g.m; p++)
-      for (int a = 0; a < 3; a++) x[3 * j + a] += wj * g.g[p][a] * y[g.row[p]];
   }
 }
 
@@ -871,6 +869,7 @@ static void rod_substep(tx_thread* t, double h, double margin) {
   memset(t->lam, 0, sizeof(double) * 4 * nseg);
   bool self = d->self_collision && nseg > t->skip + 1;
   if (self) broadphase(t, margin);
+  bend_factor(t, h);
   for (int it = 0; it < d->iterations; it++) {
     rod_solve(t, h);
     solve_capsules(t);
@@ -900,7 +899,7 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
   memset(t->colliding, 0, (size_t)t->nseg);
   memset(&t->last, 0, sizeof t->last);
   // substeps: the head and, by their last velocities, the nodes move no
-  // more than r / 2 in one
+  // more than 3 r / 4 in one
   double move = dist3(t->head_from, t->head_to);
   if (d->model == TX_THREAD_ROD) {
     double vmax2 = 0;
@@ -912,16 +911,16 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
     if (vm > move) move = vm;
   }
   double sub = ceil(dt / d->max_substep - 1e-9);
-  double need = ceil(move / (0.5 * d->radius));
+  double need = ceil(move / (0.75 * d->radius));
   if (need > sub) sub = need;
   if (sub < 1) sub = 1;
   if (sub > d->max_substeps) sub = d->max_substeps;
   double h = dt / sub, hmin = dt / d->max_substeps, tau = 0;
   int ns = 0;
-  // a substep in which a free node moved more than r (a kink springing
+  // a substep in which a free node moved more than 0.9 r (a kink springing
   // back, a whip) is taken again at half the length, down to dt /
-  // max_substeps: the contacts' margin of 2 r covers two nodes that each
-  // moved r, so no cylinder jumps across another's 2 r
+  // max_substeps: two cylinders 2 r apart that each move less than r cannot
+  // pass through each other, and the contacts' margin of 2 r covers them
   while (tau < dt * (1 - 1e-12)) {
     if (h > dt - tau) h = dt - tau;
     double f = (tau + h) / dt;
@@ -942,7 +941,7 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
       double s = dot3(e, e);
       if (s > far2 && !t->pinned[i]) far2 = s;
     }
-    if (far2 > d->radius * d->radius && h > hmin * (1 + 1e-9) && ns < 4 * d->max_substeps) {
+    if (far2 > 0.81 * d->radius * d->radius && h > hmin * (1 + 1e-9) && ns < 4 * d->max_substeps) {
       memcpy(t->x, t->x0, sizeof(double) * 3 * n);
       memcpy(t->v, t->v0, sizeof(double) * 3 * n);
       h = fmax(0.5 * h, hmin);

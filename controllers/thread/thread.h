@@ -21,14 +21,18 @@
 //         masses from the density. After the iterations of a substep no
 //         segment is longer than l0 (1 + max_stretch): a projection along the
 //         thread from the head (and back from the last pin) enforces the cap.
+//         Each iteration solves all the bends at once, then all the
+//         distances at once (a pentadiagonal and a tridiagonal Cholesky,
+//         O(N)), so a stiff rod converges in a few iterations where
+//         constraint-by-constraint sweeps would need O(N^2).
 //
 // Both models share the contacts (step 2 of the thread's issue): self
 // contact between cylinders (|AB| < 2 r, segment.h) found through a uniform
 // grid, kinematic capsules and spheres, and a triangle mesh (the skin's
 // SKIN.x / SKIN.tri arrays). A step is split into substeps short enough
 // that the head and, by its last velocity, every node move no more than
-// r / 2 in one; a substep in which a free node still moved more than r is
-// taken again at half the length (down to dt / max_substeps). So neither a
+// 3 r / 4 in one; a substep in which a free node still moved more than
+// 0.9 r is taken again at half the length (down to dt / max_substeps). So neither a
 // fast head nor a fast node jumps across a 2 r contact. Against triangles
 // each node's move in a substep is also tested as a segment (continuous),
 // so a node never crosses a triangle whatever its speed.
@@ -67,7 +71,7 @@ typedef struct tx_thread_def {
   double density;        // kg/m^3, in (0, 1e5]; 1140 (nylon)
   double gravity;        // m/s^2, along -y, in [0, 100]; 9.81
   double damping;        // 1/s, decay rate of node velocities, in [0, 1e4]; 1
-  int iterations;        // rod: direct XPBD solves per substep; ftl with pins: FABRIK passes; in [1, 1000]; 4
+  int iterations;        // rod: direct XPBD solves per substep; ftl with pins: FABRIK passes; in [1, 1000]; 2
   double max_substep;    // s, the step is split into substeps no longer than this, in [1e-7, 0.1]; 1e-3
   int max_substeps;      // at most this many substeps per step, in [1, 10000]; 64
   double max_stretch;    // the stretch cap: (l - l0) / l0 of a segment, in [0, 1]; 0.05
