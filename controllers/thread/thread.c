@@ -58,6 +58,7 @@ struct tx_thread {
   tx_tri_bvh bvh;
   bool have_bvh;
   bool move_first;           // edge contacts may move a cylinder's first node
+  double probe;              // m, the nearest triangle found by a query
   tx_thread_contacts last;
   int faults;
 };
@@ -644,6 +645,41 @@ static void solve_mesh_edges(tx_thread* t, int i) {
     hi[a] = (float)(fmax(fmax(p[a], p[a + 3]), fmax(p0[a], p0[a + 3])) + reach) + 1e-6f;
   }
   for_triangles_near(t, lo, hi, i, edge_contacts);
+}
+
+// the nearest distance from node i to a triangle, at most what it was
+static void nearest_triangle(tx_thread* t, int i, const double v[3][3]) {
+  double cp[3];
+  tx_tri_closest_point(t->x + 3 * i, v[0], v[1], v[2], cp, NULL);
+  double d = dist3(cp, t->x + 3 * i);
+  if (d < t->probe) t->probe = d;
+}
+
+int tx_thread_fix_near_mesh(tx_thread* t, int first, int last, double limit) {
+  if (first < 0 || last >= t->nseg || first > last) {
+    tx_set_error("thread: fix cylinders %d to %d, must be within [0, %d]", first, last, t->nseg - 1);
+    return -1;
+  }
+  if (range("fix limit", limit, 0, false, 1, false, "m")) return -1;
+  if (t->mntri == 0) return 0;
+  t->probe = INFINITY;
+  for (int i = first; i <= last + 1; i++) {
+    float lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+      lo[a] = (float)(t->x[3 * i + a] - limit) - 1e-6f;
+      hi[a] = (float)(t->x[3 * i + a] + limit) + 1e-6f;
+    }
+    for_triangles_near(t, lo, hi, i, nearest_triangle);
+  }
+  if (!(t->probe <= limit)) return 0;
+  for (int i = first; i <= last + 1; i++)
+    if (i > 0) {
+      t->pinned[i] = 1;
+      memcpy(t->pin + 3 * i, t->x + 3 * i, sizeof(double) * 3);
+      memset(t->v + 3 * i, 0, sizeof(double) * 3);
+    }
+  update_last_pin(t);
+  return 1;
 }
 
 static void solve_mesh(tx_thread* t) {

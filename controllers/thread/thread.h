@@ -140,6 +140,12 @@ double tx_thread_current_length(const tx_thread* t);
 // the largest (l - l0) / l0 over the segments
 double tx_thread_max_strain(const tx_thread* t);
 
+// a knot's fixing: when a node of cylinders first..last (a knot's, from
+// the knot rules) is within limit (m, in [0, 1]) of the mesh, those
+// cylinders' nodes are pinned where they are (immobilised) and it returns 1;
+// 0 when none is that near (or there is no mesh); -1 (tx_error()) on a bad range
+int tx_thread_fix_near_mesh(tx_thread* t, int first, int last, double limit);
+
 // contacts of the last step
 typedef struct tx_thread_contacts {
   int self_pairs;  // cylinder pairs closer than 2 r (found and pushed apart)

@@ -8,6 +8,8 @@
 #include <cmocka.h>
 
 #include "knot_shapes.h"
+#include "controllers/physics/skin_grid.h"
+#include "controllers/thread/thread.h"
 #include "model/error.h"
 
 #include <stdio.h>
@@ -134,11 +136,59 @@ static void test_reference_shapes(void** state) {
   tx_knot_work_destroy(w);
 }
 
+// the tight overhand lying 0.5 mm over a skin patch: the papers' rule finds
+// it, it is near the skin, so its cylinders are pinned where they are; the
+// rest of the thread still falls. Far from the skin nothing is fixed.
+static void test_knot_near_the_skin_is_fixed(void** state) {
+  (void)state;
+  shape s[16];
+  int ns = knot_shapes(s);
+  shape* k = &s[0];
+  static float px[41 * 41 * 3];
+  static int32_t tri[2 * 40 * 40 * 3];
+  double ymin = 1;
+  for (int i = 0; i < k->n; i++) ymin = fmin(ymin, k->x[3 * i + 1]);
+  uint32_t ntri = tx_skin_grid(41, 41, 0.0005, 0.0005, (double[3]){0, ymin - 0.0005, 0}, px, tri);
+  uint8_t col[SHAPE_MAX];
+  tx_knot_rule rule = tx_knot_rule_papers();
+  tx_knot_contacts(k->x, k->n, SHAPE_RADIUS, rule.min_gap, col);
+  tx_knot_papers p;
+  assert_true(tx_knot_papers_rule(col, k->n - 1, &rule, &p));
+  for (int near = 1; near >= 0; near--) {
+    tx_thread_def d = tx_thread_def_default();
+    d.model = TX_THREAD_ROD;
+    d.nodes = k->n;
+    d.length = SHAPE_SPACING * (k->n - 1);
+    d.radius = SHAPE_RADIUS;
+    d.max_triangles = (int)ntri;
+    d.self_collision = false;
+    tx_thread* t = tx_thread_create(&d);
+    assert_non_null(t);
+    assert_int_equal(tx_thread_set_positions(t, k->x), TX_THREAD_OK);
+    assert_int_equal(tx_thread_set_mesh(t, px, 41 * 41, tri, ntri, 0), TX_THREAD_OK);
+    assert_int_equal(tx_thread_fix_near_mesh(t, p.first, p.last, near ? 0.001 : 0.0001), near);
+    for (int step = 0; step < 50; step++) assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
+    double still = 0, tail = 0;
+    for (int i = p.first; i <= p.last + 1; i++)
+      for (int a = 0; a < 3; a++) still = fmax(still, fabs(tx_thread_position(t, i)[a] - k->x[3 * i + a]));
+    for (int a = 0; a < 3; a++) tail = fmax(tail, fabs(tx_thread_position(t, k->n - 1)[a] - k->x[3 * (k->n - 1) + a]));
+    print_message("%s: knot cylinders %d..%d moved %.3g mm, tail %.3g mm\n", near ? "near" : "far", p.first, p.last,
+                  still * 1e3, tail * 1e3);
+    if (near) assert_true(still == 0);
+    else assert_true(still > 1e-5);
+    assert_true(tail > 1e-4);
+    assert_int_equal(tx_thread_fix_near_mesh(t, 5, 2, 0.001), -1);
+    tx_thread_destroy(t);
+  }
+  free_shapes(s, ns);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_papers_rule_blocks_and_gaps),
       cmocka_unit_test(test_classifier_moves),
       cmocka_unit_test(test_reference_shapes),
+      cmocka_unit_test(test_knot_near_the_skin_is_fixed),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
