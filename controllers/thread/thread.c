@@ -60,6 +60,7 @@ struct tx_thread {
   bool move_first;           // edge contacts may move a cylinder's first node
   double probe;              // m, the nearest triangle found by a query
   tx_thread_contacts last;
+  double head_force[3];      // N, the rod's constraints on the head in the last substep
   int faults;
 };
 
@@ -248,6 +249,12 @@ const double* tx_thread_position(const tx_thread* t, int i) { return t->x + 3 * 
 const uint8_t* tx_thread_colliding(const tx_thread* t) { return t->colliding; }
 int tx_thread_faults(const tx_thread* t) { return t->faults; }
 void tx_thread_last_contacts(const tx_thread* t, tx_thread_contacts* out) { *out = t->last; }
+void tx_thread_head_force(const tx_thread* t, double out[3]) { memcpy(out, t->head_force, sizeof t->head_force); }
+bool tx_thread_pin_of(const tx_thread* t, int i, double out[3]) {
+  if (i < 0 || i >= t->n || !t->pinned[i]) return false;
+  memcpy(out, t->pin + 3 * i, sizeof(double) * 3);
+  return true;
+}
 
 double tx_thread_current_length(const tx_thread* t) {
   double s = 0;
@@ -921,6 +928,12 @@ static void rod_substep(tx_thread* t, double h, double margin) {
   solve_mesh(t);
   for (int i = 0; i < n; i++)
     for (int a = 0; a < 3; a++) v[3 * i + a] = t->pinned[i] ? 0 : (x[3 * i + a] - t->x0[3 * i + a]) / h;
+  // the force the constraints put on the (pinned) head: gradient x lambda /
+  // h^2 of the first distance and of the bend at node 1 (its coefficient at node 0 is 1)
+  for (int a = 0; a < 3; a++) {
+    t->head_force[a] = t->dir[a] * t->lam[0] / (h * h);
+    if (n > 2) t->head_force[a] += t->lam[nseg + a] / (h * h);
+  }
 }
 
 tx_thread_status tx_thread_step(tx_thread* t, double dt) {

@@ -159,6 +159,11 @@ void tx_thread_last_contacts(const tx_thread* t, tx_thread_contacts* out);
 // per cylinder (N - 1 entries): 1 when it touched another cylinder of the
 // thread in the last step (the input of the knot rules)
 const uint8_t* tx_thread_colliding(const tx_thread* t);
+// rod: the force (N) the constraints put on the head in the last substep,
+// the distance's pull and the first bend's (zero in ftl)
+void tx_thread_head_force(const tx_thread* t, double out[3]);
+// where node i is pinned: false when it is free
+bool tx_thread_pin_of(const tx_thread* t, int i, double out[3]);
 // steps that faulted and were put back
 int tx_thread_faults(const tx_thread* t);
 
