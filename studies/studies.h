@@ -19,5 +19,6 @@ int tx_study_skin_paper(const tx_study_args* a);
 int tx_study_skin_stability(const tx_study_args* a);
 int tx_study_skin_accuracy(const tx_study_args* a);
 int tx_study_skin_membrane(const tx_study_args* a);
+int tx_study_thread_accuracy(const tx_study_args* a);
 
 #endif

@@ -27,6 +27,8 @@ static const struct {
      "the skin against closed-form membranes (disc load, own weight), rupture under refinement, gravity sag"},
     {"skin-accuracy", tx_study_skin_accuracy,
      "spacing, iterations and step refined together: observed order, Richardson reference, error vs CPU time"},
+    {"thread-accuracy", tx_study_thread_accuracy,
+     "the rod hanging against the catenary: error vs nodes, iterations and step with CPU time; ftl's length error"},
 };
 
 // the studies that take a FILE after their name

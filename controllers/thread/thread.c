@@ -87,6 +87,7 @@ tx_thread_def tx_thread_def_default(void) {
   d.pin_tail = false;
   d.self_collision = true;
   d.youngs_modulus = 2e9;
+  d.bend_factor = 1;
   d.density = 1140;
   d.gravity = 9.81;
   d.damping = 1;
@@ -117,6 +118,7 @@ int tx_thread_def_check(const tx_thread_def* d) {
   }
   if (dot3(d->direction, d->direction) < 1e-24) return tx_check_fail("thread: direction = (0, 0, 0), must not be zero");
   if (range("youngs_modulus", d->youngs_modulus, 0, true, 1e12, false, "Pa")) return -1;
+  if (range("bend_factor", d->bend_factor, 0, false, 1, false, "")) return -1;
   if (range("density", d->density, 0, true, 1e5, false, "kg/m^3")) return -1;
   if (range("gravity", d->gravity, 0, false, 100, false, "m/s^2")) return -1;
   if (range("damping", d->damping, 0, false, 1e4, false, "1/s")) return -1;
@@ -158,7 +160,7 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   while (t->skip * t->l0 < 2 * def->radius && t->skip < nseg) t->skip++;
   double area = PI * def->radius * def->radius, inertia = PI * pow(def->radius, 4) / 4;
   t->alpha_d = t->l0 / (def->youngs_modulus * area);
-  t->alpha_b = pow(t->l0, 3) / (def->youngs_modulus * inertia);
+  t->alpha_b = def->bend_factor > 0 ? pow(t->l0, 3) / (def->bend_factor * def->youngs_modulus * inertia) : INFINITY;
   uint32_t hsize = 16;
   while (hsize < 2u * (uint32_t)nseg) hsize <<= 1;
   t->hash_mask = hsize - 1;
@@ -830,7 +832,7 @@ static void bend_factor(tx_thread* t, double h) {
     B[k * 3 + 1] = k >= 1 ? -2 * w[i - 1] - 2 * w[i] : 0;
     B[k * 3 + 2] = k >= 2 ? w[i - 1] : 0;
   }
-  if (nb > 0) band_factor(B, nb, 2);
+  if (nb > 0 && isfinite(ab)) band_factor(B, nb, 2);
 }
 
 // one XPBD iteration, the bends then the distances, each group solved
@@ -850,7 +852,7 @@ static void rod_solve(tx_thread* t, double h) {
   double* y = t->rhs;
   double* lam_d = t->lam;
   double* lam_b = t->lam + nseg; // 3 per bend
-  if (nb > 0) {
+  if (nb > 0 && isfinite(ab)) {
     // bend k (node k + 1): rows k, k + 1, k + 2 share nodes
     for (int k = 0; k < nb; k++) {
       int i = k + 1;

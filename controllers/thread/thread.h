@@ -68,6 +68,8 @@ typedef struct tx_thread_def {
   bool pin_tail;         // the tail stays where it was created (or tx_thread_pin puts it); false
   bool self_collision;   // cylinders of the thread push each other apart; true
   double youngs_modulus; // Pa, E, in (0, 1e12]; 2e9 (monofilament nylon, 2 GPa)
+  double bend_factor;    // the bending stiffness is bend_factor E I, in [0, 1]; 1 (0: a perfectly flexible
+                         // thread, the catenary's chain; braided threads bend more easily than their E says)
   double density;        // kg/m^3, in (0, 1e5]; 1140 (nylon)
   double gravity;        // m/s^2, along -y, in [0, 100]; 9.81
   double damping;        // 1/s, decay rate of node velocities, in [0, 1e4]; 1

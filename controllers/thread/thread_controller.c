@@ -46,6 +46,7 @@ static const tx_param_def params[] = {
     {"radius_m", TX_PARAM_NUM, "m", 1e-6, 0.01, 0.00025, NULL, "r of the spheres and cylinders (a 0.5 mm thread)"},
     {"length_m", TX_PARAM_NUM, "m", 1e-4, 10, 0.2, NULL, "rest length head to tail"},
     {"youngs_modulus_pa", TX_PARAM_NUM, "Pa", 1, 1e12, 2e9, NULL, "rod: E (monofilament nylon, 2 GPa)"},
+    {"bend_factor", TX_PARAM_NUM, "1", 0, 1, 1, NULL, "rod: bending stiffness bend_factor E I (0: perfectly flexible)"},
     {"density_kg_m3", TX_PARAM_NUM, "kg/m^3", 1, 1e5, 1140, NULL, "rod: the thread's density (nylon)"},
     {"gravity", TX_PARAM_NUM, "m/s^2", 0, 100, 9.81, NULL, "rod: along -y"},
     {"damping", TX_PARAM_NUM, "1/s", 0, 1e4, 1, NULL, "rod: decay rate of node velocities"},
@@ -96,6 +97,7 @@ static int configure(tx_setup* s, void** self) {
   d.radius = tx_table_num(s, "radius_m");
   d.length = tx_table_num(s, "length_m");
   d.youngs_modulus = tx_table_num(s, "youngs_modulus_pa");
+  d.bend_factor = tx_table_num(s, "bend_factor");
   d.density = tx_table_num(s, "density_kg_m3");
   d.gravity = tx_table_num(s, "gravity");
   d.damping = tx_table_num(s, "damping");
