@@ -20,5 +20,6 @@ int tx_study_skin_stability(const tx_study_args* a);
 int tx_study_skin_accuracy(const tx_study_args* a);
 int tx_study_skin_membrane(const tx_study_args* a);
 int tx_study_thread_accuracy(const tx_study_args* a);
+int tx_study_thread_stability(const tx_study_args* a);
 
 #endif

@@ -117,7 +117,7 @@ int tx_thread_def_check(const tx_thread_def* d) {
     if (range(dir_name[a], d->direction[a], -1e6, false, 1e6, false, "")) return -1;
   }
   if (dot3(d->direction, d->direction) < 1e-24) return tx_check_fail("thread: direction = (0, 0, 0), must not be zero");
-  if (range("youngs_modulus", d->youngs_modulus, 0, true, 1e12, false, "Pa")) return -1;
+  if (range("youngs_modulus", d->youngs_modulus, 0, true, 1e16, false, "Pa")) return -1;
   if (range("bend_factor", d->bend_factor, 0, false, 1, false, "")) return -1;
   if (range("density", d->density, 0, true, 1e5, false, "kg/m^3")) return -1;
   if (range("gravity", d->gravity, 0, false, 100, false, "m/s^2")) return -1;
@@ -252,6 +252,37 @@ const uint8_t* tx_thread_colliding(const tx_thread* t) { return t->colliding; }
 int tx_thread_faults(const tx_thread* t) { return t->faults; }
 void tx_thread_last_contacts(const tx_thread* t, tx_thread_contacts* out) { *out = t->last; }
 void tx_thread_head_force(const tx_thread* t, double out[3]) { memcpy(out, t->head_force, sizeof t->head_force); }
+void tx_thread_tension(const tx_thread* t, double stiffness, double max_force, double f[3], double K[9]) {
+  int n = t->n;
+  const double* h = t->x;
+  const double* tail = t->x + 3 * (n - 1);
+  double sum[3], len = tx_thread_current_length(t);
+  memset(K, 0, sizeof(double) * 9);
+  for (int a = 0; a < 3; a++) {
+    f[a] = 0;
+    sum[a] = tail[a] - h[a];
+  }
+  if (t->pinned[n - 1]) { // the length runs on to the tail's pin
+    const double* pin = t->pin + 3 * (n - 1);
+    len += dist3(pin, tail);
+    for (int a = 0; a < 3; a++) sum[a] = pin[a] - h[a];
+  }
+  double ls = sqrt(dot3(sum, sum));
+  if (t->def.model == TX_THREAD_ROD) {
+    memcpy(f, t->head_force, sizeof t->head_force);
+  } else if (ls > 0 && len > t->def.length) {
+    double mag = stiffness * (len - t->def.length);
+    for (int a = 0; a < 3; a++) {
+      f[a] = mag * sum[a] / ls;
+      for (int b = 0; b < 3; b++) K[3 * a + b] = -stiffness * sum[a] * sum[b] / (ls * ls);
+    }
+  }
+  double fm = sqrt(dot3(f, f));
+  double scale = fm > max_force ? max_force / fm : 1;
+  for (int a = 0; a < 3; a++) f[a] = isfinite(f[a]) ? f[a] * scale : 0;
+  for (int a = 0; a < 9; a++) K[a] = isfinite(K[a]) ? K[a] : 0;
+}
+
 bool tx_thread_pin_of(const tx_thread* t, int i, double out[3]) {
   if (i < 0 || i >= t->n || !t->pinned[i]) return false;
   memcpy(out, t->pin + 3 * i, sizeof(double) * 3);
@@ -878,12 +909,14 @@ static void rod_solve(tx_thread* t, double h) {
     double l = sqrt(dot3(e, e));
     if (l > 1e-12 * t->l0) {
       for (int a = 0; a < 3; a++) u[3 * k + a] = e[a] / l;
-      y[k] = -(l - t->l0) - ad * lam_d[k];
-    } else { // no direction: the segment waits for its neighbours to pull it open
-      u[3 * k] = u[3 * k + 1] = u[3 * k + 2] = 0;
-      y[k] = 0;
+    } else { // coincident nodes: open the segment along the one before it (or the thread's first direction)
+      double f[3] = {-t->def.direction[0], -t->def.direction[1], -t->def.direction[2]};
+      if (k > 0 && dot3(u + 3 * k - 3, u + 3 * k - 3) > 0.5) memcpy(f, u + 3 * k - 3, sizeof f);
+      double lf = sqrt(dot3(f, f));
+      for (int a = 0; a < 3; a++) u[3 * k + a] = f[a] / lf;
     }
-    A[k * 2] = (w[k] + w[k + 1]) * (l > 1e-12 * t->l0 ? 1 : 0) + ad;
+    y[k] = -(l - t->l0) - ad * lam_d[k];
+    A[k * 2] = (w[k] + w[k + 1]) + ad;
     A[k * 2 + 1] = k >= 1 ? -w[k] * dot3(u + 3 * k - 3, u + 3 * k) : 0;
   }
   band_factor(A, nseg, 1);
@@ -927,6 +960,9 @@ static void rod_substep(tx_thread* t, double h, double margin) {
     solve_capsules(t);
     if (self) solve_self(t);
   }
+  // the cap again: pushes in a crowded knot can stretch a segment; shortening
+  // towards the leader barely opens a contact again
+  cap_stretch(t);
   solve_mesh(t);
   for (int i = 0; i < n; i++)
     for (int a = 0; a < 3; a++) v[3 * i + a] = t->pinned[i] ? 0 : (x[3 * i + a] - t->x0[3 * i + a]) / h;

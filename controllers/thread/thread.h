@@ -67,7 +67,7 @@ typedef struct tx_thread_def {
   double direction[3];   // the thread lies straight from the head this way at creation (normalised); (1, 0, 0)
   bool pin_tail;         // the tail stays where it was created (or tx_thread_pin puts it); false
   bool self_collision;   // cylinders of the thread push each other apart; true
-  double youngs_modulus; // Pa, E, in (0, 1e12]; 2e9 (monofilament nylon, 2 GPa)
+  double youngs_modulus; // Pa, E, in (0, 1e16]; 2e9 (monofilament nylon, 2 GPa; the top is x5e6, for stability studies)
   double bend_factor;    // the bending stiffness is bend_factor E I, in [0, 1]; 1 (0: a perfectly flexible
                          // thread, the catenary's chain; braided threads bend more easily than their E says)
   double density;        // kg/m^3, in (0, 1e5]; 1140 (nylon)
@@ -164,6 +164,13 @@ const uint8_t* tx_thread_colliding(const tx_thread* t);
 // rod: the force (N) the constraints put on the head in the last substep,
 // the distance's pull and the first bend's (zero in ftl)
 void tx_thread_head_force(const tx_thread* t, double out[3]);
+// the tension at the head as a force model (step B of the conference
+// paper): ftl: (length - rest length) x stiffness (N/m) along the sum of the
+// segments (from the head towards the tail), the length running on from the
+// tail to its pin when the tail is pinned, K = -stiffness d d^T; rod: the
+// constraints' force on the head (tx_thread_head_force), K = 0. f (N) is
+// clamped to max_force (N) and never NaN.
+void tx_thread_tension(const tx_thread* t, double stiffness, double max_force, double f[3], double K[9]);
 // where node i is pinned: false when it is free
 bool tx_thread_pin_of(const tx_thread* t, int i, double out[3]);
 // steps that faulted and were put back

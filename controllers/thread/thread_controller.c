@@ -45,7 +45,7 @@ static const tx_param_def params[] = {
     {"nodes", TX_PARAM_INT, "1", 2, 100000, 64, NULL, "N, spheres joined by N - 1 cylinders"},
     {"radius_m", TX_PARAM_NUM, "m", 1e-6, 0.01, 0.00025, NULL, "r of the spheres and cylinders (a 0.5 mm thread)"},
     {"length_m", TX_PARAM_NUM, "m", 1e-4, 10, 0.2, NULL, "rest length head to tail"},
-    {"youngs_modulus_pa", TX_PARAM_NUM, "Pa", 1, 1e12, 2e9, NULL, "rod: E (monofilament nylon, 2 GPa)"},
+    {"youngs_modulus_pa", TX_PARAM_NUM, "Pa", 1, 1e16, 2e9, NULL, "rod: E (monofilament nylon, 2 GPa)"},
     {"bend_factor", TX_PARAM_NUM, "1", 0, 1, 1, NULL, "rod: bending stiffness bend_factor E I (0: perfectly flexible)"},
     {"density_kg_m3", TX_PARAM_NUM, "kg/m^3", 1, 1e5, 1140, NULL, "rod: the thread's density (nylon)"},
     {"gravity", TX_PARAM_NUM, "m/s^2", 0, 100, 9.81, NULL, "rod: along -y"},
@@ -174,38 +174,10 @@ static void publish(tx_ctx* c, thread_ctl* k) {
     memcpy(out[i].x, tx_thread_position(t, i), sizeof out[i].x);
     out[i].radius = r;
   }
-  // the tension at the head. ftl: (length - rest length) x tension_n_per_m
-  // along the sum of the segments (from the head towards the tail), the
-  // length running on to the tail's pin when the tail is pinned; rod: the
-  // constraints' force on the head
-  const tx_thread_def* d = tx_thread_get_def(t);
-  const double* h = tx_thread_position(t, 0);
-  double sum[3], len = tx_thread_current_length(t), pin[3], f[3] = {0, 0, 0};
-  const double* tail = tx_thread_position(t, n - 1);
-  for (int a = 0; a < 3; a++) sum[a] = tail[a] - h[a];
-  if (tx_thread_pin_of(t, n - 1, pin)) {
-    double gap = 0;
-    for (int a = 0; a < 3; a++) {
-      gap += (pin[a] - tail[a]) * (pin[a] - tail[a]);
-      sum[a] = pin[a] - h[a];
-    }
-    len += sqrt(gap);
-  }
-  double ls = sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
   tx_force_model* m = tx_write(c, k->force);
   memset(m, 0, sizeof *m);
-  memcpy(m->x0, h, sizeof m->x0);
-  if (d->model == TX_THREAD_ROD) {
-    tx_thread_head_force(t, f);
-  } else if (ls > 0 && len > d->length) {
-    double mag = k->tension_k * (len - d->length);
-    for (int a = 0; a < 3; a++) f[a] = mag * sum[a] / ls;
-    for (int a = 0; a < 3; a++)
-      for (int b = 0; b < 3; b++) m->k[3 * a + b] = -k->tension_k * sum[a] * sum[b] / (ls * ls);
-  }
-  double fm = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
-  double scale = fm > k->max_force ? k->max_force / fm : 1;
-  for (int a = 0; a < 3; a++) m->f0[a] = isfinite(f[a]) ? f[a] * scale : 0;
+  memcpy(m->x0, tx_thread_position(t, 0), sizeof m->x0);
+  tx_thread_tension(t, k->tension_k, k->max_force, m->f0, m->k);
 }
 
 static void emit_knot(tx_ctx* c, thread_ctl* k, const tx_knot_papers* p, bool fixed) {
