@@ -46,7 +46,7 @@ static double cpu_now(void) {
 
 // the catenary's a for length L over span s: 2 a sinh(s / (2 a)) = L, by
 // bisection on log a (the left side falls from infinity to s as a grows)
-double tx_catenary_a(double span, double length) {
+static double catenary_a(double span, double length) {
   double lo = log(1e-6), hi = log(1e6);
   for (int i = 0; i < 200; i++) {
     double m = 0.5 * (lo + hi), a = exp(m);
@@ -91,7 +91,7 @@ static int hang(int nodes, int iterations, double dt, double settle, acc_row* r)
       return fprintf(stderr, "tactus: study thread-accuracy: the rod faulted at %d nodes\n", nodes), 1;
     }
   r->cpu = (cpu_now() - c0) / settle;
-  double a = tx_catenary_a(SPAN, LENGTH), top = a * cosh(SPAN / (2 * a)), sag = top - a, err = 0;
+  double a = catenary_a(SPAN, LENGTH), top = a * cosh(SPAN / (2 * a)), sag = top - a, err = 0;
   for (int i = 0; i < nodes; i++) {
     const double* p = tx_thread_position(t, i);
     double y = a * cosh(p[0] / a) - top;
@@ -144,7 +144,7 @@ static int write_outputs(const char* dir, const acc_row* rows, int n, double ftl
                                           rows[i].nodes, "iterations", rows[i].iterations, "time_step_s", rows[i].dt,
                                           "error_of_sag", rows[i].error, "cpu_s_per_sim_s", rows[i].cpu, "max_strain",
                                           rows[i].strain));
-  double a = tx_catenary_a(SPAN, LENGTH);
+  double a = catenary_a(SPAN, LENGTH);
   json_t* doc = json_pack("{s:s,s:s,s:{s:f,s:f,s:f,s:f},s:s,s:o,s:f}", "study", "thread-accuracy", "path",
                           quick ? "quick" : "full", "catenary", "span_m", SPAN, "length_m", LENGTH, "a_m", a, "sag_m",
                           a * cosh(SPAN / (2 * a)) - a, "error",
