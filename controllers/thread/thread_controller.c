@@ -5,7 +5,8 @@
 // and on PREFIX.events a TX_EVENT_KNOT when the papers' rule finds a knot
 // (value[0..1]: its first and last cylinder, value[2]: 0) and when a knot
 // within fix_distance_m of the skin is fixed (value[2]: 1). With skin set,
-// the thread collides with SKIN.x / SKIN.tri.
+// the thread collides with SKIN.x / SKIN.tri, and with the rigid capsules
+// (tx_capsule rows) of the components listed in capsules.
 #include "thread_controller.h"
 
 #include "knot.h"
@@ -30,11 +31,14 @@ typedef struct thread_ctl {
   bool knotted, fixed;
   int knots;
   tx_port head, nodes, force, events, skin_x, skin_tri, skin_h;
+  tx_port caps[8];
+  int ncaps;
+  tx_thread_capsule* shapes; // (max_shapes) the capsules' rows gathered each step
   uint8_t* marks;
   double* start;      // (N x 3) the first shape
   double tail[3];     // m, tail_m
   bool started;
-  tx_warning fault, bad_head, bad_skin;
+  tx_warning fault, bad_head, bad_skin, bad_capsule, too_many;
   tx_result knots_result, first_knot_result, faults_result;
   double first_knot_s;
 } thread_ctl;
@@ -60,6 +64,8 @@ static const tx_param_def params[] = {
     {"head", TX_PARAM_STR, NULL, 0, 0, 0, "device0.pose", "the pose the head follows (f64 1 x 7)"},
     {"prefix", TX_PARAM_STR, NULL, 0, 0, 0, "thread", "writes PREFIX.nodes, PREFIX.force_model, PREFIX.events"},
     {"skin", TX_PARAM_STR, NULL, 0, 0, 0, "", "a skin's prefix (skin): collide with SKIN.x and SKIN.tri; empty: none"},
+    {"capsules", TX_PARAM_STRS, NULL, 0, 8, 0, NULL, "components of rigid capsules (tx_capsule rows: instrument jaws, the needle) the thread keeps out of"},
+    {"max_shapes", TX_PARAM_INT, "1", 0, 4096, 16, NULL, "room for the capsules' rows, all together"},
     {"max_triangles", TX_PARAM_INT, "1", 1, 10000000, 200000, NULL, "room for the skin's triangles"},
     {"tension_n_per_m", TX_PARAM_NUM, "N/m", 0, 1e6, 200, NULL, "ftl: force (length - rest length) x this, along the segments' sum"},
     {"max_force_n", TX_PARAM_NUM, "N", 0, 100, 10, NULL, "the published force never exceeds this"},
@@ -107,7 +113,7 @@ static int configure(tx_setup* s, void** self) {
   d.max_stretch = tx_table_num(s, "max_stretch");
   d.self_collision = tx_table_bool(s, "self_collision");
   d.pin_tail = tx_table_bool(s, "pin_tail");
-  d.max_shapes = 0;
+  d.max_shapes = (int)tx_table_int(s, "max_shapes");
   k->tension_k = tx_table_num(s, "tension_n_per_m");
   k->max_force = tx_table_num(s, "max_force_n");
   k->knot_every = (int)tx_table_int(s, "knot_every");
@@ -155,9 +161,16 @@ static int configure(tx_setup* s, void** self) {
     snprintf(name, sizeof name, "%s.thickness", skin);
     k->skin_h = TX_READ_OF(s, name, tx_thickness);
   }
+  const char* caps[8];
+  k->ncaps = tx_table_strs(s, "capsules", caps, 8);
+  for (int i = 0; i < k->ncaps; i++) k->caps[i] = TX_READ_OF(s, caps[i], tx_capsule);
+  k->shapes = malloc(sizeof(tx_thread_capsule) * (size_t)(d.max_shapes + 1));
+  if (!k->shapes) return tx_setup_fail(s, NULL, "out of memory");
+  k->too_many = tx_setup_warning(s, "too_many_capsules");
   k->fault = tx_setup_warning(s, "numerical_fault");
   k->bad_head = tx_setup_warning(s, "bad_head");
   k->bad_skin = tx_setup_warning(s, "bad_skin");
+  k->bad_capsule = tx_setup_warning(s, "bad_capsule");
   k->knots_result = tx_setup_result(s, "knots");
   k->first_knot_result = tx_setup_result(s, "first_knot_s");
   k->faults_result = tx_setup_result(s, "faults");
@@ -235,6 +248,23 @@ static void step(tx_ctx* c, void* self) {
         tx_thread_set_mesh(k->t, sx.data, sx.rows, st.data, st.rows, ((const tx_thickness*)sh.data)->m) != TX_THREAD_OK)
       tx_warn(c, k->bad_skin);
   }
+  if (k->ncaps) { // every capsule row, as far as there is room
+    int m = 0, max = tx_thread_get_def(k->t)->max_shapes;
+    for (int i = 0; i < k->ncaps; i++) {
+      tx_snapshot sc = tx_read(c, k->caps[i]);
+      const tx_capsule* rows = sc.data;
+      for (uint32_t r = 0; sc.seq > 0 && r < sc.rows; r++) {
+        if (m == max) {
+          tx_warn(c, k->too_many);
+          break;
+        }
+        memcpy(k->shapes[m].a, rows[r].a, sizeof rows[r].a);
+        memcpy(k->shapes[m].b, rows[r].b, sizeof rows[r].b);
+        k->shapes[m++].radius = rows[r].radius;
+      }
+    }
+    if (tx_thread_set_capsules(k->t, k->shapes, m) != TX_THREAD_OK) tx_warn(c, k->bad_capsule);
+  }
   if (tx_thread_step(k->t, k->dt) == TX_THREAD_FAULT) tx_warn(c, k->fault);
   if (k->steps % k->knot_every == 0) check_knot(c, k);
   k->steps++;
@@ -259,6 +289,7 @@ static void fini(void* self) {
   tx_thread_destroy(k->t);
   free(k->marks);
   free(k->start);
+  free(k->shapes);
   free(k);
 }
 

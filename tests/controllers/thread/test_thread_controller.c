@@ -108,6 +108,62 @@ static void rod_force_on_the_head(void** state) {
   tx_scenario_free(s);
 }
 
+// a test class that writes one capsule, 1 mm thick along z, across where
+// the thread hangs from the device (slide-x-over holds still at (-3, 1, 0) cm)
+typedef struct capsule_writer {
+  tx_port out;
+} capsule_writer;
+static capsule_writer the_writer;
+static int capsule_configure(tx_setup* s, void** self) {
+  *self = &the_writer;
+  the_writer.out = tx_setup_write(s, &TX_COMPONENT_OF("tool.capsules", tx_capsule, 1));
+  return 0;
+}
+static void capsule_step(tx_ctx* c, void* self) {
+  tx_capsule* k = tx_write(c, ((capsule_writer*)self)->out);
+  *k = (tx_capsule){{-0.03, 0.0, -0.01}, {-0.03, 0.0, 0.01}, 0.001};
+}
+static const tx_controller_class capsule_class = {
+    .type = "test.capsule", .summary = "one capsule", .configure = capsule_configure, .step = capsule_step};
+
+static double capsule_distance(tx_scenario* s) {
+  const tx_thread_node* n = latest_snapshot(s, "thread.nodes").data;
+  double best = 1;
+  for (int i = 0; i < 20; i++) {
+    // the axis runs along z at x = -3 cm, y = 0: the distance of segment i from it
+    for (int k = 0; k <= 50; k++) {
+      double f = k / 50.0, x = n[i].x[0] + f * (n[i + 1].x[0] - n[i].x[0]), y = n[i].x[1] + f * (n[i + 1].x[1] - n[i].x[1]);
+      best = fmin(best, sqrt((x + 0.03) * (x + 0.03) + y * y));
+    }
+  }
+  return best;
+}
+
+// the rod hangs through where the capsule is: with the capsule listed it
+// drapes aside, 1.25 mm (r + R) from its axis at least; without, it passes through
+static void rod_keeps_out_of_a_capsule(void** state) {
+  (void)state;
+  if (!tx_find_controller(capsule_class.type)) assert_int_equal(tx_register_controller(&capsule_class), 0);
+  for (int listed = 1; listed >= 0; listed--) {
+    char text[1024];
+    snprintf(text, sizeof text,
+             "{\"name\":\"t\",\"controllers\":["
+             "{\"name\":\"thread\",\"type\":\"physics.thread\",\"rate_hz\":1000,\"params\":{\"model\":\"rod\","
+             "\"nodes\":21,\"length_m\":0.02,\"tail_m\":[-0.03,-0.1,0],\"bend_factor\":0,\"damping\":10%s}},"
+             "{\"name\":\"tool\",\"type\":\"test.capsule\",\"rate_hz\":1000},"
+             "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:slide-x-over\"}}]}",
+             listed ? ",\"capsules\":[\"tool.capsules\"]" : "");
+    tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+    if (!s) fail_msg("%s", tx_error());
+    run(s, 0.45);
+    double dmin = capsule_distance(s);
+    print_message("capsule %s: the thread %.3f mm from its axis\n", listed ? "listed" : "not listed", dmin * 1e3);
+    if (listed) assert_true(dmin > 0.99 * 0.00125);
+    else assert_true(dmin < 0.0005);
+    tx_scenario_free(s);
+  }
+}
+
 static void bad_input_is_named(void** state) {
   (void)state;
   struct {
@@ -123,6 +179,7 @@ static void bad_input_is_named(void** state) {
       {"\"tail_m\":[0,0,0]", "params.tail_m"},
       {"\"prefix\":\"\"", "params.prefix"},
       {"\"head\":\"nobody.pose\"", "nobody.pose"},
+      {"\"capsules\":[\"nobody.capsules\"]", "nobody.capsules"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
     tx_scenario* s = load(cases[i].params, "slide-x-over");
@@ -137,6 +194,7 @@ int main(void) {
       cmocka_unit_test(ftl_follows_the_device),
       cmocka_unit_test(tension_of_a_thread_pulled_past_its_pin),
       cmocka_unit_test(rod_force_on_the_head),
+      cmocka_unit_test(rod_keeps_out_of_a_capsule),
       cmocka_unit_test(bad_input_is_named),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
