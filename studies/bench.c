@@ -4,6 +4,7 @@
 #include "bench_hip.h"
 #include "bench_instruments.h"
 #include "bench_render.h"
+#include "bench_thread.h"
 #include "bench_voxels.h"
 #include "../scenarios/command.h"
 #include "../scenarios/run.h"
@@ -350,6 +351,7 @@ static int bench_haptics(const bench_args* a) {
 static int bench_voxels(const bench_args* a) { return tx_bench_voxels(a->duration_s); }
 static int bench_cloth(const bench_args* a) { return tx_bench_cloth(a->duration_s); }
 static int bench_instruments(const bench_args* a) { return tx_bench_instruments(a->duration_s); }
+static int bench_thread(const bench_args* a) { return tx_bench_thread(a->duration_s); }
 static int bench_hip(const bench_args* a) {
   (void)a;
   return tx_bench_hip();
@@ -369,6 +371,7 @@ static const struct {
     {"cloth", bench_cloth, "skin physics step at 10404 particles with rupture; overhead vs a bare Bullet loop"},
     {"hip", bench_hip, "collision.hip query (98 rays) on 10404 and 102400 particles, and the refit"},
     {"instruments", bench_instruments, "one 1 kHz ODE step of two articulated instruments and the needle"},
+    {"thread", bench_thread, "suture thread step, ftl and rod, 100 and 1000 nodes with self collision"},
 };
 
 int tx_cmd_bench(int argc, char** argv) {

@@ -31,6 +31,10 @@ static const struct {
      "spacing, iterations and step refined together: observed order, Richardson reference, error vs CPU time"},
     {"organ-hemisphere", tx_study_organ_hemisphere,
      "a hemisphere indented at its pole: Bullet FEM and links against Hertz, Richardson, error vs CPU time (Fig. 14)"},
+    {"thread-accuracy", tx_study_thread_accuracy,
+     "the rod hanging against the catenary: error vs nodes, iterations and step with CPU time; ftl's length error"},
+    {"thread-stability", tx_study_thread_stability,
+     "the thread at 10 m/s, a 10 cm teleport, coincident nodes, stiffness x1e6, steps 1e-5..1e-2 s, a knot at 20 N"},
 };
 
 // the studies that take a FILE after their name

@@ -229,6 +229,17 @@ typedef struct tx_thread_node {
 #define tx_thread_node_UNITS "m"
 TX_LAYOUT_ASSERT(tx_thread_node, double);
 
+// INSTRUMENT.capsules, NEEDLE.capsules (N rows): rigid shapes the thread
+// keeps out of (instrument jaws, the needle), read by physics.thread
+typedef struct tx_capsule {
+  double a[3], b[3]; // m, the ends of the axis (a == b: a sphere)
+  double radius;     // m
+} tx_capsule;
+#define tx_capsule_TYPE TX_F64
+#define tx_capsule_COLS 7u
+#define tx_capsule_UNITS "m"
+TX_LAYOUT_ASSERT(tx_capsule, double);
+
 // INSTRUMENT.pose (1 row): a pose and the angle of its jaws
 typedef struct tx_instrument_pose {
   double pos[3];  // tool point (between the jaws), m

@@ -1,0 +1,1050 @@
+// The suture thread: follow-the-leader or an XPBD rod, with contacts
+// (thread.h says what each model does).
+#include "thread.h"
+
+#include "segment.h"
+#include "../collision/tri_bvh.h"
+#include "../range_check.h"
+#include "../../model/error.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define PI 3.14159265358979323846
+#define BVH_STACK 128
+
+typedef struct pair {
+  int32_t i, j; // cylinders i < j
+} pair;
+
+struct tx_thread {
+  tx_thread_def def;
+  int n, nseg, skip;
+  double l0, lmax;           // rest and capped segment length, m
+  double alpha_d, alpha_b;   // compliances of the distance (m/N) and bending (1/(N m)) constraints
+  double* x;                 // (n x 3) positions, m
+  double* x0;                // (n x 3) at the start of the substep
+  double* v;                 // (n x 3) velocities, m/s
+  double* xs;                // (n x 3) at the start of the step, for a fault
+  double* vs;                // (n x 3)
+  double* v0;                // (n x 3) at the start of the substep
+  double* w;                 // (n) inverse masses, 1/kg; 0 for pinned nodes
+  double* wf;                // (n) inverse masses of the nodes when free
+  double* lam;               // (4 nseg) XPBD multipliers: the distances, then 3 per bend
+  double* band;              // (2 nseg) the distances' tridiagonal system, then its Cholesky factor
+  double* bend;              // (3 nseg) the bends' pentadiagonal system, then its factor
+  double* rhs;               // (3 nseg)
+  double* dir;               // (nseg x 3) unit segment directions, x[i] - x[i+1]
+  uint8_t* pinned;           // (n)
+  double* pin;               // (n x 3) where pinned nodes are held, m
+  int last_pin;              // the highest pinned node (0: the head alone)
+  double head_from[3], head_to[3];
+  // the self-contact broadphase: a hashed uniform grid over cylinder midpoints
+  uint32_t hash_mask;
+  uint32_t* cell_start;      // (hash size + 1)
+  uint32_t* cell_item;       // (nseg) cylinders sorted by cell
+  uint32_t* seg_cell;        // (nseg) each cylinder's bucket
+  int64_t* seg_ijk;          // (nseg x 3) each cylinder's cell
+  pair* pairs;               // candidate pairs of the substep
+  int npairs, pair_cap;
+  uint8_t* colliding;        // (nseg)
+  tx_thread_capsule* caps;
+  int ncaps;
+  const float* mx;           // the mesh, the caller's arrays
+  const int32_t* mtri;
+  uint32_t mnx, mntri;
+  double thickness;
+  tx_tri_bvh bvh;
+  bool have_bvh;
+  bool move_first;           // edge contacts may move a cylinder's first node
+  double probe;              // m, the nearest triangle found by a query
+  tx_thread_contacts last;
+  double head_force[3];      // N, the rod's constraints on the head in the last substep
+  int faults;
+};
+
+// ---------------------------------------------------------------------------
+// small vector helpers
+
+static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static double dist3(const double a[3], const double b[3]) {
+  double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+  return sqrt(dot3(d, d));
+}
+
+// ---------------------------------------------------------------------------
+// definition
+
+tx_thread_def tx_thread_def_default(void) {
+  tx_thread_def d;
+  memset(&d, 0, sizeof d);
+  d.nodes = 64;
+  d.radius = 0.00025;
+  d.length = 0.2;
+  d.model = TX_THREAD_FTL;
+  d.direction[0] = 1;
+  d.pin_tail = false;
+  d.self_collision = true;
+  d.youngs_modulus = 2e9;
+  d.bend_factor = 1;
+  d.density = 1140;
+  d.gravity = 9.81;
+  d.damping = 1;
+  d.iterations = 2;
+  d.max_substep = 1e-3;
+  d.max_substeps = 64;
+  d.max_stretch = 0.05;
+  d.max_shapes = 16;
+  d.max_triangles = 0;
+  return d;
+}
+
+static int range(const char* name, double v, double lo, bool open_lo, double hi, bool open_hi, const char* units) {
+  return tx_check_range("thread", name, v, lo, open_lo, hi, open_hi, units);
+}
+
+int tx_thread_def_check(const tx_thread_def* d) {
+  static const char* const head_name[3] = {"head[0]", "head[1]", "head[2]"};
+  static const char* const dir_name[3] = {"direction[0]", "direction[1]", "direction[2]"};
+  if (tx_check_count("thread", "nodes", d->nodes, 2, 100000)) return -1;
+  if (range("radius", d->radius, 0, true, 0.01, false, "m")) return -1;
+  if (range("length", d->length, 0, true, 10, false, "m")) return -1;
+  if (d->model != TX_THREAD_FTL && d->model != TX_THREAD_ROD)
+    return tx_check_fail("thread: model = %d, must be ftl (0) or rod (1)", (int)d->model);
+  for (int a = 0; a < 3; a++) {
+    if (range(head_name[a], d->head[a], -10, false, 10, false, "m")) return -1;
+    if (range(dir_name[a], d->direction[a], -1e6, false, 1e6, false, "")) return -1;
+  }
+  if (dot3(d->direction, d->direction) < 1e-24) return tx_check_fail("thread: direction = (0, 0, 0), must not be zero");
+  if (range("youngs_modulus", d->youngs_modulus, 0, true, 1e16, false, "Pa")) return -1;
+  if (range("bend_factor", d->bend_factor, 0, false, 1, false, "")) return -1;
+  if (range("density", d->density, 0, true, 1e5, false, "kg/m^3")) return -1;
+  if (range("gravity", d->gravity, 0, false, 100, false, "m/s^2")) return -1;
+  if (range("damping", d->damping, 0, false, 1e4, false, "1/s")) return -1;
+  if (tx_check_count("thread", "iterations", d->iterations, 1, 1000)) return -1;
+  if (range("max_substep", d->max_substep, 1e-7, false, 0.1, false, "s")) return -1;
+  if (tx_check_count("thread", "max_substeps", d->max_substeps, 1, 10000)) return -1;
+  if (range("max_stretch", d->max_stretch, 0, false, 1, false, "")) return -1;
+  if (tx_check_count("thread", "max_shapes", d->max_shapes, 0, 4096)) return -1;
+  if (tx_check_count("thread", "max_triangles", d->max_triangles, 0, 10000000)) return -1;
+  return 0;
+}
+
+// ---------------------------------------------------------------------------
+// creation
+
+static void update_last_pin(tx_thread* t) {
+  for (int i = 0; i < t->n; i++) t->w[i] = t->pinned[i] ? 0 : t->wf[i];
+  t->last_pin = 0;
+  for (int i = t->n - 1; i > 0; i--)
+    if (t->pinned[i]) {
+      t->last_pin = i;
+      break;
+    }
+}
+
+tx_thread* tx_thread_create(const tx_thread_def* def) {
+  if (tx_thread_def_check(def)) return NULL;
+  tx_thread* t = calloc(1, sizeof *t);
+  if (!t) goto oom;
+  t->def = *def;
+  int n = def->nodes, nseg = n - 1;
+  t->n = n;
+  t->nseg = nseg;
+  t->l0 = def->length / nseg;
+  t->lmax = t->l0 * (1 + def->max_stretch);
+  // cylinders that share a node always touch; so may those a fold of less
+  // than 2 r apart (a segment shorter than the diameter): such pairs are not contacts
+  t->skip = 1;
+  while (t->skip * t->l0 < 2 * def->radius && t->skip < nseg) t->skip++;
+  double area = PI * def->radius * def->radius, inertia = PI * pow(def->radius, 4) / 4;
+  t->alpha_d = t->l0 / (def->youngs_modulus * area);
+  t->alpha_b = def->bend_factor > 0 ? pow(t->l0, 3) / (def->bend_factor * def->youngs_modulus * inertia) : INFINITY;
+  uint32_t hsize = 16;
+  while (hsize < 2u * (uint32_t)nseg) hsize <<= 1;
+  t->hash_mask = hsize - 1;
+  t->pair_cap = 16 * nseg + 64;
+  t->x = malloc(sizeof(double) * 3 * n);
+  t->x0 = malloc(sizeof(double) * 3 * n);
+  t->v = calloc(3 * (size_t)n, sizeof(double));
+  t->xs = malloc(sizeof(double) * 3 * n);
+  t->vs = malloc(sizeof(double) * 3 * n);
+  t->v0 = malloc(sizeof(double) * 3 * n);
+  t->w = malloc(sizeof(double) * n);
+  t->wf = malloc(sizeof(double) * n);
+  t->lam = malloc(sizeof(double) * 4 * nseg);
+  t->band = malloc(sizeof(double) * 2 * nseg);
+  t->bend = malloc(sizeof(double) * 3 * nseg);
+  t->rhs = malloc(sizeof(double) * 3 * nseg);
+  t->dir = malloc(sizeof(double) * 3 * nseg);
+  t->pinned = calloc((size_t)n, 1);
+  t->pin = calloc(3 * (size_t)n, sizeof(double));
+  t->cell_start = malloc(sizeof(uint32_t) * (hsize + 1));
+  t->cell_item = malloc(sizeof(uint32_t) * nseg);
+  t->seg_cell = malloc(sizeof(uint32_t) * nseg);
+  t->seg_ijk = malloc(sizeof(int64_t) * 3 * nseg);
+  t->pairs = malloc(sizeof(pair) * t->pair_cap);
+  t->colliding = calloc((size_t)nseg, 1);
+  t->caps = malloc(sizeof(tx_thread_capsule) * (def->max_shapes + 1));
+  if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->v0 || !t->w || !t->wf || !t->lam || !t->band || !t->bend || !t->rhs || !t->dir || !t->pinned || !t->pin || !t->cell_start ||
+      !t->cell_item || !t->seg_cell || !t->seg_ijk || !t->pairs || !t->colliding || !t->caps)
+    goto oom;
+  if (def->max_triangles > 0) {
+    if (tx_tri_bvh_init(&t->bvh, (uint32_t)def->max_triangles)) goto oom;
+    t->have_bvh = true;
+  }
+  // masses: each segment's mass rho A l0 shared by its two nodes
+  double m = def->density * area * t->l0;
+  for (int i = 0; i < n; i++) t->wf[i] = (i == 0 || i == n - 1) ? 2 / m : 1 / m;
+  double dl = sqrt(dot3(def->direction, def->direction));
+  for (int i = 0; i < n; i++)
+    for (int a = 0; a < 3; a++) t->x[3 * i + a] = def->head[a] + def->direction[a] / dl * t->l0 * i;
+  for (int a = 0; a < 3; a++) t->head_from[a] = t->head_to[a] = def->head[a];
+  t->pinned[0] = 1;
+  memcpy(t->pin, t->x, sizeof(double) * 3);
+  if (def->pin_tail) {
+    t->pinned[n - 1] = 1;
+    memcpy(t->pin + 3 * (n - 1), t->x + 3 * (n - 1), sizeof(double) * 3);
+  }
+  update_last_pin(t);
+  return t;
+oom:
+  tx_set_error("thread: out of memory for %d nodes", def->nodes);
+  tx_thread_destroy(t);
+  return NULL;
+}
+
+void tx_thread_destroy(tx_thread* t) {
+  if (!t) return;
+  free(t->x);
+  free(t->x0);
+  free(t->v);
+  free(t->xs);
+  free(t->vs);
+  free(t->v0);
+  free(t->w);
+  free(t->wf);
+  free(t->lam);
+  free(t->band);
+  free(t->bend);
+  free(t->rhs);
+  free(t->dir);
+  free(t->pinned);
+  free(t->pin);
+  free(t->cell_start);
+  free(t->cell_item);
+  free(t->seg_cell);
+  free(t->seg_ijk);
+  free(t->pairs);
+  free(t->colliding);
+  free(t->caps);
+  if (t->have_bvh) tx_tri_bvh_free(&t->bvh);
+  free(t);
+}
+
+const tx_thread_def* tx_thread_get_def(const tx_thread* t) { return &t->def; }
+double tx_thread_rest_segment(const tx_thread* t) { return t->l0; }
+int tx_thread_node_count(const tx_thread* t) { return t->n; }
+void tx_thread_positions(const tx_thread* t, double* out) { memcpy(out, t->x, sizeof(double) * 3 * t->n); }
+const double* tx_thread_position(const tx_thread* t, int i) { return t->x + 3 * i; }
+const uint8_t* tx_thread_colliding(const tx_thread* t) { return t->colliding; }
+int tx_thread_faults(const tx_thread* t) { return t->faults; }
+void tx_thread_last_contacts(const tx_thread* t, tx_thread_contacts* out) { *out = t->last; }
+void tx_thread_head_force(const tx_thread* t, double out[3]) { memcpy(out, t->head_force, sizeof t->head_force); }
+void tx_thread_tension(const tx_thread* t, double stiffness, double max_force, double f[3], double K[9]) {
+  int n = t->n;
+  const double* h = t->x;
+  const double* tail = t->x + 3 * (n - 1);
+  double sum[3], len = tx_thread_current_length(t);
+  memset(K, 0, sizeof(double) * 9);
+  for (int a = 0; a < 3; a++) {
+    f[a] = 0;
+    sum[a] = tail[a] - h[a];
+  }
+  if (t->pinned[n - 1]) { // the length runs on to the tail's pin
+    const double* pin = t->pin + 3 * (n - 1);
+    len += dist3(pin, tail);
+    for (int a = 0; a < 3; a++) sum[a] = pin[a] - h[a];
+  }
+  double ls = sqrt(dot3(sum, sum));
+  if (t->def.model == TX_THREAD_ROD) {
+    memcpy(f, t->head_force, sizeof t->head_force);
+  } else if (ls > 0 && len > t->def.length) {
+    double mag = stiffness * (len - t->def.length);
+    for (int a = 0; a < 3; a++) {
+      f[a] = mag * sum[a] / ls;
+      for (int b = 0; b < 3; b++) K[3 * a + b] = -stiffness * sum[a] * sum[b] / (ls * ls);
+    }
+  }
+  double fm = sqrt(dot3(f, f));
+  double scale = fm > max_force ? max_force / fm : 1;
+  for (int a = 0; a < 3; a++) f[a] = isfinite(f[a]) ? f[a] * scale : 0;
+  for (int a = 0; a < 9; a++) K[a] = isfinite(K[a]) ? K[a] : 0;
+}
+
+bool tx_thread_pin_of(const tx_thread* t, int i, double out[3]) {
+  if (i < 0 || i >= t->n || !t->pinned[i]) return false;
+  memcpy(out, t->pin + 3 * i, sizeof(double) * 3);
+  return true;
+}
+
+double tx_thread_current_length(const tx_thread* t) {
+  double s = 0;
+  for (int i = 0; i < t->nseg; i++) s += dist3(t->x + 3 * i, t->x + 3 * i + 3);
+  return s;
+}
+
+double tx_thread_max_strain(const tx_thread* t) {
+  double m = -1;
+  for (int i = 0; i < t->nseg; i++) {
+    double e = dist3(t->x + 3 * i, t->x + 3 * i + 3) / t->l0 - 1;
+    if (e > m) m = e;
+  }
+  return m;
+}
+
+// ---------------------------------------------------------------------------
+// inputs
+
+static int check_point(const char* what, const double p[3]) {
+  for (int a = 0; a < 3; a++)
+    if (!isfinite(p[a]) || fabs(p[a]) > 10)
+      return tx_check_fail("thread: %s[%d] = %g m, must be finite and in [-10, 10]", what, a, p[a]);
+  return 0;
+}
+
+tx_thread_status tx_thread_set_head(tx_thread* t, const double pos[3]) {
+  if (check_point("head", pos)) return TX_THREAD_BAD;
+  memcpy(t->head_to, pos, sizeof(double) * 3);
+  return TX_THREAD_OK;
+}
+
+tx_thread_status tx_thread_pin(tx_thread* t, int i, const double pos[3]) {
+  if (i <= 0 || i >= t->n) {
+    tx_set_error("thread: pin node %d, must be in [1, %d]", i, t->n - 1);
+    return TX_THREAD_BAD;
+  }
+  if (check_point("pin", pos)) return TX_THREAD_BAD;
+  t->pinned[i] = 1;
+  memcpy(t->pin + 3 * i, pos, sizeof(double) * 3);
+  memcpy(t->x + 3 * i, pos, sizeof(double) * 3);
+  memset(t->v + 3 * i, 0, sizeof(double) * 3);
+  update_last_pin(t);
+  return TX_THREAD_OK;
+}
+
+tx_thread_status tx_thread_unpin(tx_thread* t, int i) {
+  if (i <= 0 || i >= t->n) {
+    tx_set_error("thread: unpin node %d, must be in [1, %d]", i, t->n - 1);
+    return TX_THREAD_BAD;
+  }
+  t->pinned[i] = 0;
+  update_last_pin(t);
+  return TX_THREAD_OK;
+}
+
+tx_thread_status tx_thread_set_positions(tx_thread* t, const double* x) {
+  for (int i = 0; i < 3 * t->n; i++)
+    if (!isfinite(x[i]) || fabs(x[i]) > 10) {
+      tx_set_error("thread: positions[%d][%d] = %g m, must be finite and in [-10, 10]", i / 3, i % 3, x[i]);
+      return TX_THREAD_BAD;
+    }
+  memcpy(t->x, x, sizeof(double) * 3 * t->n);
+  memset(t->v, 0, sizeof(double) * 3 * t->n);
+  for (int i = 0; i < t->n; i++)
+    if (t->pinned[i]) memcpy(t->pin + 3 * i, x + 3 * i, sizeof(double) * 3);
+  memcpy(t->head_from, x, sizeof(double) * 3);
+  memcpy(t->head_to, x, sizeof(double) * 3);
+  return TX_THREAD_OK;
+}
+
+tx_thread_status tx_thread_set_capsules(tx_thread* t, const tx_thread_capsule* caps, int n) {
+  if (n < 0 || n > t->def.max_shapes) {
+    tx_set_error("thread: %d capsules, must be in [0, %d] (max_shapes)", n, t->def.max_shapes);
+    return TX_THREAD_BAD;
+  }
+  for (int k = 0; k < n; k++) {
+    if (check_point("capsule a", caps[k].a) || check_point("capsule b", caps[k].b)) return TX_THREAD_BAD;
+    if (range("capsule radius", caps[k].radius, 0, false, 1, false, "m")) return TX_THREAD_BAD;
+  }
+  if (n) memcpy(t->caps, caps, sizeof *caps * n);
+  t->ncaps = n;
+  return TX_THREAD_OK;
+}
+
+tx_thread_status tx_thread_set_mesh(tx_thread* t, const float* x, uint32_t nx, const int32_t* tri, uint32_t ntri,
+                                    double thickness) {
+  if (ntri == 0) {
+    t->mntri = 0;
+    return TX_THREAD_OK;
+  }
+  if (!t->have_bvh || ntri > (uint32_t)t->def.max_triangles) {
+    tx_set_error("thread: %u mesh triangles, more than max_triangles = %d", ntri, t->def.max_triangles);
+    return TX_THREAD_BAD;
+  }
+  if (range("thickness", thickness, 0, false, 0.02, false, "m")) return TX_THREAD_BAD;
+  bool same = t->mntri == ntri && t->mnx == nx && tx_tri_bvh_same(&t->bvh, tri, ntri);
+  if (same) {
+    tx_tri_bvh_refit(&t->bvh, x);
+  } else if (tx_tri_bvh_build(&t->bvh, x, nx, tri, ntri)) {
+    tx_set_error("thread: mesh triangle index outside [0, %u)", nx);
+    t->mntri = 0;
+    return TX_THREAD_BAD;
+  }
+  t->mx = x;
+  t->mtri = tri;
+  t->mnx = nx;
+  t->mntri = ntri;
+  t->thickness = thickness;
+  return TX_THREAD_OK;
+}
+
+// ---------------------------------------------------------------------------
+// contacts
+
+// cylinder i against cylinder j: pushes them to 2 r apart (positions
+// weighted by the closest points' parameters and inverse masses)
+static void solve_self_pair(tx_thread* t, int i, int j) {
+  double* x = t->x;
+  tx_seg_closest c;
+  tx_seg_closest_points(x + 3 * i, x + 3 * i + 3, x + 3 * j, x + 3 * j + 3, &c);
+  double d2r = 2 * t->def.radius;
+  if (c.dist >= d2r) return;
+  double n[3];
+  if (c.dist > 1e-12 * d2r) {
+    for (int a = 0; a < 3; a++) n[a] = (c.a[a] - c.b[a]) / c.dist;
+  } else {
+    // crossing exactly: the side they were on at the start of the substep
+    tx_seg_closest c0;
+    tx_seg_closest_points(t->x0 + 3 * i, t->x0 + 3 * i + 3, t->x0 + 3 * j, t->x0 + 3 * j + 3, &c0);
+    if (c0.dist > 0) {
+      for (int a = 0; a < 3; a++) n[a] = (c0.a[a] - c0.b[a]) / c0.dist;
+    } else {
+      n[0] = 0, n[1] = 1, n[2] = 0;
+    }
+  }
+  double wi = t->w[i] * (1 - c.t), wi1 = t->w[i + 1] * c.t, wj = t->w[j] * (1 - c.s), wj1 = t->w[j + 1] * c.s;
+  double den = wi * (1 - c.t) + wi1 * c.t + wj * (1 - c.s) + wj1 * c.s;
+  if (den <= 0) return;
+  double dl = (d2r - c.dist) / den;
+  for (int a = 0; a < 3; a++) {
+    x[3 * i + a] += wi * dl * n[a];
+    x[3 * i + 3 + a] += wi1 * dl * n[a];
+    x[3 * j + a] -= wj * dl * n[a];
+    x[3 * j + 3 + a] -= wj1 * dl * n[a];
+  }
+}
+
+static uint32_t cell_hash(int64_t ix, int64_t iy, int64_t iz, uint32_t mask) {
+  uint64_t h = (uint64_t)ix * 73856093u ^ (uint64_t)iy * 19349663u ^ (uint64_t)iz * 83492791u;
+  return (uint32_t)(h ^ (h >> 32)) & mask;
+}
+
+// the candidate pairs of the substep: cylinders whose midpoints lie in
+// neighbouring cells of a grid whose cell is longer than any cylinder plus
+// the contact distance and a margin, so that every pair that can come within
+// 2 r during the substep is listed once
+static void broadphase(tx_thread* t, double margin) {
+  const double* x = t->x;
+  int nseg = t->nseg;
+  double lmax = 0;
+  for (int i = 0; i < nseg; i++) {
+    double l = dist3(x + 3 * i, x + 3 * i + 3);
+    if (l > lmax) lmax = l;
+  }
+  double cell = lmax + 2 * t->def.radius + margin, inv = 1 / cell;
+  uint32_t hsize = t->hash_mask + 1;
+  memset(t->cell_start, 0, sizeof(uint32_t) * (hsize + 1));
+  for (int i = 0; i < nseg; i++) {
+    const double* p = x + 3 * i;
+    int64_t* c = t->seg_ijk + 3 * i;
+    for (int a = 0; a < 3; a++) c[a] = (int64_t)floor((p[a] + p[a + 3]) * 0.5 * inv);
+    uint32_t h = cell_hash(c[0], c[1], c[2], t->hash_mask);
+    t->seg_cell[i] = h;
+    t->cell_start[h + 1]++;
+  }
+  for (uint32_t h = 0; h < hsize; h++) t->cell_start[h + 1] += t->cell_start[h];
+  // fill with cell_start as the running cursor, then shift it back
+  for (int i = 0; i < nseg; i++) t->cell_item[t->cell_start[t->seg_cell[i]]++] = (uint32_t)i;
+  for (uint32_t h = hsize; h > 0; h--) t->cell_start[h] = t->cell_start[h - 1];
+  t->cell_start[0] = 0;
+  t->npairs = 0;
+  double reach = 2 * t->def.radius + margin;
+  for (int i = 0; i < nseg; i++) {
+    const double* p = x + 3 * i;
+    const int64_t* c = t->seg_ijk + 3 * i;
+    for (int dz = -1; dz <= 1; dz++)
+      for (int dy = -1; dy <= 1; dy++)
+        for (int dx = -1; dx <= 1; dx++) {
+          int64_t cx = c[0] + dx, cy = c[1] + dy, cz = c[2] + dz;
+          uint32_t h = cell_hash(cx, cy, cz, t->hash_mask);
+          for (uint32_t k = t->cell_start[h]; k < t->cell_start[h + 1]; k++) {
+            int j = (int)t->cell_item[k];
+            const int64_t* cj = t->seg_ijk + 3 * j;
+            // only the bucket's items of this very cell: each pair once, no hash collisions
+            if (j <= i + t->skip || cj[0] != cx || cj[1] != cy || cj[2] != cz) continue;
+            t->last.broad_pairs++;
+            tx_seg_closest cl;
+            tx_seg_closest_points(p, p + 3, x + 3 * j, x + 3 * j + 3, &cl);
+            if (cl.dist >= reach) continue;
+            if (t->npairs < t->pair_cap) t->pairs[t->npairs++] = (pair){i, j};
+            // held apart at exactly 2 r, touching cylinders stay marked
+            if (cl.dist < 2 * t->def.radius * 1.01) {
+              t->last.self_pairs++;
+              t->colliding[i] = t->colliding[j] = 1;
+            }
+          }
+        }
+  }
+}
+
+static void solve_self(tx_thread* t) {
+  for (int k = 0; k < t->npairs; k++) solve_self_pair(t, t->pairs[k].i, t->pairs[k].j);
+}
+
+// every cylinder against every capsule: the thread moves out to r + R
+static void solve_capsules(tx_thread* t) {
+  double* x = t->x;
+  for (int k = 0; k < t->ncaps; k++) {
+    const tx_thread_capsule* cp = &t->caps[k];
+    double reach = t->def.radius + cp->radius;
+    for (int i = 0; i < t->nseg; i++) {
+      tx_seg_closest c;
+      tx_seg_closest_points(x + 3 * i, x + 3 * i + 3, cp->a, cp->b, &c);
+      if (c.dist >= reach) continue;
+      double n[3];
+      if (c.dist > 1e-12 * reach) {
+        for (int a = 0; a < 3; a++) n[a] = (c.a[a] - c.b[a]) / c.dist;
+      } else {
+        tx_seg_closest c0;
+        tx_seg_closest_points(t->x0 + 3 * i, t->x0 + 3 * i + 3, cp->a, cp->b, &c0);
+        if (c0.dist > 0)
+          for (int a = 0; a < 3; a++) n[a] = (c0.a[a] - c0.b[a]) / c0.dist;
+        else
+          n[0] = 0, n[1] = 1, n[2] = 0;
+      }
+      double wi = t->w[i] * (1 - c.t), wi1 = t->w[i + 1] * c.t;
+      double den = wi * (1 - c.t) + wi1 * c.t;
+      if (den <= 0) continue;
+      double dl = (reach - c.dist) / den;
+      for (int a = 0; a < 3; a++) {
+        x[3 * i + a] += wi * dl * n[a];
+        x[3 * i + 3 + a] += wi1 * dl * n[a];
+      }
+      t->last.shape_hits++;
+    }
+  }
+}
+
+// node i against the triangles near its move from x0 to x in this substep:
+// a move across a triangle goes back to the side it came from (continuous),
+// and a node nearer than r + thickness / 2 is pushed out to that distance
+static void solve_mesh_node(tx_thread* t, int i) {
+  double* p = t->x + 3 * i;
+  const double* p0 = t->x0 + 3 * i;
+  double reach = t->def.radius + 0.5 * t->thickness;
+  float lo[3], hi[3];
+  for (int a = 0; a < 3; a++) {
+    lo[a] = (float)(fmin(p[a], p0[a]) - reach) - 1e-6f;
+    hi[a] = (float)(fmax(p[a], p0[a]) + reach) + 1e-6f;
+  }
+  const tx_tri_bvh* b = &t->bvh;
+  if (b->nnodes == 0) return;
+  uint32_t stack[BVH_STACK];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const tx_bvh_node* nd = &b->nodes[stack[--top]];
+    if (nd->lo[0] > hi[0] || nd->hi[0] < lo[0] || nd->lo[1] > hi[1] || nd->hi[1] < lo[1] || nd->lo[2] > hi[2] ||
+        nd->hi[2] < lo[2])
+      continue;
+    if (nd->count == 0) {
+      uint32_t self = (uint32_t)(nd - b->nodes);
+      if (top + 2 <= BVH_STACK) {
+        stack[top++] = nd->first;
+        stack[top++] = self + 1;
+      }
+      continue;
+    }
+    for (uint32_t sl = nd->first; sl < nd->first + nd->count; sl++) {
+      if (b->order[sl] == UINT32_MAX) continue;
+      const int32_t* tv = b->tri + 3 * sl;
+      double v[3][3];
+      for (int c = 0; c < 3; c++)
+        for (int a = 0; a < 3; a++) v[c][a] = t->mx[3 * tv[c] + a];
+      double e1[3], e2[3], nrm[3];
+      for (int a = 0; a < 3; a++) {
+        e1[a] = v[1][a] - v[0][a];
+        e2[a] = v[2][a] - v[0][a];
+      }
+      nrm[0] = e1[1] * e2[2] - e1[2] * e2[1];
+      nrm[1] = e1[2] * e2[0] - e1[0] * e2[2];
+      nrm[2] = e1[0] * e2[1] - e1[1] * e2[0];
+      double nl = sqrt(dot3(nrm, nrm));
+      if (nl <= 0) continue;
+      for (int a = 0; a < 3; a++) nrm[a] /= nl;
+      double rel0[3] = {p0[0] - v[0][0], p0[1] - v[0][1], p0[2] - v[0][2]};
+      double side = dot3(nrm, rel0) >= 0 ? 1 : -1;
+      double tc;
+      if (tx_seg_tri_cross(p0, p, v[0], v[1], v[2], &tc)) {
+        // crossed the face: back to the crossing point, out on its own side
+        for (int a = 0; a < 3; a++) p[a] = p0[a] + tc * (p[a] - p0[a]) + side * reach * nrm[a];
+        t->last.mesh_hits++;
+      }
+      double cp[3], bary[3];
+      tx_tri_closest_point(p, v[0], v[1], v[2], cp, bary);
+      double d[3] = {p[0] - cp[0], p[1] - cp[1], p[2] - cp[2]};
+      double dl = sqrt(dot3(d, d));
+      if (dl >= reach) continue;
+      bool inside = bary[0] > 0 && bary[1] > 0 && bary[2] > 0;
+      if (inside || dl <= 1e-12 * reach) {
+        // over the face the side it came from decides the way out
+        for (int a = 0; a < 3; a++) p[a] = cp[a] + side * reach * nrm[a];
+      } else {
+        for (int a = 0; a < 3; a++) p[a] = cp[a] + d[a] / dl * reach;
+      }
+      t->last.mesh_hits++;
+    }
+  }
+}
+
+// the mesh triangles whose boxes meet [lo, hi]: calls fn on each (its 3 corners)
+typedef void (*tri_fn)(tx_thread* t, int i, const double v[3][3]);
+
+static void for_triangles_near(tx_thread* t, const float lo[3], const float hi[3], int i, tri_fn fn) {
+  const tx_tri_bvh* b = &t->bvh;
+  if (b->nnodes == 0) return;
+  uint32_t stack[BVH_STACK];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const tx_bvh_node* nd = &b->nodes[stack[--top]];
+    if (nd->lo[0] > hi[0] || nd->hi[0] < lo[0] || nd->lo[1] > hi[1] || nd->hi[1] < lo[1] || nd->lo[2] > hi[2] ||
+        nd->hi[2] < lo[2])
+      continue;
+    if (nd->count == 0) {
+      if (top + 2 <= BVH_STACK) {
+        stack[top++] = nd->first;
+        stack[top++] = (uint32_t)(nd - b->nodes) + 1;
+      }
+      continue;
+    }
+    for (uint32_t sl = nd->first; sl < nd->first + nd->count; sl++) {
+      if (b->order[sl] == UINT32_MAX) continue;
+      const int32_t* tv = b->tri + 3 * sl;
+      double v[3][3];
+      for (int c = 0; c < 3; c++)
+        for (int a = 0; a < 3; a++) v[c][a] = t->mx[3 * tv[c] + a];
+      fn(t, i, v);
+    }
+  }
+}
+
+// cylinder i against the three edges of a triangle: a cylinder cannot pass
+// across an edge (the skin's border, a fold), so its nodes cannot end up on
+// two sides of the skin without going round it. The side is the one the
+// cylinder was on at the start of the substep.
+static void edge_contacts(tx_thread* t, int i, const double v[3][3]) {
+  double reach = t->def.radius + 0.5 * t->thickness;
+  double* x = t->x;
+  double wi = t->move_first ? t->w[i] : 0, wj = t->w[i + 1];
+  for (int e = 0; e < 3; e++) {
+    const double *va = v[e], *vb = v[(e + 1) % 3];
+    tx_seg_closest c, c0;
+    tx_seg_closest_points(x + 3 * i, x + 3 * i + 3, va, vb, &c);
+    if (c.dist >= reach) continue;
+    tx_seg_closest_points(t->x0 + 3 * i, t->x0 + 3 * i + 3, va, vb, &c0);
+    double n[3], sep[3] = {c.a[0] - c.b[0], c.a[1] - c.b[1], c.a[2] - c.b[2]};
+    double sep0[3] = {c0.a[0] - c0.b[0], c0.a[1] - c0.b[1], c0.a[2] - c0.b[2]};
+    if (c0.dist > 0 && (c.dist <= 1e-12 * reach || dot3(sep, sep0) < 0)) {
+      for (int a = 0; a < 3; a++) n[a] = sep0[a] / c0.dist;
+    } else if (c.dist > 0) {
+      for (int a = 0; a < 3; a++) n[a] = sep[a] / c.dist;
+    } else {
+      continue;
+    }
+    double ga = wi * (1 - c.t), gb = wj * c.t, den = ga * (1 - c.t) + gb * c.t;
+    if (den <= 0) continue;
+    // move A so that it sits reach from the edge along n
+    for (int a = 0; a < 3; a++) {
+      double delta = n[a] * reach - sep[a];
+      x[3 * i + a] += ga / den * delta;
+      x[3 * i + 3 + a] += gb / den * delta;
+    }
+    t->last.mesh_hits++;
+  }
+}
+
+static void solve_mesh_edges(tx_thread* t, int i) {
+  double reach = t->def.radius + 0.5 * t->thickness;
+  float lo[3], hi[3];
+  const double *p = t->x + 3 * i, *p0 = t->x0 + 3 * i;
+  for (int a = 0; a < 3; a++) {
+    lo[a] = (float)(fmin(fmin(p[a], p[a + 3]), fmin(p0[a], p0[a + 3])) - reach) - 1e-6f;
+    hi[a] = (float)(fmax(fmax(p[a], p[a + 3]), fmax(p0[a], p0[a + 3])) + reach) + 1e-6f;
+  }
+  for_triangles_near(t, lo, hi, i, edge_contacts);
+}
+
+// the nearest distance from node i to a triangle, at most what it was
+static void nearest_triangle(tx_thread* t, int i, const double v[3][3]) {
+  double cp[3];
+  tx_tri_closest_point(t->x + 3 * i, v[0], v[1], v[2], cp, NULL);
+  double d = dist3(cp, t->x + 3 * i);
+  if (d < t->probe) t->probe = d;
+}
+
+int tx_thread_fix_near_mesh(tx_thread* t, int first, int last, double limit) {
+  if (first < 0 || last >= t->nseg || first > last) {
+    tx_set_error("thread: fix cylinders %d to %d, must be within [0, %d]", first, last, t->nseg - 1);
+    return -1;
+  }
+  if (range("fix limit", limit, 0, false, 1, false, "m")) return -1;
+  if (t->mntri == 0) return 0;
+  t->probe = INFINITY;
+  for (int i = first; i <= last + 1; i++) {
+    float lo[3], hi[3];
+    for (int a = 0; a < 3; a++) {
+      lo[a] = (float)(t->x[3 * i + a] - limit) - 1e-6f;
+      hi[a] = (float)(t->x[3 * i + a] + limit) + 1e-6f;
+    }
+    for_triangles_near(t, lo, hi, i, nearest_triangle);
+  }
+  if (!(t->probe <= limit)) return 0;
+  for (int i = first; i <= last + 1; i++)
+    if (i > 0) {
+      t->pinned[i] = 1;
+      memcpy(t->pin + 3 * i, t->x + 3 * i, sizeof(double) * 3);
+      memset(t->v + 3 * i, 0, sizeof(double) * 3);
+    }
+  update_last_pin(t);
+  return 1;
+}
+
+static void solve_mesh(tx_thread* t) {
+  if (t->mntri == 0) return;
+  t->move_first = true;
+  for (int i = 0; i < t->nseg; i++) solve_mesh_edges(t, i);
+  for (int i = 0; i < t->n; i++)
+    if (!t->pinned[i]) solve_mesh_node(t, i);
+}
+
+// ---------------------------------------------------------------------------
+// the two models
+
+// each free node at l0 from the node before it, on the line to where it is;
+// a node that sits on its leader keeps the direction of the segment before
+static void place_after(tx_thread* t, int i, int from, double len) {
+  double* p = t->x + 3 * i;
+  const double* q = t->x + 3 * from;
+  double d[3] = {p[0] - q[0], p[1] - q[1], p[2] - q[2]};
+  double l = sqrt(dot3(d, d));
+  if (l <= 1e-12 * t->l0) {
+    int k = 2 * from - i; // the node beyond the leader
+    if (k >= 0 && k < t->n) {
+      for (int a = 0; a < 3; a++) d[a] = q[a] - t->x[3 * k + a];
+    } else {
+      memcpy(d, t->def.direction, sizeof d);
+      if (i < from)
+        for (int a = 0; a < 3; a++) d[a] = -d[a];
+    }
+    l = sqrt(dot3(d, d));
+    if (l <= 0) d[0] = 1, d[1] = d[2] = 0, l = 1;
+  }
+  for (int a = 0; a < 3; a++) p[a] = q[a] + d[a] / l * len;
+}
+
+// against a mesh each node is also kept on its side of it (the continuous
+// test from where it was at the start of the substep): where the two
+// disagree, not crossing the skin wins over the exact length
+static void ftl_forward(tx_thread* t) {
+  for (int i = 1; i < t->n; i++) {
+    place_after(t, i, i - 1, t->l0);
+    if (t->mntri) {
+      t->move_first = false; // the leader is placed: only this node moves
+      solve_mesh_edges(t, i - 1);
+      solve_mesh_node(t, i);
+    }
+  }
+}
+
+// FABRIK towards the pins behind the head, the last pass from the head
+static void ftl_solve(tx_thread* t) {
+  ftl_forward(t);
+  if (t->last_pin == 0) return;
+  for (int it = 0; it < t->def.iterations; it++) {
+    for (int i = t->last_pin; i > 0; i--) {
+      if (t->pinned[i])
+        memcpy(t->x + 3 * i, t->pin + 3 * i, sizeof(double) * 3);
+      else
+        place_after(t, i, i + 1, t->l0);
+    }
+    ftl_forward(t);
+  }
+}
+
+static void ftl_substep(tx_thread* t, double h, double margin) {
+  ftl_solve(t);
+  if (t->def.self_collision && t->nseg > t->skip + 1) {
+    broadphase(t, margin);
+    for (int it = 0; it < t->def.iterations; it++) {
+      solve_self(t);
+      ftl_solve(t);
+    }
+  }
+  // the kinematic thread follows around shapes: push out, follow again
+  for (int it = 0; it < 2 && (t->ncaps || t->mntri); it++) {
+    solve_capsules(t);
+    solve_mesh(t);
+    ftl_solve(t);
+  }
+  for (int i = 0; i < 3 * t->n; i++) t->v[i] = (t->x[i] - t->x0[i]) / h;
+}
+
+// no segment longer than lmax: from the head along the thread, then back from the last pin
+static void cap_stretch(tx_thread* t) {
+  for (int pass = 0; pass < 2; pass++) {
+    for (int i = 1; i < t->n; i++)
+      if (!t->pinned[i] && dist3(t->x + 3 * i, t->x + 3 * i - 3) > t->lmax) place_after(t, i, i - 1, t->lmax);
+    if (t->last_pin == 0) break;
+    for (int i = t->last_pin - 1; i > 0; i--)
+      if (!t->pinned[i] && dist3(t->x + 3 * i, t->x + 3 * i + 3) > t->lmax) place_after(t, i, i + 1, t->lmax);
+  }
+  for (int i = 1; i < t->n; i++)
+    if (!t->pinned[i] && dist3(t->x + 3 * i, t->x + 3 * i - 3) > t->lmax) place_after(t, i, i - 1, t->lmax);
+}
+
+// Cholesky of a symmetric banded matrix in place: A[r (bw + 1) + k] holds
+// A(r, r - k), k = 0..bw, and then L(r, r - k), with 1 / L(r, r) on the
+// diagonal (the solves multiply: a chain of divisions is slow)
+static void band_factor(double* A, int rows, int bw) {
+  int w = bw + 1;
+  for (int r = 0; r < rows; r++) {
+    int c0 = r - bw < 0 ? 0 : r - bw;
+    for (int c = c0; c <= r; c++) {
+      double sum = A[r * w + (r - c)];
+      int m0 = c - bw > c0 ? c - bw : c0;
+      for (int m = m0; m < c; m++) sum -= A[r * w + (r - m)] * A[c * w + (c - m)];
+      if (c == r)
+        A[r * w] = 1 / sqrt(sum > 1e-300 ? sum : 1e-300);
+      else
+        A[r * w + (r - c)] = sum * A[c * w];
+    }
+  }
+}
+
+// solves L L^T y = b in place; stride: the distance between y's entries
+static void band_solve(const double* L, int rows, int bw, double* y, int stride) {
+  int w = bw + 1;
+  for (int r = 0; r < rows; r++) {
+    int m0 = r - bw < 0 ? 0 : r - bw;
+    double sum = y[r * stride];
+    for (int m = m0; m < r; m++) sum -= L[r * w + (r - m)] * y[m * stride];
+    y[r * stride] = sum * L[r * w];
+  }
+  for (int r = rows - 1; r >= 0; r--) {
+    int m1 = r + bw >= rows ? rows - 1 : r + bw;
+    double sum = y[r * stride];
+    for (int m = r + 1; m <= m1; m++) sum -= L[m * w + (m - r)] * y[m * stride];
+    y[r * stride] = sum * L[r * w];
+  }
+}
+
+// the bends' system depends on the masses and h alone: factored once a substep
+static void bend_factor(tx_thread* t, double h) {
+  int nb = t->n - 2;
+  const double* w = t->w;
+  double ab = t->alpha_b / (h * h);
+  double* B = t->bend;
+  for (int k = 0; k < nb; k++) {
+    int i = k + 1;
+    B[k * 3] = w[i - 1] + 4 * w[i] + w[i + 1] + ab;
+    B[k * 3 + 1] = k >= 1 ? -2 * w[i - 1] - 2 * w[i] : 0;
+    B[k * 3 + 2] = k >= 2 ? w[i - 1] : 0;
+  }
+  if (nb > 0 && isfinite(ab)) band_factor(B, nb, 2);
+}
+
+// one XPBD iteration, the bends then the distances, each group solved
+// exactly: (J W J^T + alpha / h^2) dlambda = -(C + alpha / h^2 lambda).
+// The bends' gradients are constant (1, -2, 1 on each axis), so their
+// system is one pentadiagonal matrix for the three axes; the distances'
+// is tridiagonal. A stiff rod converges in a few iterations where
+// Gauss-Seidel sweeps would need O(N^2); bends and stretch barely couple
+// (one moves across the rod, the other along it), so alternating the two
+// exact solves converges fast.
+static void rod_solve(tx_thread* t, double h) {
+  int n = t->n, nseg = t->nseg, nb = n - 2;
+  double* x = t->x;
+  const double* w = t->w;
+  double ad = t->alpha_d / (h * h), ab = t->alpha_b / (h * h);
+  double* A = t->band;
+  double* y = t->rhs;
+  double* lam_d = t->lam;
+  double* lam_b = t->lam + nseg; // 3 per bend
+  if (nb > 0 && isfinite(ab)) {
+    // bend k (node k + 1): rows k, k + 1, k + 2 share nodes
+    for (int k = 0; k < nb; k++) {
+      int i = k + 1;
+      for (int c = 0; c < 3; c++)
+        y[3 * k + c] = -(x[3 * i - 3 + c] - 2 * x[3 * i + c] + x[3 * i + 3 + c]) - ab * lam_b[3 * k + c];
+    }
+    for (int c = 0; c < 3; c++) band_solve(t->bend, nb, 2, y + c, 3);
+    for (int k = 0; k < nb; k++) {
+      int i = k + 1;
+      for (int c = 0; c < 3; c++) {
+        double dl = y[3 * k + c];
+        lam_b[3 * k + c] += dl;
+        x[3 * i - 3 + c] += w[i - 1] * dl;
+        x[3 * i + c] -= 2 * w[i] * dl;
+        x[3 * i + 3 + c] += w[i + 1] * dl;
+      }
+    }
+  }
+  // distances: segment k's gradient is +u_k at node k and -u_k at node k + 1
+  double* u = t->dir;
+  for (int k = 0; k < nseg; k++) {
+    double e[3] = {x[3 * k] - x[3 * k + 3], x[3 * k + 1] - x[3 * k + 4], x[3 * k + 2] - x[3 * k + 5]};
+    double l = sqrt(dot3(e, e));
+    if (l > 1e-12 * t->l0) {
+      for (int a = 0; a < 3; a++) u[3 * k + a] = e[a] / l;
+    } else { // coincident nodes: open the segment along the one before it (or the thread's first direction)
+      double f[3] = {-t->def.direction[0], -t->def.direction[1], -t->def.direction[2]};
+      if (k > 0 && dot3(u + 3 * k - 3, u + 3 * k - 3) > 0.5) memcpy(f, u + 3 * k - 3, sizeof f);
+      double lf = sqrt(dot3(f, f));
+      for (int a = 0; a < 3; a++) u[3 * k + a] = f[a] / lf;
+    }
+    y[k] = -(l - t->l0) - ad * lam_d[k];
+    A[k * 2] = (w[k] + w[k + 1]) + ad;
+    A[k * 2 + 1] = k >= 1 ? -w[k] * dot3(u + 3 * k - 3, u + 3 * k) : 0;
+  }
+  band_factor(A, nseg, 1);
+  band_solve(A, nseg, 1, y, 1);
+  for (int k = 0; k < nseg; k++) {
+    lam_d[k] += y[k];
+    for (int a = 0; a < 3; a++) {
+      x[3 * k + a] += w[k] * u[3 * k + a] * y[k];
+      x[3 * k + 3 + a] -= w[k + 1] * u[3 * k + a] * y[k];
+    }
+  }
+}
+
+static void rod_substep(tx_thread* t, double h, double margin) {
+  const tx_thread_def* d = &t->def;
+  int n = t->n, nseg = t->nseg;
+  double* x = t->x;
+  double* v = t->v;
+  double decay = exp(-d->damping * h);
+  for (int i = 0; i < n; i++) {
+    if (t->pinned[i]) continue;
+    v[3 * i + 1] -= d->gravity * h;
+    for (int a = 0; a < 3; a++) {
+      v[3 * i + a] *= decay;
+      x[3 * i + a] += v[3 * i + a] * h;
+    }
+  }
+  memset(t->lam, 0, sizeof(double) * 4 * nseg);
+  bool self = d->self_collision && nseg > t->skip + 1;
+  if (self) broadphase(t, margin);
+  bend_factor(t, h);
+  for (int it = 0; it < d->iterations; it++) {
+    rod_solve(t, h);
+    solve_capsules(t);
+    if (self) solve_self(t);
+  }
+  cap_stretch(t);
+  // a node moved by one cylinder's push can go back into its neighbour's
+  // capsule: a second pass settles the pair
+  for (int pass = 0; pass < 2; pass++) {
+    solve_capsules(t);
+    if (self) solve_self(t);
+  }
+  // the cap again: pushes in a crowded knot can stretch a segment; shortening
+  // towards the leader barely opens a contact again
+  cap_stretch(t);
+  solve_mesh(t);
+  for (int i = 0; i < n; i++)
+    for (int a = 0; a < 3; a++) v[3 * i + a] = t->pinned[i] ? 0 : (x[3 * i + a] - t->x0[3 * i + a]) / h;
+  // the force the constraints put on the (pinned) head: gradient x lambda /
+  // h^2 of the first distance and of the bend at node 1 (its coefficient at node 0 is 1)
+  for (int a = 0; a < 3; a++) {
+    t->head_force[a] = t->dir[a] * t->lam[0] / (h * h);
+    if (n > 2) t->head_force[a] += t->lam[nseg + a] / (h * h);
+  }
+}
+
+tx_thread_status tx_thread_step(tx_thread* t, double dt) {
+  if (!(dt > 0 && dt <= 1)) {
+    tx_set_error("thread: dt = %g s, must be in (0, 1]", dt);
+    return TX_THREAD_BAD;
+  }
+  const tx_thread_def* d = &t->def;
+  int n = t->n;
+  memcpy(t->xs, t->x, sizeof(double) * 3 * n);
+  memcpy(t->vs, t->v, sizeof(double) * 3 * n);
+  memset(t->colliding, 0, (size_t)t->nseg);
+  memset(&t->last, 0, sizeof t->last);
+  // substeps: the head and, by their last velocities, the nodes move no
+  // more than 3 r / 4 in one
+  double move = dist3(t->head_from, t->head_to);
+  if (d->model == TX_THREAD_ROD) {
+    double vmax2 = 0;
+    for (int i = 0; i < n; i++) {
+      double s = dot3(t->v + 3 * i, t->v + 3 * i);
+      if (s > vmax2) vmax2 = s;
+    }
+    double vm = (sqrt(vmax2) + d->gravity * dt) * dt;
+    if (vm > move) move = vm;
+  }
+  double sub = ceil(dt / d->max_substep - 1e-9);
+  double need = ceil(move / (0.75 * d->radius));
+  if (need > sub) sub = need;
+  if (sub < 1) sub = 1;
+  if (sub > d->max_substeps) sub = d->max_substeps;
+  double h = dt / sub, hmin = dt / d->max_substeps, tau = 0;
+  int ns = 0;
+  // a substep in which a free node moved more than 0.9 r (a kink springing
+  // back, a whip) is taken again at half the length, down to dt /
+  // max_substeps: two cylinders 2 r apart that each move less than r cannot
+  // pass through each other, and the contacts' margin of 2 r covers them
+  while (tau < dt * (1 - 1e-12)) {
+    if (h > dt - tau) h = dt - tau;
+    double f = (tau + h) / dt;
+    memcpy(t->x0, t->x, sizeof(double) * 3 * n);
+    memcpy(t->v0, t->v, sizeof(double) * 3 * n);
+    for (int a = 0; a < 3; a++) t->x[a] = t->head_from[a] + f * (t->head_to[a] - t->head_from[a]);
+    for (int i = 1; i < n; i++)
+      if (t->pinned[i]) memcpy(t->x + 3 * i, t->pin + 3 * i, sizeof(double) * 3);
+    double margin = 2 * d->radius + dist3(t->x, t->x0);
+    if (d->model == TX_THREAD_FTL)
+      ftl_substep(t, h, margin);
+    else
+      rod_substep(t, h, margin);
+    ns++;
+    double far2 = 0;
+    for (int i = 1; i < n; i++) {
+      double e[3] = {t->x[3 * i] - t->x0[3 * i], t->x[3 * i + 1] - t->x0[3 * i + 1], t->x[3 * i + 2] - t->x0[3 * i + 2]};
+      double s = dot3(e, e);
+      if (s > far2 && !t->pinned[i]) far2 = s;
+    }
+    if (far2 > 0.81 * d->radius * d->radius && h > hmin * (1 + 1e-9) && ns < 4 * d->max_substeps) {
+      memcpy(t->x, t->x0, sizeof(double) * 3 * n);
+      memcpy(t->v, t->v0, sizeof(double) * 3 * n);
+      h = fmax(0.5 * h, hmin);
+      t->last.retries++;
+      continue;
+    }
+    tau += h;
+  }
+  memcpy(t->head_from, t->head_to, sizeof(double) * 3);
+  t->last.substeps = ns;
+  for (int i = 0; i < 3 * n; i++)
+    if (!isfinite(t->x[i]) || !isfinite(t->v[i])) {
+      memcpy(t->x, t->xs, sizeof(double) * 3 * n);
+      memcpy(t->v, t->vs, sizeof(double) * 3 * n);
+      t->faults++;
+      return TX_THREAD_FAULT;
+    }
+  return TX_THREAD_OK;
+}

@@ -1,0 +1,179 @@
+// Internal: the suture thread, N nodes (spheres of radius r) joined by
+// cylinders of rest length l0 = length / (N - 1). Node 0 is the head: it is
+// pinned where the caller puts it (the needle's swage end, or a device).
+// The tail (node N - 1) is free or pinned; any other node can be pinned too.
+//
+//   ftl   follow-the-leader (Brown, Latombe and Montgomery 2004; the suturing
+//         papers' thread): each node is put at l0 from the one ahead of it,
+//         on the line to where it was. Kinematic, and every segment keeps its
+//         length exactly. With pinned nodes behind the head it is FABRIK
+//         (passes from the head, then back from the last pin, alternated; the
+//         last pass is from the head, so lengths stay exact and a pin that
+//         is out of reach is missed).
+//   rod   XPBD (Macklin et al. 2016) on a mass-spring rod: a distance
+//         constraint per segment of compliance l0 / (E A) (A = pi r^2: the
+//         axial stiffness E A / l0), and a bending constraint per inner node
+//         on the second difference d = x[i-1] - 2 x[i] + x[i+1] (3 linear
+//         components; |d| = l0 theta for a small bend theta) of compliance
+//         l0^3 / (E I), I = pi r^4 / 4, so that its energy E I theta^2 /
+//         (2 l0) is the bending energy of an elastic rod of curvature
+//         theta / l0 over a length l0. Gravity along -y, velocity damping,
+//         masses from the density. After the iterations of a substep no
+//         segment is longer than l0 (1 + max_stretch): a projection along the
+//         thread from the head (and back from the last pin) enforces the cap.
+//         Each iteration solves all the bends at once, then all the
+//         distances at once (a pentadiagonal and a tridiagonal Cholesky,
+//         O(N)), so a stiff rod converges in a few iterations where
+//         constraint-by-constraint sweeps would need O(N^2).
+//
+// Both models share the contacts (step 2 of the thread's issue): self
+// contact between cylinders (|AB| < 2 r, segment.h) found through a uniform
+// grid, kinematic capsules and spheres, and a triangle mesh (the skin's
+// SKIN.x / SKIN.tri arrays). A step is split into substeps short enough
+// that the head and, by its last velocity, every node move no more than
+// 3 r / 4 in one; a substep in which a free node still moved more than
+// 0.9 r is taken again at half the length (down to dt / max_substeps). So neither a
+// fast head nor a fast node jumps across a 2 r contact. Against triangles
+// each node's move in a substep is also tested as a segment (continuous),
+// so a node never crosses a triangle whatever its speed.
+//
+//     tx_thread_def d = tx_thread_def_default();
+//     d.model = TX_THREAD_ROD;
+//     tx_thread* t = tx_thread_create(&d);        // NULL and tx_error() on bad input
+//     tx_thread_set_head(t, (double[3]){0, 0.01, 0});
+//     tx_thread_step(t, 0.001);
+//     tx_thread_positions(t, x);                  // (N x 3) m
+//     tx_thread_destroy(t);
+//
+// Create allocates everything; step and the getters never allocate. One
+// thread of execution at a time per thread.
+#ifndef TX_CONTROLLERS_THREAD_THREAD_H
+#define TX_CONTROLLERS_THREAD_THREAD_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+typedef enum tx_thread_model {
+  TX_THREAD_FTL = 0, // follow-the-leader, kinematic
+  TX_THREAD_ROD = 1, // XPBD rod
+} tx_thread_model;
+
+typedef struct tx_thread_def {
+  int nodes;             // N, in [2, 100000]; 64
+  double radius;         // m, r, in (0, 0.01]; 0.00025 (a 0.5 mm thread)
+  double length;         // m, rest length head to tail, in (0, 10]; 0.2
+  tx_thread_model model; // TX_THREAD_FTL or TX_THREAD_ROD; TX_THREAD_FTL
+  double head[3];        // m, the head at creation, each in [-10, 10]; 0
+  double direction[3];   // the thread lies straight from the head this way at creation (normalised); (1, 0, 0)
+  bool pin_tail;         // the tail stays where it was created (or tx_thread_pin puts it); false
+  bool self_collision;   // cylinders of the thread push each other apart; true
+  double youngs_modulus; // Pa, E, in (0, 1e16]; 2e9 (monofilament nylon, 2 GPa; the top is x5e6, for stability studies)
+  double bend_factor;    // the bending stiffness is bend_factor E I, in [0, 1]; 1 (0: a perfectly flexible
+                         // thread, the catenary's chain; braided threads bend more easily than their E says)
+  double density;        // kg/m^3, in (0, 1e5]; 1140 (nylon)
+  double gravity;        // m/s^2, along -y, in [0, 100]; 9.81
+  double damping;        // 1/s, decay rate of node velocities, in [0, 1e4]; 1
+  int iterations;        // rod: direct XPBD solves per substep; ftl with pins: FABRIK passes; in [1, 1000]; 2
+  double max_substep;    // s, the step is split into substeps no longer than this, in [1e-7, 0.1]; 1e-3
+  int max_substeps;      // at most this many substeps per step, in [1, 10000]; 64
+  double max_stretch;    // the stretch cap: (l - l0) / l0 of a segment, in [0, 1]; 0.05
+  int max_shapes;        // room for capsules and spheres, in [0, 4096]; 16
+  int max_triangles;     // room for mesh triangles, in [0, 10000000]; 0: no mesh
+} tx_thread_def;
+
+// a kinematic capsule: the points within radius of segment a b (a sphere when a == b)
+typedef struct tx_thread_capsule {
+  double a[3], b[3]; // m
+  double radius;     // m
+} tx_thread_capsule;
+
+typedef struct tx_thread tx_thread;
+
+typedef enum tx_thread_status {
+  TX_THREAD_OK = 0,    // stepped
+  TX_THREAD_FAULT = 1, // a node went non-finite: put back to the state before the step
+  TX_THREAD_BAD = 2,   // bad argument: nothing done, tx_error() set
+} tx_thread_status;
+
+// the defaults above
+tx_thread_def tx_thread_def_default(void);
+
+// 0 when every field is finite and in range; otherwise -1, and tx_error()
+// names the field, its value and the range
+int tx_thread_def_check(const tx_thread_def* def);
+
+// the thread straight from def.head along def.direction, at rest; NULL (and
+// tx_error()) on bad input or no memory
+tx_thread* tx_thread_create(const tx_thread_def* def);
+void tx_thread_destroy(tx_thread* t);
+
+const tx_thread_def* tx_thread_get_def(const tx_thread* t);
+double tx_thread_rest_segment(const tx_thread* t); // l0, m
+
+// the head's target: the next step moves it in a straight line from where it
+// was to here (each coordinate finite, in [-10, 10] m)
+tx_thread_status tx_thread_set_head(tx_thread* t, const double pos[3]);
+// pins node i (0 < i < N) at pos; tx_thread_unpin frees it (not the head)
+tx_thread_status tx_thread_pin(tx_thread* t, int i, const double pos[3]);
+tx_thread_status tx_thread_unpin(tx_thread* t, int i);
+// puts every node at x (N x 3, m) at rest (zero velocity); the head and the
+// pins move there too. For reference shapes and tests.
+tx_thread_status tx_thread_set_positions(tx_thread* t, const double* x);
+
+// the rigid shapes for the next steps (copied; n in [0, max_shapes])
+tx_thread_status tx_thread_set_capsules(tx_thread* t, const tx_thread_capsule* caps, int n);
+// the triangle mesh for the next steps: x (nx x 3) and tri (ntri x 3) as the
+// skin's SKIN.x (tx_vertex) and SKIN.tri (tx_triangle) rows. Both arrays are
+// read during tx_thread_step and must stay valid until the next call; the
+// BVH is rebuilt when the triangles change and refitted otherwise. thickness
+// (m, in [0, 0.02]): the surface's collision thickness. ntri = 0 removes it.
+tx_thread_status tx_thread_set_mesh(tx_thread* t, const float* x, uint32_t nx, const int32_t* tri, uint32_t ntri,
+                                    double thickness);
+
+// advances by dt (s, in (0, 1])
+tx_thread_status tx_thread_step(tx_thread* t, double dt);
+
+int tx_thread_node_count(const tx_thread* t);
+// out: (N x 3) positions, m
+void tx_thread_positions(const tx_thread* t, double* out);
+const double* tx_thread_position(const tx_thread* t, int i); // node i, m
+// the sum of the segment lengths, m
+double tx_thread_current_length(const tx_thread* t);
+// the largest (l - l0) / l0 over the segments
+double tx_thread_max_strain(const tx_thread* t);
+
+// a knot's fixing: when a node of cylinders first..last (a knot's, from
+// the knot rules) is within limit (m, in [0, 1]) of the mesh, those
+// cylinders' nodes are pinned where they are (immobilised) and it returns 1;
+// 0 when none is that near (or there is no mesh); -1 (tx_error()) on a bad range
+int tx_thread_fix_near_mesh(tx_thread* t, int first, int last, double limit);
+
+// contacts of the last step
+typedef struct tx_thread_contacts {
+  int self_pairs;  // cylinder pairs closer than 2 r (found and pushed apart)
+  int shape_hits;  // node or cylinder contacts with capsules
+  int mesh_hits;   // node contacts with triangles
+  int substeps;    // substeps the step took
+  int broad_pairs; // cylinder pairs the grid proposed (the broadphase's work)
+  int retries;     // substeps taken again shorter because a node moved more than r
+} tx_thread_contacts;
+void tx_thread_last_contacts(const tx_thread* t, tx_thread_contacts* out);
+// per cylinder (N - 1 entries): 1 when it touched another cylinder of the
+// thread in the last step (the input of the knot rules)
+const uint8_t* tx_thread_colliding(const tx_thread* t);
+// rod: the force (N) the constraints put on the head in the last substep,
+// the distance's pull and the first bend's (zero in ftl)
+void tx_thread_head_force(const tx_thread* t, double out[3]);
+// the tension at the head as a force model (step B of the conference
+// paper): ftl: (length - rest length) x stiffness (N/m) along the sum of the
+// segments (from the head towards the tail), the length running on from the
+// tail to its pin when the tail is pinned, K = -stiffness d d^T; rod: the
+// constraints' force on the head (tx_thread_head_force), K = 0. f (N) is
+// clamped to max_force (N) and never NaN.
+void tx_thread_tension(const tx_thread* t, double stiffness, double max_force, double f[3], double K[9]);
+// where node i is pinned: false when it is free
+bool tx_thread_pin_of(const tx_thread* t, int i, double out[3]);
+// steps that faulted and were put back
+int tx_thread_faults(const tx_thread* t);
+
+#endif

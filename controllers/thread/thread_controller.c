@@ -1,0 +1,306 @@
+// physics.thread: the suture thread, follow-the-leader or rod, its head on a
+// pose (device0.pose by default; the needle's swage end in a full suture).
+// Each step it publishes PREFIX.nodes (tx_thread_node), the tension at the
+// head as PREFIX.force_model (tx_force_model) for the haptics controller,
+// and on PREFIX.events a TX_EVENT_KNOT when the papers' rule finds a knot
+// (value[0..1]: its first and last cylinder, value[2]: 0) and when a knot
+// within fix_distance_m of the skin is fixed (value[2]: 1). With skin set,
+// the thread collides with SKIN.x / SKIN.tri, and with the rigid capsules
+// (tx_capsule rows) of the components listed in capsules.
+#include "thread_controller.h"
+
+#include "knot.h"
+#include "thread.h"
+#include "../system.h" // tx_param_json
+
+#include <tactus/components.h>
+#include <tactus/events.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct thread_ctl {
+  tx_thread* t;
+  double dt;
+  double tension_k;  // N/m, ftl's tension model
+  double max_force;  // N, the clamp on the published force
+  double fix_distance;
+  int knot_every, steps;
+  bool knotted, fixed;
+  int knots;
+  tx_port head, nodes, force, events, skin_x, skin_tri, skin_h;
+  tx_port caps[8];
+  int ncaps;
+  tx_thread_capsule* shapes; // (max_shapes) the capsules' rows gathered each step
+  uint8_t* marks;
+  double* start;      // (N x 3) the first shape
+  double tail[3];     // m, tail_m
+  bool started;
+  tx_warning fault, bad_head, bad_skin, bad_capsule, too_many;
+  tx_result knots_result, first_knot_result, faults_result;
+  double first_knot_s;
+} thread_ctl;
+
+// defaults are tx_thread_def_default()'s
+static const tx_param_def params[] = {
+    {"model", TX_PARAM_STR, NULL, 0, 0, 0, "ftl", "ftl (follow-the-leader, kinematic) or rod (XPBD, E and diameter)"},
+    {"nodes", TX_PARAM_INT, "1", 2, 100000, 64, NULL, "N, spheres joined by N - 1 cylinders"},
+    {"radius_m", TX_PARAM_NUM, "m", 1e-6, 0.01, 0.00025, NULL, "r of the spheres and cylinders (a 0.5 mm thread)"},
+    {"length_m", TX_PARAM_NUM, "m", 1e-4, 10, 0.2, NULL, "rest length head to tail"},
+    {"youngs_modulus_pa", TX_PARAM_NUM, "Pa", 1, 1e16, 2e9, NULL, "rod: E (monofilament nylon, 2 GPa)"},
+    {"bend_factor", TX_PARAM_NUM, "1", 0, 1, 1, NULL, "rod: bending stiffness bend_factor E I (0: perfectly flexible)"},
+    {"density_kg_m3", TX_PARAM_NUM, "kg/m^3", 1, 1e5, 1140, NULL, "rod: the thread's density (nylon)"},
+    {"gravity", TX_PARAM_NUM, "m/s^2", 0, 100, 9.81, NULL, "rod: along -y"},
+    {"damping", TX_PARAM_NUM, "1/s", 0, 1e4, 1, NULL, "rod: decay rate of node velocities"},
+    {"iterations", TX_PARAM_INT, "1", 1, 1000, 2, NULL, "rod: direct solves per substep; ftl: passes towards a pinned tail"},
+    {"max_substep_s", TX_PARAM_NUM, "s", 1e-7, 0.1, 1e-3, NULL, "substeps no longer than this (shorter when nodes move fast)"},
+    {"max_substeps", TX_PARAM_INT, "1", 1, 10000, 64, NULL, "at most this many substeps a step"},
+    {"max_stretch", TX_PARAM_NUM, "1", 0, 1, 0.05, NULL, "rod: no segment longer than (1 + this) its rest length"},
+    {"self_collision", TX_PARAM_BOOL, NULL, 0, 0, 1, NULL, "cylinders of the thread push each other apart"},
+    {"pin_tail", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "the tail stays where it starts"},
+    {"tail_m", TX_PARAM_JSON, NULL, 0, 0, 0, NULL, "[x, y, z], m: where the thread starts straight towards from the head; [0.2, 0, 0] by default"},
+    {"head", TX_PARAM_STR, NULL, 0, 0, 0, "device0.pose", "the pose the head follows (f64 1 x 7)"},
+    {"prefix", TX_PARAM_STR, NULL, 0, 0, 0, "thread", "writes PREFIX.nodes, PREFIX.force_model, PREFIX.events"},
+    {"skin", TX_PARAM_STR, NULL, 0, 0, 0, "", "a skin's prefix (skin): collide with SKIN.x and SKIN.tri; empty: none"},
+    {"capsules", TX_PARAM_STRS, NULL, 0, 8, 0, NULL, "components of rigid capsules (tx_capsule rows: instrument jaws, the needle) the thread keeps out of"},
+    {"max_shapes", TX_PARAM_INT, "1", 0, 4096, 16, NULL, "room for the capsules' rows, all together"},
+    {"max_triangles", TX_PARAM_INT, "1", 1, 10000000, 200000, NULL, "room for the skin's triangles"},
+    {"tension_n_per_m", TX_PARAM_NUM, "N/m", 0, 1e6, 200, NULL, "ftl: force (length - rest length) x this, along the segments' sum"},
+    {"max_force_n", TX_PARAM_NUM, "N", 0, 100, 10, NULL, "the published force never exceeds this"},
+    {"knot_every", TX_PARAM_INT, "1", 1, 100000, 10, NULL, "steps between two knot checks (the papers' rule, O(N^2))"},
+    {"fix_distance_m", TX_PARAM_NUM, "m", 0, 1, 0.002, NULL, "a knot this near the skin is fixed"},
+};
+
+static int read_tail(tx_setup* s, double tail[3]) {
+  json_t* j = tx_param_json(s, "tail_m");
+  tail[0] = 0.2, tail[1] = tail[2] = 0;
+  if (!j || json_is_null(j)) return 0;
+  if (!json_is_array(j) || json_array_size(j) != 3) return tx_setup_fail(s, "tail_m", "expected [x, y, z] in m");
+  for (int a = 0; a < 3; a++) {
+    json_t* v = json_array_get(j, (size_t)a);
+    if (!json_is_number(v) || !isfinite(json_number_value(v)) || fabs(json_number_value(v)) > 10)
+      return tx_setup_fail(s, "tail_m", "element %d must be a number in [-10, 10]", a);
+    tail[a] = json_number_value(v);
+  }
+  return 0;
+}
+
+static int configure(tx_setup* s, void** self) {
+  thread_ctl* k = calloc(1, sizeof *k);
+  if (!k) return -1;
+  *self = k;
+  k->dt = 1.0 / tx_setup_rate(s);
+  if (k->dt > 1) return tx_setup_fail(s, NULL, "physics.thread runs at 1 Hz or faster, not %g", tx_setup_rate(s));
+  tx_thread_def d = tx_thread_def_default();
+  const char* model = tx_table_str(s, "model");
+  if (!model) return -1;
+  if (strcmp(model, "ftl") == 0) d.model = TX_THREAD_FTL;
+  else if (strcmp(model, "rod") == 0) d.model = TX_THREAD_ROD;
+  else return tx_setup_fail(s, "model", "'%s': expected ftl or rod", model);
+  d.nodes = (int)tx_table_int(s, "nodes");
+  d.radius = tx_table_num(s, "radius_m");
+  d.length = tx_table_num(s, "length_m");
+  d.youngs_modulus = tx_table_num(s, "youngs_modulus_pa");
+  d.bend_factor = tx_table_num(s, "bend_factor");
+  d.density = tx_table_num(s, "density_kg_m3");
+  d.gravity = tx_table_num(s, "gravity");
+  d.damping = tx_table_num(s, "damping");
+  d.iterations = (int)tx_table_int(s, "iterations");
+  d.max_substep = tx_table_num(s, "max_substep_s");
+  d.max_substeps = (int)tx_table_int(s, "max_substeps");
+  d.max_stretch = tx_table_num(s, "max_stretch");
+  d.self_collision = tx_table_bool(s, "self_collision");
+  d.pin_tail = tx_table_bool(s, "pin_tail");
+  d.max_shapes = (int)tx_table_int(s, "max_shapes");
+  k->tension_k = tx_table_num(s, "tension_n_per_m");
+  k->max_force = tx_table_num(s, "max_force_n");
+  k->knot_every = (int)tx_table_int(s, "knot_every");
+  k->fix_distance = tx_table_num(s, "fix_distance_m");
+  double tail[3];
+  if (read_tail(s, tail)) return -1;
+  const char* head = tx_table_str(s, "head");
+  const char* prefix = tx_table_str(s, "prefix");
+  const char* skin = tx_table_str(s, "skin");
+  if (!head || !prefix || !skin) return -1;
+  if (!*prefix) return tx_setup_fail(s, "prefix", "must not be empty");
+  bool with_skin = *skin != 0;
+  d.max_triangles = with_skin ? (int)tx_table_int(s, "max_triangles") : 0;
+  // until the head's first pose the thread lies from the origin towards
+  // tail_m; then it starts again straight from the head towards tail_m
+  for (int a = 0; a < 3; a++) d.direction[a] = tail[a];
+  if (tx_thread_def_check(&d)) {
+    // name the parameter behind the field
+    static const char* const keys[][2] = {{"nodes", "nodes"}, {"radius", "radius_m"}, {"length", "length_m"},
+                                          {"direction", "tail_m"}, {"max_stretch", "max_stretch"}};
+    const char* key = NULL;
+    for (size_t i = 0; i < sizeof keys / sizeof keys[0] && !key; i++)
+      if (strstr(tx_error(), keys[i][0])) key = keys[i][1];
+    return tx_setup_fail(s, key, "%s", tx_error());
+  }
+  k->t = tx_thread_create(&d);
+  if (!k->t) return tx_setup_fail(s, NULL, "%s", tx_error());
+  k->marks = malloc((size_t)d.nodes);
+  k->start = malloc(sizeof(double) * 3 * (size_t)d.nodes);
+  memcpy(k->tail, tail, sizeof k->tail);
+  if (!k->marks || !k->start) return tx_setup_fail(s, NULL, "out of memory");
+  char name[256];
+  k->head = TX_READ_OF(s, head, tx_pose);
+  snprintf(name, sizeof name, "%s.nodes", prefix);
+  k->nodes = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_thread_node, (uint32_t)d.nodes));
+  snprintf(name, sizeof name, "%s.force_model", prefix);
+  k->force = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_force_model, 1));
+  snprintf(name, sizeof name, "%s.events", prefix);
+  k->events = tx_setup_emit(s, name, 64);
+  if (with_skin) {
+    snprintf(name, sizeof name, "%s.x", skin);
+    k->skin_x = TX_READ_OF(s, name, tx_vertex);
+    snprintf(name, sizeof name, "%s.tri", skin);
+    k->skin_tri = TX_READ_OF(s, name, tx_triangle);
+    snprintf(name, sizeof name, "%s.thickness", skin);
+    k->skin_h = TX_READ_OF(s, name, tx_thickness);
+  }
+  const char* caps[8];
+  k->ncaps = tx_table_strs(s, "capsules", caps, 8);
+  for (int i = 0; i < k->ncaps; i++) k->caps[i] = TX_READ_OF(s, caps[i], tx_capsule);
+  k->shapes = malloc(sizeof(tx_thread_capsule) * (size_t)(d.max_shapes + 1));
+  if (!k->shapes) return tx_setup_fail(s, NULL, "out of memory");
+  k->too_many = tx_setup_warning(s, "too_many_capsules");
+  k->fault = tx_setup_warning(s, "numerical_fault");
+  k->bad_head = tx_setup_warning(s, "bad_head");
+  k->bad_skin = tx_setup_warning(s, "bad_skin");
+  k->bad_capsule = tx_setup_warning(s, "bad_capsule");
+  k->knots_result = tx_setup_result(s, "knots");
+  k->first_knot_result = tx_setup_result(s, "first_knot_s");
+  k->faults_result = tx_setup_result(s, "faults");
+  k->first_knot_s = -1;
+  return 0;
+}
+
+static void publish(tx_ctx* c, thread_ctl* k) {
+  tx_thread* t = k->t;
+  int n = tx_thread_node_count(t);
+  double r = tx_thread_get_def(t)->radius;
+  tx_thread_node* out = tx_write(c, k->nodes);
+  for (int i = 0; i < n; i++) {
+    memcpy(out[i].x, tx_thread_position(t, i), sizeof out[i].x);
+    out[i].radius = r;
+  }
+  tx_force_model* m = tx_write(c, k->force);
+  memset(m, 0, sizeof *m);
+  memcpy(m->x0, tx_thread_position(t, 0), sizeof m->x0);
+  tx_thread_tension(t, k->tension_k, k->max_force, m->f0, m->k);
+}
+
+static void emit_knot(tx_ctx* c, thread_ctl* k, const tx_knot_papers* p, bool fixed) {
+  tx_event e = {.kind = TX_EVENT_KNOT, .source = (uint32_t)k->knots, .sim_ns = tx_sim_ns(c)};
+  e.value[0] = p->first;
+  e.value[1] = p->last;
+  e.value[2] = fixed ? 1 : 0;
+  tx_emit(c, k->events, &e);
+}
+
+static void check_knot(tx_ctx* c, thread_ctl* k) {
+  tx_thread* t = k->t;
+  int n = tx_thread_node_count(t);
+  tx_knot_rule rule = tx_knot_rule_papers();
+  tx_knot_contacts(tx_thread_position(t, 0), n, tx_thread_get_def(t)->radius, rule.min_gap, k->marks);
+  tx_knot_papers p;
+  bool knot = tx_knot_papers_rule(k->marks, n - 1, &rule, &p);
+  if (knot && !k->knotted) {
+    k->knots++;
+    if (k->first_knot_s < 0) k->first_knot_s = (double)tx_sim_ns(c) * 1e-9;
+    emit_knot(c, k, &p, false);
+  }
+  if (knot && !k->fixed && k->skin_x.id && tx_thread_fix_near_mesh(t, p.first, p.last, k->fix_distance) == 1) {
+    k->fixed = true;
+    emit_knot(c, k, &p, true);
+  }
+  k->knotted = knot;
+}
+
+static void step(tx_ctx* c, void* self) {
+  thread_ctl* k = self;
+  tx_snapshot p = tx_read(c, k->head);
+  if (p.seq > 0) { // nothing published yet: the head waits
+    const tx_pose* pose = p.data;
+    if (tx_thread_set_head(k->t, pose->pos) != TX_THREAD_OK) tx_warn(c, k->bad_head);
+    if (!k->started) { // the thread starts at the head's first pose, straight towards tail_m
+      const tx_thread_def* d = tx_thread_get_def(k->t);
+      int n = d->nodes;
+      double dir[3], l = 0;
+      for (int a = 0; a < 3; a++) {
+        dir[a] = k->tail[a] - pose->pos[a];
+        l += dir[a] * dir[a];
+      }
+      l = sqrt(l);
+      for (int i = 0; i < n; i++)
+        for (int a = 0; a < 3; a++)
+          k->start[3 * i + a] = pose->pos[a] + (l > 0 ? dir[a] / l : a == 0) * d->length * i / (n - 1);
+      tx_thread_set_positions(k->t, k->start);
+      k->started = true;
+    }
+  }
+  if (k->skin_x.id) {
+    tx_snapshot sx = tx_read(c, k->skin_x), st = tx_read(c, k->skin_tri), sh = tx_read(c, k->skin_h);
+    if (sx.seq > 0 && st.seq > 0 && sh.seq > 0 &&
+        tx_thread_set_mesh(k->t, sx.data, sx.rows, st.data, st.rows, ((const tx_thickness*)sh.data)->m) != TX_THREAD_OK)
+      tx_warn(c, k->bad_skin);
+  }
+  if (k->ncaps) { // every capsule row, as far as there is room
+    int m = 0, max = tx_thread_get_def(k->t)->max_shapes;
+    for (int i = 0; i < k->ncaps; i++) {
+      tx_snapshot sc = tx_read(c, k->caps[i]);
+      const tx_capsule* rows = sc.data;
+      for (uint32_t r = 0; sc.seq > 0 && r < sc.rows; r++) {
+        if (m == max) {
+          tx_warn(c, k->too_many);
+          break;
+        }
+        memcpy(k->shapes[m].a, rows[r].a, sizeof rows[r].a);
+        memcpy(k->shapes[m].b, rows[r].b, sizeof rows[r].b);
+        k->shapes[m++].radius = rows[r].radius;
+      }
+    }
+    if (tx_thread_set_capsules(k->t, k->shapes, m) != TX_THREAD_OK) tx_warn(c, k->bad_capsule);
+  }
+  if (tx_thread_step(k->t, k->dt) == TX_THREAD_FAULT) tx_warn(c, k->fault);
+  if (k->steps % k->knot_every == 0) check_knot(c, k);
+  k->steps++;
+  publish(c, k);
+}
+
+static int init(tx_ctx* c, void* self) {
+  publish(c, self);
+  return 0;
+}
+
+static void finish(tx_ctx* c, void* self) {
+  thread_ctl* k = self;
+  tx_set_result(c, k->knots_result, k->knots);
+  tx_set_result(c, k->first_knot_result, k->first_knot_s);
+  tx_set_result(c, k->faults_result, tx_thread_faults(k->t));
+}
+
+static void fini(void* self) {
+  thread_ctl* k = self;
+  if (!k) return;
+  tx_thread_destroy(k->t);
+  free(k->marks);
+  free(k->start);
+  free(k->shapes);
+  free(k);
+}
+
+const tx_controller_class tx_physics_thread = {
+    .type = "physics.thread",
+    .summary = "suture thread, ftl or XPBD rod, head on a pose: writes THREAD.nodes, THREAD.force_model, THREAD.events (knots)",
+    .configure = configure,
+    .init = init,
+    .step = step,
+    .finish = finish,
+    .fini = fini,
+    .params = params,
+    .nparams = TX_PARAMS_COUNT(params),
+};

@@ -1,0 +1,387 @@
+// The thread's contacts: the grid's self contacts against every pair tested
+// by brute force, two crossing strands pushed to 2 r apart, the thread
+// draped on a capsule and on a triangle patch, and the 1 m/s sweeps: the head
+// drags the thread around a 0.5 mm thread (a capsule, then a pinned strand of
+// the thread itself) and around the edge of a skin patch, and no node or
+// cylinder ever passes through.
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include "controllers/physics/skin_grid.h"
+#include "controllers/thread/segment.h"
+#include "controllers/thread/thread.h"
+#include "model/error.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define PI 3.14159265358979323846
+
+static double frand(void) { return rand() / (double)RAND_MAX * 2 - 1; }
+
+static double min_self_distance(const tx_thread* t, int skip) {
+  int n = tx_thread_node_count(t);
+  double best = INFINITY;
+  for (int i = 0; i + 1 < n; i++)
+    for (int j = i + skip + 1; j + 1 < n; j++) {
+      tx_seg_closest c;
+      tx_seg_closest_points(tx_thread_position(t, i), tx_thread_position(t, i + 1), tx_thread_position(t, j),
+                            tx_thread_position(t, j + 1), &c);
+      if (c.dist < best) best = c.dist;
+    }
+  return best;
+}
+
+// a random walk of rest-length steps crumpled into a 12 mm box: every
+// cylinder the grid marks touching is one that brute force finds within
+// 2 r (and none is missed). A compliant rod with no gravity does not move
+// before the marks are taken.
+static void test_grid_finds_every_touching_pair(void** state) {
+  (void)state;
+  tx_thread_def d = tx_thread_def_default();
+  d.model = TX_THREAD_ROD;
+  d.nodes = 400;
+  d.length = 0.4; // l0 = 1 mm
+  d.radius = 0.00025;
+  d.gravity = 0;
+  d.youngs_modulus = 1e-6;
+  d.iterations = 1;
+  d.max_substeps = 1; // the marks of one substep, at these positions
+  tx_thread* t = tx_thread_create(&d);
+  assert_non_null(t);
+  double* x = malloc(sizeof(double) * 3 * d.nodes);
+  assert_non_null(x);
+  srand(3);
+  memset(x, 0, sizeof(double) * 3);
+  for (int i = 1; i < d.nodes; i++) {
+    double u[3], l;
+    do {
+      for (int a = 0; a < 3; a++) u[a] = frand();
+      l = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    } while (l > 1 || l < 0.1);
+    for (int a = 0; a < 3; a++) {
+      x[3 * i + a] = x[3 * i - 3 + a] + 0.001 * u[a] / l;
+      if (fabs(x[3 * i + a]) > 0.006) x[3 * i + a] = x[3 * i - 3 + a] - 0.001 * u[a] / l; // reflect
+    }
+  }
+  assert_int_equal(tx_thread_set_positions(t, x), TX_THREAD_OK);
+  uint8_t* want = calloc(d.nodes, 1);
+  assert_non_null(want);
+  int pairs = 0;
+  for (int i = 0; i + 1 < d.nodes; i++)
+    for (int j = i + 2; j + 1 < d.nodes; j++) {
+      tx_seg_closest c;
+      tx_seg_closest_points(x + 3 * i, x + 3 * i + 3, x + 3 * j, x + 3 * j + 3, &c);
+      if (c.dist < 2 * d.radius * 1.01) want[i] = want[j] = 1, pairs++;
+    }
+  assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
+  const uint8_t* got = tx_thread_colliding(t);
+  int marked = 0;
+  tx_thread_contacts c;
+  tx_thread_last_contacts(t, &c);
+  for (int i = 0; i + 1 < d.nodes; i++) {
+    if (got[i] != want[i]) print_message("cylinder %d: %d, brute force %d (%d substeps)\n", i, got[i], want[i], c.substeps);
+    assert_int_equal(got[i], want[i]);
+    marked += got[i];
+  }
+  print_message("%d touching pairs, %d cylinders marked; the grid proposed %d pairs of %d\n", pairs, marked,
+                c.broad_pairs, (d.nodes - 1) * (d.nodes - 2) / 2);
+  assert_true(pairs > 20);
+  // even crumpled this tight, the grid proposes fewer than half of all pairs
+  assert_true(c.broad_pairs < (d.nodes - 1) * (d.nodes - 2) / 4);
+  free(want);
+  free(x);
+  tx_thread_destroy(t);
+  // a thread lying straight: a few pairs per cylinder, not N of them
+  d.nodes = 2000;
+  d.length = 2;
+  t = tx_thread_create(&d);
+  assert_non_null(t);
+  assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
+  tx_thread_last_contacts(t, &c);
+  print_message("straight, %d nodes: the grid proposed %d pairs\n", d.nodes, c.broad_pairs);
+  assert_true(c.broad_pairs < 8 * d.nodes);
+  tx_thread_destroy(t);
+}
+
+// two strands of one thread cross 0.2 mm apart (a 0.5 mm thread): after a
+// step they are 2 r apart, and the crossing cylinders are marked
+static void test_crossing_strands_are_pushed_apart(void** state) {
+  (void)state;
+  for (int model = 0; model < 2; model++) {
+    tx_thread_def d = tx_thread_def_default();
+    d.model = (tx_thread_model)model;
+    d.nodes = 28;
+    d.length = 0.027;
+    d.gravity = 0;
+    tx_thread* t = tx_thread_create(&d);
+    assert_non_null(t);
+    // a leg along x at y = 0, a connector, and a leg along z 0.2 mm above
+    // the first, crossing it at the origin
+    double x[28 * 3];
+    for (int i = 0; i <= 10; i++) x[3 * i] = -0.005 + 0.001 * i, x[3 * i + 1] = 0, x[3 * i + 2] = 0;
+    for (int i = 11; i <= 17; i++) {
+      double f = (i - 10) / 7.0;
+      x[3 * i] = 0.005 * (1 - f), x[3 * i + 1] = 0.0002 * f, x[3 * i + 2] = -0.005 * f;
+    }
+    for (int i = 18; i < 28; i++) x[3 * i] = 0, x[3 * i + 1] = 0.0002, x[3 * i + 2] = -0.005 + 0.001 * (i - 17);
+    assert_int_equal(tx_thread_set_positions(t, x), TX_THREAD_OK);
+    tx_thread_set_head(t, x);
+    assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
+    const uint8_t* col = tx_thread_colliding(t);
+    int marked = 0;
+    for (int i = 0; i < 27; i++) marked += col[i];
+    double dmin = min_self_distance(t, 1);
+    print_message("%s: closest cylinders %.4g mm apart (2 r = 0.5 mm), %d marked\n", model ? "rod" : "ftl", dmin * 1e3,
+                  marked);
+    assert_true(marked >= 2);
+    assert_true(dmin > 2 * d.radius * 0.98);
+    tx_thread_destroy(t);
+  }
+}
+
+// the rod falls onto a capsule across its middle and drapes over it, never
+// nearer than r + R
+static void test_rod_drapes_over_a_capsule(void** state) {
+  (void)state;
+  tx_thread_def d = tx_thread_def_default();
+  d.model = TX_THREAD_ROD;
+  d.nodes = 41;
+  d.length = 0.04;
+  d.head[0] = -0.02, d.head[1] = 0.002;
+  d.youngs_modulus = 2e5; // bends within a few mm under its weight
+  d.damping = 5;
+  tx_thread* t = tx_thread_create(&d);
+  assert_non_null(t);
+  assert_int_equal(tx_thread_unpin(t, 0), TX_THREAD_BAD); // the head stays pinned
+  tx_thread_capsule cap = {{0, 0, -0.01}, {0, 0, 0.01}, 0.001};
+  assert_int_equal(tx_thread_set_capsules(t, &cap, 1), TX_THREAD_OK);
+  // the head held 2 cm to one side; the rest falls across the capsule
+  double closest = INFINITY;
+  int hits = 0;
+  for (int k = 0; k < 500; k++) {
+    assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
+    tx_thread_contacts c;
+    tx_thread_last_contacts(t, &c);
+    hits += c.shape_hits;
+    for (int i = 0; i < 40; i++) {
+      tx_seg_closest cl;
+      tx_seg_closest_points(tx_thread_position(t, i), tx_thread_position(t, i + 1), cap.a, cap.b, &cl);
+      if (cl.dist < closest) closest = cl.dist;
+    }
+  }
+  print_message("capsule: closest %.4g mm (r + R = 1.25 mm), %d contacts\n", closest * 1e3, hits);
+  assert_true(hits > 0);
+  assert_true(closest > (d.radius + cap.radius) * 0.99);
+  // the part beyond the capsule hangs below it
+  assert_true(tx_thread_position(t, 40)[1] < -0.002);
+  tx_thread_destroy(t);
+}
+
+// the total angle the thread turns around the z axis, from its tail to its
+// head (each node's angle in the x y plane)
+static double winding(const tx_thread* t, int from, int to) {
+  double sum = 0;
+  for (int i = to; i > from; i--) {
+    const double *a = tx_thread_position(t, i), *b = tx_thread_position(t, i - 1);
+    double da = atan2(b[1], b[0]) - atan2(a[1], a[0]);
+    while (da > PI) da -= 2 * PI;
+    while (da < -PI) da += 2 * PI;
+    sum += da;
+  }
+  return sum;
+}
+
+// the head sweeps at 1 m/s under an obstacle on the z axis while the thread
+// is held above it (a pinned node at (0, 2 cm, 0)): the thread must wrap
+// around the obstacle, turning by about +236 degrees; passing through it
+// would turn by -124 degrees. A crossing is a jump of the winding by 2 pi.
+static int sweep(tx_thread* t, int anchor, double* final_winding) {
+  double head[3] = {-0.015, -0.01, 0};
+  double prev = winding(t, 0, anchor);
+  int crossings = 0;
+  for (int k = 0; k < 60; k++) {
+    if (k < 30) head[0] += 0.001; // 1 mm a step at 1 kHz: 1 m/s
+    assert_int_equal(tx_thread_set_head(t, head), TX_THREAD_OK);
+    assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
+    double w = winding(t, 0, anchor);
+    if (fabs(w - prev) > PI) crossings++;
+    prev = w;
+  }
+  *final_winding = prev;
+  return crossings;
+}
+
+// head (-1.5, -1) cm up to (-1.5, 2) cm, then along to the anchor (0, 2) cm: 45 mm
+static void free_leg(double* x) {
+  for (int i = 0; i <= 45; i++) {
+    if (i <= 30)
+      x[3 * i] = -0.015, x[3 * i + 1] = -0.01 + 0.001 * i;
+    else
+      x[3 * i] = -0.015 + 0.001 * (i - 30), x[3 * i + 1] = 0.02;
+    x[3 * i + 2] = 0;
+  }
+}
+
+static void test_sweep_around_a_capsule_thread(void** state) {
+  (void)state;
+  for (int model = 0; model < 2; model++) {
+    tx_thread_def d = tx_thread_def_default();
+    d.model = (tx_thread_model)model;
+    d.nodes = 46;
+    d.length = 0.045;
+    d.pin_tail = true;
+    d.gravity = 0;
+    d.iterations = model ? 4 : 20;
+    tx_thread* t = tx_thread_create(&d);
+    assert_non_null(t);
+    double x[46 * 3];
+    free_leg(x);
+    assert_int_equal(tx_thread_set_positions(t, x), TX_THREAD_OK);
+    tx_thread_capsule cap = {{0, 0, -0.02}, {0, 0, 0.02}, 0.00025}; // a 0.5 mm thread
+    tx_thread_set_capsules(t, &cap, 1);
+    double w;
+    int crossings = sweep(t, 45, &w);
+    print_message("%s around a 0.5 mm capsule: %d crossings, winding %.0f degrees\n", model ? "rod" : "ftl", crossings,
+                  w * 180 / PI);
+    assert_int_equal(crossings, 0);
+    assert_true(w > 3.5); // wrapped: ~236 degrees
+    tx_thread_destroy(t);
+  }
+}
+
+// the same sweep where the obstacle is the thread itself: its far part runs
+// from the anchor up along z and back down the z axis, pinned there
+static void test_sweep_around_its_own_strand(void** state) {
+  (void)state;
+  for (int model = 0; model < 2; model++) {
+    int n = 46 + 30 + 20 + 50;
+    tx_thread_def d = tx_thread_def_default();
+    d.model = (tx_thread_model)model;
+    d.nodes = n;
+    d.length = 0.001 * (n - 1);
+    d.gravity = 0;
+    d.iterations = model ? 4 : 20;
+    tx_thread* t = tx_thread_create(&d);
+    assert_non_null(t);
+    double* x = malloc(sizeof(double) * 3 * n);
+    assert_non_null(x);
+    free_leg(x);
+    int i = 46;
+    for (int k = 1; k <= 30; k++, i++) x[3 * i] = 0, x[3 * i + 1] = 0.02, x[3 * i + 2] = 0.001 * k;
+    for (int k = 1; k <= 20; k++, i++) x[3 * i] = 0, x[3 * i + 1] = 0.02 - 0.001 * k, x[3 * i + 2] = 0.03;
+    for (int k = 1; k <= 50; k++, i++) x[3 * i] = 0, x[3 * i + 1] = 0, x[3 * i + 2] = 0.03 - 0.001 * k;
+    assert_int_equal(i, n);
+    assert_int_equal(tx_thread_set_positions(t, x), TX_THREAD_OK);
+    for (int k = 45; k < n; k++) assert_int_equal(tx_thread_pin(t, k, x + 3 * k), TX_THREAD_OK);
+    double w;
+    int crossings = sweep(t, 45, &w);
+    print_message("%s around its own 0.5 mm strand: %d crossings, winding %.0f degrees\n", model ? "rod" : "ftl",
+                  crossings, w * 180 / PI);
+    assert_int_equal(crossings, 0);
+    assert_true(w > 3.5);
+    free(x);
+    tx_thread_destroy(t);
+  }
+}
+
+// a 2 x 2 cm skin patch (1 mm triangles) at y = 0; the head drags the thread
+// at 1 m/s over it, past its edge and back underneath: no node ever goes from
+// one side to the other inside the patch (0.5 mm clear of its border), and
+// no cylinder joins nodes on both sides over it
+static void test_sweep_around_a_skin_patch(void** state) {
+  (void)state;
+  float px[21 * 21 * 3];
+  int32_t tri[2 * 20 * 20 * 3];
+  uint32_t ntri = tx_skin_grid(21, 21, 0.001, 0.001, (double[3]){0, 0, 0}, px, tri);
+  for (int model = 0; model < 2; model++) {
+    tx_thread_def d = tx_thread_def_default();
+    d.model = (tx_thread_model)model;
+    d.nodes = 31;
+    d.length = 0.03;
+    d.head[1] = 0.001;
+    d.direction[0] = -1;
+    d.max_triangles = (int)ntri;
+    d.youngs_modulus = 2e7;
+    tx_thread* t = tx_thread_create(&d);
+    assert_non_null(t);
+    assert_int_equal(tx_thread_set_mesh(t, px, 21 * 21, tri, ntri, 0), TX_THREAD_OK);
+    double path[4][3] = {{0, 0.001, 0}, {0.0105, 0.001, 0}, {0.0105, -0.001, 0}, {-0.005, -0.001, 0}};
+    double head[3] = {0, 0.001, 0}, prev[31 * 3], now[31 * 3];
+    tx_thread_positions(t, prev);
+    int crossings = 0, hits = 0, below = 0;
+    for (int leg = 0; leg < 3; leg++) {
+      double len = sqrt(pow(path[leg + 1][0] - path[leg][0], 2) + pow(path[leg + 1][1] - path[leg][1], 2));
+      int steps = (int)lround(len / 0.001);
+      for (int k = 1; k <= steps + (leg == 2 ? 30 : 0); k++) {
+        double f = k > steps ? 1 : (double)k / steps;
+        for (int a = 0; a < 3; a++) head[a] = path[leg][a] + f * (path[leg + 1][a] - path[leg][a]);
+        assert_int_equal(tx_thread_set_head(t, head), TX_THREAD_OK);
+        assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
+        tx_thread_contacts c;
+        tx_thread_last_contacts(t, &c);
+        hits += c.mesh_hits;
+        tx_thread_positions(t, now);
+        for (int i = 0; i < 31; i++) {
+          const double *a = prev + 3 * i, *b = now + 3 * i;
+          bool inside = fabs(b[0]) < 0.0095 && fabs(b[2]) < 0.0095 && fabs(a[0]) < 0.0095 && fabs(a[2]) < 0.0095;
+          if (inside && (a[1] > 0) != (b[1] > 0)) crossings++;
+          // a cylinder through the patch: its nodes on two sides, over it
+          if (i < 30) {
+            const double* e = now + 3 * i + 3;
+            bool over = fabs(b[0]) < 0.0095 && fabs(b[2]) < 0.0095 && fabs(e[0]) < 0.0095 && fabs(e[2]) < 0.0095;
+            if (over && (b[1] > 0) != (e[1] > 0)) crossings++;
+          }
+        }
+        memcpy(prev, now, sizeof prev);
+      }
+    }
+    for (int i = 0; i < 31; i++) below += now[3 * i + 1] < 0;
+    print_message("%s around a skin patch: %d crossings, %d contacts, %d of 31 nodes below at the end\n",
+                  model ? "rod" : "ftl", crossings, hits, below);
+    assert_int_equal(crossings, 0);
+    assert_true(hits > 0);
+    assert_true(below > 5); // the thread did follow the head around
+    tx_thread_destroy(t);
+  }
+}
+
+static void test_bad_shapes_and_mesh_refused(void** state) {
+  (void)state;
+  tx_thread_def d = tx_thread_def_default();
+  d.max_shapes = 1;
+  d.max_triangles = 2;
+  tx_thread* t = tx_thread_create(&d);
+  assert_non_null(t);
+  tx_thread_capsule caps[2] = {{{0, 0, 0}, {0, 0, 0}, 0.001}, {{0, 0, 0}, {0, 0, 0}, 0.001}};
+  assert_int_equal(tx_thread_set_capsules(t, caps, 2), TX_THREAD_BAD);
+  assert_non_null(strstr(tx_error(), "max_shapes"));
+  caps[0].radius = NAN;
+  assert_int_equal(tx_thread_set_capsules(t, caps, 1), TX_THREAD_BAD);
+  assert_non_null(strstr(tx_error(), "radius"));
+  float x[9] = {0, 0, 0, 1, 0, 0, 0, 0, 1};
+  int32_t tri[6] = {0, 1, 2, 0, 2, 5};
+  assert_int_equal(tx_thread_set_mesh(t, x, 3, tri, 2, 0), TX_THREAD_BAD);
+  assert_int_equal(tx_thread_set_mesh(t, x, 3, tri, 3, 0), TX_THREAD_BAD);
+  assert_non_null(strstr(tx_error(), "max_triangles"));
+  assert_int_equal(tx_thread_set_mesh(t, x, 3, tri, 1, -1), TX_THREAD_BAD);
+  assert_non_null(strstr(tx_error(), "thickness"));
+  assert_int_equal(tx_thread_set_mesh(t, x, 3, tri, 1, 0), TX_THREAD_OK);
+  tx_thread_destroy(t);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_grid_finds_every_touching_pair),
+      cmocka_unit_test(test_crossing_strands_are_pushed_apart),
+      cmocka_unit_test(test_rod_drapes_over_a_capsule),
+      cmocka_unit_test(test_sweep_around_a_capsule_thread),
+      cmocka_unit_test(test_sweep_around_its_own_strand),
+      cmocka_unit_test(test_sweep_around_a_skin_patch),
+      cmocka_unit_test(test_bad_shapes_and_mesh_refused),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,201 @@
+// physics.thread through the loader, in lockstep beside the haptics
+// controller's scripted device: the nodes it publishes follow the device
+// pose at rest length (ftl), the tension force model of a thread pulled
+// past its pinned tail, the rod's force within the clamp, and bad
+// parameters and a missing head component named.
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include "scenarios/loader.h"
+#include "tests/scenario_support.h"
+
+#include <tactus/components.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+static tx_scenario* load(const char* params, const char* device) {
+  char text[2048];
+  snprintf(text, sizeof text,
+           "{\"name\":\"t\",\"controllers\":["
+           "{\"name\":\"thread\",\"type\":\"physics.thread\",\"rate_hz\":1000,\"params\":{%s}},"
+           "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:%s\"}}]}",
+           params, device);
+  return tx_scenario_load_text("test", text, strlen(text), NULL);
+}
+
+// slide-x-over starts at (-3, 1, 0) cm, comes down to 2 mm and slides along +x
+static void ftl_follows_the_device(void** state) {
+  (void)state;
+  tx_scenario* s = load("\"nodes\":41,\"length_m\":0.04,\"tail_m\":[-0.1,0.01,0]", "slide-x-over");
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 3);
+  tx_snapshot x = latest_snapshot(s, "thread.nodes");
+  assert_int_equal(x.rows, 41);
+  assert_int_equal(x.cols, 4);
+  const tx_thread_node* n = x.data;
+  const tx_pose* pose = (const tx_pose*)latest(s, "device0.pose");
+  for (int a = 0; a < 3; a++) assert_true(fabs(n[0].x[a] - pose->pos[a]) < 1e-3);
+  for (int i = 0; i < 40; i++) {
+    double l = 0;
+    for (int a = 0; a < 3; a++) l += pow(n[i + 1].x[a] - n[i].x[a], 2);
+    assert_true(fabs(sqrt(l) - 0.001) < 1e-12);
+    assert_true(n[i].radius == 0.00025);
+  }
+  // the thread trails behind the head along its path: down, then along +x
+  assert_true(n[10].x[0] < n[0].x[0]);
+  assert_int_equal(result(s, "thread.knots"), 0);
+  tx_scenario_free(s);
+}
+
+// the tail pinned 1.5 cm from the head's start; the head slides 6 cm away:
+// the force pulls back towards the pin, (length - rest length) x 200 N/m
+static void tension_of_a_thread_pulled_past_its_pin(void** state) {
+  (void)state;
+  tx_scenario* s = load("\"nodes\":16,\"length_m\":0.015,\"tail_m\":[0,0.01,0],\"pin_tail\":true", "slide-x-over");
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 6);
+  const tx_thread_node* n = latest_snapshot(s, "thread.nodes").data;
+  const tx_force_model* m = (const tx_force_model*)latest(s, "thread.force_model");
+  double pin[3] = {-0.015, 0.01, 0}, gap = 0, dir[3], ld = 0;
+  for (int a = 0; a < 3; a++) {
+    gap += pow(pin[a] - n[15].x[a], 2);
+    dir[a] = pin[a] - n[0].x[a];
+    ld += dir[a] * dir[a];
+  }
+  double want = 200 * sqrt(gap); // the segments keep their length: the excess is the gap to the pin
+  print_message("tension %.3f N (want %.3f), f0 = (%.3f, %.3f, %.3f)\n", sqrt(m->f0[0] * m->f0[0] + m->f0[1] * m->f0[1] + m->f0[2] * m->f0[2]),
+                want, m->f0[0], m->f0[1], m->f0[2]);
+  assert_true(want > 1);
+  for (int a = 0; a < 3; a++) {
+    assert_true(fabs(m->f0[a] - want * dir[a] / sqrt(ld)) < 1e-6 * want + 1e-9);
+    assert_true(fabs(m->x0[a] - n[0].x[a]) < 1e-12);
+  }
+  assert_true(m->f0[0] < 0);       // back towards the pin
+  assert_true(m->k[0] < 0);        // stiffer the further it is pulled
+  tx_scenario_free(s);
+  // the clamp: at 1000 N/m it would be above 10 N
+  s = load("\"nodes\":16,\"length_m\":0.015,\"tail_m\":[0,0.01,0],\"pin_tail\":true,\"tension_n_per_m\":1000,"
+           "\"max_force_n\":5",
+           "slide-x-over");
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 6);
+  m = (const tx_force_model*)latest(s, "thread.force_model");
+  assert_true(fabs(sqrt(m->f0[0] * m->f0[0] + m->f0[1] * m->f0[1] + m->f0[2] * m->f0[2]) - 5) < 1e-9);
+  tx_scenario_free(s);
+}
+
+// the rod hangs from the device and is dragged: finite, within the clamp,
+// its head force the weight it holds when still
+static void rod_force_on_the_head(void** state) {
+  (void)state;
+  tx_scenario* s = load("\"model\":\"rod\",\"nodes\":21,\"length_m\":0.02,\"tail_m\":[-0.03,-0.1,0],\"damping\":20",
+                        "slide-x-over");
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 0.9); // still at (-3, 1, 0) cm... then coming down: hanging
+  const tx_force_model* m = (const tx_force_model*)latest(s, "thread.force_model");
+  double weight = 1140 * 3.14159265358979 * 0.00025 * 0.00025 * 0.02 * 9.81;
+  print_message("rod head force (%.3g, %.3g, %.3g) N, weight %.3g N\n", m->f0[0], m->f0[1], m->f0[2], weight);
+  assert_true(m->f0[1] < 0); // the thread pulls the hand down
+  assert_true(fabs(-m->f0[1] - weight) < 0.2 * weight);
+  run(s, 2);
+  m = (const tx_force_model*)latest(s, "thread.force_model");
+  for (int a = 0; a < 3; a++) assert_true(isfinite(m->f0[a]) && fabs(m->f0[a]) <= 10);
+  assert_int_equal(warnings(s, "thread.numerical_fault"), 0);
+  tx_scenario_free(s);
+}
+
+// a test class that writes one capsule, 1 mm thick along z, across where
+// the thread hangs from the device (slide-x-over holds still at (-3, 1, 0) cm)
+typedef struct capsule_writer {
+  tx_port out;
+} capsule_writer;
+static capsule_writer the_writer;
+static int capsule_configure(tx_setup* s, void** self) {
+  *self = &the_writer;
+  the_writer.out = tx_setup_write(s, &TX_COMPONENT_OF("tool.capsules", tx_capsule, 1));
+  return 0;
+}
+static void capsule_step(tx_ctx* c, void* self) {
+  tx_capsule* k = tx_write(c, ((capsule_writer*)self)->out);
+  *k = (tx_capsule){{-0.03, 0.0, -0.01}, {-0.03, 0.0, 0.01}, 0.001};
+}
+static const tx_controller_class capsule_class = {
+    .type = "test.capsule", .summary = "one capsule", .configure = capsule_configure, .step = capsule_step};
+
+static double capsule_distance(tx_scenario* s) {
+  const tx_thread_node* n = latest_snapshot(s, "thread.nodes").data;
+  double best = 1;
+  for (int i = 0; i < 20; i++) {
+    // the axis runs along z at x = -3 cm, y = 0: the distance of segment i from it
+    for (int k = 0; k <= 50; k++) {
+      double f = k / 50.0, x = n[i].x[0] + f * (n[i + 1].x[0] - n[i].x[0]), y = n[i].x[1] + f * (n[i + 1].x[1] - n[i].x[1]);
+      best = fmin(best, sqrt((x + 0.03) * (x + 0.03) + y * y));
+    }
+  }
+  return best;
+}
+
+// the rod hangs through where the capsule is: with the capsule listed it
+// drapes aside, 1.25 mm (r + R) from its axis at least; without, it passes through
+static void rod_keeps_out_of_a_capsule(void** state) {
+  (void)state;
+  if (!tx_find_controller(capsule_class.type)) assert_int_equal(tx_register_controller(&capsule_class), 0);
+  for (int listed = 1; listed >= 0; listed--) {
+    char text[1024];
+    snprintf(text, sizeof text,
+             "{\"name\":\"t\",\"controllers\":["
+             "{\"name\":\"thread\",\"type\":\"physics.thread\",\"rate_hz\":1000,\"params\":{\"model\":\"rod\","
+             "\"nodes\":21,\"length_m\":0.02,\"tail_m\":[-0.03,-0.1,0],\"bend_factor\":0,\"damping\":10%s}},"
+             "{\"name\":\"tool\",\"type\":\"test.capsule\",\"rate_hz\":1000},"
+             "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:slide-x-over\"}}]}",
+             listed ? ",\"capsules\":[\"tool.capsules\"]" : "");
+    tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+    if (!s) fail_msg("%s", tx_error());
+    run(s, 0.45);
+    double dmin = capsule_distance(s);
+    print_message("capsule %s: the thread %.3f mm from its axis\n", listed ? "listed" : "not listed", dmin * 1e3);
+    if (listed) assert_true(dmin > 0.99 * 0.00125);
+    else assert_true(dmin < 0.0005);
+    tx_scenario_free(s);
+  }
+}
+
+static void bad_input_is_named(void** state) {
+  (void)state;
+  struct {
+    const char* params;
+    const char* expect;
+  } cases[] = {
+      {"\"model\":\"spring\"", "params.model"},
+      {"\"nodes\":1", "params.nodes"},
+      {"\"radius_m\":0", "params.radius_m"},
+      {"\"length_m\":20", "params.length_m"},
+      {"\"max_stretch\":2", "params.max_stretch"},
+      {"\"tail_m\":[0,0]", "params.tail_m"},
+      {"\"tail_m\":[0,0,0]", "params.tail_m"},
+      {"\"prefix\":\"\"", "params.prefix"},
+      {"\"head\":\"nobody.pose\"", "nobody.pose"},
+      {"\"capsules\":[\"nobody.capsules\"]", "nobody.capsules"},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    tx_scenario* s = load(cases[i].params, "slide-x-over");
+    if (s) fail_msg("case %zu loaded", i);
+    if (!strstr(tx_error(), cases[i].expect)) fail_msg("case %zu: '%s' does not name %s", i, tx_error(), cases[i].expect);
+    assert_null(strchr(tx_error(), '\n'));
+  }
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(ftl_follows_the_device),
+      cmocka_unit_test(tension_of_a_thread_pulled_past_its_pin),
+      cmocka_unit_test(rod_force_on_the_head),
+      cmocka_unit_test(rod_keeps_out_of_a_capsule),
+      cmocka_unit_test(bad_input_is_named),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
