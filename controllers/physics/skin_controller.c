@@ -39,7 +39,7 @@ static const tx_param_def params[] = {
     {"fixed_border", TX_PARAM_BOOL, NULL, 0, 0, 1, NULL, "the outer ring of particles does not move"},
     {"pretension_n_per_m", TX_PARAM_NUM, "N/m", 0, 1e9, 0, NULL,
      "isotropic tension of the flat skin at rest against its fixed border; below (3 k + 4 k_bend) / 2"},
-    {"rupture_tension_n_per_m", TX_PARAM_NUM, "N/m", 0, 1e7, 1, NULL,
+    {"rupture_tension_n_per_m", TX_PARAM_NUM, "N/m", 0, 1e7, 80, NULL,
      "membrane tension, averaged over rupture_length_m, that tears the skin; 0: never"},
     {"rupture_length_m", TX_PARAM_NUM, "m", 1e-4, 0.05, 0.002, NULL, "radius over which the tension is averaged"},
     {"solver", TX_PARAM_STR, NULL, 0, 0, 0, "implicit",

@@ -100,7 +100,7 @@ typedef struct tx_cloth_def {
   double clamp_radius;      // m, particles this far or further from the centre (in the plane) cannot move
                             // either, in [0, 10]; 0: none (a circular membrane inside the square)
   double pretension;        // N/m, isotropic tension of the flat patch at rest, in [0, (3 k + 4 k_bend) / 2]; 0
-  double rupture_tension;   // N/m, membrane tension that tears, in [0, 1e7]; 1; 0: never
+  double rupture_tension;   // N/m, membrane tension that tears, in [0, 1e7]; 80; 0: never
   double rupture_length;    // m, radius over which the tension is averaged, in [1e-4, 0.05]; 0.002
   int solver;               // tx_cloth_solver; TX_CLOTH_IMPLICIT
   int iterations;           // XPBD iterations per substep, in [1, 200]; 1

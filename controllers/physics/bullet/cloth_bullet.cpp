@@ -68,6 +68,7 @@ struct tx_cloth {
   std::vector<double> pinv;        // (n x 6) m/N, inverse of each particle's diagonal block
   std::vector<int32_t> lend;       // (links x 2) the particles of each link, by slot
   std::vector<uint8_t> hold;       // (n) held along hold_n in the solve (the contact moved it)
+  std::vector<uint8_t> held_solve; // (n) held at the end of the last solve (its active set)
   std::vector<uint8_t> state;      // (n) in the solve: 0 fixed, 1 free, 2 held (hold and the mass, packed)
   std::vector<double> mh2;         // (n) N/m, m / h^2 of each particle, 0 when fixed
   std::vector<double> hold_n;      // (n x 3) 1, the contact's push on a held particle, summed
@@ -133,7 +134,7 @@ extern "C" tx_cloth_def tx_cloth_def_default(void) {
   d.fixed_border = true;
   d.clamp_radius = 0;
   d.pretension = 0;
-  d.rupture_tension = 1;
+  d.rupture_tension = 80;
   d.rupture_length = 0.002;
   d.solver = TX_CLOTH_IMPLICIT;
   d.iterations = 1;
@@ -400,6 +401,7 @@ static bool build(tx_cloth* c) {
     c->lend.assign((size_t)c->nlink * 2, 0);
     c->hold.assign((size_t)c->n, 0);
     c->state.assign((size_t)c->n, 0);
+    c->held_solve.assign((size_t)c->n, 0);
     c->mh2.assign((size_t)c->n, 0.0);
   }
   return true;
@@ -515,7 +517,6 @@ static void predict(tx_cloth* c, double h) {
   for (int i = 0; i < c->n; i++) {
     btSoftBody::Node& nd = nodes[i];
     nd.m_q = nd.m_x;
-    const btVector3 v0 = nd.m_v;
     if (nd.m_im > 0) {
       nd.m_v += g;
       if (c->loaded > 0) nd.m_v += c->load[(size_t)i] * (nd.m_im * hs);
@@ -523,11 +524,13 @@ static void predict(tx_cloth* c, double h) {
     nd.m_x += nd.m_v * hs;
     if (implicit) {
       // y, the inertial prediction with the loads, is what the energy measures from; the
-      // Newton steps start from the move without them, x0 + h v0, so that a patch at rest
-      // is the solve's fixed point whatever the Newton steps (from y, one step of a slack
-      // membrane would settle short of its equilibrium)
+      // Newton steps start where the particles are, so that a patch at rest is the solve's
+      // fixed point whatever the Newton steps (from y, one step of a slack membrane settles
+      // short of its equilibrium), and the skin resting on the HIP still touches it when the
+      // contact is found (carried by its velocity it would leave the stopped HIP, and its
+      // tension would pull it through in the solve)
       for (int a = 0; a < 3; a++) c->y[(size_t)i * 3 + a] = nd.m_x[a];
-      nd.m_x = nd.m_q + v0 * hs;
+      nd.m_x = nd.m_q;
     }
   }
 }
@@ -844,6 +847,7 @@ static void solve_implicit(tx_cloth* c, double h) {
     if (res > c->stats.residual) c->stats.residual = res;
     c->stats.newton++;
   }
+  c->held_solve = c->hold; // same size: a copy, no allocation
   std::fill(c->hold.begin(), c->hold.end(), 0);
 }
 
@@ -1348,6 +1352,19 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
     std::fill(c->in_contact.begin(), c->in_contact.end(), 0);
     for (int a = 0; a < 3; a++) c->contact_dir[a] = 0;
     project_contact(c, h1, h0, h, true, true);
+    if (c->def.solver == TX_CLOTH_IMPLICIT) {
+      // the solve's active set holds the HIP too: a vertex sliding across its sphere ends
+      // a little off it (second order), beyond the touch test, and still pushes
+      const btSoftBody::Node* base = &b->m_nodes[0];
+      for (int i = 0; i < c->n; i++) {
+        if (!c->held_solve[(size_t)i]) continue;
+        c->in_contact[(size_t)i] = 1;
+        const btVector3 r = base[i].m_x - h1;
+        const btScalar rl = r.length();
+        if (rl > 0)
+          for (int a = 0; a < 3; a++) c->contact_dir[a] += r[a] / rl;
+      }
+    }
     if (!healthy(c)) {
       c->faults++;
       tx_cloth_restore(c);
