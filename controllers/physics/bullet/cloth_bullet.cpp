@@ -1012,14 +1012,16 @@ static void sweep_contact(tx_cloth* c, const btVector3& h0, const btVector3& h1,
   int moves = (int)std::ceil(len / (0.5 * rc));
   if (moves < 1) moves = 1;
   if (moves > 64) moves = 64; // a teleport: the path is sampled, not followed
+  // a HIP this fast drags the skin further than the links can follow within
+  // the substep, and the solve would spread the strain before anyone saw it:
+  // what it overstretched tears now, move by move (a substep of the implicit
+  // solver is a whole 60 Hz step: torn only at its end, the skin would be
+  // dragged centimetres with the HIP)
   for (int k = 1; k <= moves; k++) {
     btVector3 h = h0.lerp(h1, (btScalar)k / (btScalar)moves);
     project_contact(c, h, h0, dt, count, false);
+    if (moves > 1) rupture(c, &h);
   }
-  // a HIP this fast drags the skin further than the links can follow within
-  // the substep, and the solve would spread the strain before anyone saw it:
-  // what it overstretched tears now
-  if (moves > 1) rupture(c, &h1);
 }
 
 // every particle finite, slower than max_speed and near the patch
