@@ -45,7 +45,7 @@ static const tx_param_def params[] = {
     {"solver", TX_PARAM_STR, NULL, 0, 0, 0, "implicit",
      "\"implicit\": backward Euler, Newton and preconditioned CG (real time); \"xpbd\": XPBD, converged only with k w h^2 <= 1/4"},
     {"iterations", TX_PARAM_INT, "1", 1, 200, 1, NULL, "XPBD iterations per substep"},
-    {"newton_steps", TX_PARAM_INT, "1", 1, 20, 3, NULL, "implicit: most Newton steps per substep; they stop once the gradient is a tenth of the first step's"},
+    {"newton_steps", TX_PARAM_INT, "1", 1, 20, 2, NULL, "implicit: most Newton steps per substep; they stop once the gradient is a tenth of the first step's"},
     {"cg_iterations", TX_PARAM_INT, "1", 1, 10000, 100, NULL, "implicit: most CG iterations per Newton step"},
     {"cg_tolerance", TX_PARAM_NUM, "1", 1e-12, 1, 1e-2, NULL, "implicit: CG stops at this relative residual"},
     {"max_substep_s", TX_PARAM_NUM, "s", 1e-6, 0.1, 1.0 / 60, NULL, "a step is split into substeps of at most this"},

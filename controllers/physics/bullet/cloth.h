@@ -104,7 +104,7 @@ typedef struct tx_cloth_def {
   double rupture_length;    // m, radius over which the tension is averaged, in [1e-4, 0.05]; 0.002
   int solver;               // tx_cloth_solver; TX_CLOTH_IMPLICIT
   int iterations;           // XPBD iterations per substep, in [1, 200]; 1
-  int newton_steps;         // implicit: most Newton steps per substep, in [1, 20]; 3 (they stop once the
+  int newton_steps;         // implicit: most Newton steps per substep, in [1, 20]; 2 (they stop once the
                             // gradient is a tenth of the first's)
   int cg_iterations;        // implicit: most conjugate-gradient iterations per Newton step, in [1, 10000]; 100
   double cg_tolerance;      // implicit: the CG stops at this residual over the right-hand side's, in [1e-12, 1]; 1e-2

@@ -138,7 +138,7 @@ extern "C" tx_cloth_def tx_cloth_def_default(void) {
   d.rupture_length = 0.002;
   d.solver = TX_CLOTH_IMPLICIT;
   d.iterations = 1;
-  d.newton_steps = 3;
+  d.newton_steps = 2;
   d.cg_iterations = 100;
   d.cg_tolerance = 1e-2;
   d.max_substep = 1.0 / 60;
