@@ -160,6 +160,9 @@ typedef struct setting {
   int iterations;
   double rate_hz; // physics.skin's rate
   double substep; // s, its max_substep_s
+  char solver[12]; // "xpbd" or "implicit"
+  int newton_steps, cg_iterations; // implicit only
+  double cg_tolerance;
 } setting;
 
 typedef struct row {
@@ -181,7 +184,8 @@ static const char* const q_label[NQ] = {"force at indentation", "rupture force",
 // true stiffness (docs/skin.md). physics.skin runs at RATE_HZ; h is its step
 // split into whole substeps.
 static setting level_setting(int l, int cells0) {
-  setting s = {.iterations = ITERATIONS, .rate_hz = RATE_HZ};
+  setting s = {.iterations = ITERATIONS, .rate_hz = RATE_HZ, .solver = "xpbd", .newton_steps = 1, .cg_iterations = 1,
+               .cg_tolerance = 1};
   snprintf(s.name, sizeof s.name, "level %d", l);
   int cells = cells0 << l;
   s.spacing = EDGE_M / (double)cells;
@@ -192,9 +196,61 @@ static setting level_setting(int l, int cells0) {
   return s;
 }
 
-// suturing-skin as it ships (scenarios/suturing-skin/suturing-skin.json and
-// the skin's defaults: 1 iteration, ten substeps a 60 Hz step)
-static const setting real_time = {"real time", 0.0025, 0.1, 1, 60, 1.0 / 600};
+// a parameter of physics.skin: what the scenario's skin sets, else the class default
+static const tx_param_def* skin_param(const char* key) {
+  tx_register_builtin();
+  const tx_controller_class* k = tx_find_controller("physics.skin");
+  for (int i = 0; k && i < k->nparams; i++)
+    if (strcmp(k->params[i].key, key) == 0) return &k->params[i];
+  return NULL;
+}
+
+static double num_of(json_t* params, const char* key) {
+  json_t* v = json_object_get(params, key);
+  if (json_is_number(v)) return json_number_value(v);
+  const tx_param_def* p = skin_param(key);
+  return p ? p->def_num : NAN;
+}
+
+// suturing-skin as it ships: the skin's rate and parameters in its scenario
+// file, the rest physics.skin's defaults. 0, or 1 with a message
+static int real_time_setting(setting* s) {
+  memset(s, 0, sizeof *s);
+  snprintf(s->name, sizeof s->name, "real time");
+  char path[4096];
+  if (tx_scenario_locate("suturing-skin", path, sizeof path)) return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
+  json_error_t e;
+  json_t* doc = json_load_file(path, 0, &e);
+  json_t* skin = NULL;
+  size_t i;
+  json_t* ctl;
+  json_array_foreach(json_object_get(doc, "controllers"), i, ctl)
+    if (json_is_string(json_object_get(ctl, "type")) &&
+        strcmp(json_string_value(json_object_get(ctl, "type")), "physics.skin") == 0)
+      skin = ctl;
+  if (!skin) {
+    json_decref(doc);
+    return fprintf(stderr, "tactus: skin-accuracy: %s has no physics.skin\n", path), 1;
+  }
+  json_t* params = json_object_get(skin, "params");
+  s->rate_hz = json_number_value(json_object_get(skin, "rate_hz"));
+  s->spacing = num_of(params, "spacing_m");
+  s->size = num_of(params, "size_m");
+  s->iterations = (int)num_of(params, "iterations");
+  s->substep = num_of(params, "max_substep_s");
+  s->newton_steps = (int)num_of(params, "newton_steps");
+  s->cg_iterations = (int)num_of(params, "cg_iterations");
+  s->cg_tolerance = num_of(params, "cg_tolerance");
+  json_t* sv = json_object_get(params, "solver");
+  const tx_param_def* sp = skin_param("solver");
+  snprintf(s->solver, sizeof s->solver, "%s", json_is_string(sv) ? json_string_value(sv) : sp ? sp->def_str : "?");
+  json_decref(doc);
+  // the study's substeps are whole divisions of the step, as physics.skin's
+  if (!(s->rate_hz > 0) || !(s->substep > 0) || !(s->spacing > 0))
+    return fprintf(stderr, "tactus: skin-accuracy: %s: no rate or spacing for its skin\n", path), 1;
+  s->substep = (1 / s->rate_hz) / ceil((1 / s->rate_hz) / s->substep - 1e-9);
+  return 0;
+}
 
 // the hand: down at 1 cm/s. The full path uses the table's accuracy-pierce-down
 // (1 cm above the mid-plane to 1.5 cm below, 3 s); the quick path a shorter
@@ -269,9 +325,10 @@ static void measure_pierce(const curve* c, double depth, row* r) {
 static void no_rupture(json_t* params) { json_object_set_new(params, "rupture_tension_n_per_m", json_real(0)); }
 
 static json_t* skin_params(const setting* s, bool gravity, double hip_radius) {
-  json_t* p = json_pack("{s:f,s:f,s:f,s:f,s:i,s:f,s:b}", "spacing_m", s->spacing, "size_m", s->size, "thickness_m",
-                        THICKNESS_M, "hip_radius_m", hip_radius, "iterations", s->iterations, "max_substep_s",
-                        s->substep, "gravity", gravity);
+  json_t* p = json_pack("{s:f,s:f,s:f,s:f,s:i,s:f,s:b,s:s,s:i,s:i,s:f}", "spacing_m", s->spacing, "size_m", s->size,
+                        "thickness_m", THICKNESS_M, "hip_radius_m", hip_radius, "iterations", s->iterations,
+                        "max_substep_s", s->substep, "gravity", gravity, "solver", s->solver, "newton_steps",
+                        s->newton_steps, "cg_iterations", s->cg_iterations, "cg_tolerance", s->cg_tolerance);
   if (p && gravity) no_rupture(p);
   else if (p) {
     json_object_set_new(p, "rupture_tension_n_per_m", json_real(RUPTURE_T));
@@ -405,8 +462,8 @@ static int parse_options(const tx_study_args* a, options* o) {
 }
 
 static void print_row(const setting* s, const row* r) {
-  printf("  %-10s %7.3f %5d %7.0f %8.5f %9.3f %8.2f | %9.2f %6.2f | %9.2f %6.2f | %8.3f %6.2f | %8.3f %6.2f\n", s->name,
-         s->spacing * 1e3, s->iterations, 1 / s->substep, s->size + s->spacing, r->cpu_s_per_s, r->wall_s,
+  printf("  %-10s %-8s %7.3f %5d %7.0f %8.5f %9.3f %8.2f | %9.2f %6.2f | %9.2f %6.2f | %8.3f %6.2f | %8.3f %6.2f\n", s->name,
+         s->solver, s->spacing * 1e3, s->iterations, 1 / s->substep, s->size + s->spacing, r->cpu_s_per_s, r->wall_s,
          r->q[0] * 1e3, 100 * r->err[0], r->q[1] * 1e3, 100 * r->err[1], r->q[2] * 1e3, 100 * r->err[2], r->q[3] * 1e3,
          100 * r->err[3]);
 }
@@ -456,7 +513,7 @@ static int write_outputs(const char* dir, const setting* set, const row* rows, c
   json_t* quantities = json_object();
   for (int i = 0; i < nset && list; i++) {
     const setting* s = &set[i];
-    json_t* r = json_pack("{s:s,s:f,s:f,s:i,s:f,s:f,s:f,s:f,s:f,s:i}", "setting", s->name, "spacing_m", s->spacing,
+    json_t* r = json_pack("{s:s,s:s,s:f,s:f,s:i,s:f,s:f,s:f,s:f,s:f,s:i}", "setting", s->name, "solver", s->solver, "spacing_m", s->spacing,
                           "edge_m", s->size + s->spacing, "iterations", s->iterations, "rate_hz", s->rate_hz,
                           "time_step_s", s->substep, "k_w_h2", k_w_h2(s), "cpu_s_per_sim_s", rows[i].cpu_s_per_s, "wall_s", rows[i].wall_s,
                           "torn_links", rows[i].torn);
@@ -513,14 +570,14 @@ int tx_study_skin_accuracy(const tx_study_args* a) {
   int nlev = o.levels, nset = nlev + 1;
   setting set[LEVELS_MAX + 1];
   for (int l = 0; l < nlev; l++) set[l] = level_setting(l, CELLS0);
-  set[nlev] = real_time;
+  if (real_time_setting(&set[nlev])) return 1;
   curve* curves = calloc((size_t)nset, sizeof *curves);
   row rows[LEVELS_MAX + 1];
   if (!curves) return fprintf(stderr, "tactus: out of memory\n"), 1;
   printf("study skin-accuracy (%s path, %d levels): pierce-down at 1 cm/s, HIP r = 0.5 mm, 0.4 cm skin, 26 rays; "
          "force %.1f mm below first contact; tears at %.0f N/m over %.0f mm; sag after %.1f s hanging\n",
          o.quick ? "quick" : "full", nlev, o.depth * 1e3, RUPTURE_T, RUPTURE_L * 1e3, 1 + SAG_AFTER_S);
-  printf("  %-10s %7s %5s %7s %8s %9s %8s | %9s %6s | %9s %6s | %8s %6s | %8s %6s\n", "setting", "dx mm", "iter",
+  printf("  %-10s %-8s %7s %5s %7s %8s %9s %8s | %9s %6s | %9s %6s | %8s %6s | %8s %6s\n", "setting", "solver", "dx mm", "iter",
          "1/dt Hz", "edge m", "CPU s/s", "wall s", "F_ind mN", "err %", "F_rup mN", "err %", "d_rup mm", "err %",
          "sag mm", "err %");
   int rc = 0;

@@ -39,11 +39,16 @@ static const tx_param_def params[] = {
     {"fixed_border", TX_PARAM_BOOL, NULL, 0, 0, 1, NULL, "the outer ring of particles does not move"},
     {"pretension_n_per_m", TX_PARAM_NUM, "N/m", 0, 1e9, 0, NULL,
      "isotropic tension of the flat skin at rest against its fixed border; below (3 k + 4 k_bend) / 2"},
-    {"rupture_tension_n_per_m", TX_PARAM_NUM, "N/m", 0, 1e7, 1, NULL,
+    {"rupture_tension_n_per_m", TX_PARAM_NUM, "N/m", 0, 1e7, 80, NULL,
      "membrane tension, averaged over rupture_length_m, that tears the skin; 0: never"},
     {"rupture_length_m", TX_PARAM_NUM, "m", 1e-4, 0.05, 0.002, NULL, "radius over which the tension is averaged"},
+    {"solver", TX_PARAM_STR, NULL, 0, 0, 0, "implicit",
+     "\"implicit\": backward Euler, Newton and preconditioned CG (real time); \"xpbd\": XPBD, converged only with k w h^2 <= 1/4"},
     {"iterations", TX_PARAM_INT, "1", 1, 200, 1, NULL, "XPBD iterations per substep"},
-    {"max_substep_s", TX_PARAM_NUM, "s", 1e-6, 0.1, 1.0 / 600, NULL, "a step is split into substeps of at most this"},
+    {"newton_steps", TX_PARAM_INT, "1", 1, 20, 2, NULL, "implicit: most Newton steps per substep; they stop once the gradient is a tenth of the first step's"},
+    {"cg_iterations", TX_PARAM_INT, "1", 1, 10000, 100, NULL, "implicit: most CG iterations per Newton step"},
+    {"cg_tolerance", TX_PARAM_NUM, "1", 1e-12, 1, 1e-2, NULL, "implicit: CG stops at this relative residual"},
+    {"max_substep_s", TX_PARAM_NUM, "s", 1e-6, 0.1, 1.0 / 60, NULL, "a step is split into substeps of at most this"},
     {"max_speed", TX_PARAM_NUM, "m/s", 1e-3, 1e4, 100, NULL, "a faster particle is a blow-up"},
     {"hip_radius_m", TX_PARAM_NUM, "m", 0, 0.01, 0.0005, NULL, "the HIP sphere (0.05 cm); 0: no HIP"},
     {"pose", TX_PARAM_STR, NULL, 0, 0, 0, "device0.pose", "the pose the HIP follows (f64 1 x 7)"},
@@ -73,7 +78,15 @@ static int configure(tx_setup* s, void** self) {
   d.pretension = tx_table_num(s, "pretension_n_per_m");
   d.rupture_tension = tx_table_num(s, "rupture_tension_n_per_m");
   d.rupture_length = tx_table_num(s, "rupture_length_m");
+  const char* solver = tx_table_str(s, "solver");
+  if (!solver) return -1;
+  if (strcmp(solver, "implicit") == 0) d.solver = TX_CLOTH_IMPLICIT;
+  else if (strcmp(solver, "xpbd") == 0) d.solver = TX_CLOTH_XPBD;
+  else return tx_setup_fail(s, "solver", "expected \"implicit\" or \"xpbd\", got \"%s\"", solver);
   d.iterations = (int)tx_table_int(s, "iterations");
+  d.newton_steps = (int)tx_table_int(s, "newton_steps");
+  d.cg_iterations = (int)tx_table_int(s, "cg_iterations");
+  d.cg_tolerance = tx_table_num(s, "cg_tolerance");
   d.max_substep = tx_table_num(s, "max_substep_s");
   d.max_speed = tx_table_num(s, "max_speed");
   k->hip_radius = tx_table_num(s, "hip_radius_m");

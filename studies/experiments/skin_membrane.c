@@ -15,7 +15,7 @@
 #endif
 
 tx_membrane_case tx_membrane_case_default(tx_membrane_kind kind) {
-  tx_membrane_case k = {kind, 0.04, 100, 2000, 4.4, 0.02, 0.005, 9.81, 0.15, 300};
+  tx_membrane_case k = {kind, 0.04, 100, 2000, 4.4, 0.02, 0.005, 9.81, 0.15, 300, 0};
   return k;
 }
 
@@ -45,9 +45,11 @@ static double inside(double x, double z, double s, double r0) {
 // A membrane clamped at radius a: a square of side 2 a + 2 s around the disc,
 // a particle at the centre, areal density rho_t (kg/m^2) per cell, no bending
 // links, and the converged solver: the substep makes k w h^2 = 1/4, where one
-// iteration already takes most of a link's stretch, and 4 iterations finish it.
-// half: the particles from the centre to the edge
-static bool disc_patch(double a, double spacing, double rho_t, double stiffness, tx_cloth_def* d, int* half) {
+// iteration already takes most of a link's stretch, and 4 iterations finish it;
+// or (implicit) the implicit solver as physics.skin ships it (one substep a
+// 60 Hz step). half: the particles from the centre to the edge
+static bool disc_patch(double a, double spacing, double rho_t, double stiffness, bool implicit, tx_cloth_def* d,
+                       int* half) {
   double cells = a / spacing;
   if (!(spacing > 0) || fabs(cells - lround(cells)) > 1e-6 * cells || lround(cells) < 4)
     return tx_set_error("skin-membrane: spacing %g m must divide the radius %g m into at least 4 cells", spacing, a), false;
@@ -61,6 +63,8 @@ static bool disc_patch(double a, double spacing, double rho_t, double stiffness,
   d->stretch_stiffness = stiffness;
   d->bend_stiffness = 0;
   d->clamp_radius = a;
+  if (implicit) return true;
+  d->solver = TX_CLOTH_XPBD;
   d->max_substep = tx_cloth_converged_substep(stiffness, d->mass / (res * res), 0.25);
   d->iterations = 4;
   return true;
@@ -83,7 +87,7 @@ static bool settle(tx_cloth* c, int centre, double time, double* sag, double* dr
 bool tx_membrane_run(const tx_membrane_case* k, double spacing, tx_membrane_result* out) {
   tx_cloth_def d;
   int half;
-  if (!disc_patch(k->radius, spacing, k->density, k->stiffness, &d, &half)) return false;
+  if (!disc_patch(k->radius, spacing, k->density, k->stiffness, k->implicit != 0, &d, &half)) return false;
   const int res = d.res[0];
   d.pretension = k->tension;
   d.rupture_tension = 0;
@@ -146,7 +150,7 @@ bool tx_membrane_rupture_run(double spacing, tx_membrane_rupture* out) {
   const double a = 0.015, r = 0.0005, thickness = 0.004, rc = r + 0.5 * thickness, speed = 0.02;
   tx_cloth_def d;
   int half;
-  if (!disc_patch(a, spacing, 100 * 4.4, 2000, &d, &half)) return false;
+  if (!disc_patch(a, spacing, 100 * 4.4, 2000, false, &d, &half)) return false;
   const int res = d.res[0];
   d.thickness = thickness;
   d.pretension = 50;
@@ -211,6 +215,7 @@ bool tx_membrane_gravity_run(int res, tx_membrane_sag* out) {
   double t0 = wall_now(), drift;
   if (!hang(&d, 3, &out->realtime, &drift)) return false; // the real-time default, as it comes
   d.damping = 50; // to rest sooner; the rest state does not depend on it
+  d.solver = TX_CLOTH_XPBD;
   d.max_substep = tx_cloth_converged_substep(d.stretch_stiffness, d.mass / (res * res), 0.25);
   d.iterations = 4;
   if (!hang(&d, 0.5, &out->converged, &out->drift)) return false;

@@ -31,6 +31,7 @@ typedef struct tx_membrane_case {
   double gravity;     // m/s^2, the sag's g; 9.81
   double time;        // s, simulated before the deflection is read; 0.15
   double damping;     // 1/s, the velocity decay that brings it to rest (the rest state does not depend on it); 300
+  int implicit;       // 0: XPBD at k w h^2 = 1/4, 4 iterations; 1: the implicit solver at its real-time defaults
 } tx_membrane_case;
 
 typedef struct tx_membrane_result {

@@ -68,8 +68,15 @@ int main(int argc, char** argv) {
   expect(strcmp(json_string_value(json_object_get(json_array_get(settings, (size_t)levels), "setting")), "real time") == 0,
          "the last setting", "is not the real-time default");
   json_t* rt = json_array_get(settings, (size_t)levels);
-  expect(num(rt, "iterations") == 1 && fabs(num(rt, "time_step_s") * 600 - 1) < 1e-9, "the real-time default",
-         "is not physics.skin's (1 iteration, 1/600 s substeps)");
+  // suturing-skin as it ships: the implicit solver, one 1/60 s substep a step; the path is XPBD's
+  const char* rts = json_string_value(json_object_get(rt, "solver"));
+  expect(rts && strcmp(rts, "implicit") == 0 && fabs(num(rt, "time_step_s") * 60 - 1) < 1e-9 &&
+             num(rt, "rate_hz") == 60 && fabs(num(rt, "spacing_m") - 0.0025) < 1e-12,
+         "the real-time default", "is not physics.skin's (implicit, 1/60 s substeps, suturing-skin's 2.5 mm at 60 Hz)");
+  for (int l = 0; l < levels; l++) {
+    const char* ps = json_string_value(json_object_get(json_array_get(settings, (size_t)l), "solver"));
+    expect(ps && strcmp(ps, "xpbd") == 0, "the path", "is not XPBD's");
+  }
   for (int k = 0; k < 4; k++) {
     json_t* q = json_object_get(quantities, keys[k]);
     const char* status = json_string_value(json_object_get(q, "status"));

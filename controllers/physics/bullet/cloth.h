@@ -8,7 +8,16 @@
 // Fig. 2) and bending links two spacings long along x and z. Bullet's
 // btSoftBody holds the particles and links; this adapter integrates them.
 //
-//   solver     XPBD (Macklin et al. 2016): each link is a distance constraint
+//   solver     implicit (the default): backward Euler on the links, a few
+//              Newton steps a substep, each a linear solve by block-Jacobi
+//              preconditioned conjugate gradients, matrix-free over the links
+//              and warm-started; the SPD part of each link's Hessian (its
+//              transverse term clamped at zero under compression). The
+//              particles the HIP contact moved are held along the contact's
+//              normal in the solve (a Baraff-Witkin filter), and let go where
+//              holding them would pull. A link's tension is k (l - l0) at the
+//              end of the substep. Or
+//              XPBD (Macklin et al. 2016): each link is a distance constraint
 //              of compliance 1/k with a Lagrange multiplier accumulated over
 //              the iterations of a substep, so the cloth tends to implicit
 //              Euler with the true k as iterations grow and substeps shrink
@@ -70,6 +79,11 @@
 extern "C" {
 #endif
 
+typedef enum tx_cloth_solver {
+  TX_CLOTH_IMPLICIT = 0, // backward Euler, Newton and preconditioned CG: the real-time default
+  TX_CLOTH_XPBD = 1,     // XPBD: converges only with k w h^2 under about 1 (the refinement path)
+} tx_cloth_solver;
+
 typedef struct tx_cloth_def {
   double size[2];           // m, edge lengths along x and z; 0.1 (the papers' 10 x 10 cm patch)
   int res[2];               // particles along x and z, in [2, 1024]; 42 (0.25 cm spacing: 1764 particles)
@@ -86,10 +100,15 @@ typedef struct tx_cloth_def {
   double clamp_radius;      // m, particles this far or further from the centre (in the plane) cannot move
                             // either, in [0, 10]; 0: none (a circular membrane inside the square)
   double pretension;        // N/m, isotropic tension of the flat patch at rest, in [0, (3 k + 4 k_bend) / 2]; 0
-  double rupture_tension;   // N/m, membrane tension that tears, in [0, 1e7]; 1; 0: never
+  double rupture_tension;   // N/m, membrane tension that tears, in [0, 1e7]; 80; 0: never
   double rupture_length;    // m, radius over which the tension is averaged, in [1e-4, 0.05]; 0.002
+  int solver;               // tx_cloth_solver; TX_CLOTH_IMPLICIT
   int iterations;           // XPBD iterations per substep, in [1, 200]; 1
-  double max_substep;       // s, a step is split into substeps of at most this, in [1e-6, 0.1]; 1/600
+  int newton_steps;         // implicit: most Newton steps per substep, in [1, 20]; 2 (they stop once the
+                            // gradient is a tenth of the first's)
+  int cg_iterations;        // implicit: most conjugate-gradient iterations per Newton step, in [1, 10000]; 100
+  double cg_tolerance;      // implicit: the CG stops at this residual over the right-hand side's, in [1e-12, 1]; 1e-2
+  double max_substep;       // s, a step is split into substeps of at most this, in [1e-6, 0.1]; 1/60
   double max_speed;         // m/s, a faster particle is a blow-up, in (0, 1e4]; 100
   double settle_time;       // s, with gravity the patch first hangs this long without rupture, in [0, 10]; 1
 } tx_cloth_def;
@@ -156,8 +175,9 @@ tx_cloth_status tx_cloth_set_load(tx_cloth* c, int i, const double f[3]);
 // broken link keeps its id. Its two particles; false for a bad id
 int tx_cloth_link_total(const tx_cloth* c);
 bool tx_cloth_link_ends(const tx_cloth* c, int link, int32_t ends[2]);
-// the link's tension over the last substep (N, > 0 stretched): its XPBD
-// multiplier / substep^2, i.e. the force the solver applied; 0 once broken
+// the link's tension over the last substep (N, > 0 stretched): implicit,
+// k (l - l0) at its end; XPBD, its multiplier / substep^2, the force the
+// solver applied; 0 once broken
 double tx_cloth_link_tension(const tx_cloth* c, int link);
 // the membrane tension at particle i now (N/m): the largest principal value
 // of the link stresses averaged over rupture_length, as rupture sees it
@@ -169,6 +189,15 @@ double tx_cloth_membrane_tension(const tx_cloth* c, int i);
 double tx_cloth_peak_tension(const tx_cloth* c);
 // faults found and recovered so far
 int tx_cloth_faults(const tx_cloth* c);
+// implicit solver, the last step: CG iterations summed over its Newton steps and
+// substeps, and the largest relative residual a Newton step ended with (0: XPBD)
+typedef struct tx_cloth_solve_info {
+  int cg_iterations;
+  double residual;
+  int released; // held particles let go because holding them would pull
+  int newton;   // Newton steps taken
+} tx_cloth_solve_info;
+void tx_cloth_solve_stats(const tx_cloth* c, tx_cloth_solve_info* out);
 // the substep (s) at which k w h^2 = kwh2 for links of stiffness k (N/m) between
 // particles of mass m (kg), w = 2 / m: XPBD reaches the links' true stiffness for
 // kwh2 up to about 1/4 with a few iterations (docs/skin.md)

@@ -1,6 +1,7 @@
 // The skin patch on a Bullet soft body: the C interface of cloth.h over
 // btSoftBody. Bullet holds the particles and links; this file builds the
-// patch, integrates it (XPBD links), projects the HIP contact, breaks links
+// patch, integrates it (implicit Euler by Newton and preconditioned CG, or
+// XPBD), projects the HIP contact, breaks links
 // where the membrane tension passes the rupture tension and guards against
 // numerical faults.
 #include "cloth.h"
@@ -56,6 +57,22 @@ struct tx_cloth {
   std::vector<btVector3> load;     // (n) N, external force on each particle
   int loaded;                      // particles with a non-zero load
   double peak_tension;             // N/m, largest averaged tension of the last step's checks
+
+  // the implicit solver's work vectors, all made at create (Bullet's btConjugateGradient
+  // allocates two arrays an iteration: its multAndAdd and sub return by value)
+  std::vector<double> y;           // (n x 3) m, the inertial prediction of the substep
+  std::vector<double> dx, rr, zz, pp, qq; // (n x 3) CG: solution, residual, preconditioned, direction, A p
+  std::vector<double> warm;        // (n x 3) m, the last Newton step's solution: the next one's start
+  std::vector<double> grad;        // (n x 3) N, gradient of the substep's energy
+  std::vector<double> hess;        // (links x 6) N/m, each link's SPD Hessian block, by slot
+  std::vector<double> pinv;        // (n x 6) m/N, inverse of each particle's diagonal block
+  std::vector<int32_t> lend;       // (links x 2) the particles of each link, by slot
+  std::vector<uint8_t> hold;       // (n) held along hold_n in the solve (the contact moved it)
+  std::vector<uint8_t> held_solve; // (n) held at the end of the last solve (its active set)
+  std::vector<uint8_t> state;      // (n) in the solve: 0 fixed, 1 free, 2 held (hold and the mass, packed)
+  std::vector<double> mh2;         // (n) N/m, m / h^2 of each particle, 0 when fixed
+  std::vector<double> hold_n;      // (n x 3) 1, the contact's push on a held particle, summed
+  tx_cloth_solve_info stats;       // the last step's
 
   std::vector<int32_t> tri;        // (ntri x 3) vertex indices
   std::vector<uint8_t> tri_alive;  // (ntri)
@@ -117,10 +134,14 @@ extern "C" tx_cloth_def tx_cloth_def_default(void) {
   d.fixed_border = true;
   d.clamp_radius = 0;
   d.pretension = 0;
-  d.rupture_tension = 1;
+  d.rupture_tension = 80;
   d.rupture_length = 0.002;
+  d.solver = TX_CLOTH_IMPLICIT;
   d.iterations = 1;
-  d.max_substep = 1.0 / 600;
+  d.newton_steps = 2;
+  d.cg_iterations = 100;
+  d.cg_tolerance = 1e-2;
+  d.max_substep = 1.0 / 60;
   d.max_speed = 100;
   d.settle_time = 1;
   return d;
@@ -153,7 +174,14 @@ extern "C" int tx_cloth_def_check(const tx_cloth_def* d) {
     return -1;
   if (range("rupture_tension", d->rupture_tension, 0, false, 1e7, false, "N/m")) return -1;
   if (range("rupture_length", d->rupture_length, 1e-4, false, 0.05, false, "m")) return -1;
+  if (d->solver != TX_CLOTH_IMPLICIT && d->solver != TX_CLOTH_XPBD) {
+    tx_set_error("skin: solver = %d, must be %d (implicit) or %d (xpbd)", d->solver, TX_CLOTH_IMPLICIT, TX_CLOTH_XPBD);
+    return -1;
+  }
   if (tx_check_count("skin", "iterations", d->iterations, 1, 200)) return -1;
+  if (tx_check_count("skin", "newton_steps", d->newton_steps, 1, 20)) return -1;
+  if (tx_check_count("skin", "cg_iterations", d->cg_iterations, 1, 10000)) return -1;
+  if (range("cg_tolerance", d->cg_tolerance, 1e-12, false, 1, false, "1")) return -1;
   if (range("max_substep", d->max_substep, 1e-6, false, 0.1, false, "s")) return -1;
   if (range("max_speed", d->max_speed, 0, true, 1e4, false, "m/s")) return -1;
   if (range("settle_time", d->settle_time, 0, false, 10, false, "s")) return -1;
@@ -364,6 +392,18 @@ static bool build(tx_cloth* c) {
   c->good_link.assign((size_t)c->nlink, 1);
   c->good_tri.assign((size_t)c->ntri, 1);
   c->good_tension.assign((size_t)c->nlink, 0);
+  if (d.solver == TX_CLOTH_IMPLICIT) {
+    const size_t n3 = (size_t)c->n * 3;
+    for (std::vector<double>* v : {&c->y, &c->dx, &c->rr, &c->zz, &c->pp, &c->qq, &c->warm, &c->grad, &c->hold_n})
+      v->assign(n3, 0.0);
+    c->hess.assign((size_t)c->nlink * 6, 0.0);
+    c->pinv.assign((size_t)c->n * 6, 0.0);
+    c->lend.assign((size_t)c->nlink * 2, 0);
+    c->hold.assign((size_t)c->n, 0);
+    c->state.assign((size_t)c->n, 0);
+    c->held_solve.assign((size_t)c->n, 0);
+    c->mh2.assign((size_t)c->n, 0.0);
+  }
   return true;
 }
 
@@ -473,6 +513,7 @@ static void predict(tx_cloth* c, double h) {
   btAlignedObjectArray<btSoftBody::Node>& nodes = c->body->m_nodes;
   const btVector3 g = c->world.m_gravity * (btScalar)h;
   const btScalar hs = (btScalar)h;
+  const bool implicit = c->def.solver == TX_CLOTH_IMPLICIT;
   for (int i = 0; i < c->n; i++) {
     btSoftBody::Node& nd = nodes[i];
     nd.m_q = nd.m_x;
@@ -481,6 +522,16 @@ static void predict(tx_cloth* c, double h) {
       if (c->loaded > 0) nd.m_v += c->load[(size_t)i] * (nd.m_im * hs);
     }
     nd.m_x += nd.m_v * hs;
+    if (implicit) {
+      // y, the inertial prediction with the loads, is what the energy measures from; the
+      // Newton steps start where the particles are, so that a patch at rest is the solve's
+      // fixed point whatever the Newton steps (from y, one step of a slack membrane settles
+      // short of its equilibrium), and the skin resting on the HIP still touches it when the
+      // contact is found (carried by its velocity it would leave the stopped HIP, and its
+      // tension would pull it through in the solve)
+      for (int a = 0; a < 3; a++) c->y[(size_t)i * 3 + a] = nd.m_x[a];
+      nd.m_x = nd.m_q;
+    }
   }
 }
 
@@ -521,6 +572,283 @@ static void solve_links(tx_cloth* c, double h) {
       n0->m_x -= corr * n0->m_im;
       n1->m_x += corr * n1->m_im;
     }
+}
+
+// ---------------------------------------------------------------------------
+// the implicit solver
+//
+// Backward Euler on the links: the substep's positions x minimise
+// E(x) = |x - y|^2_M / (2 h^2) + U(x), y = x0 + h v0 + h^2 M^-1 f_ext the
+// inertial prediction and U the springs' energy sum k (l - l0)^2 / 2. Each
+// Newton step solves (M / h^2 + H) dx = -grad E by conjugate gradients
+// preconditioned with the 3 x 3 diagonal blocks, matrix-free over the links,
+// with H each link's SPD part k (n n^T + max(0, 1 - l0 / l) (I - n n^T)): the
+// transverse term is the link's tension over its length, negative under
+// compression, where it is dropped (a compressed link buckles, it does not
+// push sideways). Fixed particles do not move; a particle the contact moved
+// keeps its position along the contact's normal and slides across it (the
+// filter S = I - n n^T of Baraff and Witkin, SIGGRAPH 1998). Every vector is
+// made at create: Bullet's btConjugateGradient (BulletSoftBody) allocates two
+// arrays an iteration, which a step must not.
+
+// the filter: nothing for a fixed particle, the tangential part for a held one
+static inline void filter(const tx_cloth* c, int i, double* v) {
+  const uint8_t st = c->state[(size_t)i];
+  if (st == 0) {
+    v[0] = v[1] = v[2] = 0;
+    return;
+  }
+  if (st == 2) {
+    const double* n = &c->hold_n[(size_t)i * 3];
+    const double d = v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
+    for (int a = 0; a < 3; a++) v[a] -= d * n[a];
+  }
+}
+
+// the springs' gradient and SPD Hessian blocks at the current positions, each
+// particle's diagonal block inverted, and grad E into c->grad
+static void assemble(tx_cloth* c, double h) {
+  const btAlignedObjectArray<btSoftBody::Link>& links = c->body->m_links;
+  const btSoftBody::Node* base = &c->body->m_nodes[0];
+  const int n = c->n, nl = links.size();
+  const double ks = c->def.stretch_stiffness, kb = c->def.bend_stiffness, ih2 = 1 / (h * h);
+  double* g = c->grad.data();
+  double* pi = c->pinv.data(); // the diagonal blocks first, inverted below
+  for (int i = 0; i < n; i++) {
+    const double m = base[i].m_im > 0 ? 1 / (double)base[i].m_im : 0, w = m * ih2;
+    c->mh2[(size_t)i] = w;
+    c->state[(size_t)i] = m > 0 ? (c->hold[(size_t)i] ? 2 : 1) : 0;
+    for (int a = 0; a < 3; a++) g[i * 3 + a] = w * ((double)base[i].m_x[a] - c->y[(size_t)i * 3 + a]);
+    double* b = &pi[i * 6];
+    b[0] = b[1] = b[2] = w;
+    b[3] = b[4] = b[5] = 0;
+  }
+  for (int s = 0; s < nl; s++) {
+    const btSoftBody::Link& l = links[s];
+    const int a = (int)(l.m_n[0] - base), b = (int)(l.m_n[1] - base);
+    c->lend[(size_t)s * 2] = a;
+    c->lend[(size_t)s * 2 + 1] = b;
+    double* H = &c->hess[(size_t)s * 6];
+    const double k = l.m_material == c->bend_mat ? kb : ks;
+    double d[3] = {(double)l.m_n[1]->m_x[0] - l.m_n[0]->m_x[0], (double)l.m_n[1]->m_x[1] - l.m_n[0]->m_x[1],
+                   (double)l.m_n[1]->m_x[2] - l.m_n[0]->m_x[2]};
+    const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (!(k > 0) || !(len > 0)) {
+      for (int e = 0; e < 6; e++) H[e] = 0;
+      continue;
+    }
+    for (double& v : d) v /= len;
+    const double f = k * (len - (double)l.m_rl); // pulls a towards b when stretched
+    for (int e = 0; e < 3; e++) {
+      g[a * 3 + e] -= f * d[e];
+      g[b * 3 + e] += f * d[e];
+    }
+    const double t = std::max(0.0, 1 - (double)l.m_rl / len), kn = k * (1 - t), kt = k * t;
+    H[0] = kn * d[0] * d[0] + kt, H[1] = kn * d[1] * d[1] + kt, H[2] = kn * d[2] * d[2] + kt;
+    H[3] = kn * d[0] * d[1], H[4] = kn * d[0] * d[2], H[5] = kn * d[1] * d[2];
+    for (int e = 0; e < 6; e++) pi[a * 6 + e] += H[e], pi[b * 6 + e] += H[e];
+  }
+  for (int i = 0; i < n; i++) { // inverse of the symmetric block (xx, yy, zz, xy, xz, yz)
+    double* m = &pi[i * 6];
+    const double c00 = m[1] * m[2] - m[5] * m[5], c01 = m[4] * m[5] - m[3] * m[2], c02 = m[3] * m[5] - m[4] * m[1];
+    const double det = m[0] * c00 + m[3] * c01 + m[4] * c02;
+    if (!(std::fabs(det) > 0) || !std::isfinite(det)) {
+      for (int e = 0; e < 6; e++) m[e] = 0;
+      continue;
+    }
+    const double id = 1 / det;
+    const double i11 = (m[0] * m[2] - m[4] * m[4]) * id, i22 = (m[0] * m[1] - m[3] * m[3]) * id,
+                 i12 = (m[3] * m[4] - m[0] * m[5]) * id;
+    m[0] = c00 * id, m[1] = i11, m[2] = i22, m[3] = c01 * id, m[4] = c02 * id, m[5] = i12;
+  }
+}
+
+// out = S (M / h^2 + H) S v
+static void apply_system(tx_cloth* c, const double* v, double* out) {
+  const int n = c->n, nl = c->body->m_links.size();
+  const double* mh2 = c->mh2.data();
+  for (int i = 0; i < n; i++) {
+    const double w = mh2[i];
+    for (int a = 0; a < 3; a++) out[i * 3 + a] = w * v[i * 3 + a];
+  }
+  const int32_t* le = c->lend.data();
+  const double* hs = c->hess.data();
+  for (int s = 0; s < nl; s++) {
+    const int a = le[s * 2], b = le[s * 2 + 1];
+    const double* H = &hs[s * 6];
+    const double d0 = v[a * 3] - v[b * 3], d1 = v[a * 3 + 1] - v[b * 3 + 1], d2 = v[a * 3 + 2] - v[b * 3 + 2];
+    const double r0 = H[0] * d0 + H[3] * d1 + H[4] * d2, r1 = H[3] * d0 + H[1] * d1 + H[5] * d2,
+                 r2 = H[4] * d0 + H[5] * d1 + H[2] * d2;
+    out[a * 3] += r0, out[a * 3 + 1] += r1, out[a * 3 + 2] += r2;
+    out[b * 3] -= r0, out[b * 3 + 1] -= r1, out[b * 3 + 2] -= r2;
+  }
+  for (int i = 0; i < n; i++) filter(c, i, &out[i * 3]);
+}
+
+// z = S P^-1 r
+static void precondition(tx_cloth* c, const double* r, double* z) {
+  const double* pi = c->pinv.data();
+  for (int i = 0; i < c->n; i++) {
+    const double* m = &pi[i * 6];
+    const double* v = &r[i * 3];
+    z[i * 3] = m[0] * v[0] + m[3] * v[1] + m[4] * v[2];
+    z[i * 3 + 1] = m[3] * v[0] + m[1] * v[1] + m[5] * v[2];
+    z[i * 3 + 2] = m[4] * v[0] + m[5] * v[1] + m[2] * v[2];
+    filter(c, i, &z[i * 3]);
+  }
+}
+
+static double dot(const std::vector<double>& a, const std::vector<double>& b) {
+  double s = 0;
+  for (size_t i = 0; i < a.size(); i++) s += a[i] * b[i];
+  return s;
+}
+
+// the substep's energy E at the particles' positions (J)
+static double energy(const tx_cloth* c, double h) {
+  const btSoftBody::Node* base = &c->body->m_nodes[0];
+  const double ih2 = 1 / (h * h);
+  double e = 0;
+  for (int i = 0; i < c->n; i++) {
+    if (!(base[i].m_im > 0)) continue;
+    double s = 0;
+    for (int a = 0; a < 3; a++) {
+      const double d = (double)base[i].m_x[a] - c->y[(size_t)i * 3 + a];
+      s += d * d;
+    }
+    e += 0.5 * ih2 / (double)base[i].m_im * s;
+  }
+  const btAlignedObjectArray<btSoftBody::Link>& links = c->body->m_links;
+  for (int i = 0, nl = links.size(); i < nl; i++) {
+    const btSoftBody::Link& l = links[i];
+    const double k = l.m_material == c->bend_mat ? c->def.bend_stiffness : c->def.stretch_stiffness;
+    const double d = (double)(l.m_n[1]->m_x - l.m_n[0]->m_x).length() - (double)l.m_rl;
+    e += 0.5 * k * d * d;
+  }
+  return e;
+}
+
+// one Newton step: solves S (M / h^2 + H) S dx = -S grad E by PCG (from the
+// last substep's dx with warm), moves the particles by dx; the relative
+// residual reached. *gg: |S grad E|^2 before the step; none is taken when
+// that is stop2 or less (converged)
+static double newton_step(tx_cloth* c, double h, bool warm, double* gg, double stop2) {
+  const int n3 = c->n * 3;
+  assemble(c, h);
+  double* g = c->grad.data();
+  for (int i = 0; i < c->n; i++) filter(c, i, &g[i * 3]);
+  double bb = 0;
+  for (int i = 0; i < n3; i++) bb += g[i] * g[i];
+  *gg = bb;
+  if (!(bb > stop2)) return 0;
+  double* x = c->dx.data();
+  double* r = c->rr.data();
+  if (warm) std::memcpy(x, c->warm.data(), (size_t)n3 * sizeof(double));
+  else std::fill(c->dx.begin(), c->dx.end(), 0.0);
+  for (int i = 0; i < c->n; i++) filter(c, i, &x[i * 3]);
+  apply_system(c, x, c->qq.data());
+  for (int i = 0; i < n3; i++) r[i] = -g[i] - c->qq[(size_t)i];
+  if (!(dot(c->rr, c->rr) < bb)) { // the warm start is worse than none: from zero
+    std::fill(c->dx.begin(), c->dx.end(), 0.0);
+    for (int i = 0; i < n3; i++) r[i] = -g[i];
+  }
+  precondition(c, r, c->zz.data());
+  c->pp = c->zz; // same size: a copy, no allocation
+  double rz = dot(c->rr, c->zz), rr = dot(c->rr, c->rr);
+  const double tol2 = c->def.cg_tolerance * c->def.cg_tolerance * bb;
+  int it = 0;
+  double* p = c->pp.data();
+  double* q = c->qq.data();
+  double* z = c->zz.data();
+  while (it < c->def.cg_iterations && rr > tol2) {
+    apply_system(c, p, q);
+    const double pq = dot(c->pp, c->qq);
+    if (!(pq > 0)) break;
+    const double alpha = rz / pq;
+    rr = 0;
+    for (int i = 0; i < n3; i++) {
+      x[i] += alpha * p[i];
+      r[i] -= alpha * q[i];
+      rr += r[i] * r[i];
+    }
+    it++;
+    if (rr <= tol2) break;
+    precondition(c, r, z);
+    const double rz1 = dot(c->rr, c->zz), beta = rz1 / rz;
+    rz = rz1;
+    for (int i = 0; i < n3; i++) p[i] = z[i] + beta * p[i];
+  }
+  c->stats.cg_iterations += it;
+  // a backtracking line search on E: a full step from a slack membrane, whose
+  // transverse stiffness is nearly nothing, overshoots, and undamped the steps
+  // that follow go round a cycle instead of reaching the equilibrium
+  btSoftBody::Node* nodes = &c->body->m_nodes[0];
+  double* x0 = c->zz.data(); // free once the CG is done
+  for (int i = 0; i < c->n; i++)
+    for (int a = 0; a < 3; a++) x0[i * 3 + a] = nodes[i].m_x[a];
+  const double e0 = energy(c, h);
+  double step = 1;
+  for (int tries = 0;; tries++) {
+    for (int i = 0; i < c->n; i++)
+      for (int a = 0; a < 3; a++) nodes[i].m_x[a] = (btScalar)(x0[i * 3 + a] + step * x[i * 3 + a]);
+    if (tries == 8 || energy(c, h) <= e0 + 1e-12 * std::fabs(e0)) break; // (float positions: a little noise)
+    step *= 0.5;
+  }
+  if (step < 1)
+    for (int i = 0; i < n3; i++) x[i] *= step;
+  if (warm) c->warm = c->dx; // same size: a copy, no allocation
+  return std::sqrt(rr / bb);
+}
+
+// held particles whose contact would have to pull them (towards the HIP) to
+// hold them: the constraint force grad E . n is negative; how many let go
+static int release_pulling(tx_cloth* c, double h) {
+  assemble(c, h);
+  int freed = 0;
+  for (int i = 0; i < c->n; i++) {
+    if (!c->hold[(size_t)i]) continue;
+    const double* n = &c->hold_n[(size_t)i * 3];
+    const double* g = &c->grad[(size_t)i * 3];
+    if (g[0] * n[0] + g[1] * n[1] + g[2] * n[2] < 0) c->hold[(size_t)i] = 0, freed++;
+  }
+  return freed;
+}
+
+#define NEWTON_STOP 0.1 // Newton stops at this gradient over the first step's
+
+// the substep's positions: newton_steps Newton steps from where the contact
+// left the particles; held particles that would pull are let go and the
+// solve goes on one step more (at most once)
+static void solve_implicit(tx_cloth* c, double h) {
+  for (int i = 0; i < c->n; i++) {
+    if (!c->hold[(size_t)i]) continue;
+    double* n = &c->hold_n[(size_t)i * 3];
+    const double l = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (l > 0) n[0] /= l, n[1] /= l, n[2] /= l;
+    else c->hold[(size_t)i] = 0;
+  }
+  // Newton steps until the gradient is a tenth of the first one's (a slack
+  // membrane falling from flat needs two or three; a pierce, one)
+  double g0 = 0, gg = 0;
+  for (int s = 0; s < c->def.newton_steps; s++) {
+    const double stop2 = s == 0 ? 0 : NEWTON_STOP * NEWTON_STOP * g0;
+    const double res = newton_step(c, h, s == 0, &gg, stop2);
+    if (s == 0) g0 = gg;
+    else if (!(gg > stop2)) break;
+    if (res > c->stats.residual) c->stats.residual = res;
+    c->stats.newton++;
+  }
+  bool any = false;
+  for (int i = 0; i < c->n && !any; i++) any = c->hold[(size_t)i] != 0;
+  int freed = any ? release_pulling(c, h) : 0;
+  if (freed > 0) {
+    c->stats.released += freed;
+    const double res = newton_step(c, h, false, &gg, 0);
+    if (res > c->stats.residual) c->stats.residual = res;
+    c->stats.newton++;
+  }
+  c->held_solve = c->hold; // same size: a copy, no allocation
+  std::fill(c->hold.begin(), c->hold.end(), 0);
 }
 
 // closest point of triangle (a, b, cc) to p, as barycentric weights (Ericson's region tests)
@@ -639,23 +967,34 @@ static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& fr
           if (w[j] > 0) c->in_contact[(size_t)(p[j] - &nodes[0])] = 1;
         for (int a = 0; a < 3; a++) c->contact_dir[a] += dir[a];
       }
-      if (!(depth > 0)) continue;
       btScalar wsum = 0;
       for (int j = 0; j < 3; j++) wsum += p[j]->m_im * w[j] * w[j];
-      if (!(wsum > 0)) continue;
-      btScalar s = depth / wsum;
-      for (int j = 0; j < 3; j++) {
-        if (p[j]->m_im <= 0) continue;
-        btVector3 dx = dir * (s * p[j]->m_im * w[j]);
-        p[j]->m_x += dx;
-        if (fix_velocity) p[j]->m_v += dx * (btScalar)(1 / dt);
-        if (count) {
-          const float* r0 = &c->rest_x[(size_t)(p[j] - &nodes[0]) * 3];
-          double moved = (p[j]->m_x - btVector3(r0[0], r0[1], r0[2])).length();
-          if (moved > c->contact_depth) c->contact_depth = moved;
-          c->contact_moves++;
+      if (depth > 0 && wsum > 0) {
+        btScalar s = depth / wsum;
+        for (int j = 0; j < 3; j++) {
+          if (p[j]->m_im <= 0) continue;
+          btVector3 dx = dir * (s * p[j]->m_im * w[j]);
+          p[j]->m_x += dx;
+          if (fix_velocity) p[j]->m_v += dx * (btScalar)(1 / dt);
+          if (count) {
+            const float* r0 = &c->rest_x[(size_t)(p[j] - &nodes[0]) * 3];
+            double moved = (p[j]->m_x - btVector3(r0[0], r0[1], r0[2])).length();
+            if (moved > c->contact_depth) c->contact_depth = moved;
+            c->contact_moves++;
+          }
         }
       }
+      // the implicit solve holds the corners of a triangle the HIP touches, pushed now or
+      // not (one already resting on it, moving with it), each on its sphere about the HIP's
+      // centre: free to slide across, not to come in
+      if (!fix_velocity && near && c->def.solver == TX_CLOTH_IMPLICIT)
+        for (int j = 0; j < 3; j++) {
+          if (p[j]->m_im <= 0 || !(w[j] > 0)) continue;
+          const size_t pi = (size_t)(p[j] - &nodes[0]);
+          const btVector3 radial = p[j]->m_x - h;
+          c->hold[pi] = 1;
+          for (int a = 0; a < 3; a++) c->hold_n[pi * 3 + a] = radial[a];
+        }
     }
 }
 
@@ -673,14 +1012,16 @@ static void sweep_contact(tx_cloth* c, const btVector3& h0, const btVector3& h1,
   int moves = (int)std::ceil(len / (0.5 * rc));
   if (moves < 1) moves = 1;
   if (moves > 64) moves = 64; // a teleport: the path is sampled, not followed
+  // a HIP this fast drags the skin further than the links can follow within
+  // the substep, and the solve would spread the strain before anyone saw it:
+  // what it overstretched tears now, move by move (a substep of the implicit
+  // solver is a whole 60 Hz step: torn only at its end, the skin would be
+  // dragged centimetres with the HIP)
   for (int k = 1; k <= moves; k++) {
     btVector3 h = h0.lerp(h1, (btScalar)k / (btScalar)moves);
     project_contact(c, h, h0, dt, count, false);
+    if (moves > 1) rupture(c, &h);
   }
-  // a HIP this fast drags the skin further than the links can follow within
-  // the substep, and the solve would spread the strain before anyone saw it:
-  // what it overstretched tears now
-  if (moves > 1) rupture(c, &h1);
 }
 
 // every particle finite, slower than max_speed and near the patch
@@ -781,13 +1122,22 @@ static void measure_links(tx_cloth* c, double h) {
   float* local = c->local.data();
   if (sums) std::fill(local, local + c->n, 0.0f);
   const double ih2 = 1 / (h * h);
+  const bool implicit = c->def.solver == TX_CLOTH_IMPLICIT;
   btScalar longest = 0;
   for (int i = 0, ni = links.size(); i < ni; i++) {
     const btSoftBody::Link& l = links[i];
     const int id = (int)reinterpret_cast<intptr_t>(l.m_tag);
-    const float f = (float)(-c->lambda[(size_t)i] * ih2);
+    float f;
+    btScalar len;
+    if (implicit) { // the spring's force at the end of the substep
+      len = (l.m_n[1]->m_x - l.m_n[0]->m_x).length();
+      const double k = l.m_material == c->bend_mat ? c->def.bend_stiffness : c->def.stretch_stiffness;
+      f = (float)(k * ((double)len - (double)l.m_rl));
+    } else {
+      f = (float)(-c->lambda[(size_t)i] * ih2);
+      len = c->length[(size_t)i]; // before the last correction and the contact: close enough
+    }
     c->tension[(size_t)id] = f;
-    const btScalar len = c->length[(size_t)i]; // before the last correction and the contact: close enough
     if (len > longest && c->info[(size_t)id].kind != BEND) longest = len;
     const float fx = f - c->hanging[(size_t)id];
     if (sums && fx > 0) {
@@ -977,6 +1327,10 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
   const double h = dt / substeps;
   btSoftBody* b = c->body;
   c->peak_tension = 0;
+  c->stats.cg_iterations = 0;
+  c->stats.residual = 0;
+  c->stats.released = 0;
+  c->stats.newton = 0;
   const btScalar ih = (btScalar)(1 / h);
   c->contact_depth = 0;
   c->contact_moves = 0;
@@ -988,7 +1342,8 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
     btVector3 h1 = start.lerp(end, (btScalar)(s + 1) / (btScalar)substeps);
     predict(c, h);
     sweep_contact(c, h0, h1, h, true);
-    solve_links(c, h);
+    if (c->def.solver == TX_CLOTH_IMPLICIT) solve_implicit(c, h);
+    else solve_links(c, h);
     btAlignedObjectArray<btSoftBody::Node>& nodes = b->m_nodes;
     const btScalar vc = (btScalar)(ih * std::exp(-c->def.damping * h));
     for (int i = 0; i < c->n; i++) {
@@ -999,6 +1354,19 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
     std::fill(c->in_contact.begin(), c->in_contact.end(), 0);
     for (int a = 0; a < 3; a++) c->contact_dir[a] = 0;
     project_contact(c, h1, h0, h, true, true);
+    if (c->def.solver == TX_CLOTH_IMPLICIT) {
+      // the solve's active set holds the HIP too: a vertex sliding across its sphere ends
+      // a little off it (second order), beyond the touch test, and still pushes
+      const btSoftBody::Node* base = &b->m_nodes[0];
+      for (int i = 0; i < c->n; i++) {
+        if (!c->held_solve[(size_t)i]) continue;
+        c->in_contact[(size_t)i] = 1;
+        const btVector3 r = base[i].m_x - h1;
+        const btScalar rl = r.length();
+        if (rl > 0)
+          for (int a = 0; a < 3; a++) c->contact_dir[a] += r[a] / rl;
+      }
+    }
     if (!healthy(c)) {
       c->faults++;
       tx_cloth_restore(c);
@@ -1110,6 +1478,8 @@ extern "C" double tx_cloth_membrane_tension(const tx_cloth* c, int i) {
 }
 
 extern "C" double tx_cloth_peak_tension(const tx_cloth* c) { return c->peak_tension; }
+
+extern "C" void tx_cloth_solve_stats(const tx_cloth* c, tx_cloth_solve_info* out) { *out = c->stats; }
 
 extern "C" double tx_cloth_converged_substep(double stiffness, double particle_mass, double kwh2) {
   return std::sqrt(kwh2 / (stiffness * 2 / particle_mass));

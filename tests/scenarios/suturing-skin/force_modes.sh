@@ -11,34 +11,37 @@ fail() { echo "force_modes: $*"; exit 1; }
 
 # paper: from zero at first contact (no step above alpha x the hand's move over the two ticks
 # between the pose the collision saw and the one rendered, 2 x 5 um: 2e-4 N; it was alpha h/2 = 0.04 N), and
-# blind to the skin's stiffness (2 vs 2e6 N/m: the same trace). When the skin tears depends on its
-# tension, so on its stiffness: the two skins here cannot tear, and the whole trace must match
+# blind to the skin's stiffness (2 vs 2e6 N/m: the same trace, to within one tick of the hand at
+# first contact, alpha x 5 um = 1e-4 N: the implicit skin's float positions there differ by a few nm).
+# When the skin tears depends on its tension, so on its stiffness: the two skins here cannot tear
 run p2 --set hip.force_mode=paper --set skin.stretch_stiffness=2 --set skin.rupture_tension_n_per_m=0
 run p6 --set hip.force_mode=paper --set skin.stretch_stiffness=2e6 --set skin.rupture_tension_n_per_m=0
-cmp <(cut -d, -f5-8 "$d/p2/force_displacement.csv") <(cut -d, -f5-8 "$d/p6/force_displacement.csv") || fail "paper: stiffness changed the force"
+paste -d, <(cut -d, -f5-7 "$d/p2/force_displacement.csv") <(cut -d, -f5-7 "$d/p6/force_displacement.csv") |
+  awk -F, 'NR > 1 { for (i = 1; i <= 3; i++) { e = $i - $(i + 3); if (e < 0) e = -e; if (e > m) m = e } }
+           END { exit !(NR > 5000 && m <= 1.1e-4) }' || fail "paper: stiffness changed the force"
 awk -F, 'NR > 1 && $8 > 0 && n < 10 { s = $6 - f; if (s < 0) s = -s; if (s > m) m = s; n++ } { f = $6 } END { exit !(n == 10 && m <= 2.1e-4) }' \
   "$d/p2/force_displacement.csv" || fail "paper: a force step at first contact"
 
 # mechanics: stiffer (200 vs 2000 N/m), thicker (0.2 vs 0.8 cm) and pre-tensioned (0 vs 50 N/m)
-# skins push back harder at the same HIP height
-run ms --set duration_s=3 --set skin.stretch_stiffness=200
-run mk --set duration_s=3
-run mt --set duration_s=3 --set skin.thickness_m=0.002
-run mT --set duration_s=3 --set skin.thickness_m=0.008
-run mp --set duration_s=3 --set skin.pretension_n_per_m=50
+# skins push back harder at the same HIP height (skins that cannot tear: a pre-tensioned one
+# reaches the default rupture tension, 80 N/m, before 2.7 s)
+nt="--set skin.rupture_tension_n_per_m=0"
+run ms --set duration_s=3 $nt --set skin.stretch_stiffness=200
+run mk --set duration_s=3 $nt
+run mt --set duration_s=3 $nt --set skin.thickness_m=0.002
+run mT --set duration_s=3 $nt --set skin.thickness_m=0.008
+run mp --set duration_s=3 $nt --set skin.pretension_n_per_m=50
 a=$(at ms 2.700000) b=$(at mk 2.700000) c=$(at mt 2.700000) e=$(at mT 2.700000) g=$(at mp 2.700000)
 echo "mechanics at 2.7 s: stiffness 200 -> $a N, 2000 -> $b N; thickness 0.2 cm -> $c N, 0.8 cm -> $e N; pretension 0 -> $b N, 50 N/m -> $g N"
 awk -v a="$a" -v b="$b" 'BEGIN { exit !(a > 0 && b > a) }' || fail "mechanics: stiffness"
 awk -v a="$c" -v b="$e" 'BEGIN { exit !(a > 0 && b > a) }' || fail "mechanics: thickness"
 awk -v a="$b" -v b="$g" 'BEGIN { exit !(a > 0 && b > a) }' || fail "mechanics: pretension"
 # a heavier hanging skin (22 vs 88 g, gravity), pushed from below, 50 ms after contact: density
-# acts through the weight the skin hangs by. On a converged solver (0.5 cm spacing, 0.15 ms
-# substeps: k w h^2 < 1), since the real-time default is not converged, and there a heavier
-# skin is a softer one (XPBD's correction per substep shrinks with the particles' mass)
+# acts through the weight the skin hangs by. On the real-time default, the implicit solver, which
+# converges (with XPBD at ten substeps of one iteration a heavier skin was a softer one)
 printf 't_s,x_m,y_m,z_m\n0,0,-0.03,0\n0.2,0,-0.03,0\n6.2,0,0,0\n' > "$d/up.csv"
 for m in 0.022 0.088; do
-  run "g$m" --set duration_s=7 --set skin.gravity=true --set skin.mass_kg=$m --set "haptics.device=scripted:$d/up.csv" \
-    --set skin.spacing_m=0.005 --set skin.max_substep_s=0.00015 --set skin.iterations=2
+  run "g$m" --set duration_s=7 --set skin.gravity=true --set skin.mass_kg=$m --set "haptics.device=scripted:$d/up.csv"
 done
 first50() { awk -F, 'NR > 1 && $8 > 0 && !t { t = $1 } NR > 1 && t && $1 >= t + 0.05 { print -$6; exit }' "$d/$1/force_displacement.csv"; }
 a=$(first50 g0.022) b=$(first50 g0.088)

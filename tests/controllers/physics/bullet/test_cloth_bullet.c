@@ -17,8 +17,21 @@
 
 #include "tests/alloc_count.h"
 
+// under the sanitizers the long runs below are cut short (their logic is the same)
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define SANITIZED 1
+#else
+#define SANITIZED 0
+#endif
+
+// the solver make() builds with: the default (implicit), or XPBD at its old
+// real-time setting (ten substeps of one iteration a 60 Hz step)
+static int solver = TX_CLOTH_IMPLICIT;
+
 static tx_cloth* make(int res, double gravity, double rupture) {
   tx_cloth_def d = tx_cloth_def_default();
+  d.solver = solver;
+  if (solver == TX_CLOTH_XPBD) d.max_substep = 1.0 / 600;
   d.res[0] = d.res[1] = res;
   d.gravity = gravity;
   d.rupture_tension = rupture;
@@ -74,7 +87,9 @@ static void counts_match_the_papers(void** state) {
 }
 
 // a fixed-border patch under gravity hangs: the centre goes down, the border
-// stays, and after a second it no longer moves; nothing tears by itself
+// stays, and after a second it no longer moves; nothing tears by itself. The
+// real-time default (implicit) sags what the converged XPBD solver does, 2.91 mm
+// at 42 x 42 (docs/skin.md), and Hencky's membrane (3.0 mm) within 5 %
 static void hanging_patch_sags_and_settles(void** state) {
   (void)state;
   tx_cloth_def d = tx_cloth_def_default();
@@ -91,8 +106,8 @@ static void hanging_patch_sags_and_settles(void** state) {
   tx_cloth_particle(c, centre(c), p);
   tx_cloth_particle(c, 0, corner);
   print_message("  centre sags %.2f mm\n", -p[1] * 1e3);
-  assert_true(p[1] < -0.005);                 // it sags
-  assert_true(p[1] > -0.08);                  // and hangs, not falls
+  assert_true(fabs(-p[1] - 2.91e-3) < 0.03 * 2.91e-3); // the converged sag
+  assert_true(fabs(-p[1] - 3.0e-3) < 0.05 * 3.0e-3);  // Hencky's
   assert_true(fabs(p[1] - before) < 1e-5);    // settled: under 10 um over the last half second
   assert_float_equal(corner[1], 0, 1e-9);     // the border holds
   assert_float_equal(corner[0], -0.05, 1e-7);
@@ -100,20 +115,20 @@ static void hanging_patch_sags_and_settles(void** state) {
   tx_cloth_destroy(c);
 
   // with settle_time, the patch starts hanging and rupture counts from there:
-  // at the default rupture tension, which the hanging patch holds more than
+  // at a rupture tension of 1 N/m, which the hanging patch holds more than
   // near its border, it does not tear by its weight
-  c = make(42, 9.81, tx_cloth_def_default().rupture_tension);
+  const double weak = 1;
+  c = make(42, 9.81, weak);
   tx_cloth_particle(c, centre(c), p);
-  assert_true(p[1] < -0.005);
+  assert_true(p[1] < -0.0025);
   double most = 0; // the largest tension per unit length of a stretch link: the weight alone passes the criterion
   for (int id = 0; id < tx_cloth_link_total(c); id++) {
     int32_t e[2];
     tx_cloth_link_ends(c, id, e);
     if (abs(e[1] - e[0]) == 1 || abs(e[1] - e[0]) == 42) most = fmax(most, tx_cloth_link_tension(c, id) / (0.1 / 41));
   }
-  print_message("  hanging: a stretch link carries up to %.2f N/m, the rupture tension is %.2f N/m\n", most,
-                tx_cloth_def_default().rupture_tension);
-  assert_true(most > tx_cloth_def_default().rupture_tension);
+  print_message("  hanging: a stretch link carries up to %.2f N/m, the rupture tension is %.2f N/m\n", most, weak);
+  assert_true(most > weak);
   for (int s = 0; s < 60; s++) assert_int_equal(tx_cloth_step(c, 1.0 / 60), TX_CLOTH_OK);
   assert_int_equal(tx_cloth_torn(c), 0);
   tx_cloth_destroy(c);
@@ -481,6 +496,150 @@ static void steps_never_allocate(void** state) {
 #endif
 }
 
+// the part of a cell of side s centred at (x, z) inside the disc r < r0 (8 x 8 samples)
+static double cell_inside(double x, double z, double s, double r0) {
+  int in = 0;
+  for (int i = 0; i < 8; i++)
+    for (int j = 0; j < 8; j++) {
+      double px = x + (i + 0.5) / 8 * s - 0.5 * s, pz = z + (j + 0.5) / 8 * s - 0.5 * s;
+      in += px * px + pz * pz < r0 * r0;
+    }
+  return in / 64.0;
+}
+
+// the implicit solver's static answer is the converged XPBD's and the closed
+// form's: a clamped circle (a = 4 cm, T = 100 N/m, 2.5 mm spacing) under
+// F = 0.02 N spread over r0 = 5 mm (each particle by its cell's part inside), at its real-time
+// defaults (one 1/60 s substep a step) against XPBD at k w h^2 = 1/4
+static double disc_deflection(int which) {
+  const double a = 0.04, s = 0.0025, T = 100;
+  const int half = (int)lround(a / s) + 1, res = 2 * half + 1;
+  tx_cloth_def d = tx_cloth_def_default();
+  d.size[0] = d.size[1] = (res - 1) * s;
+  d.res[0] = d.res[1] = res;
+  d.mass = 4.4 * d.size[0] * d.size[1];
+  d.bend_stiffness = 0;
+  d.clamp_radius = a;
+  d.pretension = T;
+  d.rupture_tension = 0;
+  d.damping = 300;
+  d.solver = which;
+  if (which == TX_CLOTH_XPBD) {
+    d.max_substep = tx_cloth_converged_substep(d.stretch_stiffness, d.mass / (res * res), 0.25);
+    d.iterations = 4;
+  }
+  tx_cloth* c = tx_cloth_create(&d);
+  assert_non_null(c);
+  double total = 0;
+  for (int pass = 0; pass < 2; pass++)
+    for (int iz = 0; iz < res; iz++)
+      for (int ix = 0; ix < res; ix++) {
+        double part = cell_inside((ix - half) * s, (iz - half) * s, s, 0.005);
+        if (part <= 0) continue;
+        if (pass == 0) total += part;
+        else assert_int_equal(tx_cloth_set_load(c, iz * res + ix, (double[3]){0, -0.02 * part / total, 0}), TX_CLOTH_OK);
+      }
+  for (int f = 0; f < 9; f++) assert_int_equal(tx_cloth_step(c, 1.0 / 60), TX_CLOTH_OK);
+  double p[3];
+  tx_cloth_particle(c, half * res + half, p);
+  tx_cloth_destroy(c);
+  return -p[1];
+}
+
+static void implicit_converges_to_the_static_answer(void** state) {
+  (void)state;
+  const double F = 0.02, a = 0.04, r0 = 0.005, T = 100;
+  const double exact = F * (log(a / r0) + 0.5) / (2 * M_PI * T);
+  double wi = disc_deflection(TX_CLOTH_IMPLICIT), wx = SANITIZED ? wi : disc_deflection(TX_CLOTH_XPBD);
+  print_message("  disc: implicit %.5f mm, converged XPBD %.5f mm, closed form %.5f mm\n", wi * 1e3, wx * 1e3,
+                exact * 1e3);
+  assert_true(fabs(wi - wx) < 0.01 * wx);
+  assert_true(fabs(wi - exact) < 0.05 * exact);
+}
+
+// the implicit skin is unconditionally stable: links 5 x 10^5 times stiffer
+// (1e9 N/m, the largest allowed) than the default, pierced 1 cm, never fault,
+// stay finite and push back
+static void implicit_is_stable_when_stiff(void** state) {
+  (void)state;
+  tx_cloth_def d = tx_cloth_def_default();
+  d.stretch_stiffness = 1e9;
+  d.bend_stiffness = 1e7;
+  d.rupture_tension = 0;
+  tx_cloth* c = tx_cloth_create(&d);
+  assert_non_null(c);
+  double h[3] = {0.001, 0.003, 0.0007}, f[3] = {0, 0, 0};
+  const int steps = SANITIZED ? 40 : 150;
+  for (int s = 0; s < steps; s++) {
+    h[1] = 0.003 - 0.013 * s / steps; // from above the skin to 1 cm into it
+    tx_cloth_set_hip(c, h, 0.0005);
+    assert_int_equal(tx_cloth_step(c, 1.0 / 60), TX_CLOTH_OK);
+    tx_cloth_contact_force(c, f);
+    assert_true(isfinite(f[0]) && isfinite(f[1]) && isfinite(f[2]));
+  }
+  assert_int_equal(tx_cloth_faults(c), 0);
+  assert_true(all_finite(c));
+  print_message("  k = 1e9 N/m: %.1f N at HIP y = %.1f mm\n", f[1], h[1] * 1e3);
+  assert_true(f[1] > 0);
+  tx_cloth_destroy(c);
+}
+
+// a skin that never tears is never passed: pressed 3 cm down at 1 cm/s over
+// a cell's middle (2.5 cm over a particle), every particle under the HIP's
+// cross-section stays below it and the force keeps growing (to 1 cm at every
+// step; to 3 cm above half its largest)
+static void untorn_skin_holds_to_3cm(void** state) {
+  (void)state;
+  const double at[2][2] = {{0, 0}, {0.00125, 0.00125}}; // the default 42 x 42: a cell's middle, a particle
+  for (int k = 0; k < 2; k++) {
+    tx_cloth* c = make(42, 0, 0);
+    double h[3] = {at[k][0], 0.0026, at[k][1]}, f[3], last = 0, most = 0;
+    int s = 0;
+    // over a particle it loses the skin at 2.66 cm (docs/skin.md)
+    const double bottom = SANITIZED ? -0.006 : k ? -0.025 : -0.03;
+    for (; h[1] > bottom; s++) {
+      h[1] = 0.0026 - 0.01 * s / 60.0;
+      assert_int_equal(tx_cloth_set_hip(c, h, 0.0005), TX_CLOTH_OK);
+      assert_int_equal(tx_cloth_step(c, 1.0 / 60), TX_CLOTH_OK);
+      tx_cloth_contact_force(c, f);
+      if (h[1] < -0.001) {
+        // it grows at every step to 1 cm; beyond, with the links several times their length,
+        // the skin wraps the sphere, the particles the contact holds change, and the force
+        // jumps by up to a third when one lets go (docs/skin.md)
+        const double keep = h[1] > -0.01 ? 0.99 * last : 0.5 * most;
+        if (!(f[1] >= keep && f[1] > 0))
+          fail_msg("HIP at %.2f mm: force %.4f N after %.4f N", h[1] * 1e3, f[1], most);
+        last = f[1];
+        most = fmax(most, f[1]);
+      }
+    }
+    double p[3];
+    for (int i = 0; i < tx_cloth_particle_count(c); i++) {
+      tx_cloth_particle(c, i, p);
+      double dx = p[0] - h[0], dz = p[2] - h[2];
+      if (dx * dx + dz * dz < 0.003 * 0.003 && !(p[1] < h[1])) fail_msg("particle %d at %.2f mm, above the HIP", i, p[1] * 1e3);
+    }
+    print_message("  HIP over %s, %.1f cm down: %.2f N, the skin still under it\n", k ? "a particle" : "a cell's middle",
+                  -bottom * 100, last);
+    assert_int_equal(tx_cloth_torn(c), 0);
+    tx_cloth_destroy(c);
+  }
+}
+
+// the faults, restore, rupture and allocation tests again with the XPBD solver
+#if !SANITIZED
+static int use_xpbd(void** state) {
+  (void)state;
+  solver = TX_CLOTH_XPBD;
+  return 0;
+}
+static int use_implicit(void** state) {
+  (void)state;
+  solver = TX_CLOTH_IMPLICIT;
+  return 0;
+}
+#endif
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(counts_match_the_papers),
@@ -495,6 +654,15 @@ int main(void) {
       cmocka_unit_test(pretension_is_the_membrane_tension),
       cmocka_unit_test(loads_and_the_circular_clamp),
       cmocka_unit_test(steps_never_allocate),
+      cmocka_unit_test(implicit_converges_to_the_static_answer),
+      cmocka_unit_test(implicit_is_stable_when_stiff),
+      cmocka_unit_test(untorn_skin_holds_to_3cm),
+#if !SANITIZED // the same code paths as above, but for the links' solve; minutes under the sanitizers
+      cmocka_unit_test_setup_teardown(rupture_opens_a_hole, use_xpbd, use_implicit),
+      cmocka_unit_test_setup_teardown(faults_are_recovered, use_xpbd, use_implicit),
+      cmocka_unit_test_setup_teardown(restore_brings_links_back, use_xpbd, use_implicit),
+      cmocka_unit_test_setup_teardown(steps_never_allocate, use_xpbd, use_implicit),
+#endif
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
