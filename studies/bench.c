@@ -29,11 +29,14 @@ typedef struct bench_args {
   double duration_s; // 0: the bench's own
 } bench_args;
 
-static void print_target(const char* what, const char* measured, const char* limit, bool ok) {
+void tx_bench_target(const char* what, const char* measured, const char* limit, bool ok) {
   printf("  %-44s %-24s %-12s %s\n", what, measured, limit, ok ? "met" : "MISSED");
 }
-void print_bench_target(const char* what, const char* measured, const char* limit, bool ok) {
-  print_target(what, measured, limit, ok);
+void tx_bench_target_us(const char* what, double measured_us, double limit_us) {
+  char m[64], l[32];
+  snprintf(m, sizeof m, "%.1f us", measured_us);
+  snprintf(l, sizeof l, "<= %.0f us", limit_us);
+  tx_bench_target(what, m, l, measured_us <= limit_us);
 }
 static int bench_render(const bench_args* a) { return tx_bench_render(a->out, a->duration_s); }
 
@@ -99,18 +102,18 @@ static int bench_rates(const bench_args* a) {
     char what[96];
     snprintf(what, sizeof what, "%s rate within 1%% of %g Hz", json_string_value(json_object_get(c, "name")), target);
     snprintf(measured, sizeof measured, "%.3f Hz (%.3f%%)", achieved, error);
-    print_target(what, measured, "<= 1%", error <= 1.0);
+    tx_bench_target(what, measured, "<= 1%", error <= 1.0);
     all &= error <= 1.0;
   }
   json_t* h = find_controller(report, "haptics");
   if (h) {
     double p99 = json_number_value(json_object_get(json_object_get(h, "jitter_us"), "p99"));
     snprintf(measured, sizeof measured, "%.1f us", p99);
-    print_target("haptics (1 kHz) period jitter p99", measured, "<= 100 us", p99 <= 100);
+    tx_bench_target("haptics (1 kHz) period jitter p99", measured, "<= 100 us", p99 <= 100);
     double steps = json_number_value(json_object_get(h, "steps")), missed = json_number_value(json_object_get(h, "missed"));
     double pct = 100 * missed / (steps + missed > 0 ? steps + missed : 1);
     snprintf(measured, sizeof measured, "%.0f of %.0f (%.3f%%)", missed, steps + missed, pct);
-    print_target("haptics (1 kHz) missed deadlines", measured, "<= 0.1%", pct <= 0.1);
+    tx_bench_target("haptics (1 kHz) missed deadlines", measured, "<= 0.1%", pct <= 0.1);
     all &= p99 <= 100 && pct <= 0.1;
   }
   printf("%s\n", all ? "all targets met" : "some targets MISSED");
@@ -238,9 +241,9 @@ static int bench_model(const bench_args* a) {
   printf("\ntargets:\n");
   char measured[64];
   snprintf(measured, sizeof measured, "%.2f us (with the fill)", pf.p99 * 1e-3);
-  print_target("publish + acquire 10404x3 f32, p99", measured, "<= 20 us", pf.p99 * 1e-3 <= 20);
+  tx_bench_target("publish + acquire 10404x3 f32, p99", measured, "<= 20 us", pf.p99 * 1e-3 <= 20);
   snprintf(measured, sizeof measured, "%.3f us", pe.p99 * 1e-3);
-  print_target("event push of a 1 kHz writer, p99", measured, "<= 1 us", pe.p99 * 1e-3 <= 1 && taken == pushes);
+  tx_bench_target("event push of a 1 kHz writer, p99", measured, "<= 1 us", pe.p99 * 1e-3 <= 1 && taken == pushes);
   if (sink == -1.0f) printf("(unreachable: keeps the reads)\n");
   free(source);
   tx_model_destroy(m);
@@ -274,7 +277,7 @@ static int bench_overhead(const bench_args* a) {
   printf("\ntargets:\n");
   char measured[64];
   snprintf(measured, sizeof measured, "%.3f us", per_step * 1e-3);
-  print_target("framework overhead of an empty step", measured, "<= 5 us", per_step * 1e-3 <= 5);
+  tx_bench_target("framework overhead of an empty step", measured, "<= 5 us", per_step * 1e-3 <= 5);
   return 0;
 }
 
@@ -338,12 +341,12 @@ static int bench_haptics(const bench_args* a) {
   printf("\ntargets:\n");
   char measured[64];
   snprintf(measured, sizeof measured, "%.2f us", loaded1k.step_ns.p99 * 1e-3);
-  print_target("one haptics tick, p99 (loaded)", measured, "<= 20 us", loaded1k.step_ns.p99 * 1e-3 <= 20);
+  tx_bench_target("one haptics tick, p99 (loaded)", measured, "<= 20 us", loaded1k.step_ns.p99 * 1e-3 <= 20);
   double pct = 100.0 * (double)loaded1k.missed / (double)(loaded1k.steps + loaded1k.missed);
   snprintf(measured, sizeof measured, "%.3f%%", pct);
-  print_target("1 kHz with both cores loaded, missed", measured, "<= 0.1%", pct <= 0.1);
+  tx_bench_target("1 kHz with both cores loaded, missed", measured, "<= 0.1%", pct <= 0.1);
   snprintf(measured, sizeof measured, "%.1f Hz, p99 %.1f us", idle10k.achieved_hz, idle10k.jitter_ns.p99 * 1e-3);
-  print_target("10 kHz reachable, jitter p99", measured, "<= 50 us",
+  tx_bench_target("10 kHz reachable, jitter p99", measured, "<= 50 us",
                idle10k.achieved_hz > 9900 && idle10k.jitter_ns.p99 * 1e-3 <= 50);
   return 0;
 }

@@ -8,6 +8,7 @@
 // adapter alone. Both run in one lockstep run, stepped alternately at every
 // 60 Hz tick, so that a busy machine slows both alike.
 #include "bench_cloth.h"
+#include "studies.h"
 
 #include "../scenarios/command.h"
 
@@ -85,10 +86,6 @@ static const tx_controller_class bare_class = {.type = "bench.bare_cloth",
                                                .summary = "steps a cloth through the adapter alone, timed",
                                                .configure = bare_configure,
                                                .step = bare_step};
-
-static void print_target(const char* what, const char* measured, const char* limit, bool ok) {
-  printf("  %-44s %-30s %-10s %s\n", what, measured, limit, ok ? "met" : "MISSED");
-}
 
 // a patch of res x res particles at the spacing (rupture at its default)
 // stepped alone under the same HIP for the given simulated seconds, with the
@@ -183,10 +180,10 @@ int tx_bench_cloth(double duration_s) {
     double hz50 = 1e9 / p.p50, hz99 = 1e9 / p.p99;
     snprintf(measured, sizeof measured, "p50 %.2f ms (%.0f Hz), p99 %.2f ms (%.0f Hz)", p.p50 * 1e-6, hz50,
              p.p99 * 1e-6, hz99);
-    print_target("10404-particle step with rupture, 1/p99", measured, ">= 60 Hz", hz99 >= 60 && torn > 0);
+    tx_bench_target("10404-particle step with rupture, 1/p99", measured, ">= 60 Hz", hz99 >= 60 && torn > 0);
     double over = 100 * (st.step_ns.p50 / p.p50 - 1);
     snprintf(measured, sizeof measured, "%.3f / %.3f ms = %+.2f%%", st.step_ns.p50 * 1e-6, p.p50 * 1e-6, over);
-    print_target("framework overhead, step medians", measured, "<= 5%", over <= 5);
+    tx_bench_target("framework overhead, step medians", measured, "<= 5%", over <= 5);
     if (torn == 0) printf("  (no link tore: the rupture path was not exercised)\n");
 
     // each solver alone: suturing-skin's patch (42 x 42, 2.5 mm), and the implicit one at 0.1 cm
@@ -210,7 +207,7 @@ int tx_bench_cloth(double duration_s) {
       if (k == 0) {
         snprintf(measured, sizeof measured, "p50 %.2f ms, p99 %.2f ms (%.0f Hz)", q.p50 * 1e-6, q.p99 * 1e-6,
                  1e9 / q.p99);
-        print_target("1764-particle implicit step, 1/p99", measured, ">= 60 Hz", 1e9 / q.p99 >= 60 && torn2[0] > 0);
+        tx_bench_target("1764-particle implicit step, 1/p99", measured, ">= 60 Hz", 1e9 / q.p99 >= 60 && torn2[0] > 0);
       }
     }
     printf("  (the executor's own cost per tick, a few us, is in `tactus bench overhead`)\n");

@@ -6,6 +6,7 @@
 // by a moving dent, so no physics engine is involved; the HIP sits in the dent,
 // touching it, and moves a little between queries as a hand would.
 #include "bench_hip.h"
+#include "studies.h"
 
 #include "../controllers/collision/hip.h"
 #include "experiments/skin_dent.h"
@@ -124,13 +125,6 @@ static int run_size(uint32_t n, bool mechanics, hip_bench_row* row) {
   return 0;
 }
 
-static void target(const char* what, double measured_us, double limit_us) {
-  char m[64], l[32];
-  snprintf(m, sizeof m, "%.1f us", measured_us);
-  snprintf(l, sizeof l, "<= %.0f us", limit_us);
-  printf("  %-44s %-24s %-12s %s\n", what, m, l, measured_us <= limit_us ? "met" : "MISSED");
-}
-
 int tx_bench_hip(void) {
   static const uint32_t sides[] = {102, 320}; // 10404 and 102400 particles on 10 x 10 cm
   hip_bench_row rows[4];                      // mechanics, then paper; each size
@@ -151,9 +145,9 @@ int tx_bench_hip(void) {
          (double)rows[1].particles / rows[0].particles, rows[1].query.p50 / rows[0].query.p50,
          rows[1].nodes_per_query / rows[0].nodes_per_query);
   printf("\ntargets:\n");
-  target("query, mechanics, 10404 particles, p99", rows[0].query.p99 * 1e-3, 100);
-  target("query, mechanics, 102400 particles, p99", rows[1].query.p99 * 1e-3, 250);
-  target("query, paper, 10404 particles, p99", rows[2].query.p99 * 1e-3, 100);
-  target("query, paper, 102400 particles, p99", rows[3].query.p99 * 1e-3, 250);
+  tx_bench_target_us("query, mechanics, 10404 particles, p99", rows[0].query.p99 * 1e-3, 100);
+  tx_bench_target_us("query, mechanics, 102400 particles, p99", rows[1].query.p99 * 1e-3, 250);
+  tx_bench_target_us("query, paper, 10404 particles, p99", rows[2].query.p99 * 1e-3, 100);
+  tx_bench_target_us("query, paper, 102400 particles, p99", rows[3].query.p99 * 1e-3, 250);
   return 0;
 }

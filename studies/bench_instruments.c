@@ -5,6 +5,7 @@
 // the grips open and close, and the needle holder's jaws pass over the
 // needle, so contacts come and go as in use. Target (issue 14): p99 <= 200 us.
 #include "bench_instruments.h"
+#include "studies.h"
 
 #include "../scenarios/command.h"
 
@@ -14,7 +15,6 @@
 #include <math.h>
 #include <stdio.h>
 
-void print_bench_target(const char* what, const char* measured, const char* limit, bool ok);
 
 #if TX_WITH_ODE && TX_WITH_URDFDOM && TX_WITH_ASSIMP
 #include "../controllers/instruments/instrument_desc.h"
@@ -68,7 +68,7 @@ int tx_bench_instruments(double duration_s) {
   printf("\ntargets:\n");
   char measured[64];
   snprintf(measured, sizeof measured, "p99 %.1f us", q.p99 * 1e-3);
-  print_bench_target("one ODE step, 2 instruments + needle, p99", measured, "<= 200 us", q.p99 * 1e-3 <= 200);
+  tx_bench_target("one ODE step, 2 instruments + needle, p99", measured, "<= 200 us", q.p99 * 1e-3 <= 200);
   printf("resets %d, needle grasps %d\n", tx_instrument_world_resets(w), tx_instrument_world_needle_grasps(w));
   tx_instrument_world_destroy(w);
   tx_instrument_desc_free(d[0]), tx_instrument_desc_free(d[1]);

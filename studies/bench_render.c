@@ -2,6 +2,7 @@
 // size of scene, mono and 2 x 640 x 480 stereo, with a 1 kHz haptics
 // controller running beside it. Timings are printed, never asserted.
 #include "bench_render.h"
+#include "studies.h"
 #include "../scenarios/command.h"
 
 #include <tactus/components.h>
@@ -204,13 +205,13 @@ int tx_bench_render(const char* out, double duration_s) {
   char measured[64];
   double eye_hz = st->frames / st->seconds;
   snprintf(measured, sizeof measured, "%.1f Hz per eye", eye_hz);
-  print_bench_target("stereo 2x640x480 at >= 30 Hz per eye", measured, ">= 29.7 Hz", eye_hz >= 29.7);
+  tx_bench_target("stereo 2x640x480 at >= 30 Hz per eye", measured, ">= 29.7 Hz", eye_hz >= 29.7);
   snprintf(measured, sizeof measured, "%.2f ms", st->p99);
-  print_bench_target("stereo frame time p99 fits the 30 Hz period", measured, "<= 33.3 ms", st->p99 <= 33.3);
+  tx_bench_target("stereo frame time p99 fits the 30 Hz period", measured, "<= 33.3 ms", st->p99 <= 33.3);
   double missed = 100.0 * (double)st->haptics.missed / (double)(st->haptics.steps + st->haptics.missed);
   snprintf(measured, sizeof measured, "%.3f%% (%llu of %llu)", missed, (unsigned long long)st->haptics.missed,
            (unsigned long long)(st->haptics.steps + st->haptics.missed));
-  print_bench_target("haptics 1 kHz beside stereo rendering, missed", measured, "<= 0.1%", missed <= 0.1);
+  tx_bench_target("haptics 1 kHz beside stereo rendering, missed", measured, "<= 0.1%", missed <= 0.1);
   printf("frames: %s/{mono,sbs,sbs-10404,voxels-1000,voxels-20000}/frames/\n", dir);
   return 0;
 }

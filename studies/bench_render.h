@@ -6,7 +6,5 @@
 
 // frame times of the graphics view, mono and stereo, beside 1 kHz haptics; the exit status
 int tx_bench_render(const char* out, double duration_s);
-// one line of a bench's target table
-void print_bench_target(const char* what, const char* measured, const char* limit, bool ok);
 
 #endif

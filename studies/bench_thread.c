@@ -9,6 +9,7 @@
 // and in the thread's CPU time: on a loaded machine the wall clock also
 // counts the time the step was descheduled. Timings are printed, never asserted.
 #include "bench_thread.h"
+#include "studies.h"
 
 #include "../controllers/thread/thread.h"
 
@@ -104,13 +105,6 @@ static int run_row(int nodes, tx_thread_model model, int steps, int settle, thre
   return 0;
 }
 
-static void target(const char* what, double measured_us, double limit_us) {
-  char m[64], l[32];
-  snprintf(m, sizeof m, "%.1f us", measured_us);
-  snprintf(l, sizeof l, "<= %.0f us", limit_us);
-  printf("  %-44s %-24s %-12s %s\n", what, m, l, measured_us <= limit_us ? "met" : "MISSED");
-}
-
 int tx_bench_thread(double duration_s) {
   thread_row rows[4];
   static const int sizes[2] = {100, 1000};
@@ -132,9 +126,9 @@ int tx_bench_thread(double duration_s) {
            rows[i].broad_pairs, rows[i].substeps);
   printf("\n  touching: cylinder pairs within 2 r per step; grid pairs: the pairs the broadphase proposed\n");
   printf("\ntargets:\n");
-  target("step, ftl, 100 nodes, self collision, cpu p99", rows[0].cpu.p99 * 1e-3, 100);
-  target("step, ftl, 1000 nodes, self collision, cpu p99", rows[1].cpu.p99 * 1e-3, 1000);
-  target("step, rod, 100 nodes, self collision, cpu p99", rows[2].cpu.p99 * 1e-3, 100);
-  target("step, rod, 1000 nodes, self collision, cpu p99", rows[3].cpu.p99 * 1e-3, 1000);
+  tx_bench_target_us("step, ftl, 100 nodes, self collision, cpu p99", rows[0].cpu.p99 * 1e-3, 100);
+  tx_bench_target_us("step, ftl, 1000 nodes, self collision, cpu p99", rows[1].cpu.p99 * 1e-3, 1000);
+  tx_bench_target_us("step, rod, 100 nodes, self collision, cpu p99", rows[2].cpu.p99 * 1e-3, 100);
+  tx_bench_target_us("step, rod, 1000 nodes, self collision, cpu p99", rows[3].cpu.p99 * 1e-3, 1000);
   return 0;
 }

@@ -24,15 +24,9 @@
 static json_t* num(double v) { return isfinite(v) ? json_real(v) : json_null(); }
 
 int tx_study_skin_membrane(const tx_study_args* a) {
-  bool quick = false;
-  for (int i = 0; i < a->nsets; i++) {
-    const char* eq = strchr(a->sets[i], '=');
-    double v;
-    if (!eq || (size_t)(eq - a->sets[i]) != 5 || strncmp(a->sets[i], "quick", 5) != 0)
-      return tx_bad_input("--set %s: unknown key (known: quick)", a->sets[i]);
-    if (!tx_parse_num(eq + 1, 0, 1, &v) || (v != 0 && v != 1)) return tx_bad_input("--set %s: expected 0 or 1", a->sets[i]);
-    quick = v == 1;
-  }
+  bool quick;
+  int bad = tx_study_quick_set(a, &quick);
+  if (bad) return bad;
 #if !TX_WITH_BULLET
   (void)num, (void)quick;
   return tx_bad_input("study skin-membrane: this build has no Bullet (configured with TX_WITH_BULLET=OFF)");

@@ -5,12 +5,23 @@
 #ifndef TX_SCENARIOS_STUDIES_H
 #define TX_SCENARIOS_STUDIES_H
 
+#include <stdbool.h>
+
 typedef struct tx_study_args {
   const char* out_dir;      // made and checked already
   const char* const* sets;  // KEY=VALUE
   int nsets;
   const char* file;         // the FILE operand of a study that takes one, else NULL
 } tx_study_args;
+
+// the --set of a study with a quick path, quick=0|1: 0, or TX_EXIT_BAD_INPUT
+// after one line naming the --set
+int tx_study_quick_set(const tx_study_args* a, bool* quick);
+
+// one target line of a bench's table: what, the measured value, the limit,
+// met or MISSED; _us: a time in microseconds against an upper limit
+void tx_bench_target(const char* what, const char* measured, const char* limit, bool ok);
+void tx_bench_target_us(const char* what, double measured_us, double limit_us);
 
 int tx_study_haptic_stability(const tx_study_args* a);
 int tx_study_needle_fit(const tx_study_args* a);

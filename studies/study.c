@@ -10,6 +10,19 @@
 #include <stdio.h>
 #include <string.h>
 
+int tx_study_quick_set(const tx_study_args* a, bool* quick) {
+  *quick = false;
+  for (int i = 0; i < a->nsets; i++) {
+    const char* eq = strchr(a->sets[i], '=');
+    double v;
+    if (!eq || (size_t)(eq - a->sets[i]) != 5 || strncmp(a->sets[i], "quick", 5) != 0)
+      return tx_bad_input("--set %s: unknown key (known: quick)", a->sets[i]);
+    if (!tx_parse_num(eq + 1, 0, 1, &v) || (v != 0 && v != 1)) return tx_bad_input("--set %s: expected 0 or 1", a->sets[i]);
+    *quick = v == 1;
+  }
+  return 0;
+}
+
 static const struct {
   const char* name;
   int (*run)(const tx_study_args*);
