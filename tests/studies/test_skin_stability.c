@@ -14,6 +14,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define SANITIZED 1
+#else
+#define SANITIZED 0
+#endif
+
 static char dir[] = "/tmp/tx_skin_stability_XXXXXX";
 
 static int setup(void** state) {
@@ -50,10 +56,13 @@ static void every_case_is_finite_and_clamped(void** state) {
   const tx_skin_stability_case* cs;
   int n = tx_skin_stability_cases(&cs);
   assert_true(n >= 19);
-  const char* names[] = {"stiffness x1e-3", "stiffness x1e3", "time step 1/20 s", "time step 1/1000 s",
-                         "stiffness x1e3, 1/20 s", "teleport 10 cm through", "teleport 10 cm in contact",
+  const char* names[] = {"stiffness x1e-3", "time step 1/20 s", "stiffness x1e3, 1/20 s", "stiffness x1e3",
+                         "time step 1/1000 s", "teleport 10 cm through", "teleport 10 cm in contact",
                          "10 m/s through", "10 m/s along, in contact", "zero thickness"};
-  for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+  // under the sanitizers the first three (each kind of extreme, the cheap
+  // ones: the implicit skin's long runs take minutes there); all in Release
+  size_t count = SANITIZED ? 3 : sizeof names / sizeof names[0];
+  for (size_t i = 0; i < count; i++) {
     tx_skin_stability_row r = run_case(names[i]);
     assert_true(r.skin_steps > 0);
     assert_int_equal(r.nan_values, 0);
