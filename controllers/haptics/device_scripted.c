@@ -54,6 +54,13 @@ static const tx_hand_motion motions[] = {
     {"paper-pierce-down", 4, {{0, 0, 0.030, 0}, {0.2, 0, 0.030, 0}, {9.2, 0, -0.015, 0}, {9.5, 0, -0.015, 0}}},
     // tactus study skin-accuracy: down through the skin at 1 cm/s
     {"accuracy-pierce-down", 4, {{0, 0, 0.010, 0}, {0.2, 0, 0.010, 0}, {2.7, 0, -0.015, 0}, {3.0, 0, -0.015, 0}}},
+    // scenario thread-knot: the thread lies along +x to its pinned tail at
+    // x = 0.2 m; the head doubles back above it (a bight), crosses over the
+    // standing part, back under it, up through the bight and over its upper
+    // strand (an overhand knot), then pulls along +y until the bight closes
+    {"thread-overhand", 10, {{0, 0, 0, 0}, {0.5, 0, 0.005, 0}, {2.0, 0.14, 0.005, 0}, {2.3, 0.15, -0.005, 0.003},
+                             {2.6, 0.125, -0.005, -0.003}, {2.9, 0.125, 0.0025, -0.003}, {3.1, 0.125, 0.0025, 0.003},
+                             {3.4, 0.125, 0.012, 0.003}, {5.0, 0.125, 0.072, 0}, {5.5, 0.125, 0.072, 0}}},
 };
 
 const tx_hand_motion* tx_hand_motion_find(const char* name) {

@@ -17,7 +17,7 @@ tx_device* tx_scripted_read_csv(FILE* f, const char* path);
 typedef struct tx_hand_motion {
   const char* name;
   int count;
-  double t_pos[6][4];
+  double t_pos[12][4];
 } tx_hand_motion;
 // the motion of that name, or NULL
 const tx_hand_motion* tx_hand_motion_find(const char* name);

@@ -86,6 +86,7 @@ tx_thread_def tx_thread_def_default(void) {
   d.direction[0] = 1;
   d.pin_tail = false;
   d.self_collision = true;
+  d.slack = false;
   d.youngs_modulus = 2e9;
   d.bend_factor = 1;
   d.density = 1140;
@@ -758,9 +759,14 @@ static void place_after(tx_thread* t, int i, int from, double len) {
 // against a mesh each node is also kept on its side of it (the continuous
 // test from where it was at the start of the substep): where the two
 // disagree, not crossing the skin wins over the exact length
+// with slack a node is placed only when pulled: its leader is more than l0 away
+static void follow(tx_thread* t, int i, int from) {
+  if (!t->def.slack || dist3(t->x + 3 * i, t->x + 3 * from) > t->l0) place_after(t, i, from, t->l0);
+}
+
 static void ftl_forward(tx_thread* t) {
   for (int i = 1; i < t->n; i++) {
-    place_after(t, i, i - 1, t->l0);
+    follow(t, i, i - 1);
     if (t->mntri) {
       t->move_first = false; // the leader is placed: only this node moves
       solve_mesh_edges(t, i - 1);
@@ -778,7 +784,7 @@ static void ftl_solve(tx_thread* t) {
       if (t->pinned[i])
         memcpy(t->x + 3 * i, t->pin + 3 * i, sizeof(double) * 3);
       else
-        place_after(t, i, i + 1, t->l0);
+        follow(t, i, i + 1);
     }
     ftl_forward(t);
   }

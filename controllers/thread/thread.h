@@ -67,6 +67,8 @@ typedef struct tx_thread_def {
   double direction[3];   // the thread lies straight from the head this way at creation (normalised); (1, 0, 0)
   bool pin_tail;         // the tail stays where it was created (or tx_thread_pin puts it); false
   bool self_collision;   // cylinders of the thread push each other apart; true
+  bool slack;            // ftl: a node follows only when pulled, so a segment may be shorter than
+                         // l0, never longer (a string on a table); false: every segment at l0
   double youngs_modulus; // Pa, E, in (0, 1e16]; 2e9 (monofilament nylon, 2 GPa; the top is x5e6, for stability studies)
   double bend_factor;    // the bending stiffness is bend_factor E I, in [0, 1]; 1 (0: a perfectly flexible
                          // thread, the catenary's chain; braided threads bend more easily than their E says)

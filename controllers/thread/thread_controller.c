@@ -30,7 +30,16 @@ typedef struct thread_ctl {
   int knot_every, steps;
   bool knotted, fixed;
   int knots;
+  int classify_every;   // steps between two runs of the classifier; 0: never
+  tx_knot_work* work;
+  int classified;       // times the classifier went from the unknot to a knot
+  tx_knot_class cls;    // its last answer
+  double classified_s;  // s, the first of those (-1: none)
+  tx_warning classify_failed;
+  tx_result classified_result, classified_s_result, class_result;
   tx_port head, nodes, force, events, skin_x, skin_tri, skin_h;
+  bool draw;
+  tx_port segments, spheres; // with draw: the thread as a tube for the graphics view
   tx_port caps[8];
   int ncaps;
   tx_thread_capsule* shapes; // (max_shapes) the capsules' rows gathered each step
@@ -59,6 +68,7 @@ static const tx_param_def params[] = {
     {"max_substeps", TX_PARAM_INT, "1", 1, 10000, 64, NULL, "at most this many substeps a step"},
     {"max_stretch", TX_PARAM_NUM, "1", 0, 1, 0.05, NULL, "rod: no segment longer than (1 + this) its rest length"},
     {"self_collision", TX_PARAM_BOOL, NULL, 0, 0, 1, NULL, "cylinders of the thread push each other apart"},
+    {"slack", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "ftl: a node follows only when pulled (no segment longer than its rest length, some shorter)"},
     {"pin_tail", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "the tail stays where it starts"},
     {"tail_m", TX_PARAM_JSON, NULL, 0, 0, 0, NULL, "[x, y, z], m: where the thread starts straight towards from the head; [0.2, 0, 0] by default"},
     {"head", TX_PARAM_STR, NULL, 0, 0, 0, "device0.pose", "the pose the head follows (f64 1 x 7)"},
@@ -70,6 +80,8 @@ static const tx_param_def params[] = {
     {"tension_n_per_m", TX_PARAM_NUM, "N/m", 0, 1e6, 200, NULL, "ftl: force (length - rest length) x this, along the segments' sum"},
     {"max_force_n", TX_PARAM_NUM, "N", 0, 100, 10, NULL, "the published force never exceeds this"},
     {"knot_every", TX_PARAM_INT, "1", 1, 100000, 10, NULL, "steps between two knot checks (the papers' rule, O(N^2))"},
+    {"draw", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "also write PREFIX.segments and PREFIX.spheres: the thread as a tube for the graphics view"},
+    {"classify_every", TX_PARAM_INT, "1", 0, 100000, 0, NULL, "steps between two runs of the knot classifier (Gauss code, 32 projections); 0: never"},
     {"fix_distance_m", TX_PARAM_NUM, "m", 0, 1, 0.002, NULL, "a knot this near the skin is fixed"},
 };
 
@@ -113,11 +125,13 @@ static int configure(tx_setup* s, void** self) {
   d.max_stretch = tx_table_num(s, "max_stretch");
   d.self_collision = tx_table_bool(s, "self_collision");
   d.pin_tail = tx_table_bool(s, "pin_tail");
+  d.slack = tx_table_bool(s, "slack");
   d.max_shapes = (int)tx_table_int(s, "max_shapes");
   k->tension_k = tx_table_num(s, "tension_n_per_m");
   k->max_force = tx_table_num(s, "max_force_n");
   k->knot_every = (int)tx_table_int(s, "knot_every");
   k->fix_distance = tx_table_num(s, "fix_distance_m");
+  k->classify_every = (int)tx_table_int(s, "classify_every");
   double tail[3];
   if (read_tail(s, tail)) return -1;
   const char* head = tx_table_str(s, "head");
@@ -145,6 +159,7 @@ static int configure(tx_setup* s, void** self) {
   k->start = malloc(sizeof(double) * 3 * (size_t)d.nodes);
   memcpy(k->tail, tail, sizeof k->tail);
   if (!k->marks || !k->start) return tx_setup_fail(s, NULL, "out of memory");
+  if (k->classify_every > 0 && !(k->work = tx_knot_work_create(d.nodes))) return tx_setup_fail(s, NULL, "out of memory");
   char name[256];
   k->head = TX_READ_OF(s, head, tx_pose);
   snprintf(name, sizeof name, "%s.nodes", prefix);
@@ -153,6 +168,13 @@ static int configure(tx_setup* s, void** self) {
   k->force = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_force_model, 1));
   snprintf(name, sizeof name, "%s.events", prefix);
   k->events = tx_setup_emit(s, name, 64);
+  k->draw = tx_table_bool(s, "draw");
+  if (k->draw) {
+    snprintf(name, sizeof name, "%s.segments", prefix);
+    k->segments = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_segment, (uint32_t)d.nodes - 1));
+    snprintf(name, sizeof name, "%s.spheres", prefix);
+    k->spheres = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_sphere, (uint32_t)d.nodes));
+  }
   if (with_skin) {
     snprintf(name, sizeof name, "%s.x", skin);
     k->skin_x = TX_READ_OF(s, name, tx_vertex);
@@ -175,6 +197,11 @@ static int configure(tx_setup* s, void** self) {
   k->first_knot_result = tx_setup_result(s, "first_knot_s");
   k->faults_result = tx_setup_result(s, "faults");
   k->first_knot_s = -1;
+  k->classify_failed = tx_setup_warning(s, "classify_failed");
+  k->classified_result = tx_setup_result(s, "classifier_knots");
+  k->classified_s_result = tx_setup_result(s, "classifier_knot_s");
+  k->class_result = tx_setup_result(s, "knot_class");
+  k->classified_s = -1;
   return 0;
 }
 
@@ -186,6 +213,18 @@ static void publish(tx_ctx* c, thread_ctl* k) {
   for (int i = 0; i < n; i++) {
     memcpy(out[i].x, tx_thread_position(t, i), sizeof out[i].x);
     out[i].radius = r;
+  }
+  if (k->draw) { // cylinders joined by spheres: a tube
+    tx_segment* sg = tx_write(c, k->segments);
+    tx_sphere* sp = tx_write(c, k->spheres);
+    for (int i = 0; i < n; i++) {
+      for (int a = 0; a < 3; a++) {
+        sp[i].c[a] = (float)tx_thread_position(t, i)[a];
+        if (i + 1 < n) sg[i].a[a] = sp[i].c[a], sg[i].b[a] = (float)tx_thread_position(t, i + 1)[a];
+      }
+      sp[i].r = (float)r;
+      if (i + 1 < n) sg[i].r = (float)r;
+    }
   }
   tx_force_model* m = tx_write(c, k->force);
   memset(m, 0, sizeof *m);
@@ -218,6 +257,20 @@ static void check_knot(tx_ctx* c, thread_ctl* k) {
     emit_knot(c, k, &p, true);
   }
   k->knotted = knot;
+}
+
+// beside the papers' rule: the topology, which a loose knot has too
+static void classify(tx_ctx* c, thread_ctl* k) {
+  tx_knot_diagram d;
+  if (tx_knot_classify(k->work, tx_thread_position(k->t, 0), tx_thread_node_count(k->t), &d)) {
+    tx_warn(c, k->classify_failed);
+    return;
+  }
+  if (d.cls != TX_KNOT_UNKNOT && k->cls == TX_KNOT_UNKNOT) {
+    k->classified++;
+    if (k->classified_s < 0) k->classified_s = (double)tx_sim_ns(c) * 1e-9;
+  }
+  k->cls = d.cls;
 }
 
 static void step(tx_ctx* c, void* self) {
@@ -267,6 +320,7 @@ static void step(tx_ctx* c, void* self) {
   }
   if (tx_thread_step(k->t, k->dt) == TX_THREAD_FAULT) tx_warn(c, k->fault);
   if (k->steps % k->knot_every == 0) check_knot(c, k);
+  if (k->classify_every > 0 && k->steps % k->classify_every == 0) classify(c, k);
   k->steps++;
   publish(c, k);
 }
@@ -281,12 +335,16 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, k->knots_result, k->knots);
   tx_set_result(c, k->first_knot_result, k->first_knot_s);
   tx_set_result(c, k->faults_result, tx_thread_faults(k->t));
+  tx_set_result(c, k->classified_result, k->classified);
+  tx_set_result(c, k->classified_s_result, k->classified_s);
+  tx_set_result(c, k->class_result, (double)k->cls);
 }
 
 static void fini(void* self) {
   thread_ctl* k = self;
   if (!k) return;
   tx_thread_destroy(k->t);
+  tx_knot_work_destroy(k->work);
   free(k->marks);
   free(k->start);
   free(k->shapes);

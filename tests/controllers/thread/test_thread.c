@@ -139,6 +139,43 @@ static void test_ftl_reaches_a_pinned_tail(void** state) {
   tx_thread_destroy(t);
 }
 
+// slack (a string on a table): a head moving back towards its pinned tail
+// drags only the nodes it pulls; no segment is ever longer than l0, some are
+// shorter; pulled out of reach, every segment is l0 again
+static void test_ftl_slack_follows_only_when_pulled(void** state) {
+  (void)state;
+  tx_thread_def d = tx_thread_def_default();
+  d.nodes = 41;
+  d.length = 0.04; // l0 = 1 mm
+  d.pin_tail = true;
+  d.slack = true;
+  d.iterations = 4;
+  d.self_collision = false;
+  tx_thread* t = tx_thread_create(&d);
+  assert_non_null(t);
+  // half a segment towards node 1: nothing is pulled, the first segment is slack
+  tx_thread_set_head(t, (double[3]){0.0005, 0, 0});
+  assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
+  assert_true(fabs(seg_len(t, 0) - 0.0005) < 1e-15);
+  for (int i = 1; i < 40; i++) assert_true(fabs(seg_len(t, i) - 0.001) < 1e-15);
+  // 1 cm back along the thread, 2 mm off it, at 1 cm/s: a bight forms near the
+  // head and the far half of the thread is never pulled
+  for (int k = 1; k <= 1000; k++) {
+    tx_thread_set_head(t, (double[3]){0.0005 + 0.0095 * k / 1000, 0.002 * (k < 200 ? k / 200.0 : 1), 0});
+    assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
+    for (int i = 0; i < 40; i++) assert_true(seg_len(t, i) <= 0.001 * (1 + 1e-12));
+  }
+  assert_true(tx_thread_position(t, 5)[0] < 0.006); // the bight: node 5 lies behind the head
+  for (int i = 20; i <= 40; i++) { // to 1 nm: a leader l0 away to rounding may pull
+    const double* x = tx_thread_position(t, i);
+    assert_true(fabs(x[0] - 0.001 * i) < 1e-9 && fabs(x[1]) < 1e-9 && fabs(x[2]) < 1e-9);
+  }
+  tx_thread_set_head(t, (double[3]){-0.01, 0, 0});
+  assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
+  for (int i = 0; i < 40; i++) assert_true(fabs(seg_len(t, i) - 0.001) < 1e-15);
+  tx_thread_destroy(t);
+}
+
 // a horizontal cantilever under its weight, clamped by pinning its first two
 // nodes: the tip sags q L^4 / (8 E I) (Euler-Bernoulli, small deflection)
 static void test_rod_cantilever_matches_the_beam(void** state) {
@@ -236,6 +273,7 @@ int main(void) {
       cmocka_unit_test(test_definition_checks),
       cmocka_unit_test(test_ftl_keeps_length_and_takes_the_heads_path),
       cmocka_unit_test(test_ftl_reaches_a_pinned_tail),
+      cmocka_unit_test(test_ftl_slack_follows_only_when_pulled),
       cmocka_unit_test(test_rod_cantilever_matches_the_beam),
       cmocka_unit_test(test_rod_stretch_cap),
       cmocka_unit_test(test_rod_hangs_from_the_head),

@@ -51,6 +51,35 @@ static void ftl_follows_the_device(void** state) {
   tx_scenario_free(s);
 }
 
+// draw: the thread as cylinders joined by spheres, at the nodes' positions;
+// the classifier beside the papers' rule finds no knot in a sliding thread
+static void draw_and_classify(void** state) {
+  (void)state;
+  tx_scenario* s = load("\"nodes\":41,\"length_m\":0.04,\"tail_m\":[-0.1,0.01,0],\"draw\":true,\"classify_every\":10", "slide-x-over");
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 1);
+  tx_snapshot x = latest_snapshot(s, "thread.nodes"), sg = latest_snapshot(s, "thread.segments"),
+              sp = latest_snapshot(s, "thread.spheres");
+  assert_int_equal(sg.rows, 40);
+  assert_int_equal(sg.cols, 7);
+  assert_int_equal(sp.rows, 41);
+  assert_int_equal(sp.cols, 4);
+  const tx_thread_node* n = x.data;
+  const tx_segment* g = sg.data;
+  const tx_sphere* b = sp.data;
+  for (int i = 0; i < 41; i++) {
+    for (int a = 0; a < 3; a++) {
+      assert_true(b[i].c[a] == (float)n[i].x[a]);
+      if (i < 40) assert_true(g[i].a[a] == (float)n[i].x[a] && g[i].b[a] == (float)n[i + 1].x[a]);
+    }
+    assert_true(b[i].r == 0.00025f && (i == 40 || g[i].r == 0.00025f));
+  }
+  assert_true(result(s, "thread.classifier_knots") == 0);
+  assert_true(result(s, "thread.classifier_knot_s") == -1);
+  assert_true(result(s, "thread.knot_class") == 0);
+  tx_scenario_free(s);
+}
+
 // the tail pinned 1.5 cm from the head's start; the head slides 6 cm away:
 // the force pulls back towards the pin, (length - rest length) x 200 N/m
 static void tension_of_a_thread_pulled_past_its_pin(void** state) {
@@ -192,6 +221,7 @@ static void bad_input_is_named(void** state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(ftl_follows_the_device),
+      cmocka_unit_test(draw_and_classify),
       cmocka_unit_test(tension_of_a_thread_pulled_past_its_pin),
       cmocka_unit_test(rod_force_on_the_head),
       cmocka_unit_test(rod_keeps_out_of_a_capsule),
