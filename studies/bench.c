@@ -399,7 +399,7 @@ int tx_cmd_bench(int argc, char** argv) {
   }
   if (optind != argc - 1) {
     printf("usage: tactus bench NAME [--out DIR [--force]] [--duration S]\n\n");
-    for (size_t i = 0; i < sizeof benches / sizeof benches[0]; i++) printf("  %-10s %s\n", benches[i].name, benches[i].what);
+    for (size_t i = 0; i < sizeof benches / sizeof benches[0]; i++) printf("  %-11s %s\n", benches[i].name, benches[i].what);
     if (optind == argc + 1) return 0; // --help
     return tx_bad_input("bench: expected one NAME from the list above");
   }

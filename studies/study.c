@@ -83,7 +83,7 @@ int tx_cmd_study(int argc, char** argv) {
     printf("usage: tactus study NAME [FILE] [--out DIR [--force]] [--set KEY=VALUE]...\n\n"
            "A --out that holds files is refused unless --force. A relative FILE not found here is looked for\n"
            "in the source tree and its assets/ folder (" TX_SCENARIO_DIR "/..).\n\n");
-    for (size_t i = 0; i < sizeof studies / sizeof studies[0]; i++) printf("  %-18s %s\n", studies[i].name, studies[i].what);
+    for (size_t i = 0; i < sizeof studies / sizeof studies[0]; i++) printf("  %-21s %s\n", studies[i].name, studies[i].what);
     return help ? 0 : tx_bad_input("study: expected one NAME from the list above");
   }
   for (size_t i = 0; i < sizeof studies / sizeof studies[0]; i++) {
