@@ -538,78 +538,6 @@ static void solve_capsules(tx_thread* t) {
   }
 }
 
-// node i against the triangles near its move from x0 to x in this substep:
-// a move across a triangle goes back to the side it came from (continuous),
-// and a node nearer than r + thickness / 2 is pushed out to that distance
-static void solve_mesh_node(tx_thread* t, int i) {
-  double* p = t->x + 3 * i;
-  const double* p0 = t->x0 + 3 * i;
-  double reach = t->def.radius + 0.5 * t->thickness;
-  float lo[3], hi[3];
-  for (int a = 0; a < 3; a++) {
-    lo[a] = (float)(fmin(p[a], p0[a]) - reach) - 1e-6f;
-    hi[a] = (float)(fmax(p[a], p0[a]) + reach) + 1e-6f;
-  }
-  const tx_tri_bvh* b = &t->bvh;
-  if (b->nnodes == 0) return;
-  uint32_t stack[BVH_STACK];
-  int top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const tx_bvh_node* nd = &b->nodes[stack[--top]];
-    if (nd->lo[0] > hi[0] || nd->hi[0] < lo[0] || nd->lo[1] > hi[1] || nd->hi[1] < lo[1] || nd->lo[2] > hi[2] ||
-        nd->hi[2] < lo[2])
-      continue;
-    if (nd->count == 0) {
-      uint32_t self = (uint32_t)(nd - b->nodes);
-      if (top + 2 <= BVH_STACK) {
-        stack[top++] = nd->first;
-        stack[top++] = self + 1;
-      }
-      continue;
-    }
-    for (uint32_t sl = nd->first; sl < nd->first + nd->count; sl++) {
-      if (b->order[sl] == UINT32_MAX) continue;
-      const int32_t* tv = b->tri + 3 * sl;
-      double v[3][3];
-      for (int c = 0; c < 3; c++)
-        for (int a = 0; a < 3; a++) v[c][a] = t->mx[3 * tv[c] + a];
-      double e1[3], e2[3], nrm[3];
-      for (int a = 0; a < 3; a++) {
-        e1[a] = v[1][a] - v[0][a];
-        e2[a] = v[2][a] - v[0][a];
-      }
-      nrm[0] = e1[1] * e2[2] - e1[2] * e2[1];
-      nrm[1] = e1[2] * e2[0] - e1[0] * e2[2];
-      nrm[2] = e1[0] * e2[1] - e1[1] * e2[0];
-      double nl = sqrt(dot3(nrm, nrm));
-      if (nl <= 0) continue;
-      for (int a = 0; a < 3; a++) nrm[a] /= nl;
-      double rel0[3] = {p0[0] - v[0][0], p0[1] - v[0][1], p0[2] - v[0][2]};
-      double side = dot3(nrm, rel0) >= 0 ? 1 : -1;
-      double tc;
-      if (tx_seg_tri_cross(p0, p, v[0], v[1], v[2], &tc)) {
-        // crossed the face: back to the crossing point, out on its own side
-        for (int a = 0; a < 3; a++) p[a] = p0[a] + tc * (p[a] - p0[a]) + side * reach * nrm[a];
-        t->last.mesh_hits++;
-      }
-      double cp[3], bary[3];
-      tx_tri_closest_point(p, v[0], v[1], v[2], cp, bary);
-      double d[3] = {p[0] - cp[0], p[1] - cp[1], p[2] - cp[2]};
-      double dl = sqrt(dot3(d, d));
-      if (dl >= reach) continue;
-      bool inside = bary[0] > 0 && bary[1] > 0 && bary[2] > 0;
-      if (inside || dl <= 1e-12 * reach) {
-        // over the face the side it came from decides the way out
-        for (int a = 0; a < 3; a++) p[a] = cp[a] + side * reach * nrm[a];
-      } else {
-        for (int a = 0; a < 3; a++) p[a] = cp[a] + d[a] / dl * reach;
-      }
-      t->last.mesh_hits++;
-    }
-  }
-}
-
 // the mesh triangles whose boxes meet [lo, hi]: calls fn on each (its 3 corners)
 typedef void (*tri_fn)(tx_thread* t, int i, const double v[3][3]);
 
@@ -640,6 +568,60 @@ static void for_triangles_near(tx_thread* t, const float lo[3], const float hi[3
       fn(t, i, v);
     }
   }
+}
+
+// node i against one triangle near its move from x0 to x in this substep:
+// a move across the triangle goes back to the side it came from (continuous),
+// and a node nearer than r + thickness / 2 is pushed out to that distance
+static void node_triangle(tx_thread* t, int i, const double v[3][3]) {
+  double* p = t->x + 3 * i;
+  const double* p0 = t->x0 + 3 * i;
+  double reach = t->def.radius + 0.5 * t->thickness;
+  double e1[3], e2[3], nrm[3];
+  for (int a = 0; a < 3; a++) {
+    e1[a] = v[1][a] - v[0][a];
+    e2[a] = v[2][a] - v[0][a];
+  }
+  nrm[0] = e1[1] * e2[2] - e1[2] * e2[1];
+  nrm[1] = e1[2] * e2[0] - e1[0] * e2[2];
+  nrm[2] = e1[0] * e2[1] - e1[1] * e2[0];
+  double nl = sqrt(dot3(nrm, nrm));
+  if (nl <= 0) return;
+  for (int a = 0; a < 3; a++) nrm[a] /= nl;
+  double rel0[3] = {p0[0] - v[0][0], p0[1] - v[0][1], p0[2] - v[0][2]};
+  double side = dot3(nrm, rel0) >= 0 ? 1 : -1;
+  double tc;
+  if (tx_seg_tri_cross(p0, p, v[0], v[1], v[2], &tc)) {
+    // crossed the face: back to the crossing point, out on its own side
+    for (int a = 0; a < 3; a++) p[a] = p0[a] + tc * (p[a] - p0[a]) + side * reach * nrm[a];
+    t->last.mesh_hits++;
+  }
+  double cp[3], bary[3];
+  tx_tri_closest_point(p, v[0], v[1], v[2], cp, bary);
+  double d[3] = {p[0] - cp[0], p[1] - cp[1], p[2] - cp[2]};
+  double dl = sqrt(dot3(d, d));
+  if (dl >= reach) return;
+  bool inside = bary[0] > 0 && bary[1] > 0 && bary[2] > 0;
+  if (inside || dl <= 1e-12 * reach) {
+    // over the face the side it came from decides the way out
+    for (int a = 0; a < 3; a++) p[a] = cp[a] + side * reach * nrm[a];
+  } else {
+    for (int a = 0; a < 3; a++) p[a] = cp[a] + d[a] / dl * reach;
+  }
+  t->last.mesh_hits++;
+}
+
+// node i against every triangle near its move (the box of x0 to x, grown by the reach)
+static void solve_mesh_node(tx_thread* t, int i) {
+  const double* p = t->x + 3 * i;
+  const double* p0 = t->x0 + 3 * i;
+  double reach = t->def.radius + 0.5 * t->thickness;
+  float lo[3], hi[3];
+  for (int a = 0; a < 3; a++) {
+    lo[a] = (float)(fmin(p[a], p0[a]) - reach) - 1e-6f;
+    hi[a] = (float)(fmax(p[a], p0[a]) + reach) + 1e-6f;
+  }
+  for_triangles_near(t, lo, hi, i, node_triangle);
 }
 
 // cylinder i against the three edges of a triangle: a cylinder cannot pass
