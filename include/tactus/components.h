@@ -262,6 +262,20 @@ typedef struct tx_device_grip {
 #define tx_device_grip_UNITS "rad, 1"
 TX_LAYOUT_ASSERT(tx_device_grip, double);
 
+// NAME.punctures (N rows, in the order the needle made them), written by
+// physics.instruments, read by physics.thread: where the thread must pass
+// through the skin. Each point moves with its skin triangle (a row of
+// skin.tri); rows past the last puncture have triangle = -1.
+typedef struct tx_puncture {
+  double triangle; // row of skin.tri that was pierced (an integer), -1: no puncture in this row
+  double bary[3];  // barycentric coordinates of the point in that triangle (they sum to 1)
+  double side;     // +1: the needle entered here, -1: it came out here
+} tx_puncture;
+#define tx_puncture_TYPE TX_F64
+#define tx_puncture_COLS 5u
+#define tx_puncture_UNITS "1"
+TX_LAYOUT_ASSERT(tx_puncture, double);
+
 // physics.instruments writes, for instrument N (held by deviceN):
 //   INSTRUMENT.pose (1 row, tx_instrument_pose): the root link frame (the
 //     pivot of the jaws) and the angle between the jaws, rad

@@ -35,7 +35,7 @@ typedef enum tx_event_kind {
   TX_EVENT_GRASP = 1, // jaws closed on something: source = instrument, payload .grasp
   TX_EVENT_RELEASE,   // jaws opened: source = instrument
   TX_EVENT_PUNCTURE,  // a surface was pierced: source = surface element, payload .puncture
-  TX_EVENT_CUT,       // something was cut: source = element (thread node, link)
+  TX_EVENT_CUT,       // something was cut: source = element (thread segment, link), payload .cut
   TX_EVENT_BURN,      // tissue reached a damage temperature: source = node, value[0] = K
   TX_EVENT_KNOT,      // a knot formed or was fixed: source = knot index
   TX_EVENT_STEP,      // a procedure step began: source = step index
@@ -55,6 +55,9 @@ typedef struct tx_puncture_payload { // TX_EVENT_PUNCTURE, source = surface elem
   double depth;    // m, the tip's depth below the surface at the puncture
 } tx_puncture_payload;
 
+typedef struct tx_cut_payload { // TX_EVENT_CUT, source = thread segment (node i to i + 1) or link
+  double point[3]; // m, where the blades closed, world frame
+} tx_cut_payload;
 typedef struct tx_event {
   uint64_t seq;     // set by the push: 1, 2, ... per stream; a gap means events were lost
   int64_t sim_ns;   // simulation time of the step that sent it, ns
@@ -64,16 +67,19 @@ typedef struct tx_event {
     double value[5];             // kinds without a payload struct (e.g. TX_EVENT_BURN: value[0] = K)
     tx_grasp_payload grasp;      // TX_EVENT_GRASP
     tx_puncture_payload puncture; // TX_EVENT_PUNCTURE
+    tx_cut_payload cut;           // TX_EVENT_CUT
   };
 } tx_event;
 #ifdef __cplusplus
 static_assert(sizeof(tx_event) == 64, "one event is one cache line");
 static_assert(sizeof(tx_grasp_payload) <= 5 * sizeof(double), "a grasp fits in an event");
 static_assert(sizeof(tx_puncture_payload) <= 5 * sizeof(double), "a puncture fits in an event");
+static_assert(sizeof(tx_cut_payload) <= 5 * sizeof(double), "a cut fits in an event");
 #else
 _Static_assert(sizeof(tx_event) == 64, "one event is one cache line");
 _Static_assert(sizeof(tx_grasp_payload) <= 5 * sizeof(double), "a grasp fits in an event");
 _Static_assert(sizeof(tx_puncture_payload) <= 5 * sizeof(double), "a puncture fits in an event");
+_Static_assert(sizeof(tx_cut_payload) <= 5 * sizeof(double), "a cut fits in an event");
 #endif
 
 typedef struct tx_stream tx_stream;
