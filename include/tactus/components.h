@@ -283,6 +283,17 @@ TX_LAYOUT_ASSERT(tx_puncture, double);
 //   INSTRUMENT.force_model (1 row, tx_force_model): the virtual coupling as the
 //     hand feels it, for the haptics controller to render (docs/instruments.md)
 
+// --- gastric banding: the organs ---------------------------------------------
+
+// physics.organs writes, for each soft organ ORGAN (liver, stomach), its
+// surface, which collision.organ reads at up to 4 kHz:
+//   ORGAN.x (N rows, tx_vertex): the surface vertices, m
+//   ORGAN.tri (M rows, tx_triangle): the surface triangles, outward by the
+//     right-hand rule, rows into ORGAN.x
+// and, like SKIN.contact for the skin, the organs' reaction on the tool:
+//   organs.contact (1 row, tx_skin_contact): force, where it holds, its
+//     direction, the tangent stiffness k along it, the indentation
+
 #ifdef __cplusplus
 }
 #endif
