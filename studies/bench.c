@@ -3,6 +3,7 @@
 #include "bench_cloth.h"
 #include "bench_hip.h"
 #include "bench_instruments.h"
+#include "bench_organ_collision.h"
 #include "bench_render.h"
 #include "bench_thread.h"
 #include "bench_voxels.h"
@@ -355,6 +356,8 @@ static int bench_voxels(const bench_args* a) { return tx_bench_voxels(a->duratio
 static int bench_cloth(const bench_args* a) { return tx_bench_cloth(a->duration_s); }
 static int bench_instruments(const bench_args* a) { return tx_bench_instruments(a->duration_s); }
 static int bench_thread(const bench_args* a) { return tx_bench_thread(a->duration_s); }
+static int bench_organ_collision(const bench_args* a) { return tx_bench_organ_collision(a->duration_s); }
+
 static int bench_hip(const bench_args* a) {
   (void)a;
   return tx_bench_hip();
@@ -373,6 +376,7 @@ static const struct {
     {"render", bench_render, "graphics view frame times, mono and 2x640x480 stereo, beside 1 kHz haptics"},
     {"cloth", bench_cloth, "skin physics step at 10404 particles with rupture; overhead vs a bare Bullet loop"},
     {"hip", bench_hip, "collision.hip query (98 rays) on 10404 and 102400 particles, and the refit"},
+    {"organ-collision", bench_organ_collision, "collision.organ query against the committed liver and stomach, and the refit"},
     {"instruments", bench_instruments, "one 1 kHz ODE step of two articulated instruments and the needle"},
     {"thread", bench_thread, "suture thread step, ftl and rod, 100 and 1000 nodes with self collision"},
 };
