@@ -17,6 +17,8 @@
 
 #include <tactus/components.h>
 
+#include "tests/alloc_count.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -195,6 +197,51 @@ static void test_non_finite_surface_counted_and_dropped(void** state) {
   tx_scenario_free(s);
 }
 
+// with the haptics controller rendering the model (scripted pierce-down: from y = 10 mm at 0.5 s
+// down at 5 mm/s, touching the liver's top from 2.0 s): the force sent is k times the depth
+static void test_rendered_by_haptics(void** state) {
+  (void)state;
+  const char* text = "{\"name\":\"t\",\"controllers\":["
+                     "{\"name\":\"organs\",\"type\":\"test.organs\",\"rate_hz\":20},"
+                     "{\"name\":\"col\",\"type\":\"collision.organ\",\"rate_hz\":4000,\"params\":{\"contact\":\"\"}},"
+                     "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:pierce-down\","
+                     "\"force_model\":\"tool0.force_model\",\"record\":false}}]}";
+  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 1.9);
+  assert_true(latest(s, "device0.force")[1] == 0); // 0.5 mm above the contact
+  tx_scenario_free(s);
+  s = tx_scenario_load_text("test", text, strlen(text), NULL);
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 2.3); // y = 1 mm, 1.5 mm deep
+  double y = tool_y(s), f = latest(s, "device0.force")[1];
+  assert_true(fabs(y - 1e-3) < 1e-5);
+  assert_true(f <= 100 * (TIP - y) + 1e-3 && f >= 100 * (TIP - y - SAG) - 1e-3);
+  tx_scenario_free(s);
+}
+
+// a run 10 times longer (4000 more steps, 18 more publishes, contact all along) allocates no more
+static long allocations_in_run(double seconds) {
+  tx_scenario* s = load("\"touch_from_s\": 0.3, \"touch_until_s\": 0.4", "");
+  allocations = 0;
+  counting = 1;
+  run(s, seconds);
+  counting = 0;
+  assert_true(result(s, "col.contacts") >= 1);
+  tx_scenario_free(s);
+  return allocations;
+}
+
+static void test_steps_allocate_nothing(void** state) {
+  (void)state;
+#ifndef TX_NO_ALLOC_COUNT
+  long short_run = allocations_in_run(0.3), long_run = allocations_in_run(1.2);
+  assert_int_equal(long_run, short_run);
+#else
+  skip();
+#endif
+}
+
 static void refused(const char* col_params, const char* names) {
   tx_scenario* s = try_load("", col_params);
   if (s) tx_scenario_free(s);
@@ -223,6 +270,8 @@ int main(void) {
       cmocka_unit_test(test_refit_gives_the_new_contact),
       cmocka_unit_test(test_reaction_then_its_stiffness),
       cmocka_unit_test(test_non_finite_surface_counted_and_dropped),
+      cmocka_unit_test(test_rendered_by_haptics),
+      cmocka_unit_test(test_steps_allocate_nothing),
       cmocka_unit_test(test_bad_parameters_refused),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
