@@ -206,7 +206,7 @@ static void test_inside_unentered_gets_nothing(void** state) {
     along(u, R - 5e-3 + 2.5e-4 * i, c);
     tx_organ_tip(&side, &d, &f->b, f->s.x, c, &t);
     double s = brute(&f->s, c);
-    if (c[1] < -2e-4) { // still inside: the centre is under the top facets
+    if (c[1] < -3e-4) { // still inside: the centre is under the top facets (sagitta 0.23 mm)
       assert_false(t.on);
       tx_organ_force_out o;
       tx_organ_force(&t, 1, NULL, 100, d.depth_max, c, &o);

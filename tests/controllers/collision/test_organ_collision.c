@@ -26,7 +26,7 @@
 
 #define R 0.05    // m, the liver sphere, its top at y = 0
 #define TIP 2.5e-3
-#define SAG 1e-4  // m, more than the level-4 sphere's facets fall inside it (40 um)
+#define SAG 1e-4  // m, more than the level-4 sphere's facets fall inside it (57 um)
 
 typedef struct test_organs {
   double shift_at_s, shift_m, nan_at_s, touch_from_s, touch_until_s;
