@@ -31,6 +31,7 @@ typedef struct organ {
   tx_fem* fem;
   int nodes;
   double* pos;   // (nodes x 3) m, scratch for the positions
+  double* rest;  // (nodes x 3) m, the nodes as loaded
   surface s;     // the drawn surface
   int32_t* tet;  // (s.nv x 4) the nodes of the tetrahedron each surface vertex is embedded in
   float* w;      // (s.nv x 4) its barycentric weights there
@@ -46,7 +47,8 @@ typedef struct organs {
   tx_port pose, contact;
   double prev_f, prev_w, k;
   tx_warning fault, bad_pose;
-  tx_result fault_result, p50_result, p99_result, added_result, substeps_result;
+  tx_result fault_result, p50_result, p99_result, added_result, substeps_result, moved_result, force_result;
+  double max_moved, max_force; // m, N: the largest node displacement from rest, the largest force on the tool
   long faults;
   tx_hist steps; // ns
 } organs;
@@ -257,6 +259,8 @@ static int load_organ(tx_setup* s, organs* g, int which, const char* dir, const 
   if (rc == 0) {
     o->nodes = nx;
     o->pos = malloc(sizeof(double) * 3 * (size_t)nx);
+    o->rest = x;
+    x = NULL;
     if (!o->pos) rc = -1;
   }
   free(x);
@@ -330,6 +334,8 @@ static int configure(tx_setup* s, void** self) {
   g->p99_result = tx_setup_result(s, "step_p99_ms");
   g->added_result = tx_setup_result(s, "added_mass");
   g->substeps_result = tx_setup_result(s, "substeps");
+  g->moved_result = tx_setup_result(s, "max_displacement_m");
+  g->force_result = tx_setup_result(s, "max_force_n");
   tx_hist_clear(&g->steps);
   return 0;
 }
@@ -358,6 +364,7 @@ static void publish_contact(tx_ctx* c, organs* g, const tx_pose* pose) {
     return;
   }
   for (int a = 0; a < 3; a++) out->f[a] = fsum[a], out->n[a] = fsum[a] / f;
+  g->max_force = fmax(g->max_force, f);
   out->depth = w;
   out->touching = 1;
   if (w > 1e-7) {
@@ -373,6 +380,11 @@ static void publish(tx_ctx* c, organs* g, const tx_pose* pose) {
   for (int i = 0; i < SOFT; i++) {
     organ* o = &g->soft[i];
     tx_fem_positions(o->fem, o->pos);
+    for (int v = 0; v < o->nodes; v++) {
+      const double *p = o->pos + 3 * v, *r = o->rest + 3 * v;
+      double d2 = (p[0] - r[0]) * (p[0] - r[0]) + (p[1] - r[1]) * (p[1] - r[1]) + (p[2] - r[2]) * (p[2] - r[2]);
+      if (d2 > g->max_moved * g->max_moved) g->max_moved = sqrt(d2);
+    }
     float* x = ((tx_vertex*)tx_write(c, o->x))->x;
     for (int v = 0; v < o->s.nv; v++)
       for (int a = 0; a < 3; a++) {
@@ -434,6 +446,8 @@ static void finish(tx_ctx* c, void* self) {
   for (int i = 0; i < SOFT; i++) added = fmax(added, tx_fem_added_mass(g->soft[i].fem));
   tx_set_result(c, g->added_result, added);
   tx_set_result(c, g->substeps_result, g->substeps);
+  tx_set_result(c, g->moved_result, g->max_moved);
+  tx_set_result(c, g->force_result, g->max_force);
 }
 
 static void fini(void* self) {
@@ -443,6 +457,7 @@ static void fini(void* self) {
     organ* o = &g->soft[i];
     tx_fem_destroy(o->fem);
     free(o->pos);
+    free(o->rest);
     free(o->s.x);
     free(o->s.tri);
     free(o->tet);

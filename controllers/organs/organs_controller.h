@@ -13,7 +13,9 @@
 // reaction on the tool). Reads the tool's pose (param pose, tx_pose).
 // Warnings: numerical_fault (a NaN, an Inf or a node faster than max_speed:
 // the organs went back to the last good state), bad_pose. Results: faults,
-// step_p50_ms, step_p99_ms, added_mass (fraction), substeps.
+// step_p50_ms, step_p99_ms, added_mass (fraction), substeps,
+// max_displacement_m (the largest node displacement from rest), max_force_n
+// (the largest force on the tool).
 #ifndef TX_CONTROLLERS_ORGANS_ORGANS_CONTROLLER_H
 #define TX_CONTROLLERS_ORGANS_ORGANS_CONTROLLER_H
 
