@@ -5,15 +5,16 @@
 # the probe deformed the organs (a node moved more than 5 mm from rest) and
 # met a reaction above 0.5 N.
 #
-#   test_lagb_organs.sh TACTUS REPORT_CHECK COARSE_DIR
+#   test_lagb_organs.sh TACTUS REPORT_CHECK COARSE_DIR ["MODES"]   (default "fem links")
 set -eu
 TACTUS=$1
 CHECK=$2
 COARSE=$3
+MODES=${4:-fem links}
 d=$(mktemp -d)
 trap 'rm -rf "$d"' EXIT
 value() { awk -v k="\"$2\":" '$1 == k { gsub(",", "", $2); print $2 }' "$1"; }
-for mode in fem links; do
+for mode in $MODES; do
   "$TACTUS" run lagb-organs --lockstep --no-record --quiet --out "$d/$mode" \
     --set organs.assets="$COARSE" --set organs.mode=$mode
   r=$d/$mode/report.json
