@@ -44,6 +44,8 @@ static const struct {
      "spacing, iterations and step refined together: observed order, Richardson reference, error vs CPU time"},
     {"organ-hemisphere", tx_study_organ_hemisphere,
      "a hemisphere indented at its pole: Bullet FEM and links against Hertz, Richardson, error vs CPU time (Fig. 14)"},
+    {"organ-stability", tx_study_organ_stability,
+     "the hemisphere under scale x0.1..x10, stiffness, density, damping, FEM and links: blow-ups detected (Fig. 15)"},
     {"thread-accuracy", tx_study_thread_accuracy,
      "the rod hanging against the catenary: error vs nodes, iterations and step with CPU time; ftl's length error"},
     {"thread-stability", tx_study_thread_stability,

@@ -42,6 +42,8 @@ typedef struct tx_fem_def {
   int iterations;      // links: position iterations per step
   double link_stiffness;  // links: Bullet's kLST, 0 to 1
   double volume_stiffness;  // links: Bullet's kVC (volume conservation), >= 0
+  double gravity[3];   // m/s^2
+  double max_speed;    // m/s: a faster node is a blow-up (tx_fem_step returns false); 0: only NaN and Inf
 } tx_fem_def;
 
 tx_fem_def tx_fem_def_default(void);
@@ -59,6 +61,23 @@ void tx_fem_set_plate(tx_fem* b, double y);
 // false when a position or velocity stopped being finite
 bool tx_fem_step(tx_fem* b, int steps);
 
+// A kinematic frictionless sphere (the tool) against the tetrahedra's
+// boundary: a face it overlaps is pushed out along the sphere's normal, the
+// push shared by the face's nodes by their barycentric weights; the momentum
+// this takes is its force. r <= 0: no tool.
+void tx_fem_set_tool(tx_fem* b, const double c[3], double r);
+typedef struct tx_fem_tool_info {
+  double f[3];    // N, the body's force on the tool, averaged over the last tx_fem_step
+  double depth;   // m, how far the sphere reaches past the boundary as it lay before the tool touched it
+  int faces;      // boundary faces it touched in the last step
+} tx_fem_tool_info;
+void tx_fem_tool(const tx_fem* b, tx_fem_tool_info* out);
+// the state (positions, velocities) kept aside, and brought back
+void tx_fem_save(tx_fem* b);
+void tx_fem_restore(tx_fem* b);
+
+int tx_fem_node_count(const tx_fem* b);
+double tx_fem_added_mass(const tx_fem* b);  // mass scaling's added mass over the true mass (0 without)
 double tx_fem_dt(const tx_fem* b);          // s, the step in use
 double tx_fem_plate_force(const tx_fem* b); // N, upward, averaged over the last tx_fem_step's steps
 double tx_fem_kinetic(const tx_fem* b);     // J

@@ -18,6 +18,7 @@ extern "C" {
 #include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <new>
 #include <set>
@@ -39,10 +40,18 @@ struct tx_fem {
   btSoftBodyWorldInfo info;  // the links body's world
   btSoftBody* body;
   std::vector<double> mass;  // (nv) kg, lumped
+  std::vector<double> weight;  // (nv) true mass over mass (1 without mass scaling)
   bool has_plate;
   double plate;              // m, the plate's underside
   double plate_force;        // N, upward, averaged over the last tx_fem_step
   int contacts;              // nodes on the plate after the last step
+  double added_mass;         // mass scaling's, over the true mass
+  std::vector<btVector3> before;  // (nv) m, the nodes after the last step in which the tool touched nothing
+  std::vector<int> hull;     // (nh x 3) the tetrahedra's boundary faces, outward
+  std::vector<btVector3> saved_x, saved_v;  // tx_fem_save's state
+  bool has_tool;
+  double tool_c[3], tool_r;
+  tx_fem_tool_info tool;
 };
 
 extern "C" tx_fem_def tx_fem_def_default(void) {
@@ -57,6 +66,8 @@ extern "C" tx_fem_def tx_fem_def_default(void) {
   d.iterations = 10;
   d.link_stiffness = 1;
   d.volume_stiffness = 0;
+  d.gravity[0] = d.gravity[1] = d.gravity[2] = 0;
+  d.max_speed = 0;
   return d;
 }
 
@@ -95,8 +106,10 @@ extern "C" tx_fem* tx_fem_create(const tx_fem_def* d, const double* nodes, int n
     return NULL;
   }
   if (!(d->density > 0) || !(d->damping >= 0) || !(d->dt >= 0) || d->iterations < 1 ||
-      !(d->link_stiffness > 0 && d->link_stiffness <= 1) || !(d->volume_stiffness >= 0)) {
-    tx_set_error("soft body: density > 0, damping >= 0, dt >= 0, iterations >= 1, 0 < kLST <= 1 and kVC >= 0 needed");
+      !(d->link_stiffness > 0 && d->link_stiffness <= 1) || !(d->volume_stiffness >= 0) || !(d->max_speed >= 0) ||
+      !std::isfinite(d->gravity[0] + d->gravity[1] + d->gravity[2])) {
+    tx_set_error("soft body: density > 0, damping >= 0, dt >= 0, iterations >= 1, 0 < kLST <= 1, kVC >= 0, max speed >= 0 "
+                 "and a finite gravity needed");
     return NULL;
   }
   if (nv < 4 || ne < 1) {
@@ -147,10 +160,44 @@ extern "C" tx_fem* tx_fem_create(const tx_fem_def* d, const double* nodes, int n
     // lumped masses; with mass scaling a thin element is given the density
     // that makes its own stable step b->dt
     b->mass.assign((size_t)nv, 0.0);
+    b->weight.assign((size_t)nv, 0.0);
+    double true_mass = 0, mass = 0;
     for (int t = 0; t < ne; t++) {
       double rho = d->density;
-      if (d->mass_scaling) rho = std::max(rho, modulus * std::pow(b->dt / (0.3 * alt[(size_t)t]), 2));
-      for (int k = 0; k < 4; k++) b->mass[(size_t)tets[4 * t + k]] += rho * vol[(size_t)t] / 4;
+      if (d->mass_scaling && fem) rho = std::max(rho, modulus * std::pow(b->dt / (0.3 * alt[(size_t)t]), 2));
+      for (int k = 0; k < 4; k++) {
+        b->mass[(size_t)tets[4 * t + k]] += rho * vol[(size_t)t] / 4;
+        b->weight[(size_t)tets[4 * t + k]] += d->density * vol[(size_t)t] / 4;
+      }
+      true_mass += d->density * vol[(size_t)t], mass += rho * vol[(size_t)t];
+    }
+    b->added_mass = mass / true_mass - 1;
+    for (int i = 0; i < nv; i++) b->weight[(size_t)i] /= b->mass[(size_t)i];  // the fraction of each node's mass that gravity pulls
+    b->before.resize((size_t)nv);
+    for (int i = 0; i < nv; i++)
+      b->before[(size_t)i] = btVector3((btScalar)nodes[3 * i], (btScalar)nodes[3 * i + 1], (btScalar)nodes[3 * i + 2]);
+    b->saved_x.resize((size_t)nv);
+    b->saved_v.resize((size_t)nv);
+    // the boundary: faces that belong to one tetrahedron only, turned outward
+    {
+      std::vector<std::array<int, 4>> keyed;  // sorted face, then the tetrahedron's fourth node
+      keyed.reserve(4 * (size_t)ne);
+      for (int t = 0; t < ne; t++)
+        for (int k = 0; k < 4; k++) {
+          std::array<int, 3> f = {tets[4 * t + (k + 1) % 4], tets[4 * t + (k + 2) % 4], tets[4 * t + (k + 3) % 4]};
+          std::sort(f.begin(), f.end());
+          keyed.push_back({f[0], f[1], f[2], tets[4 * t + k]});
+        }
+      std::sort(keyed.begin(), keyed.end());
+      for (size_t i = 0; i < keyed.size(); i++) {
+        bool twin = (i + 1 < keyed.size() && std::equal(keyed[i].begin(), keyed[i].begin() + 3, keyed[i + 1].begin())) ||
+                    (i > 0 && std::equal(keyed[i].begin(), keyed[i].begin() + 3, keyed[i - 1].begin()));
+        if (twin) continue;
+        int a = keyed[i][0], c = keyed[i][1], e = keyed[i][2], o = keyed[i][3];
+        // outward: the fourth node is behind the face
+        if (tet_volume(nodes + 3 * a, nodes + 3 * c, nodes + 3 * e, nodes + 3 * o) > 0) std::swap(c, e);
+        b->hull.push_back(a), b->hull.push_back(c), b->hull.push_back(e);
+      }
     }
 
     std::vector<btVector3> x((size_t)nv);
@@ -168,12 +215,12 @@ extern "C" tx_fem* tx_fem_create(const tx_fem_def* d, const double* nodes, int n
       b->solver->setDeformableSolver(b->body_solver);
       b->world = new btDeformableMultiBodyDynamicsWorld(b->dispatcher, b->broadphase, b->solver, b->config, b->body_solver);
       b->world->setGravity(btVector3(0, 0, 0));
-      b->world->getWorldInfo().m_gravity.setValue(0, 0, 0);
+      b->world->getWorldInfo().m_gravity.setValue((btScalar)d->gravity[0], (btScalar)d->gravity[1], (btScalar)d->gravity[2]);
       b->world->getWorldInfo().m_sparsesdf.Initialize();
       b->world->setImplicit(false);
       b->body = new btSoftBody(&b->world->getWorldInfo(), nv, x.data(), m.data());
     } else {
-      b->info.m_gravity.setValue(0, 0, 0);
+      b->info.m_gravity.setValue((btScalar)d->gravity[0], (btScalar)d->gravity[1], (btScalar)d->gravity[2]);
       b->info.air_density = 0;
       b->info.m_sparsesdf.Initialize();
       b->body = new btSoftBody(&b->info, nv, x.data(), m.data());
@@ -204,6 +251,9 @@ extern "C" tx_fem* tx_fem_create(const tx_fem_def* d, const double* nodes, int n
         b->force = new btDeformableNeoHookeanForce((btScalar)(4.0 / 3.0 * mu), (btScalar)(lambda + 5.0 / 6.0 * mu), 0);
       }
       b->world->addForce(s, b->force);
+      // gravity is applied in tx_fem_step, to the true mass only: mass
+      // scaling must not make the organs heavier
+      b->world->getWorldInfo().m_gravity.setValue(0, 0, 0);
     } else {
       // a link on every edge of the tetrahedra, once
       std::set<std::pair<int, int>> edges;
@@ -225,6 +275,7 @@ extern "C" tx_fem* tx_fem_create(const tx_fem_def* d, const double* nodes, int n
     tx_fem_destroy(b);
     return NULL;
   }
+  tx_fem_save(b);
   return b;
 }
 
@@ -245,13 +296,108 @@ static void links_step(tx_fem* b) {
   s->integrateMotion();
 }
 
+// the point of triangle abc closest to p, as barycentric weights (Ericson,
+// Real-Time Collision Detection, 5.1.5)
+static void closest_on_triangle(const btVector3& p, const btVector3& a, const btVector3& b, const btVector3& c, double w[3]) {
+  btVector3 ab = b - a, ac = c - a, ap = p - a;
+  double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) { w[0] = 1, w[1] = w[2] = 0; return; }
+  btVector3 bp = p - b;
+  double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) { w[1] = 1, w[0] = w[2] = 0; return; }
+  double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) { double v = d1 / (d1 - d3); w[0] = 1 - v, w[1] = v, w[2] = 0; return; }
+  btVector3 cp = p - c;
+  double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) { w[2] = 1, w[0] = w[1] = 0; return; }
+  double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) { double v = d2 / (d2 - d6); w[0] = 1 - v, w[2] = v, w[1] = 0; return; }
+  double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    double v = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    w[1] = 1 - v, w[2] = v, w[0] = 0;
+    return;
+  }
+  double den = 1 / (va + vb + vc);
+  w[1] = vb * den, w[2] = vc * den, w[0] = 1 - w[1] - w[2];
+}
+
+// how far a sphere (c, r) reaches past triangle abc along the face's outward
+// normal side: r minus the signed distance to its closest point (> 0: overlap);
+// n, the unit direction the face must move to leave the sphere
+static double overlap(const btVector3& c, double r, const btVector3& a, const btVector3& b, const btVector3& d, double w[3],
+                      btVector3& n) {
+  closest_on_triangle(c, a, b, d, w);
+  btVector3 q = a * (btScalar)w[0] + b * (btScalar)w[1] + d * (btScalar)w[2];
+  btVector3 face = (b - a).cross(d - a);
+  double fl = face.length();
+  if (!(fl > 0)) return 0;
+  face /= (btScalar)fl;
+  btVector3 cq = q - c;
+  double dist = cq.length();
+  double side = (c - q).dot(face);  // > 0: the centre is outside
+  if (side > 0 && dist > 1e-12) {
+    n = cq / (btScalar)dist;
+    return r - dist;
+  }
+  if (dist >= r) return 0;  // behind and out of reach: a face of the far side
+  n = -face;                // the centre went past the face: push it back behind the centre
+  return r + dist;
+}
+
+// the tool against the boundary; returns the momentum taken (N s, on the body)
+static btVector3 tool_contact(tx_fem* b, int& touched) {
+  btAlignedObjectArray<btSoftBody::Node>& nodes = b->body->m_nodes;
+  btVector3 c((btScalar)b->tool_c[0], (btScalar)b->tool_c[1], (btScalar)b->tool_c[2]);
+  double r = b->tool_r;
+  btVector3 impulse(0, 0, 0);
+  touched = 0;
+  for (size_t f = 0; f < b->hull.size(); f += 3) {
+    btSoftBody::Node* v[3] = {&nodes[b->hull[f]], &nodes[b->hull[f + 1]], &nodes[b->hull[f + 2]]};
+    if ((v[0]->m_x - c).length2() > (btScalar)(16 * r * r) + 2 * ((v[1]->m_x - v[0]->m_x).length2() + (v[2]->m_x - v[0]->m_x).length2()))
+      continue;  // far: no face edge is long enough to reach the sphere
+    double w[3];
+    btVector3 n;
+    double p = overlap(c, r, v[0]->m_x, v[1]->m_x, v[2]->m_x, w, n);
+    if (!(p > 0)) continue;
+    // move the face's closest point by p along n: each free node by w_i p / sum(w^2)
+    double ww = 0;
+    for (int k = 0; k < 3; k++)
+      if (v[k]->m_im > 0) ww += w[k] * w[k];
+    if (!(ww > 0)) continue;
+    touched++;
+    for (int k = 0; k < 3; k++) {
+      if (!(v[k]->m_im > 0) || w[k] == 0) continue;
+      double move = w[k] * p / ww;
+      v[k]->m_x += n * (btScalar)move;
+      // the velocity into the tool is stopped; the momentum that takes is the
+      // larger of the velocity and the push (as for the plate)
+      double vn = -(double)v[k]->m_v.dot(n);
+      double took = std::max(vn, move / b->dt);
+      if (vn > 0) v[k]->m_v += n * (btScalar)vn;
+      impulse += n * (btScalar)(b->mass[(size_t)(v[k] - &nodes[0])] * took);
+    }
+  }
+  return impulse;
+}
+
 extern "C" bool tx_fem_step(tx_fem* b, int steps) {
   btAlignedObjectArray<btSoftBody::Node>& nodes = b->body->m_nodes;
   const double keep = std::exp(-b->def.damping * b->dt);
+  const double vmax2 = b->def.max_speed * b->def.max_speed;
   double impulse = 0;  // N s, what the plate took over these steps
+  btVector3 tool(0, 0, 0);
+  int touched = 0;
+  const btVector3 dv((btScalar)(b->def.gravity[0] * b->dt), (btScalar)(b->def.gravity[1] * b->dt),
+                    (btScalar)(b->def.gravity[2] * b->dt));
+  const bool heavy = b->world && !dv.isZero();
   for (int k = 0; k < steps; k++) {
+    if (heavy)
+      for (int i = 0; i < b->nv; i++)
+        if (nodes[i].m_im > 0) nodes[i].m_v += dv * (btScalar)b->weight[(size_t)i];
     if (b->world) b->world->stepSimulation((btScalar)b->dt, 0);
     else links_step(b);
+    if (b->has_tool) tool += tool_contact(b, touched);
     int on = 0;
     for (int i = 0; i < b->nv; i++) {
       btSoftBody::Node& n = nodes[i];
@@ -269,12 +415,63 @@ extern "C" bool tx_fem_step(tx_fem* b, int steps) {
       }
       if (!std::isfinite(n.m_x.getX() + n.m_x.getY() + n.m_x.getZ() + n.m_v.getX() + n.m_v.getY() + n.m_v.getZ()))
         return false;
+      if (vmax2 > 0 && n.m_v.length2() > vmax2) return false;
     }
     b->contacts = on;
   }
   b->plate_force = steps > 0 ? impulse / (steps * b->dt) : 0;
+  // the body's force on the tool is minus the momentum the tool gave it
+  double span = steps > 0 ? steps * b->dt : 1;
+  for (int a = 0; a < 3; a++) b->tool.f[a] = -(double)tool[a] / span;
+  b->tool.faces = touched;
+  b->tool.depth = 0;
+  if (touched == 0) {
+    for (int i = 0; i < b->nv; i++) b->before[(size_t)i] = nodes[i].m_x;
+  } else {
+    // the indentation: how far the sphere reaches past the boundary as it
+    // lay before the tool touched it
+    // lay before the tool touched it: r minus the centre's signed distance to
+    // that boundary (the nearest face's side gives the sign)
+    btVector3 c((btScalar)b->tool_c[0], (btScalar)b->tool_c[1], (btScalar)b->tool_c[2]);
+    double nearest = INFINITY, signed_dist = 0;
+    for (size_t f = 0; f < b->hull.size(); f += 3) {
+      const btVector3 &a = b->before[(size_t)b->hull[f]], &e = b->before[(size_t)b->hull[f + 1]],
+                      &g = b->before[(size_t)b->hull[f + 2]];
+      double w[3];
+      closest_on_triangle(c, a, e, g, w);
+      btVector3 q = a * (btScalar)w[0] + e * (btScalar)w[1] + g * (btScalar)w[2];
+      double d = (c - q).length();
+      if (d < nearest) nearest = d, signed_dist = (c - q).dot((e - a).cross(g - a)) >= 0 ? d : -d;
+    }
+    b->tool.depth = std::max(0.0, b->tool_r - signed_dist);
+  }
   return true;
 }
+
+extern "C" void tx_fem_set_tool(tx_fem* b, const double c[3], double r) {
+  b->has_tool = r > 0 && std::isfinite(c[0] + c[1] + c[2] + r);
+  if (!b->has_tool) return;
+  for (int a = 0; a < 3; a++) b->tool_c[a] = c[a];
+  b->tool_r = r;
+}
+
+extern "C" void tx_fem_tool(const tx_fem* b, tx_fem_tool_info* out) { *out = b->tool; }
+
+extern "C" void tx_fem_save(tx_fem* b) {
+  for (int i = 0; i < b->nv; i++) b->saved_x[(size_t)i] = b->body->m_nodes[i].m_x, b->saved_v[(size_t)i] = b->body->m_nodes[i].m_v;
+}
+
+extern "C" void tx_fem_restore(tx_fem* b) {
+  for (int i = 0; i < b->nv; i++) {
+    btSoftBody::Node& n = b->body->m_nodes[i];
+    n.m_x = n.m_q = b->saved_x[(size_t)i];
+    n.m_v = n.m_vn = b->saved_v[(size_t)i];
+  }
+  b->tool = tx_fem_tool_info();
+}
+
+extern "C" int tx_fem_node_count(const tx_fem* b) { return b->nv; }
+extern "C" double tx_fem_added_mass(const tx_fem* b) { return b->added_mass; }
 
 extern "C" double tx_fem_dt(const tx_fem* b) { return b->dt; }
 extern "C" double tx_fem_plate_force(const tx_fem* b) { return b->plate_force; }
