@@ -70,7 +70,7 @@ static const tx_param_def params[] = {
     {"needle_wire_diameter_m", TX_PARAM_NUM, "m", 5e-5, 0.003, 0.0006, NULL, "the needle's wire diameter"},
     {"needle_x_m", TX_PARAM_NUM, "m", -10, 10, 0.03, NULL, "where its circle's centre lies on the table, x"},
     {"needle_z_m", TX_PARAM_NUM, "m", -10, 10, 0, NULL, "where its circle's centre lies on the table, z"},
-    {"needle_in_jaws", TX_PARAM_INT, NULL, -1, 1, -1, NULL,
+    {"needle_in_jaws", TX_PARAM_INT, "1", -1, 1, -1, NULL,
      "-1: the needle starts on the table; N: it starts held in instrumentN's jaws (then needle_x_m, needle_z_m are unused)"},
     {"needle_grasp_m", TX_PARAM_NUM, "m", 0.005, 0.1, 0.03, NULL, "held from the start: the wire this far ahead of the jaws' pivot"},
     {"needle_grasp_rad", TX_PARAM_NUM, "rad", 0, 3.9, 0.2, NULL,

@@ -67,6 +67,7 @@ void tx_puncture_tracker_init(tx_puncture_tracker* t, double separation, double 
   memset(t, 0, sizeof *t);
   t->separation = separation;
   t->torn = torn;
+  t->next_side = 1;
 }
 
 bool tx_puncture_update(tx_puncture_tracker* t, const tx_skin_contact* c, const float* x, int nx, const int32_t* tri,
@@ -97,7 +98,14 @@ bool tx_puncture_update(tx_puncture_tracker* t, const tx_skin_contact* c, const 
   corner(x, v[0], a), corner(x, v[1], b), corner(x, v[2], cc);
   for (int k = 0; k < 3; k++) ab[k] = b[k] - a[k], ac[k] = cc[k] - a[k];
   double normal[3] = {ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2], ab[0] * ac[1] - ab[1] * ac[0]};
-  *out = (tx_puncture_found){.row = {.triangle = row, .bary = {bary[0], bary[1], bary[2]}, .side = dot(t->n, normal) >= 0 ? 1 : -1},
+  int side = dot(t->n, normal) >= 0 ? 1 : -1;
+  if (side != t->next_side) { // through one membrane the tip goes in, then out: this tear is at the hole it made
+    t->touched = false;
+    t->peak_f = t->peak_depth = 0;
+    return false;
+  }
+  t->next_side = -side;
+  *out = (tx_puncture_found){.row = {.triangle = row, .bary = {bary[0], bary[1], bary[2]}, .side = side},
                              .verts = {v[0], v[1], v[2]},
                              .point = {point[0], point[1], point[2]},
                              .force = t->peak_f,

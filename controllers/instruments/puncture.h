@@ -1,7 +1,8 @@
 // Punctures from what the skin publishes (skin.contact, skin.x, skin.tri):
 // the tip's HIP tears the skin. A puncture is the first tear after the tip
 // touched the skin, at least `separation` from the last puncture (a tear that
-// runs on at the hole is the same puncture). Its place is the point of the
+// runs on at the hole is the same puncture), and on the side the tip is on:
+// through one membrane it goes in, then out, in, out. Its place is the point of the
 // live triangles nearest the HIP centre that tore them (the hole's rim), and
 // its side is where the tip came from: +1 from the triangles' normal side (the
 // skin's outside: an entry), -1 from behind (an exit). Pure C, no ODE.
@@ -21,6 +22,7 @@ typedef struct tx_puncture_tracker {
   double peak_f, peak_depth; // the largest force since the last puncture (N) and the indentation then (m)
   bool any;
   double last[3]; // the last puncture's point
+  int next_side;  // +1: the tip is outside (an entry comes next), -1: inside
 } tx_puncture_tracker;
 
 // a tracker that has seen `torn` links torn already

@@ -89,11 +89,16 @@ static void test_entry_then_exit(void** state) {
   assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
   c = touch(0.0015, 0.0012, -1, 0.1, 5);
   assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  // the tip drags the hole's flaps down 5 mm on: a tear from above again, not a second entry
+  c = touch(0.006, 0.0012, 1, 0.2, 5);
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  c = touch(0.006, 0.0012, 1, 0.2, 6);
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
   // a tear with no touch since the last puncture: none
-  c = touch(0.012, 0.0012, 1, 0, 6);
+  c = touch(0.012, 0.0012, 1, 0, 7);
   assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
   // 1 cm away the tip comes up from below and tears: an exit
-  c = touch(0.011, 0.0012, -1, 0.3, 6);
+  c = touch(0.011, 0.0012, -1, 0.3, 7);
   assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
   c = touch(0.011, 0.0012, -1, 0.2, 8);
   assert_true(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
