@@ -38,6 +38,7 @@ typedef struct instruments {
   tx_puncture_tracker tracker;
   tx_puncture rows[TX_NEEDLE_PINS_MAX];
   int32_t pin_verts[TX_NEEDLE_PINS_MAX][3]; // the particles that carry each puncture point
+  double pin_offset[TX_NEEDLE_PINS_MAX][3]; // from the skin's point to the pin: the tip where it tore through
   int npins;
   // the thread the scissors cut (THREAD.nodes)
   tx_port thread_nodes;
@@ -272,13 +273,19 @@ static void pierce(tx_ctx* c, instruments* m) {
     for (int v = 0; v < 3; v++)
       for (int k = 0; k < 3; k++)
         if (m->pin_verts[i][v] < (int32_t)x.rows) p[k] += m->rows[i].bary[v] * xs[3 * m->pin_verts[i][v] + k];
+    for (int k = 0; k < 3; k++) p[k] += m->pin_offset[i][k];
     tx_instrument_world_needle_pin_move(m->world, i, p);
   }
   if (ct.seq == m->contact_seq) return; // one look at each of the skin's publishes
   m->contact_seq = ct.seq;
   tx_puncture_found f;
   if (!tri.seq || !tx_puncture_update(&m->tracker, sc, xs, (int)x.rows, tri.data, (int)tri.rows, &f)) return;
-  if (m->npins >= TX_NEEDLE_PINS_MAX || tx_instrument_world_needle_pin(m->world, f.point) < 0) return;
+  // the pin starts at the tip, which is on the arc (the hole's rim, where the
+  // triangle's point is, lies a few millimetres off it), and moves with the skin's point
+  double tip[3];
+  tx_instrument_world_needle_tip(m->world, tip);
+  if (m->npins >= TX_NEEDLE_PINS_MAX || tx_instrument_world_needle_pin(m->world, tip) < 0) return;
+  for (int k = 0; k < 3; k++) m->pin_offset[m->npins][k] = tip[k] - f.point[k];
   m->rows[m->npins] = f.row;
   memcpy(m->pin_verts[m->npins], f.verts, sizeof f.verts);
   m->npins++;
