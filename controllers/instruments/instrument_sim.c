@@ -42,6 +42,7 @@ struct tx_instrument_world {
   dBodyID needle; // NULL without a needle
   double needle_com[3]; // in the needle frame
   dJointID hold; // the needle's fixed joint to its holder, or NULL
+  dJointID foam; // its fixed joint to the world while it stands in foam, or NULL
   int held_by, grasps, releases;
   double grasp_point[3]; // the mean contact point of the last grasp
   double hold_angle[TX_INSTRUMENT_LINKS_MAX]; // the holder's jaw angles when it took the needle
@@ -364,7 +365,15 @@ tx_instrument_world* tx_instrument_world_create(const tx_instrument_sim_params* 
     nd->pos[0] = s[0] + nd->grasp_distance - nd->radius, nd->pos[1] = s[1], nd->pos[2] = s[2];
     nd->quat[0] = cos(-phi / 2), nd->quat[1] = nd->quat[2] = 0, nd->quat[3] = sin(-phi / 2);
   }
+  if (nd->enabled && nd->foam && nd->held_by < 0) {
+    nd->quat[0] = cos(-nd->grasp_angle / 2), nd->quat[1] = nd->quat[2] = 0, nd->quat[3] = sin(-nd->grasp_angle / 2);
+  }
   if (p->needle.enabled) needle_build(w);
+  if (nd->enabled && nd->foam && nd->held_by < 0) { // the foam holds it where it stands
+    w->foam = dJointCreateFixed(w->world, 0);
+    dJointAttach(w->foam, w->needle, 0);
+    dJointSetFixed(w->foam);
+  }
   for (int i = 0; i < n; i++) {
     w->ins[i].urdf = urdfs[i];
     memcpy(w->ins[i].start, start[i], sizeof w->ins[i].start);
@@ -510,6 +519,7 @@ static void needle_grasp(tx_instrument_world* w) {
     in->was_on = on;
     if (i == w->held_by || !came_on || !closing(in)) continue;
     if (w->hold) dJointDestroy(w->hold); // handed over: no release event, the needle stays held
+    if (w->foam) dJointDestroy(w->foam), w->foam = NULL; // taken out of the foam
     w->hold = dJointCreateFixed(w->world, 0);
     dJointAttach(w->hold, w->needle, in->body[0]);
     dJointSetFixed(w->hold);

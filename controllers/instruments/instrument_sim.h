@@ -35,6 +35,11 @@ typedef struct tx_needle_params {
   int held_by;
   double grasp_distance; // m
   double grasp_angle; // rad
+  // foam: it stands in a block of foam, held still at pos until jaws take it:
+  // its arc upright in the world's x-y plane, turned so that the point at
+  // grasp_angle from the swage lies at pos + (radius, 0, 0) with the wire
+  // there along y, across jaws that come along +x (quat is then ignored)
+  bool foam;
 } tx_needle_params;
 
 // the default: a 3/8-circle reverse-cutting skin needle 19 mm long (the

@@ -69,13 +69,16 @@ static const tx_param_def params[] = {
     {"needle_circle", TX_PARAM_NUM, "1", 0.25, 0.625, 0.375, NULL, "the needle's arc as a fraction of a circle: 3/8 or 1/2"},
     {"needle_length_m", TX_PARAM_NUM, "m", 0.003, 0.1, 0.019, NULL, "the needle's length along its arc"},
     {"needle_wire_diameter_m", TX_PARAM_NUM, "m", 5e-5, 0.003, 0.0006, NULL, "the needle's wire diameter"},
-    {"needle_x_m", TX_PARAM_NUM, "m", -10, 10, 0.03, NULL, "where its circle's centre lies on the table, x"},
-    {"needle_z_m", TX_PARAM_NUM, "m", -10, 10, 0, NULL, "where its circle's centre lies on the table, z"},
+    {"needle_x_m", TX_PARAM_NUM, "m", -10, 10, 0.03, NULL, "its circle's centre on the table (or in foam), x"},
+    {"needle_z_m", TX_PARAM_NUM, "m", -10, 10, 0, NULL, "its circle's centre on the table (or in foam), z"},
     {"needle_in_jaws", TX_PARAM_INT, "1", -1, 1, -1, NULL,
      "-1: the needle starts on the table; N: it starts held in instrumentN's jaws (then needle_x_m, needle_z_m are unused)"},
     {"needle_grasp_m", TX_PARAM_NUM, "m", 0.005, 0.1, 0.03, NULL, "held from the start: the wire this far ahead of the jaws' pivot"},
     {"needle_grasp_rad", TX_PARAM_NUM, "rad", 0, 3.9, 0.2, NULL,
      "held from the start: at this angle along the arc from the swage; the arc curves towards the root's +y"},
+    {"needle_foam", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL,
+     "the needle stands upright in foam, still until jaws take it: its arc in the x-y plane, its point needle_grasp_rad from the swage one radius along +x from its centre"},
+    {"needle_y_m", TX_PARAM_NUM, "m", -10, 10, 0, NULL, "in foam: its circle's centre's height"},
     {"skin", TX_PARAM_STR, NULL, 0, 0, 0, "",
      "the skin the needle's tip pierces: reads SKIN.x, SKIN.tri, SKIN.contact (physics.skin with pose needle.tip); \"\": none"},
     {"thread", TX_PARAM_STR, NULL, 0, 0, 0, "",
@@ -155,6 +158,10 @@ static int configure(tx_setup* s, void** self) {
   nd->pos[1] = m->p.table_height + nd->wire_diameter / 2;
   nd->pos[2] = tx_table_num(s, "needle_z_m");
   nd->held_by = (int)tx_table_int(s, "needle_in_jaws");
+  nd->foam = tx_table_bool(s, "needle_foam");
+  if (nd->foam) nd->pos[1] = tx_table_num(s, "needle_y_m");
+  if (nd->foam && nd->held_by >= 0) return tx_setup_fail(s, "needle_foam", "the needle starts in the jaws (needle_in_jaws)");
+  if (nd->foam && !nd->enabled) return tx_setup_fail(s, "needle_foam", "no needle (needle: true)");
   nd->grasp_distance = tx_table_num(s, "needle_grasp_m");
   nd->grasp_angle = tx_table_num(s, "needle_grasp_rad");
   if (nd->held_by >= 0 && !nd->enabled) return tx_setup_fail(s, "needle_in_jaws", "no needle to hold (needle: true)");

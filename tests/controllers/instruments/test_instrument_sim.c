@@ -548,6 +548,40 @@ static void test_pinned_needle_slides_along_and_resists_across(void** state) {
   tx_instrument_desc_free(d);
 }
 
+// in foam the needle stands still under gravity until the holder closes on
+// it, which takes it out (one grasp) and lifts it
+static void test_needle_taken_from_foam(void** state) {
+  (void)state;
+  tx_instrument_desc* d = load("needle_holder");
+  tx_instrument_sim_params p = tx_instrument_sim_defaults();
+  p.table_height = -1;
+  p.needle.enabled = true;
+  p.needle.foam = true;
+  memset(p.needle.pos, 0, sizeof p.needle.pos);
+  const tx_urdf* u = d->urdf;
+  double R = p.needle.radius, grasp[3] = {R - 0.03, 0, 0}, start[1][3] = {{R - 0.06, 0, 0}};
+  tx_instrument_world* w = tx_instrument_world_create(&p, &u, 1, start);
+  assert_non_null(w);
+  tx_instrument_input in = at(start[0][0], 0, 0, 0);
+  step_to(w, &in, start[0], 0.4, 0.3);
+  step_to(w, &in, grasp, 0.4, 0.3);
+  double c[3], q[4];
+  tx_instrument_world_needle(w, c, q);
+  assert_true(norm3(c) < 1e-6); // the foam holds it against gravity
+  assert_int_equal(tx_instrument_world_needle_held_by(w), -1);
+  step_to(w, &in, grasp, 0, 0.3);
+  step_to(w, &in, grasp, 0, 0.1);
+  assert_int_equal(tx_instrument_world_needle_held_by(w), 0);
+  assert_int_equal(tx_instrument_world_needle_grasps(w), 1);
+  double lift[3] = {grasp[0], 0.03, 0};
+  step_to(w, &in, lift, 0, 0.5);
+  tx_instrument_world_needle(w, c, q);
+  print_message("  taken from the foam and lifted 3 cm: the needle's centre at y = %.2f mm\n", 1e3 * c[1]);
+  assert_true(c[1] > 0.025);
+  tx_instrument_world_destroy(w);
+  tx_instrument_desc_free(d);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_links_start_where_the_urdf_puts_them),
@@ -564,6 +598,7 @@ int main(void) {
       cmocka_unit_test(test_needle_starts_in_the_jaws),
       cmocka_unit_test(test_tip_contact_reaches_the_hand),
       cmocka_unit_test(test_pinned_needle_slides_along_and_resists_across),
+      cmocka_unit_test(test_needle_taken_from_foam),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
