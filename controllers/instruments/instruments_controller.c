@@ -85,6 +85,8 @@ static const tx_param_def params[] = {
      "the thread the scissors cut: reads THREAD.nodes; \"\": none"},
     {"puncture_separation_m", TX_PARAM_NUM, "m", 0, 0.1, 0.003, NULL,
      "a tear nearer than this to the last puncture is that puncture's tear running on"},
+    {"puncture_min_force_n", TX_PARAM_NUM, "N", 0, 100, 0.05, NULL,
+     "a tear is a puncture only after the tip pushed the skin this hard (not a torn flap flicking it)"},
     {"pin_stiffness", TX_PARAM_NUM, "N/m", 0, 1e5, 200, NULL,
      "a puncture holds the needle's arc on its point across the arc with this spring"},
     {"pin_damping", TX_PARAM_NUM, "N s/m", 0, 1e3, 0.1, NULL, "and this damper"},
@@ -181,7 +183,7 @@ static int configure(tx_setup* s, void** self) {
     m->skin_tri = TX_READ_OF(s, name, tx_triangle);
     snprintf(name, sizeof name, "%s.contact", skin);
     m->skin_contact = TX_READ_OF(s, name, tx_skin_contact);
-    tx_puncture_tracker_init(&m->tracker, tx_table_num(s, "puncture_separation_m"), 0);
+    tx_puncture_tracker_init(&m->tracker, tx_table_num(s, "puncture_separation_m"), tx_table_num(s, "puncture_min_force_n"), 0);
   }
   for (int i = 0; i < TX_INSTRUMENTS_MAX; i++) {
     char key[32], path[2048], name[TX_NAME_MAX];
@@ -256,7 +258,7 @@ static int init(tx_ctx* c, void* self) {
   for (int i = 0; i < m->n; i++) m->blades[i].armed = 0;
   m->contact_seq = 0;
   for (int i = 0; i < TX_NEEDLE_PINS_MAX; i++) m->rows[i] = (tx_puncture){.triangle = -1};
-  tx_puncture_tracker_init(&m->tracker, m->tracker.separation, 0);
+  tx_puncture_tracker_init(&m->tracker, m->tracker.separation, m->tracker.min_force, 0);
   m->world = tx_instrument_world_create(&m->p, urdfs, m->n, (const double(*)[3])start);
   if (!m->world) {
     tx_stop_run(c, "physics.instruments: %s", tx_error());

@@ -63,24 +63,28 @@ int tx_nearest_triangle(const float* x, int nx, const int32_t* tri, int ntri, co
   return best;
 }
 
-void tx_puncture_tracker_init(tx_puncture_tracker* t, double separation, double torn) {
+void tx_puncture_tracker_init(tx_puncture_tracker* t, double separation, double min_force, double torn) {
   memset(t, 0, sizeof *t);
   t->separation = separation;
+  t->min_force = min_force;
   t->torn = torn;
   t->next_side = 1;
+  t->free = true;
 }
 
 bool tx_puncture_update(tx_puncture_tracker* t, const tx_skin_contact* c, const float* x, int nx, const int32_t* tri,
                         int ntri, tx_puncture_found* out) {
   double fn = sqrt(dot(c->f, c->f));
-  if (c->touching > 0 && fn > 0 && isfinite(fn)) {
+  bool touching = c->touching > 0 && fn > 0 && isfinite(fn);
+  if (!touching) t->free = true; // the tip is clear of the skin: the next touch can make a puncture
+  if (touching && t->free) {
     t->touched = true;
     memcpy(t->n, c->n, sizeof t->n);
     if (fn > t->peak_f) t->peak_f = fn, t->peak_depth = c->depth;
   }
   bool tore = c->torn > t->torn;
   if (isfinite(c->torn)) t->torn = c->torn;
-  if (!tore || !t->touched) return false;
+  if (!tore || !t->touched || t->peak_f < t->min_force) return false;
   double bary[3], point[3];
   int row = tx_nearest_triangle(x, nx, tri, ntri, c->x, bary, point);
   if (row < 0) return false;
@@ -113,6 +117,7 @@ bool tx_puncture_update(tx_puncture_tracker* t, const tx_skin_contact* c, const 
   t->any = true;
   memcpy(t->last, point, sizeof point);
   t->touched = false;
+  t->free = false;
   t->peak_f = t->peak_depth = 0;
   return true;
 }

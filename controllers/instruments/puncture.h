@@ -1,6 +1,8 @@
 // Punctures from what the skin publishes (skin.contact, skin.x, skin.tri):
-// the tip's HIP tears the skin. A puncture is the first tear after the tip
-// touched the skin, at least `separation` from the last puncture (a tear that
+// the tip's HIP tears the skin. A puncture is the first tear after the tip,
+// clear of the skin since the last puncture (torn flaps cling to it as it
+// comes out), pushed on it with at least `min_force` (a flap flicking the tip
+// is no puncture), at least `separation` from the last puncture (a tear that
 // runs on at the hole is the same puncture), and on the side the tip is on:
 // through one membrane it goes in, then out, in, out. Its place is the point of the
 // live triangles nearest the HIP centre that tore them (the hole's rim), and
@@ -16,8 +18,10 @@
 
 typedef struct tx_puncture_tracker {
   double separation; // m: the least distance between two punctures
+  double min_force;  // N: the tip must have pushed the skin this hard before a tear is its puncture
   double torn;       // links torn when last seen
-  bool touched;      // the tip touched the skin since the last puncture
+  bool free;         // the tip was clear of the skin since the last puncture
+  bool touched;      // and has touched it since
   double n[3];       // the last direction the skin pushed the tip
   double peak_f, peak_depth; // the largest force since the last puncture (N) and the indentation then (m)
   bool any;
@@ -26,7 +30,7 @@ typedef struct tx_puncture_tracker {
 } tx_puncture_tracker;
 
 // a tracker that has seen `torn` links torn already
-void tx_puncture_tracker_init(tx_puncture_tracker* t, double separation, double torn);
+void tx_puncture_tracker_init(tx_puncture_tracker* t, double separation, double min_force, double torn);
 
 // what a puncture found: the row, its vertices, the point and the force
 typedef struct tx_puncture_found {

@@ -70,7 +70,7 @@ static tx_skin_contact touch(double x, double z, double ny, double f, double tor
 static void test_entry_then_exit(void** state) {
   (void)state;
   tx_puncture_tracker t;
-  tx_puncture_tracker_init(&t, 0.003, 0);
+  tx_puncture_tracker_init(&t, 0.003, 0.05, 0);
   tx_puncture_found f;
   tx_skin_contact c = touch(0.001, 0.0012, 1, 0.2, 0);
   assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f)); // touching, not torn
@@ -106,8 +106,24 @@ static void test_entry_then_exit(void** state) {
   assert_true(fabs(f.point[0] - 0.011) < 1e-7);
   assert_true(fabs(f.row.bary[0] + f.row.bary[1] + f.row.bary[2] - 1) < 1e-12);
   assert_true(fabs(f.force - 0.3) < 1e-12);
+  // out through the skin, the flaps cling to the tip; clear of them it comes
+  // back down 1 cm on: a flap flicking it (5 mN) as it tears is no entry,
+  // nor is a firm push while the flaps still cling; a push from clear is
+  c = touch(0.011, 0.0012, 1, 0.2, 9); // clinging, pushing from above
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  c = touch(0.018, 0.0012, 1, 0.3, 10);
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  c = touch(0.018, 0.0012, 1, 0, 10); // clear
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  c = touch(0.018, 0.0012, 1, 0.005, 11);
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  c = touch(0.018, 0.0012, 1, 0.2, 11);
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  c = touch(0.018, 0.0012, 1, 0, 12);
+  assert_true(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  assert_int_equal(f.row.side, 1);
   // a skin with no triangle left: no puncture
-  tx_puncture_tracker_init(&t, 0.003, 0);
+  tx_puncture_tracker_init(&t, 0.003, 0.05, 0);
   c = touch(0, 0, 1, 0.2, 0);
   tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f);
   c = touch(0, 0, 1, 0.2, 1);
