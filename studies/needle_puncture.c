@@ -13,6 +13,7 @@
 // puncture. Writes needle-puncture.csv, .json and .png.
 #include "studies.h"
 
+#include "../scenarios/command.h"
 #include "../views/plot.h"
 #include "../views/report.h"
 
@@ -21,7 +22,6 @@
 #include <stdio.h>
 
 #if TX_WITH_ODE && TX_WITH_URDFDOM && TX_WITH_ASSIMP && TX_WITH_BULLET
-#include "../scenarios/command.h"
 #include "../scenarios/loader.h"
 #include "../controllers/system.h"
 
