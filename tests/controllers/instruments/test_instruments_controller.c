@@ -88,6 +88,18 @@ static void test_refuses_what_it_cannot_read(void** state) {
   s = load("\"instrument0\":\"\",\"instrument1\":\"lap_grasper\"");
   assert_null(s);
   assert_non_null(strstr(tx_error(), "instrument1"));
+  // the puncture and foam keys: each refused naming itself
+  static const char* const bad[][2] = {
+      {"\"skin\":\"skin\"", "params.skin: a skin to pierce needs the needle"},
+      {"\"needle\":true,\"needle_in_jaws\":1", "params.needle_in_jaws: there is no instrument1"},
+      {"\"needle\":true,\"needle_in_jaws\":0,\"needle_foam\":true", "params.needle_foam"},
+      {"\"needle\":true,\"needle_grasp_rad\":3", "params.needle_grasp_rad: past the needle's tip"},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    assert_null(load(bad[i][0]));
+    if (!strstr(tx_error(), bad[i][1])) fail_msg("'%s' lacks '%s'", tx_error(), bad[i][1]);
+    assert_null(strchr(tx_error(), '\n'));
+  }
 }
 
 // with a needle: it lies on the table where the scenario puts it, and its
@@ -266,6 +278,7 @@ static void test_needle_punctures_the_skin(void** state) {
                   np, e->source, r->side, 1e3 * e->puncture.point[0], 1e3 * e->puncture.point[1],
                   1e3 * e->puncture.point[2], e->puncture.force, 1e3 * e->puncture.depth, r->bary[0], r->bary[1], r->bary[2]);
     assert_true(r->triangle == e->source);
+    assert_true(r->triangle >= 0 && r->triangle < 2 * 41 * 41); // a row of the 42 x 42 patch's skin.tri
     assert_true(fabs(r->bary[0] + r->bary[1] + r->bary[2] - 1) < 1e-9);
     for (int k = 0; k < 3; k++) assert_true(r->bary[k] >= 0);
     assert_true(e->puncture.force > 0.01); // the tip felt the skin before it tore
