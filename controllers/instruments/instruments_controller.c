@@ -17,6 +17,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#define TX_THREAD_RELEASE_RAD 0.02 // jaws this much wider than closed let the thread go
+
 typedef struct instruments {
   tx_instrument_sim_params p;
   tx_instrument_desc* desc[TX_INSTRUMENTS_MAX];
@@ -47,6 +49,9 @@ typedef struct instruments {
   bool scissors[TX_INSTRUMENTS_MAX];
   double blade_length[TX_INSTRUMENTS_MAX], blade_reach[TX_INSTRUMENTS_MAX];
   tx_blades blades[TX_INSTRUMENTS_MAX];
+  bool holds_thread[TX_INSTRUMENTS_MAX]; // jaws closed on the thread (not scissors)
+  tx_result thread_grasps;
+  int nthread_grasps;
 } instruments;
 
 static const tx_param_def params[] = {
@@ -82,7 +87,7 @@ static const tx_param_def params[] = {
     {"skin", TX_PARAM_STR, NULL, 0, 0, 0, "",
      "the skin the needle's tip pierces: reads SKIN.x, SKIN.tri, SKIN.contact (physics.skin with pose needle.tip); \"\": none"},
     {"thread", TX_PARAM_STR, NULL, 0, 0, 0, "",
-     "the thread the scissors cut: reads THREAD.nodes; \"\": none"},
+     "the thread the scissors cut and other jaws grasp: reads THREAD.nodes; \"\": none"},
     {"puncture_separation_m", TX_PARAM_NUM, "m", 0, 0.1, 0.003, NULL,
      "a tear nearer than this to the last puncture is that puncture's tear running on"},
     {"puncture_min_force_n", TX_PARAM_NUM, "N", 0, 100, 0.05, NULL,
@@ -101,7 +106,8 @@ static void resolve(const char* given, char* path, size_t n) {
 }
 
 // a scissors (its name says so) cuts with its jaws' parts ahead of the
-// pivot: their length along x and their half width across
+// pivot, other jaws grasp with them: their reach along the root's x from the
+// pivot and their half width across
 static void blades_of(instruments* m, int i) {
   const tx_urdf* u = m->desc[i]->urdf;
   m->scissors[i] = strstr(u->name, "scissors") != NULL;
@@ -112,15 +118,22 @@ static void blades_of(instruments* m, int i) {
     for (int k = 0; k < l->nshapes; k++) {
       const tx_urdf_shape* sh = &l->shapes[k];
       if (sh->kind != TX_URDF_BOX || sh->pose.p[0] <= 0) continue;
-      m->blade_length[i] = fmax(m->blade_length[i], sh->pose.p[0] + sh->size[0] / 2);
+      m->blade_length[i] = fmax(m->blade_length[i], u->joints[j].origin.p[0] + sh->pose.p[0] + sh->size[0] / 2);
       m->blade_reach[i] = fmax(m->blade_reach[i], fmax(sh->size[1], sh->size[2]) / 2);
     }
   }
 }
 
-// scissors closing on the thread cut it between their blades
+// scissors closing on the thread cut it between their blades; other jaws
+// closing on it grasp it (until they open again)
 static void cut(tx_ctx* c, instruments* m, int i, double jaw) {
-  if (!m->scissors[i] || !tx_blades_close(&m->blades[i], jaw) || !m->thread_nodes.id) return;
+  if (!m->thread_nodes.id) return;
+  if (m->holds_thread[i] && jaw > m->blades[i].closed + TX_THREAD_RELEASE_RAD) {
+    m->holds_thread[i] = false;
+    tx_emit(c, m->events, &(tx_event){.kind = TX_EVENT_RELEASE, .source = (uint32_t)i});
+  }
+  if (!tx_blades_close(&m->blades[i], jaw)) return;
+  if (!m->scissors[i] && m->p.needle.enabled && tx_instrument_world_needle_held_by(m->world) == i) return; // on the needle
   tx_snapshot nodes = tx_read(c, m->thread_nodes);
   if (!nodes.seq) return;
   double pivot[3], q[4], dir[3], point[3];
@@ -129,6 +142,15 @@ static void cut(tx_ctx* c, instruments* m, int i, double jaw) {
   dir[0] = 1 - 2 * (q[2] * q[2] + q[3] * q[3]), dir[1] = 2 * (q[1] * q[2] + q[0] * q[3]), dir[2] = 2 * (q[1] * q[3] - q[0] * q[2]);
   int seg = tx_scissors_cut(pivot, dir, m->blade_length[i], m->blade_reach[i], nodes.data, (int)nodes.rows, point);
   if (seg < 0) return;
+  if (!m->scissors[i]) { // a grasp of the thread: its point is on the thread, between the jaws
+    tx_event e = {.kind = TX_EVENT_GRASP, .source = (uint32_t)i};
+    memcpy(e.grasp.point, point, sizeof point);
+    e.grasp.jaw = jaw;
+    tx_emit(c, m->events, &e);
+    m->holds_thread[i] = true;
+    m->nthread_grasps++;
+    return;
+  }
   tx_event e = {.kind = TX_EVENT_CUT, .source = (uint32_t)seg};
   memcpy(e.cut.point, point, sizeof point);
   tx_emit(c, m->events, &e);
@@ -219,6 +241,7 @@ static int configure(tx_setup* s, void** self) {
     snprintf(name, sizeof name, "%s.nodes", thread);
     m->thread_nodes = TX_READ_OF(s, name, tx_thread_node);
     m->cuts = tx_setup_result(s, "thread_cuts");
+    m->thread_grasps = tx_setup_result(s, "thread_grasps");
     if (!nd->enabled) m->events = tx_setup_emit(s, "instruments.events", 64);
   }
   for (int i = 0; i < m->n; i++) blades_of(m, i);
@@ -254,8 +277,8 @@ static int init(tx_ctx* c, void* self) {
       if (!isfinite(start[i][k])) start[i][k] = 0;
   }
   m->npins = 0;
-  m->ncuts = 0;
-  for (int i = 0; i < m->n; i++) m->blades[i].armed = 0;
+  m->ncuts = m->nthread_grasps = 0;
+  for (int i = 0; i < m->n; i++) m->blades[i].armed = 0, m->holds_thread[i] = false;
   m->contact_seq = 0;
   for (int i = 0; i < TX_NEEDLE_PINS_MAX; i++) m->rows[i] = (tx_puncture){.triangle = -1};
   tx_puncture_tracker_init(&m->tracker, m->tracker.separation, m->tracker.min_force, 0);
@@ -385,7 +408,7 @@ static void finish(tx_ctx* c, void* self) {
   // the world goes on the thread that made and stepped it, with ODE's data for that thread
   tx_instrument_world_destroy(m->world);
   m->world = NULL;
-  if (m->thread_nodes.id) tx_set_result(c, m->cuts, m->ncuts);
+  if (m->thread_nodes.id) tx_set_result(c, m->cuts, m->ncuts), tx_set_result(c, m->thread_grasps, m->nthread_grasps);
   tx_set_result(c, m->contacts_max, m->contacts_most);
   tx_set_result(c, m->force_max, m->force_most);
 }

@@ -213,6 +213,49 @@ static void test_scissors_cut_the_thread(void** state) {
   tx_scenario_free(s);
 }
 
+// the thumb forceps open over the thread and close on it: a grasp (source =
+// the forceps, its point on the thread between the jaws); they open: a
+// release; no cut
+static void test_forceps_grasp_the_thread(void** state) {
+  (void)state;
+  register_tests();
+  char path[64];
+  snprintf(path, sizeof path, "/tmp/tx-tgrasp-XXXXXX.csv");
+  int fd = mkstemps(path, 4);
+  assert_true(fd >= 0);
+  close(fd);
+  write_csv(path, "t_s,x_m,y_m,z_m,qw,qx,qy,qz,grip_rad\n"
+                  "0,0,0,0.0012,1,0,0,0,0\n0.3,0,0,0.0012,1,0,0,0,0.14\n0.6,0,0,0.0012,1,0,0,0,0.14\n"
+                  "0.9,0,0,0.0012,1,0,0,0,0\n1.2,0,0,0.0012,1,0,0,0,0\n1.5,0,0,0.0012,1,0,0,0,0.14\n");
+  char text[2048];
+  snprintf(text, sizeof text,
+           "{\"name\":\"t\",\"controllers\":["
+           "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:%s\","
+           "\"force_model\":\"instrument0.force_model\"}},"
+           "{\"name\":\"thread\",\"type\":\"test.thread\",\"rate_hz\":100},"
+           "{\"name\":\"instruments\",\"type\":\"physics.instruments\",\"rate_hz\":1000,\"params\":{"
+           "\"instrument0\":\"thumb_forceps\",\"thread\":\"thread\",\"gravity_m_s2\":0}},"
+           "{\"name\":\"listener\",\"type\":\"test.listener\",\"rate_hz\":1000}]}",
+           path);
+  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 1.8);
+  unlink(path);
+  print_message("  %d events: grasps %g, cuts %g\n", the_listener.n, result(s, "instruments.thread_grasps"),
+                result(s, "instruments.thread_cuts"));
+  assert_int_equal(the_listener.n, 2);
+  const tx_event* g = &the_listener.got[0];
+  print_message("  grasp by %u at (%.4f, %.4f, %.4f) m, jaws %.4f rad; then kind %u\n", g->source, g->grasp.point[0],
+                g->grasp.point[1], g->grasp.point[2], g->grasp.jaw, the_listener.got[1].kind);
+  assert_int_equal(g->kind, TX_EVENT_GRASP);
+  assert_int_equal(g->source, 0);
+  assert_true(fabs(g->grasp.point[0] - 0.02) < 1e-9 && fabs(g->grasp.point[2] - 0.0012) < 5e-4);
+  assert_int_equal(the_listener.got[1].kind, TX_EVENT_RELEASE);
+  assert_int_equal(the_listener.got[1].source, 0);
+  assert_true(result(s, "instruments.thread_grasps") == 1 && result(s, "instruments.thread_cuts") == 0);
+  tx_scenario_free(s);
+}
+
 // The needle pierces the skin: the needle holder holds a 3/8-circle needle
 // 30 mm long (R = 12.7 mm) from the start, its arc vertical and curving
 // down; the hand lowers it from 7 cm until the circle's centre is 5.5 mm above the
@@ -298,6 +341,7 @@ int main(void) {
       cmocka_unit_test(test_refuses_what_it_cannot_read),
       cmocka_unit_test(test_needle_is_published),
       cmocka_unit_test(test_scissors_cut_the_thread),
+      cmocka_unit_test(test_forceps_grasp_the_thread),
       cmocka_unit_test(test_needle_punctures_the_skin),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
