@@ -31,6 +31,7 @@ int tx_study_skin_stability(const tx_study_args* a);
 int tx_study_skin_accuracy(const tx_study_args* a);
 int tx_study_skin_membrane(const tx_study_args* a);
 int tx_study_instruments_stability(const tx_study_args* a);
+int tx_study_needle_puncture(const tx_study_args* a);
 int tx_study_organ_hemisphere(const tx_study_args* a);
 int tx_study_organ_stability(const tx_study_args* a);
 int tx_study_thread_accuracy(const tx_study_args* a);

@@ -40,6 +40,8 @@ static const struct {
      "the skin against closed-form membranes (disc load, own weight), rupture under refinement, gravity sag"},
     {"instruments-stability", tx_study_instruments_stability,
      "virtual coupling stiffness bound at 1 kHz vs haptic-stability's; a 10 m/s hand, slammed jaws, a squeezed needle"},
+    {"needle-puncture", tx_study_needle_puncture,
+     "the curved needle's tip through physics.skin: force along the needle against depth, the puncture force"},
     {"skin-accuracy", tx_study_skin_accuracy,
      "spacing, iterations and step refined together: observed order, Richardson reference, error vs CPU time"},
     {"organ-hemisphere", tx_study_organ_hemisphere,

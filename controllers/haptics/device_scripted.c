@@ -4,6 +4,10 @@
 // "insert" of the needle-insertion scenario;
 // "scripted:FILE.csv" plays a waypoint file, one row per waypoint:
 //   t_s, x_m, y_m, z_m [, qw, qx, qy, qz] [, grip_rad]
+// A relative FILE that is not there from the working folder is looked up on
+// the scenario search path ($TACTUS_SCENARIO_PATH, then the source tree's
+// scenarios/), where a scenario keeps its files beside its JSON:
+// "scripted:instruments/hand0.csv" is scenarios/instruments/hand0.csv.
 // Rows are interpolated linearly (orientation by normalised lerp); after the
 // last row the device holds still. Lines starting with '#' and a first line
 // of column names are skipped. Forces written to it are ignored.
@@ -12,7 +16,14 @@
 #include "../../model/error.h"
 #include "device_scripted.h"
 
+#if defined(__has_include) // the fuzzer builds this file alone, without the generated config
+#if __has_include(<tactus/config.h>)
+#include <tactus/config.h> // TX_SCENARIO_DIR
+#endif
+#endif
+
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -165,7 +176,19 @@ static tx_device* open_scripted(const char* arg, double period_s) {
   size_t len = strlen(arg);
   if (len > 4 && strcmp(arg + len - 4, ".csv") == 0) {
     FILE* f = fopen(arg, "r");
-    if (!f) return tx_set_error("%s: %s", arg, strerror(errno)), NULL;
+    int err = errno;
+    char path[PATH_MAX];
+    const char* env = getenv("TACTUS_SCENARIO_PATH");
+    for (const char* dir = env; !f && arg[0] != '/' && dir && *dir;) { // the scenario search path, in order
+      size_t n = strcspn(dir, ":");
+      if (n > 0 && snprintf(path, sizeof path, "%.*s/%s", (int)n, dir, arg) < (int)sizeof path) f = fopen(path, "r");
+      dir += n + (dir[n] == ':');
+    }
+#ifdef TX_SCENARIO_DIR
+    if (!f && arg[0] != '/' && snprintf(path, sizeof path, "%s/%s", TX_SCENARIO_DIR, arg) < (int)sizeof path)
+      f = fopen(path, "r");
+#endif
+    if (!f) return tx_set_error("%s: %s", arg, strerror(err)), NULL;
     tx_device* d = tx_scripted_read_csv(f, arg);
     fclose(f);
     return d;

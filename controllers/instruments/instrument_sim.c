@@ -42,10 +42,16 @@ struct tx_instrument_world {
   dBodyID needle; // NULL without a needle
   double needle_com[3]; // in the needle frame
   dJointID hold; // the needle's fixed joint to its holder, or NULL
+  dJointID foam; // its fixed joint to the world while it stands in foam, or NULL
   int held_by, grasps, releases;
   double grasp_point[3]; // the mean contact point of the last grasp
   double hold_angle[TX_INSTRUMENT_LINKS_MAX]; // the holder's jaw angles when it took the needle
   double pull[3]; // N at the swage, this step
+  double tip_f[3], tip_x[3], tip_n[3], tip_k; // the skin's contact on the tip (tx_instrument_world_needle_tip_contact)
+  double tip_force[3]; // what it put on the tip in the last step
+  double pin[TX_NEEDLE_PINS_MAX][3]; // puncture points, world
+  int npins;
+  double needle_mass;
   double depth; // deepest contact of the last step, m
 };
 
@@ -67,7 +73,10 @@ tx_needle_params tx_needle_defaults(void) {
                             .wire_diameter = 0.0006,
                             .arc = 0.75 * M_PI,
                             .pos = {0.03, -0.05 + 0.0003, 0},
-                            .quat = {M_SQRT1_2, -M_SQRT1_2, 0, 0}}; // arc plane flat on the table, normal up
+                            .quat = {M_SQRT1_2, -M_SQRT1_2, 0, 0}, // arc plane flat on the table, normal up
+                            .held_by = -1,
+                            .grasp_distance = 0.03,
+                            .grasp_angle = 0.2};
 }
 
 tx_instrument_sim_params tx_instrument_sim_defaults(void) {
@@ -81,7 +90,10 @@ tx_instrument_sim_params tx_instrument_sim_defaults(void) {
                                     .table_height = -0.05,
                                     .friction = 0.5,
                                     .erp = 0.2,
-                                    .cfm = 1e-7};
+                                    .cfm = 1e-7,
+                                    .pin_stiffness = 200,
+                                    .pin_damping = 0.1,
+                                    .pin_friction = 0.02};
 }
 
 // ---- poses: position and unit quaternion (w, x, y, z)
@@ -292,6 +304,7 @@ static void needle_build(tx_instrument_world* w) {
   const tx_needle_params* n = &w->p.needle;
   double m, I[6];
   tx_needle_mass(n, &m, w->needle_com, I);
+  w->needle_mass = m;
   w->needle = dBodyCreate(w->world);
   dMass dm;
   dMassSetParameters(&dm, m, 0, 0, 0, I[0], I[3], I[5], I[1], I[2], I[4]);
@@ -341,7 +354,26 @@ tx_instrument_world* tx_instrument_world_create(const tx_instrument_sim_params* 
   dCreatePlane(w->space, 0, 1, 0, p->table_height);
   w->n = n;
   w->held_by = -1;
+  tx_needle_params* nd = &w->p.needle;
+  if (nd->enabled && nd->held_by >= n) {
+    tx_instrument_world_destroy(w);
+    return tx_set_error("the needle is held by instrument %d of %d", nd->held_by, n), NULL;
+  }
+  if (nd->enabled && nd->held_by >= 0) { // in the jaws: the arc's point at grasp_angle on the root's x axis
+    double phi = nd->grasp_angle;
+    const double* s = start[nd->held_by];
+    nd->pos[0] = s[0] + nd->grasp_distance - nd->radius, nd->pos[1] = s[1], nd->pos[2] = s[2];
+    nd->quat[0] = cos(-phi / 2), nd->quat[1] = nd->quat[2] = 0, nd->quat[3] = sin(-phi / 2);
+  }
+  if (nd->enabled && nd->foam && nd->held_by < 0) {
+    nd->quat[0] = cos(-nd->grasp_angle / 2), nd->quat[1] = nd->quat[2] = 0, nd->quat[3] = sin(-nd->grasp_angle / 2);
+  }
   if (p->needle.enabled) needle_build(w);
+  if (nd->enabled && nd->foam && nd->held_by < 0) { // the foam holds it where it stands
+    w->foam = dJointCreateFixed(w->world, 0);
+    dJointAttach(w->foam, w->needle, 0);
+    dJointSetFixed(w->foam);
+  }
   for (int i = 0; i < n; i++) {
     w->ins[i].urdf = urdfs[i];
     memcpy(w->ins[i].start, start[i], sizeof w->ins[i].start);
@@ -349,6 +381,16 @@ tx_instrument_world* tx_instrument_world_create(const tx_instrument_sim_params* 
       tx_instrument_world_destroy(w);
       return NULL;
     }
+  }
+  if (nd->enabled && nd->held_by >= 0) { // held as a grasp holds it, the jaws on the wire (not counted as a grasp)
+    instrument* in = &w->ins[nd->held_by];
+    w->hold = dJointCreateFixed(w->world, 0);
+    dJointAttach(w->hold, w->needle, in->body[0]);
+    dJointSetFixed(w->hold);
+    w->held_by = nd->held_by;
+    in->was_on = true;
+    for (int j = 0; j < in->urdf->njoints; j++)
+      w->hold_angle[j] = in->urdf->joints[j].fixed ? 0 : asin(fmin(1, nd->wire_diameter / 2 / nd->grasp_distance));
   }
   return w;
 }
@@ -477,6 +519,7 @@ static void needle_grasp(tx_instrument_world* w) {
     in->was_on = on;
     if (i == w->held_by || !came_on || !closing(in)) continue;
     if (w->hold) dJointDestroy(w->hold); // handed over: no release event, the needle stays held
+    if (w->foam) dJointDestroy(w->foam), w->foam = NULL; // taken out of the foam
     w->hold = dJointCreateFixed(w->world, 0);
     dJointAttach(w->hold, w->needle, in->body[0]);
     dJointSetFixed(w->hold);
@@ -499,6 +542,85 @@ static bool finite_state(const instrument* in) {
   return true;
 }
 
+// the skin's force on the tip: f + k n n^T (x - tip) about where the skin
+// held it, never a pull. Explicit at the world's step, so k is capped where
+// it would be unstable on what the tip moves (the needle alone, or its holder's root too)
+static void tip_push(tx_instrument_world* w, double dt) {
+  memset(w->tip_force, 0, sizeof w->tip_force);
+  double f0n = w->tip_f[0] * w->tip_n[0] + w->tip_f[1] * w->tip_n[1] + w->tip_f[2] * w->tip_n[2];
+  if (!(f0n > 0)) return;
+  double tip[3], m = w->needle_mass;
+  tx_instrument_world_needle_tip(w, tip);
+  if (w->held_by >= 0) {
+    dMass hm;
+    dBodyGetMass(w->ins[w->held_by].body[0], &hm);
+    m += hm.mass;
+  }
+  double k = fmin(w->tip_k, m / (dt * dt));
+  double d = 0;
+  for (int c = 0; c < 3; c++) d += w->tip_n[c] * (w->tip_x[c] - tip[c]);
+  // along n the force is |f0| + k d, never below zero; across n it stays f0's
+  double along = fmax(0, f0n + k * d);
+  for (int c = 0; c < 3; c++) w->tip_force[c] = w->tip_f[c] + (along - f0n) * w->tip_n[c];
+  dBodyAddForceAtPos(w->needle, w->tip_force[0], w->tip_force[1], w->tip_force[2], tip[0], tip[1], tip[2]);
+}
+
+// a pin in the needle frame: the arc's angle nearest it, that point, the
+// arc's tangent there, and the pin's offset from the arc across it
+static double pin_locate(const tx_instrument_world* w, int i, double c[3], double t[3], double e[3]) {
+  double o[3], q[4], d[3], r[3];
+  tx_instrument_world_needle(w, o, q);
+  for (int k = 0; k < 3; k++) d[k] = w->pin[i][k] - o[k];
+  double qc[4] = {q[0], -q[1], -q[2], -q[3]};
+  qrot(qc, d, r);
+  double R = w->p.needle.radius, arc = w->p.needle.arc;
+  double phi = atan2(r[1], r[0]);
+  if (phi < -(2 * M_PI - arc) / 2) phi += 2 * M_PI; // the gap's middle splits the angles
+  double cn[3] = {R * cos(phi), R * sin(phi), 0}, tn[3] = {-sin(phi), cos(phi), 0}, en[3];
+  double along = 0;
+  for (int k = 0; k < 3; k++) en[k] = r[k] - cn[k], along += en[k] * tn[k];
+  for (int k = 0; k < 3; k++) en[k] -= along * tn[k];
+  double cw[3];
+  qrot(q, cn, cw);
+  for (int k = 0; k < 3; k++) c[k] = o[k] + cw[k];
+  qrot(q, tn, t);
+  qrot(q, en, e);
+  return phi;
+}
+
+// the arc held on a pin: one contact joint at the arc's nearest point, its
+// normal towards the pin across the arc, as deep as the pin is off the arc.
+// Its soft ERP and CFM make it the spring-damper (k, c) solved with the step
+// (the needle alone weighs 40 mg: an explicit 200 N/m spring at 1 kHz would
+// be unstable on it); its friction rows, without ODE's Approx1, are bounded by
+// pin_friction in newtons whatever the normal force: the sliding along the arc
+static void pin_hold(tx_instrument_world* w, int i, double dt) {
+  double c[3], t[3], e[3];
+  double phi = pin_locate(w, i, c, t, e);
+  if (phi < 0 || phi > w->p.needle.arc) return; // the needle is not through it
+  double gap = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+  dContact ct = {0};
+  ct.surface.mode = dContactSoftERP | dContactSoftCFM | dContactFDir1;
+  ct.surface.mu = w->p.pin_friction;
+  double hk = dt * w->p.pin_stiffness, den = hk + w->p.pin_damping;
+  if (!(den > 0)) return;
+  ct.surface.soft_erp = hk / den;
+  ct.surface.soft_cfm = 1 / den;
+  double n[3];
+  if (gap > 1e-12) for (int k = 0; k < 3; k++) n[k] = e[k] / gap;
+  else { // on the arc: any direction across it; the one towards the centre
+    double o[3], q[4];
+    tx_instrument_world_needle(w, o, q);
+    double r = 0;
+    for (int k = 0; k < 3; k++) n[k] = o[k] - c[k], r += n[k] * n[k];
+    for (int k = 0; k < 3; k++) n[k] /= sqrt(r);
+  }
+  for (int k = 0; k < 3; k++) ct.geom.pos[k] = c[k], ct.geom.normal[k] = n[k], ct.fdir1[k] = t[k];
+  ct.geom.depth = gap;
+  dJointID j = dJointCreateContact(w->world, w->contacts, &ct);
+  dJointAttach(j, w->needle, 0);
+}
+
 void tx_instrument_world_step(tx_instrument_world* w, const tx_instrument_input* in, double dt) {
   for (int i = 0; i < w->n; i++) {
     couple(w, &w->ins[i], &in[i]);
@@ -516,6 +638,8 @@ void tx_instrument_world_step(tx_instrument_world* w, const tx_instrument_input*
     tx_instrument_world_needle_swage(w, sp, sq);
     dBodyAddForceAtPos(w->needle, w->pull[0], w->pull[1], w->pull[2], sp[0], sp[1], sp[2]);
     memset(w->pull, 0, sizeof w->pull);
+    tip_push(w, dt);
+    for (int i = 0; i < w->npins; i++) pin_hold(w, i, dt);
   }
   dSpaceCollide(w->space, w, near);
   dWorldStep(w->world, dt);
@@ -536,6 +660,7 @@ void tx_instrument_world_step(tx_instrument_world* w, const tx_instrument_input*
     if (!isfinite(np[0] + np[1] + np[2] + nv[0] + nv[1] + nv[2])) {
       if (w->hold) dJointDestroy(w->hold), w->hold = NULL, w->held_by = -1, w->releases++;
       needle_place(w);
+      w->npins = 0; // put back on the table: out of the skin
       w->resets++;
     }
   }
@@ -573,4 +698,36 @@ void tx_instrument_world_needle_pull(tx_instrument_world* w, const double f[3]) 
 }
 void tx_instrument_world_needle_grasp_point(const tx_instrument_world* w, double p[3]) {
   memcpy(p, w->grasp_point, 3 * sizeof *p);
+}
+
+void tx_instrument_world_needle_tip_contact(tx_instrument_world* w, const double f[3], const double x[3], const double n[3],
+                                            double k) {
+  bool ok = isfinite(k) && k >= 0;
+  for (int c = 0; c < 3; c++) ok = ok && isfinite(f[c]) && isfinite(x[c]) && isfinite(n[c]);
+  for (int c = 0; c < 3; c++) { // what is not finite lets go of the tip
+    w->tip_f[c] = ok ? f[c] : 0, w->tip_x[c] = ok ? x[c] : 0, w->tip_n[c] = ok ? n[c] : 0;
+  }
+  w->tip_k = ok ? k : 0;
+}
+void tx_instrument_world_needle_tip_force(const tx_instrument_world* w, double f[3]) {
+  memcpy(f, w->tip_force, 3 * sizeof *f);
+}
+
+int tx_instrument_world_needle_pin(tx_instrument_world* w, const double point[3]) {
+  if (!w->needle || w->npins >= TX_NEEDLE_PINS_MAX) return -1;
+  for (int k = 0; k < 3; k++)
+    if (!isfinite(point[k])) return -1;
+  memcpy(w->pin[w->npins], point, sizeof w->pin[0]);
+  return w->npins++;
+}
+void tx_instrument_world_needle_pin_move(tx_instrument_world* w, int i, const double point[3]) {
+  if (i < 0 || i >= w->npins || !isfinite(point[0] + point[1] + point[2])) return;
+  memcpy(w->pin[i], point, sizeof w->pin[0]);
+}
+int tx_instrument_world_needle_pins(const tx_instrument_world* w) { return w->npins; }
+double tx_instrument_world_needle_pin_gap(const tx_instrument_world* w, int i, double* angle) {
+  double c[3], t[3], e[3];
+  double phi = pin_locate(w, i, c, t, e);
+  if (angle) *angle = phi;
+  return sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
 }

@@ -28,6 +28,18 @@ typedef struct tx_needle_params {
   double wire_diameter; // m
   double arc; // rad: 3/8 circle = 0.75 pi, 1/2 circle = pi
   double pos[3], quat[4]; // where its frame starts, in the world
+  // held_by >= 0: it starts in that instrument's closed jaws instead (pos and
+  // quat are then ignored): the wire across them grasp_distance ahead of the
+  // pivot, at grasp_angle along the arc from the swage, the arc in the root's
+  // x-y plane curving towards the root's +y; held as a grasp holds it
+  int held_by;
+  double grasp_distance; // m
+  double grasp_angle; // rad
+  // foam: it stands in a block of foam, held still at pos until jaws take it:
+  // its arc upright in the world's x-y plane, turned so that the point at
+  // grasp_angle from the swage lies at pos + (radius, 0, 0) with the wire
+  // there along y, across jaws that come along +x (quat is then ignored)
+  bool foam;
 } tx_needle_params;
 
 // the default: a 3/8-circle reverse-cutting skin needle 19 mm long (the
@@ -45,6 +57,13 @@ typedef struct tx_instrument_sim_params {
   double friction; // Coulomb coefficient of every contact
   double erp, cfm; // ODE's error reduction and constraint force mixing
   tx_needle_params needle;
+  // where the needle has pierced the skin (pins): a spring-damper holds its
+  // arc on each puncture point across the arc, and a friction force of at
+  // most pin_friction resists its sliding along the arc
+  double pin_stiffness; // N/m, across the arc
+  double pin_damping; // N s/m, across the arc
+  double pin_friction; // N, along the arc
+
 } tx_instrument_sim_params;
 
 tx_instrument_sim_params tx_instrument_sim_defaults(void);
@@ -104,6 +123,31 @@ int tx_instrument_world_needle_releases(const tx_instrument_world* w);
 void tx_instrument_world_needle_grasp_point(const tx_instrument_world* w, double p[3]);
 // a force (N) on the needle at its swage end during the next step (the thread's pull)
 void tx_instrument_world_needle_pull(tx_instrument_world* w, const double f[3]);
+
+// The tip's HIP against the skin: the skin's force on the tip (N), where the
+// skin's contact holds it (m), its direction and its tangent stiffness k
+// (N/m) along it, as the skin last published them (tx_skin_contact). Each
+// step until the next call the tip feels f + k n n^T (x - tip), never a
+// pull: the skin's spring about where it held the tip, at the world's rate.
+// A zero f lets go of the tip.
+void tx_instrument_world_needle_tip_contact(tx_instrument_world* w, const double f[3], const double x[3], const double n[3],
+                                            double k);
+// the force the skin put on the tip in the last step (N)
+void tx_instrument_world_needle_tip_force(const tx_instrument_world* w, double f[3]);
+
+// Punctures: points the needle's arc passes through. Pin a point (world, m):
+// its index, or -1 when TX_NEEDLE_PINS_MAX are pinned. Move it where the
+// skin carries it. While the point lies within the arc's angles, the arc is
+// held on it across the arc (pin_stiffness, pin_damping) and slides along it
+// against at most pin_friction; past the swage or the tip it holds nothing.
+#define TX_NEEDLE_PINS_MAX 16
+int tx_instrument_world_needle_pin(tx_instrument_world* w, const double point[3]);
+void tx_instrument_world_needle_pin_move(tx_instrument_world* w, int pin, const double point[3]);
+int tx_instrument_world_needle_pins(const tx_instrument_world* w);
+// a pin's distance from the arc across it (m), and the arc's angle at the
+// point nearest it (rad from the swage; outside [0, arc] when it holds nothing)
+double tx_instrument_world_needle_pin_gap(const tx_instrument_world* w, int pin, double* angle);
+
 // the needle's mass (kg) and inertia about its centre of mass, in its frame (ixx ixy ixz iyy iyz izz)
 void tx_needle_mass(const tx_needle_params* n, double* mass, double com[3], double inertia[6]);
 

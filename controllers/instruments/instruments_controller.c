@@ -5,6 +5,8 @@
 
 #include "instrument_desc.h"
 #include "instrument_sim.h"
+#include "cut.h"
+#include "puncture.h"
 
 #include <tactus/components.h>
 #include <tactus/config.h>
@@ -14,6 +16,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#define TX_THREAD_RELEASE_RAD 0.02 // jaws this much wider than closed let the thread go
 
 typedef struct instruments {
   tx_instrument_sim_params p;
@@ -28,6 +32,26 @@ typedef struct instruments {
   int grasps_seen, releases_seen, last_holder;
   int bad_seen, resets_seen, contacts_most;
   double force_most;
+  // the skin the needle's tip pierces (SKIN.x, SKIN.tri, SKIN.contact)
+  bool skin;
+  tx_port skin_x, skin_tri, skin_contact, needle_tip, punctures;
+  tx_result npunct;
+  uint64_t contact_seq;
+  tx_puncture_tracker tracker;
+  tx_puncture rows[TX_NEEDLE_PINS_MAX];
+  int32_t pin_verts[TX_NEEDLE_PINS_MAX][3]; // the particles that carry each puncture point
+  double pin_offset[TX_NEEDLE_PINS_MAX][3]; // from the skin's point to the pin: the tip where it tore through
+  int npins;
+  // the thread the scissors cut (THREAD.nodes)
+  tx_port thread_nodes;
+  tx_result cuts;
+  int ncuts;
+  bool scissors[TX_INSTRUMENTS_MAX];
+  double blade_length[TX_INSTRUMENTS_MAX], blade_reach[TX_INSTRUMENTS_MAX];
+  tx_blades blades[TX_INSTRUMENTS_MAX];
+  bool holds_thread[TX_INSTRUMENTS_MAX]; // jaws closed on the thread (not scissors)
+  tx_result thread_grasps;
+  int nthread_grasps;
 } instruments;
 
 static const tx_param_def params[] = {
@@ -50,8 +74,28 @@ static const tx_param_def params[] = {
     {"needle_circle", TX_PARAM_NUM, "1", 0.25, 0.625, 0.375, NULL, "the needle's arc as a fraction of a circle: 3/8 or 1/2"},
     {"needle_length_m", TX_PARAM_NUM, "m", 0.003, 0.1, 0.019, NULL, "the needle's length along its arc"},
     {"needle_wire_diameter_m", TX_PARAM_NUM, "m", 5e-5, 0.003, 0.0006, NULL, "the needle's wire diameter"},
-    {"needle_x_m", TX_PARAM_NUM, "m", -10, 10, 0.03, NULL, "where its circle's centre lies on the table, x"},
-    {"needle_z_m", TX_PARAM_NUM, "m", -10, 10, 0, NULL, "where its circle's centre lies on the table, z"},
+    {"needle_x_m", TX_PARAM_NUM, "m", -10, 10, 0.03, NULL, "its circle's centre on the table (or in foam), x"},
+    {"needle_z_m", TX_PARAM_NUM, "m", -10, 10, 0, NULL, "its circle's centre on the table (or in foam), z"},
+    {"needle_in_jaws", TX_PARAM_INT, "1", -1, 1, -1, NULL,
+     "-1: the needle starts on the table; N: it starts held in instrumentN's jaws (then needle_x_m, needle_z_m are unused)"},
+    {"needle_grasp_m", TX_PARAM_NUM, "m", 0.005, 0.1, 0.03, NULL, "held from the start: the wire this far ahead of the jaws' pivot"},
+    {"needle_grasp_rad", TX_PARAM_NUM, "rad", 0, 3.9, 0.2, NULL,
+     "held from the start: at this angle along the arc from the swage; the arc curves towards the root's +y"},
+    {"needle_foam", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL,
+     "the needle stands upright in foam, still until jaws take it: its arc in the x-y plane, its point needle_grasp_rad from the swage one radius along +x from its centre"},
+    {"needle_y_m", TX_PARAM_NUM, "m", -10, 10, 0, NULL, "in foam: its circle's centre's height"},
+    {"skin", TX_PARAM_STR, NULL, 0, 0, 0, "",
+     "the skin the needle's tip pierces: reads SKIN.x, SKIN.tri, SKIN.contact (physics.skin with pose needle.tip); \"\": none"},
+    {"thread", TX_PARAM_STR, NULL, 0, 0, 0, "",
+     "the thread the scissors cut and other jaws grasp: reads THREAD.nodes; \"\": none"},
+    {"puncture_separation_m", TX_PARAM_NUM, "m", 0, 0.1, 0.003, NULL,
+     "a tear nearer than this to the last puncture is that puncture's tear running on"},
+    {"puncture_min_force_n", TX_PARAM_NUM, "N", 0, 100, 0.05, NULL,
+     "a tear is a puncture only after the tip pushed the skin this hard (not a torn flap flicking it)"},
+    {"pin_stiffness", TX_PARAM_NUM, "N/m", 0, 1e5, 200, NULL,
+     "a puncture holds the needle's arc on its point across the arc with this spring"},
+    {"pin_damping", TX_PARAM_NUM, "N s/m", 0, 1e3, 0.1, NULL, "and this damper"},
+    {"pin_friction_n", TX_PARAM_NUM, "N", 0, 100, 0.02, NULL, "the most force a puncture puts against the needle sliding along its arc"},
 };
 
 // a bare name is a shipped instrument; anything else is a path
@@ -59,6 +103,58 @@ static void resolve(const char* given, char* path, size_t n) {
   size_t len = strlen(given);
   if (strchr(given, '/') || (len > 5 && strcmp(given + len - 5, ".urdf") == 0)) snprintf(path, n, "%s", given);
   else snprintf(path, n, "%s/instruments/%s.urdf", TX_ASSET_DIR, given);
+}
+
+// a scissors (its name says so) cuts with its jaws' parts ahead of the
+// pivot, other jaws grasp with them: their reach along the root's x from the
+// pivot and their half width across
+static void blades_of(instruments* m, int i) {
+  const tx_urdf* u = m->desc[i]->urdf;
+  m->scissors[i] = strstr(u->name, "scissors") != NULL;
+  m->blades[i] = (tx_blades){.open = 0.1, .closed = 0.03};
+  for (int j = 0; j < u->njoints; j++) {
+    if (u->joints[j].fixed) continue;
+    const tx_urdf_link* l = &u->links[u->joints[j].child];
+    for (int k = 0; k < l->nshapes; k++) {
+      const tx_urdf_shape* sh = &l->shapes[k];
+      if (sh->kind != TX_URDF_BOX || sh->pose.p[0] <= 0) continue;
+      m->blade_length[i] = fmax(m->blade_length[i], u->joints[j].origin.p[0] + sh->pose.p[0] + sh->size[0] / 2);
+      m->blade_reach[i] = fmax(m->blade_reach[i], fmax(sh->size[1], sh->size[2]) / 2);
+    }
+  }
+}
+
+// scissors closing on the thread cut it between their blades; other jaws
+// closing on it grasp it (until they open again)
+static void cut(tx_ctx* c, instruments* m, int i, double jaw) {
+  if (!m->thread_nodes.id) return;
+  if (m->holds_thread[i] && jaw > m->blades[i].closed + TX_THREAD_RELEASE_RAD) {
+    m->holds_thread[i] = false;
+    tx_emit(c, m->events, &(tx_event){.kind = TX_EVENT_RELEASE, .source = (uint32_t)i});
+  }
+  if (!tx_blades_close(&m->blades[i], jaw)) return;
+  if (!m->scissors[i] && m->p.needle.enabled && tx_instrument_world_needle_held_by(m->world) == i) return; // on the needle
+  tx_snapshot nodes = tx_read(c, m->thread_nodes);
+  if (!nodes.seq) return;
+  double pivot[3], q[4], dir[3], point[3];
+  tx_instrument_world_link(m->world, i, 0, pivot, q);
+  // the root's x axis: the closed blades
+  dir[0] = 1 - 2 * (q[2] * q[2] + q[3] * q[3]), dir[1] = 2 * (q[1] * q[2] + q[0] * q[3]), dir[2] = 2 * (q[1] * q[3] - q[0] * q[2]);
+  int seg = tx_scissors_cut(pivot, dir, m->blade_length[i], m->blade_reach[i], nodes.data, (int)nodes.rows, point);
+  if (seg < 0) return;
+  if (!m->scissors[i]) { // a grasp of the thread: its point is on the thread, between the jaws
+    tx_event e = {.kind = TX_EVENT_GRASP, .source = (uint32_t)i};
+    memcpy(e.grasp.point, point, sizeof point);
+    e.grasp.jaw = jaw;
+    tx_emit(c, m->events, &e);
+    m->holds_thread[i] = true;
+    m->nthread_grasps++;
+    return;
+  }
+  tx_event e = {.kind = TX_EVENT_CUT, .source = (uint32_t)seg};
+  memcpy(e.cut.point, point, sizeof point);
+  tx_emit(c, m->events, &e);
+  m->ncuts++;
 }
 
 static int configure(tx_setup* s, void** self) {
@@ -85,6 +181,32 @@ static int configure(tx_setup* s, void** self) {
   nd->pos[0] = tx_table_num(s, "needle_x_m");
   nd->pos[1] = m->p.table_height + nd->wire_diameter / 2;
   nd->pos[2] = tx_table_num(s, "needle_z_m");
+  nd->held_by = (int)tx_table_int(s, "needle_in_jaws");
+  nd->foam = tx_table_bool(s, "needle_foam");
+  if (nd->foam) nd->pos[1] = tx_table_num(s, "needle_y_m");
+  if (nd->foam && nd->held_by >= 0) return tx_setup_fail(s, "needle_foam", "the needle starts in the jaws (needle_in_jaws)");
+  if (nd->foam && !nd->enabled) return tx_setup_fail(s, "needle_foam", "no needle (needle: true)");
+  nd->grasp_distance = tx_table_num(s, "needle_grasp_m");
+  nd->grasp_angle = tx_table_num(s, "needle_grasp_rad");
+  if (nd->held_by >= 0 && !nd->enabled) return tx_setup_fail(s, "needle_in_jaws", "no needle to hold (needle: true)");
+  if (nd->grasp_angle > nd->arc) return tx_setup_fail(s, "needle_grasp_rad", "past the needle's tip (its arc is %g rad)", nd->arc);
+  m->p.pin_stiffness = tx_table_num(s, "pin_stiffness");
+  m->p.pin_damping = tx_table_num(s, "pin_damping");
+  m->p.pin_friction = tx_table_num(s, "pin_friction_n");
+  const char* skin = tx_table_str(s, "skin");
+  if (!skin) return -1;
+  if (*skin && !nd->enabled) return tx_setup_fail(s, "skin", "a skin to pierce needs the needle (needle: true)");
+  if (*skin) {
+    char name[TX_NAME_MAX];
+    m->skin = true;
+    snprintf(name, sizeof name, "%s.x", skin);
+    m->skin_x = TX_READ_OF(s, name, tx_vertex);
+    snprintf(name, sizeof name, "%s.tri", skin);
+    m->skin_tri = TX_READ_OF(s, name, tx_triangle);
+    snprintf(name, sizeof name, "%s.contact", skin);
+    m->skin_contact = TX_READ_OF(s, name, tx_skin_contact);
+    tx_puncture_tracker_init(&m->tracker, tx_table_num(s, "puncture_separation_m"), tx_table_num(s, "puncture_min_force_n"), 0);
+  }
   for (int i = 0; i < TX_INSTRUMENTS_MAX; i++) {
     char key[32], path[2048], name[TX_NAME_MAX];
     snprintf(key, sizeof key, "instrument%d", i);
@@ -111,12 +233,27 @@ static int configure(tx_setup* s, void** self) {
     m->model[i] = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_force_model, 1));
   }
   if (m->n == 0) return tx_setup_fail(s, "instrument0", "no instrument: give instrument0");
+  if (nd->held_by >= m->n) return tx_setup_fail(s, "needle_in_jaws", "there is no instrument%d", nd->held_by);
+  const char* thread = tx_table_str(s, "thread");
+  if (!thread) return -1;
+  if (*thread) {
+    char name[TX_NAME_MAX];
+    snprintf(name, sizeof name, "%s.nodes", thread);
+    m->thread_nodes = TX_READ_OF(s, name, tx_thread_node);
+    m->cuts = tx_setup_result(s, "thread_cuts");
+    m->thread_grasps = tx_setup_result(s, "thread_grasps");
+    if (!nd->enabled) m->events = tx_setup_emit(s, "instruments.events", 64);
+  }
+  for (int i = 0; i < m->n; i++) blades_of(m, i);
   m->bad_input = tx_setup_warning(s, "device_not_finite");
   m->reset = tx_setup_warning(s, "reset");
   m->contacts_max = tx_setup_result(s, "contacts_max");
   if (nd->enabled) {
     m->needle_pose = tx_setup_write(s, &TX_COMPONENT_OF("needle.pose", tx_pose, 1));
     m->needle_swage = tx_setup_write(s, &TX_COMPONENT_OF("needle.swage", tx_pose, 1));
+    m->needle_tip = tx_setup_write(s, &TX_COMPONENT_OF("needle.tip", tx_pose, 1));
+    m->punctures = tx_setup_write(s, &TX_COMPONENT_OF("needle.punctures", tx_puncture, TX_NEEDLE_PINS_MAX));
+    m->npunct = tx_setup_result(s, "needle_punctures");
     m->events = tx_setup_emit(s, "instruments.events", 64);
     m->grasps = tx_setup_result(s, "needle_grasps");
     m->releases = tx_setup_result(s, "needle_releases");
@@ -139,12 +276,56 @@ static int init(tx_ctx* c, void* self) {
     for (int k = 0; k < 3; k++)
       if (!isfinite(start[i][k])) start[i][k] = 0;
   }
+  m->npins = 0;
+  m->ncuts = m->nthread_grasps = 0;
+  for (int i = 0; i < m->n; i++) m->blades[i].armed = 0, m->holds_thread[i] = false;
+  m->contact_seq = 0;
+  for (int i = 0; i < TX_NEEDLE_PINS_MAX; i++) m->rows[i] = (tx_puncture){.triangle = -1};
+  tx_puncture_tracker_init(&m->tracker, m->tracker.separation, m->tracker.min_force, 0);
   m->world = tx_instrument_world_create(&m->p, urdfs, m->n, (const double(*)[3])start);
   if (!m->world) {
     tx_stop_run(c, "physics.instruments: %s", tx_error());
     return -1;
   }
   return 0;
+}
+
+// the skin against the tip: its contact pushes the tip; each puncture it
+// tears pins the needle's arc there, is an event and a row of needle.punctures
+static void pierce(tx_ctx* c, instruments* m) {
+  tx_snapshot ct = tx_read(c, m->skin_contact), x = tx_read(c, m->skin_x), tri = tx_read(c, m->skin_tri);
+  if (!ct.seq || !x.seq) return;
+  const tx_skin_contact* sc = ct.data;
+  const float* xs = x.data;
+  double zero[3] = {0};
+  if (sc->touching > 0) tx_instrument_world_needle_tip_contact(m->world, sc->f, sc->x, sc->n, sc->k);
+  else tx_instrument_world_needle_tip_contact(m->world, zero, zero, zero, 0);
+  for (int i = 0; i < m->npins; i++) { // the points move with the skin
+    double p[3] = {0};
+    for (int v = 0; v < 3; v++)
+      for (int k = 0; k < 3; k++)
+        if (m->pin_verts[i][v] < (int32_t)x.rows) p[k] += m->rows[i].bary[v] * xs[3 * m->pin_verts[i][v] + k];
+    for (int k = 0; k < 3; k++) p[k] += m->pin_offset[i][k];
+    tx_instrument_world_needle_pin_move(m->world, i, p);
+  }
+  if (ct.seq == m->contact_seq) return; // one look at each of the skin's publishes
+  m->contact_seq = ct.seq;
+  tx_puncture_found f;
+  if (!tri.seq || !tx_puncture_update(&m->tracker, sc, xs, (int)x.rows, tri.data, (int)tri.rows, &f)) return;
+  // the pin starts at the tip, which is on the arc (the hole's rim, where the
+  // triangle's point is, lies a few millimetres off it), and moves with the skin's point
+  double tip[3];
+  tx_instrument_world_needle_tip(m->world, tip);
+  if (m->npins >= TX_NEEDLE_PINS_MAX || tx_instrument_world_needle_pin(m->world, tip) < 0) return;
+  for (int k = 0; k < 3; k++) m->pin_offset[m->npins][k] = tip[k] - f.point[k];
+  m->rows[m->npins] = f.row;
+  memcpy(m->pin_verts[m->npins], f.verts, sizeof f.verts);
+  m->npins++;
+  tx_event e = {.kind = TX_EVENT_PUNCTURE, .source = (uint32_t)f.row.triangle};
+  memcpy(e.puncture.point, f.point, sizeof f.point);
+  e.puncture.force = f.force;
+  e.puncture.depth = f.depth;
+  tx_emit(c, m->events, &e);
 }
 
 static void step(tx_ctx* c, void* self) {
@@ -163,6 +344,7 @@ static void step(tx_ctx* c, void* self) {
     if (v.seq) memcpy(in[i].vel, ((const tx_velocity*)v.data)->v, sizeof in[i].vel);
     in[i].grip = g.seq ? ((const tx_device_grip*)g.data)->grip : 0;
   }
+  if (m->skin) pierce(c, m);
   tx_instrument_world_step(m->world, in, 1.0 / tx_rate(c));
   if (tx_instrument_world_bad_inputs(m->world) > m->bad_seen) tx_warn(c, m->bad_input);
   if (tx_instrument_world_resets(m->world) > m->resets_seen) tx_warn(c, m->reset);
@@ -174,6 +356,10 @@ static void step(tx_ctx* c, void* self) {
     tx_instrument_world_needle(m->world, np->pos, np->quat);
     tx_pose* sw = tx_write(c, m->needle_swage);
     tx_instrument_world_needle_swage(m->world, sw->pos, sw->quat);
+    tx_pose* tip = tx_write(c, m->needle_tip);
+    tx_instrument_world_needle_tip(m->world, tip->pos);
+    memcpy(tip->quat, np->quat, sizeof tip->quat);
+    memcpy(tx_write(c, m->punctures), m->rows, sizeof m->rows);
     int held = tx_instrument_world_needle_held_by(m->world);
     if (tx_instrument_world_needle_grasps(m->world) > m->grasps_seen) {
       tx_event e = {.kind = TX_EVENT_GRASP, .source = (uint32_t)held};
@@ -197,6 +383,7 @@ static void step(tx_ctx* c, void* self) {
     memcpy(ip->quat, links[0].quat, sizeof ip->quat);
     ip->jaw = 0;
     for (int j = 0; j < u->njoints; j++) ip->jaw += tx_instrument_world_joint(m->world, i, j);
+    cut(c, m, i, ip->jaw);
     // F = f0 + K (x - x0) at the haptics rate: the coupling's spring about
     // where the hand was, unless the clamp holds it (then a constant)
     tx_force_model* fm = tx_write(c, m->model[i]);
@@ -216,10 +403,12 @@ static void finish(tx_ctx* c, void* self) {
   if (m->p.needle.enabled) {
     tx_set_result(c, m->grasps, m->grasps_seen);
     tx_set_result(c, m->releases, m->releases_seen);
+    tx_set_result(c, m->npunct, m->npins);
   }
   // the world goes on the thread that made and stepped it, with ODE's data for that thread
   tx_instrument_world_destroy(m->world);
   m->world = NULL;
+  if (m->thread_nodes.id) tx_set_result(c, m->cuts, m->ncuts), tx_set_result(c, m->thread_grasps, m->nthread_grasps);
   tx_set_result(c, m->contacts_max, m->contacts_most);
   tx_set_result(c, m->force_max, m->force_most);
 }

@@ -282,6 +282,9 @@ TX_LAYOUT_ASSERT(tx_puncture, double);
 //   INSTRUMENT.links (one row per URDF link, root first, tx_pose): each link frame
 //   INSTRUMENT.force_model (1 row, tx_force_model): the virtual coupling as the
 //     hand feels it, for the haptics controller to render (docs/instruments.md)
+// and, with the needle: needle.pose, needle.swage (tx_pose: its frame, its
+// swage end for the thread's head), needle.tip (tx_pose: the tip, the skin's
+// HIP when physics.skin's pose names it) and needle.punctures (tx_puncture)
 
 // --- gastric banding: the organs ---------------------------------------------
 

@@ -36,6 +36,7 @@ static const layout layouts[] = {
     L(".x", tx_vertex),                 L(".tri", tx_triangle),            L(".thickness", tx_thickness),
     L(".torn", tx_torn),                L(".damage", tx_damage),           L(".nodes", tx_thread_node),
     L(".pointer", tx_pointer),          L(".contact", tx_skin_contact),
+    L(".tip", tx_pose),                 L(".punctures", tx_puncture),
 };
 #undef L
 

@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "tests/temp_file.h"
@@ -154,10 +155,41 @@ static void bad_files_name_the_line(void** state) {
   assert_non_null(strstr(tx_error(), "unknown kind"));
 }
 
+// a relative waypoint file not in the working folder is found on the
+// scenario search path, beside its scenario's JSON
+static void relative_file_on_the_scenario_path(void** state) {
+  (void)state;
+  char dir[] = "/tmp/tx-scen-XXXXXX", sub[64], file[96], env[128];
+  assert_non_null(mkdtemp(dir));
+  snprintf(sub, sizeof sub, "%s/hands", dir);
+  assert_int_equal(mkdir(sub, 0700), 0);
+  snprintf(file, sizeof file, "%s/right.csv", sub);
+  FILE* f = fopen(file, "w");
+  assert_non_null(f);
+  fputs("0,0.01,0.02,0.03\n", f);
+  fclose(f);
+  snprintf(env, sizeof env, "/no/such/dir:%s", dir);
+  setenv("TACTUS_SCENARIO_PATH", env, 1);
+  tx_device_handle h;
+  assert_int_equal(tx_device_open("scripted:hands/right.csv", 1e-3, &h), 0);
+  tx_device_state st;
+  assert_true(h.backend->read(h.device, 0.5, &st));
+  assert_true(fabs(st.pos[0] - 0.01) < 1e-12 && fabs(st.pos[2] - 0.03) < 1e-12);
+  tx_device_close(&h);
+  // not there either: the error names the file as given
+  assert_int_equal(tx_device_open("scripted:hands/left.csv", 1e-3, &h), -1);
+  assert_non_null(strstr(tx_error(), "hands/left.csv: No such file"));
+  unsetenv("TACTUS_SCENARIO_PATH");
+  unlink(file);
+  rmdir(sub);
+  rmdir(dir);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(pierce_down_moves_down_through_the_skin),
       cmocka_unit_test(insert_goes_in_and_out_at_3_mm_per_s),
+      cmocka_unit_test(relative_file_on_the_scenario_path),
       cmocka_unit_test(every_named_motion_opens),
       cmocka_unit_test(one_table_of_hand_motions),
       cmocka_unit_test(waypoint_file_is_interpolated),

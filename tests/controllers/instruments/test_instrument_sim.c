@@ -423,6 +423,165 @@ static void test_needle_handover(void** state) {
   tx_instrument_desc_free(b);
 }
 
+// a needle that starts in the holder's jaws, weightless, the table away
+static tx_instrument_world* held_needle(tx_instrument_desc** d, tx_instrument_sim_params* p) {
+  *d = load("needle_holder");
+  *p = tx_instrument_sim_defaults();
+  memset(p->gravity, 0, sizeof p->gravity);
+  p->table_height = -1;
+  p->needle.enabled = true;
+  p->needle.held_by = 0;
+  const tx_urdf* u = (*d)->urdf;
+  double start[1][3] = {{0, 0, 0}};
+  tx_instrument_world* w = tx_instrument_world_create(p, &u, 1, start);
+  assert_non_null(w);
+  return w;
+}
+
+static double norm3(const double v[3]) { return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+
+// started in the jaws: held (no grasp counted), the wire across them where asked
+static void test_needle_starts_in_the_jaws(void** state) {
+  (void)state;
+  tx_instrument_desc* d;
+  tx_instrument_sim_params p;
+  tx_instrument_world* w = held_needle(&d, &p);
+  tx_instrument_input in = at(0, 0, 0, 0);
+  for (int i = 0; i < 300; i++) tx_instrument_world_step(w, &in, 1e-3);
+  assert_int_equal(tx_instrument_world_needle_held_by(w), 0);
+  assert_int_equal(tx_instrument_world_needle_grasps(w), 0);
+  double c[3], q[4], R = p.needle.radius;
+  tx_instrument_world_needle(w, c, q);
+  print_message("  needle centre (%.4f, %.4f, %.4f) mm, jaws at %.4f rad\n", 1e3 * c[0], 1e3 * c[1], 1e3 * c[2],
+                tx_instrument_world_joint(w, 0, 0));
+  assert_true(fabs(c[0] - (0.03 - R)) < 1e-4 && fabs(c[1]) < 1e-4 && fabs(c[2]) < 1e-4);
+  assert_true(tx_instrument_world_joint(w, 0, 0) > 0.005); // on the wire, not through it
+  tx_instrument_world_destroy(w);
+  tx_instrument_desc_free(d);
+}
+
+// the skin's push on the tip reaches the hand through the coupling
+static void test_tip_contact_reaches_the_hand(void** state) {
+  (void)state;
+  tx_instrument_desc* d;
+  tx_instrument_sim_params p;
+  tx_instrument_world* w = held_needle(&d, &p);
+  tx_instrument_input in = at(0, 0, 0, 0);
+  for (int i = 0; i < 200; i++) tx_instrument_world_step(w, &in, 1e-3);
+  double tip[3], f[3] = {0, 0.5, 0}, n[3] = {0, 1, 0}, hf[3], tf[3];
+  tx_instrument_world_needle_tip(w, tip);
+  tx_instrument_world_needle_tip_contact(w, f, tip, n, 0); // 0.5 N up, no stiffness
+  for (int i = 0; i < 1000; i++) tx_instrument_world_step(w, &in, 1e-3);
+  tx_instrument_world_hand_force(w, 0, hf);
+  tx_instrument_world_needle_tip_force(w, tf);
+  print_message("  0.5 N up on the tip: the hand feels (%.4f, %.4f, %.4f) N\n", hf[0], hf[1], hf[2]);
+  assert_true(fabs(tf[1] - 0.5) < 1e-12);
+  assert_true(fabs(hf[1] - 0.5) < 0.025 && fabs(hf[0]) < 0.025 && fabs(hf[2]) < 0.025);
+  // with a stiffness, pushed 1 mm further than where the skin held it, never pulled
+  double t2[3];
+  tx_instrument_world_needle_tip(w, t2);
+  double x[3] = {t2[0], t2[1] + 0.001, t2[2]};
+  tx_instrument_world_needle_tip_contact(w, f, x, n, 100); // 0.5 + 100 x 1 mm = 0.6 N
+  tx_instrument_world_step(w, &in, 1e-3);
+  tx_instrument_world_needle_tip_force(w, tf);
+  assert_true(fabs(tf[1] - 0.6) < 0.01);
+  double x2[3] = {t2[0], t2[1] - 0.01, t2[2]};
+  tx_instrument_world_needle_tip_contact(w, f, x2, n, 100); // 0.5 - 1 N: no pull
+  tx_instrument_world_step(w, &in, 1e-3);
+  tx_instrument_world_needle_tip_force(w, tf);
+  assert_true(norm3(tf) == 0);
+  tx_instrument_world_destroy(w);
+  tx_instrument_desc_free(d);
+}
+
+// a pinned needle (pierced at a point) slides along its arc through the
+// point with little force and resists being moved across its arc
+static void test_pinned_needle_slides_along_and_resists_across(void** state) {
+  (void)state;
+  tx_instrument_desc* d;
+  tx_instrument_sim_params p;
+  tx_instrument_world* w = held_needle(&d, &p);
+  tx_instrument_input in = at(0, 0, 0, 0);
+  for (int i = 0; i < 300; i++) tx_instrument_world_step(w, &in, 1e-3);
+  double o[3], q[4], R = p.needle.radius;
+  tx_instrument_world_needle(w, o, q);
+  // the point 1.2 rad along the arc from the swage: 1.0 rad in the world (the needle is turned by -0.2)
+  double pin[3] = {o[0] + R * cos(1.0), o[1] + R * sin(1.0), o[2]}, angle;
+  assert_int_equal(tx_instrument_world_needle_pin(w, pin), 0);
+  assert_true(tx_instrument_world_needle_pin_gap(w, 0, &angle) < 1e-4 && fabs(angle - 1.2) < 0.02);
+  // along: the hand turns the holder about the needle's centre by -0.5 rad in 1 s
+  double most_along = 0, most_gap = 0, p0[3] = {0, 0, 0};
+  for (int i = 1; i <= 1000; i++) {
+    double th = -0.5 * i / 1000, om = -0.5;
+    double r[3] = {p0[0] - o[0], p0[1] - o[1], 0};
+    in.pos[0] = o[0] + cos(th) * r[0] - sin(th) * r[1], in.pos[1] = o[1] + sin(th) * r[0] + cos(th) * r[1], in.pos[2] = 0;
+    in.vel[0] = -om * (in.pos[1] - o[1]), in.vel[1] = om * (in.pos[0] - o[0]), in.vel[2] = 0;
+    in.quat[0] = cos(th / 2), in.quat[1] = in.quat[2] = 0, in.quat[3] = sin(th / 2);
+    tx_instrument_world_step(w, &in, 1e-3);
+    double hf[3];
+    tx_instrument_world_hand_force(w, 0, hf);
+    if (i > 100) most_along = fmax(most_along, norm3(hf)); // after the start's jerk
+    most_gap = fmax(most_gap, tx_instrument_world_needle_pin_gap(w, 0, &angle));
+  }
+  memset(in.vel, 0, sizeof in.vel);
+  for (int i = 0; i < 200; i++) tx_instrument_world_step(w, &in, 1e-3);
+  tx_instrument_world_needle_pin_gap(w, 0, &angle);
+  assert_int_equal(tx_instrument_world_needle_held_by(w), 0);
+  print_message("  along the arc: the hand feels at most %.4f N, the point at most %.3f mm off the arc, now %.3f rad along it\n",
+                most_along, 1e3 * most_gap, angle);
+  assert_true(most_along < 0.05);
+  assert_true(most_gap < 3e-4);
+  assert_true(fabs(angle - 1.7) < 0.05); // the arc slid 0.5 rad through the point
+  // across: the hand moves 2 mm along z (across the arc's plane) and holds
+  double z0 = in.pos[2], hf[3];
+  for (int i = 1; i <= 500; i++) {
+    in.pos[2] = z0 + 0.002 * fmin(1, i / 200.0);
+    tx_instrument_world_step(w, &in, 1e-3);
+  }
+  tx_instrument_world_hand_force(w, 0, hf);
+  double gap = tx_instrument_world_needle_pin_gap(w, 0, NULL);
+  print_message("  2 mm across: the hand feels %.4f N back, the point %.3f mm off the arc\n", -hf[2], 1e3 * gap);
+  // springs in series (coupling 200 N/m, pin 200 N/m): 0.2 N, the point 1 mm off
+  assert_true(-hf[2] > 0.15 && -hf[2] < 0.25);
+  assert_true(gap > 0.0007 && gap < 0.0013);
+  tx_instrument_world_destroy(w);
+  tx_instrument_desc_free(d);
+}
+
+// in foam the needle stands still under gravity until the holder closes on
+// it, which takes it out (one grasp) and lifts it
+static void test_needle_taken_from_foam(void** state) {
+  (void)state;
+  tx_instrument_desc* d = load("needle_holder");
+  tx_instrument_sim_params p = tx_instrument_sim_defaults();
+  p.table_height = -1;
+  p.needle.enabled = true;
+  p.needle.foam = true;
+  memset(p.needle.pos, 0, sizeof p.needle.pos);
+  const tx_urdf* u = d->urdf;
+  double R = p.needle.radius, grasp[3] = {R - 0.03, 0, 0}, start[1][3] = {{R - 0.06, 0, 0}};
+  tx_instrument_world* w = tx_instrument_world_create(&p, &u, 1, start);
+  assert_non_null(w);
+  tx_instrument_input in = at(start[0][0], 0, 0, 0);
+  step_to(w, &in, start[0], 0.4, 0.3);
+  step_to(w, &in, grasp, 0.4, 0.3);
+  double c[3], q[4];
+  tx_instrument_world_needle(w, c, q);
+  assert_true(norm3(c) < 1e-6); // the foam holds it against gravity
+  assert_int_equal(tx_instrument_world_needle_held_by(w), -1);
+  step_to(w, &in, grasp, 0, 0.3);
+  step_to(w, &in, grasp, 0, 0.1);
+  assert_int_equal(tx_instrument_world_needle_held_by(w), 0);
+  assert_int_equal(tx_instrument_world_needle_grasps(w), 1);
+  double lift[3] = {grasp[0], 0.03, 0};
+  step_to(w, &in, lift, 0, 0.5);
+  tx_instrument_world_needle(w, c, q);
+  print_message("  taken from the foam and lifted 3 cm: the needle's centre at y = %.2f mm\n", 1e3 * c[1]);
+  assert_true(c[1] > 0.025);
+  tx_instrument_world_destroy(w);
+  tx_instrument_desc_free(d);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_links_start_where_the_urdf_puts_them),
@@ -436,6 +595,10 @@ int main(void) {
       cmocka_unit_test(test_needle_held_and_released),
       cmocka_unit_test(test_needle_handover),
       cmocka_unit_test(test_needle_rests_on_the_table),
+      cmocka_unit_test(test_needle_starts_in_the_jaws),
+      cmocka_unit_test(test_tip_contact_reaches_the_hand),
+      cmocka_unit_test(test_pinned_needle_slides_along_and_resists_across),
+      cmocka_unit_test(test_needle_taken_from_foam),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

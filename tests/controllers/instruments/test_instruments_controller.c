@@ -12,6 +12,9 @@
 #include "scenarios/loader.h"
 #include "tests/scenario_support.h"
 
+#include <tactus/components.h>
+#include <tactus/events.h>
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -85,6 +88,18 @@ static void test_refuses_what_it_cannot_read(void** state) {
   s = load("\"instrument0\":\"\",\"instrument1\":\"lap_grasper\"");
   assert_null(s);
   assert_non_null(strstr(tx_error(), "instrument1"));
+  // the puncture and foam keys: each refused naming itself
+  static const char* const bad[][2] = {
+      {"\"skin\":\"skin\"", "params.skin: a skin to pierce needs the needle"},
+      {"\"needle\":true,\"needle_in_jaws\":1", "params.needle_in_jaws: there is no instrument1"},
+      {"\"needle\":true,\"needle_in_jaws\":0,\"needle_foam\":true", "params.needle_foam"},
+      {"\"needle\":true,\"needle_grasp_rad\":3", "params.needle_grasp_rad: past the needle's tip"},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    assert_null(load(bad[i][0]));
+    if (!strstr(tx_error(), bad[i][1])) fail_msg("'%s' lacks '%s'", tx_error(), bad[i][1]);
+    assert_null(strchr(tx_error(), '\n'));
+  }
 }
 
 // with a needle: it lies on the table where the scenario puts it, and its
@@ -107,11 +122,227 @@ static void test_needle_is_published(void** state) {
   assert_non_null(strstr(tx_error(), "needle_wire_diameter_m"));
 }
 
+// a test class that keeps every event of instruments.events
+#define EVENTS_MAX 64
+typedef struct listener {
+  tx_port in;
+  tx_event got[EVENTS_MAX];
+  int n;
+} listener;
+static listener the_listener;
+static int listen_configure(tx_setup* s, void** self) {
+  *self = &the_listener;
+  the_listener.in = tx_setup_listen(s, "instruments.events");
+  the_listener.n = 0;
+  return 0;
+}
+static void listen_step(tx_ctx* c, void* self) {
+  listener* l = self;
+  tx_event e;
+  while (tx_next_event(c, l->in, &e))
+    if (l->n < EVENTS_MAX) l->got[l->n++] = e;
+}
+static const tx_controller_class listener_class = {
+    .type = "test.listener", .summary = "keeps instruments.events", .configure = listen_configure, .step = listen_step};
+
+// a test class that writes a thread of 9 nodes along z at x = 2 cm, y = 0,
+// 5 mm apart from z = -2 cm
+static tx_port thread_out;
+static int thread_configure(tx_setup* s, void** self) {
+  *self = &thread_out;
+  thread_out = tx_setup_write(s, &TX_COMPONENT_OF("thread.nodes", tx_thread_node, 9));
+  return 0;
+}
+static void thread_step(tx_ctx* c, void* self) {
+  tx_thread_node* n = tx_write(c, *(tx_port*)self);
+  for (int i = 0; i < 9; i++) n[i] = (tx_thread_node){.x = {0.02, 0, -0.02 + 0.005 * i}, .radius = 0.00025};
+}
+static const tx_controller_class thread_class = {
+    .type = "test.thread", .summary = "a still thread", .configure = thread_configure, .step = thread_step};
+
+static void register_tests(void) {
+  if (!tx_find_controller(listener_class.type)) assert_int_equal(tx_register_controller(&listener_class), 0);
+  if (!tx_find_controller(thread_class.type)) assert_int_equal(tx_register_controller(&thread_class), 0);
+}
+
+static void write_csv(const char* path, const char* text) {
+  FILE* f = fopen(path, "w");
+  assert_non_null(f);
+  fputs(text, f);
+  fclose(f);
+}
+
+// the Metzenbaum scissors open over the thread, 2 cm ahead of the pivot, and
+// close: one cut, of segment 4 (z from 0 to 5 mm), where the blades crossed
+// it; opened and closed again away from the thread: no cut
+static void test_scissors_cut_the_thread(void** state) {
+  (void)state;
+  register_tests();
+  char path[64];
+  snprintf(path, sizeof path, "/tmp/tx-cut-XXXXXX.csv");
+  int fd = mkstemps(path, 4);
+  assert_true(fd >= 0);
+  close(fd);
+  // pivot at (0, 0, 1.2 mm), blades along x; open 0.5 s, close, then move 3 cm up, open, close
+  write_csv(path, "t_s,x_m,y_m,z_m,qw,qx,qy,qz,grip_rad\n"
+                  "0,0,0,0.0012,1,0,0,0,0\n0.3,0,0,0.0012,1,0,0,0,0.6\n0.6,0,0,0.0012,1,0,0,0,0.6\n"
+                  "0.9,0,0,0.0012,1,0,0,0,0\n1.2,0,0.03,0.0012,1,0,0,0,0\n1.5,0,0.03,0.0012,1,0,0,0,0.6\n"
+                  "1.8,0,0.03,0.0012,1,0,0,0,0\n");
+  char text[2048];
+  snprintf(text, sizeof text,
+           "{\"name\":\"t\",\"controllers\":["
+           "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:%s\","
+           "\"force_model\":\"instrument0.force_model\"}},"
+           "{\"name\":\"thread\",\"type\":\"test.thread\",\"rate_hz\":100},"
+           "{\"name\":\"instruments\",\"type\":\"physics.instruments\",\"rate_hz\":1000,\"params\":{"
+           "\"instrument0\":\"metzenbaum_scissors\",\"thread\":\"thread\",\"gravity_m_s2\":0}},"
+           "{\"name\":\"listener\",\"type\":\"test.listener\",\"rate_hz\":1000}]}",
+           path);
+  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 2.0);
+  unlink(path);
+  print_message("  %d events; cuts %g\n", the_listener.n, result(s, "instruments.thread_cuts"));
+  assert_int_equal(the_listener.n, 1);
+  const tx_event* e = &the_listener.got[0];
+  print_message("  cut segment %u at (%.4f, %.4f, %.4f) m\n", e->source, e->cut.point[0], e->cut.point[1], e->cut.point[2]);
+  assert_int_equal(e->kind, TX_EVENT_CUT);
+  assert_int_equal(e->source, 4);
+  assert_true(fabs(e->cut.point[0] - 0.02) < 1e-9 && fabs(e->cut.point[2] - 0.0012) < 5e-4);
+  assert_true(result(s, "instruments.thread_cuts") == 1);
+  tx_scenario_free(s);
+}
+
+// the thumb forceps open over the thread and close on it: a grasp (source =
+// the forceps, its point on the thread between the jaws); they open: a
+// release; no cut
+static void test_forceps_grasp_the_thread(void** state) {
+  (void)state;
+  register_tests();
+  char path[64];
+  snprintf(path, sizeof path, "/tmp/tx-tgrasp-XXXXXX.csv");
+  int fd = mkstemps(path, 4);
+  assert_true(fd >= 0);
+  close(fd);
+  write_csv(path, "t_s,x_m,y_m,z_m,qw,qx,qy,qz,grip_rad\n"
+                  "0,0,0,0.0012,1,0,0,0,0\n0.3,0,0,0.0012,1,0,0,0,0.14\n0.6,0,0,0.0012,1,0,0,0,0.14\n"
+                  "0.9,0,0,0.0012,1,0,0,0,0\n1.2,0,0,0.0012,1,0,0,0,0\n1.5,0,0,0.0012,1,0,0,0,0.14\n");
+  char text[2048];
+  snprintf(text, sizeof text,
+           "{\"name\":\"t\",\"controllers\":["
+           "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:%s\","
+           "\"force_model\":\"instrument0.force_model\"}},"
+           "{\"name\":\"thread\",\"type\":\"test.thread\",\"rate_hz\":100},"
+           "{\"name\":\"instruments\",\"type\":\"physics.instruments\",\"rate_hz\":1000,\"params\":{"
+           "\"instrument0\":\"thumb_forceps\",\"thread\":\"thread\",\"gravity_m_s2\":0}},"
+           "{\"name\":\"listener\",\"type\":\"test.listener\",\"rate_hz\":1000}]}",
+           path);
+  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 1.8);
+  unlink(path);
+  print_message("  %d events: grasps %g, cuts %g\n", the_listener.n, result(s, "instruments.thread_grasps"),
+                result(s, "instruments.thread_cuts"));
+  assert_int_equal(the_listener.n, 2);
+  const tx_event* g = &the_listener.got[0];
+  print_message("  grasp by %u at (%.4f, %.4f, %.4f) m, jaws %.4f rad; then kind %u\n", g->source, g->grasp.point[0],
+                g->grasp.point[1], g->grasp.point[2], g->grasp.jaw, the_listener.got[1].kind);
+  assert_int_equal(g->kind, TX_EVENT_GRASP);
+  assert_int_equal(g->source, 0);
+  assert_true(fabs(g->grasp.point[0] - 0.02) < 1e-9 && fabs(g->grasp.point[2] - 0.0012) < 5e-4);
+  assert_int_equal(the_listener.got[1].kind, TX_EVENT_RELEASE);
+  assert_int_equal(the_listener.got[1].source, 0);
+  assert_true(result(s, "instruments.thread_grasps") == 1 && result(s, "instruments.thread_cuts") == 0);
+  tx_scenario_free(s);
+}
+
+// The needle pierces the skin: the needle holder holds a 3/8-circle needle
+// 30 mm long (R = 12.7 mm) from the start, its arc vertical and curving
+// down; the hand lowers it from 7 cm until the circle's centre is 5.5 mm above the
+// skin, then turns it about that centre, so that its tip goes down through
+// the skin, along under it and up through it again. The skin's HIP is the
+// needle's tip (pose needle.tip). Two punctures come out in order: an entry
+// (+1) then an exit (-1), each with a live skin triangle and barycentric
+// coordinates summing to 1; and the tip felt the skin before each.
+static void write_puncture_path(const char* path, double* seconds) {
+  FILE* f = fopen(path, "w");
+  assert_non_null(f);
+  fprintf(f, "t_s,x_m,y_m,z_m,qw,qx,qy,qz,grip_rad\n");
+  double R = 0.03 / (0.75 * M_PI), d = 0.03, phi = 0.2;
+  double th0 = 0.75 * M_PI - phi + 5 * M_PI / 180; // the tip 5 degrees above the centre's horizontal
+  double turn = 205 * M_PI / 180, t = 0;
+  // the root starts unturned: it turns to the hand's orientation 7 cm above the skin, out of its reach
+  for (int i = 0; i <= 500; i++, t += 0.01) {
+    double th = th0, cy = 0.07;
+    if (t > 0.5) cy = 0.07 - (0.07 - 0.0055) * fmin(1, (t - 0.5) / 1.0);
+    if (t > 1.5) th = th0 - turn * fmin(1, (t - 1.5) / 3.0);
+    // the pivot: the centre plus the turned (R - d, 0, 0); the root: turned about z, flipped about x
+    double x = cos(th) * (R - d), y = cy + sin(th) * (R - d);
+    fprintf(f, "%.4f,%.9f,%.9f,0,0,%.9f,%.9f,0,0\n", t, x, y, cos(th / 2), sin(th / 2));
+  }
+  fclose(f);
+  *seconds = t;
+}
+
+static void test_needle_punctures_the_skin(void** state) {
+  (void)state;
+  if (!tx_find_controller("physics.skin")) skip(); // built without Bullet
+  register_tests();
+  char path[64];
+  snprintf(path, sizeof path, "/tmp/tx-pierce-XXXXXX.csv");
+  int fd = mkstemps(path, 4);
+  assert_true(fd >= 0);
+  close(fd);
+  double seconds;
+  write_puncture_path(path, &seconds);
+  char text[2048];
+  snprintf(text, sizeof text,
+           "{\"name\":\"t\",\"controllers\":["
+           "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:%s\","
+           "\"force_model\":\"instrument0.force_model\"}},"
+           "{\"name\":\"instruments\",\"type\":\"physics.instruments\",\"rate_hz\":1000,\"params\":{"
+           "\"instrument0\":\"needle_holder\",\"needle\":true,\"needle_in_jaws\":0,\"needle_length_m\":0.03,"
+           "\"table_height_m\":-1,\"skin\":\"skin\"}},"
+           "{\"name\":\"skin\",\"type\":\"physics.skin\",\"rate_hz\":60,\"params\":{\"pose\":\"needle.tip\"}},"
+           "{\"name\":\"listener\",\"type\":\"test.listener\",\"rate_hz\":1000}]}",
+           path);
+  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+  if (!s) fail_msg("%s", tx_error());
+  run(s, seconds + 0.2);
+  unlink(path);
+  const tx_puncture* rows = latest_snapshot(s, "needle.punctures").data;
+  int ntri = (int)latest_snapshot(s, "skin.tri").rows;
+  int np = 0;
+  for (int i = 0; i < the_listener.n; i++) {
+    const tx_event* e = &the_listener.got[i];
+    if (e->kind != TX_EVENT_PUNCTURE) continue;
+    const tx_puncture* r = &rows[np];
+    print_message("  puncture %d: triangle %u, side %+g, at (%.2f, %.2f, %.2f) mm, %.3f N, %.2f mm deep; bary (%.3f, %.3f, %.3f)\n",
+                  np, e->source, r->side, 1e3 * e->puncture.point[0], 1e3 * e->puncture.point[1],
+                  1e3 * e->puncture.point[2], e->puncture.force, 1e3 * e->puncture.depth, r->bary[0], r->bary[1], r->bary[2]);
+    assert_true(r->triangle == e->source);
+    assert_true(r->triangle >= 0 && r->triangle < 2 * 41 * 41); // a row of the 42 x 42 patch's skin.tri
+    assert_true(fabs(r->bary[0] + r->bary[1] + r->bary[2] - 1) < 1e-9);
+    for (int k = 0; k < 3; k++) assert_true(r->bary[k] >= 0);
+    assert_true(e->puncture.force > 0.01); // the tip felt the skin before it tore
+    np++;
+  }
+  print_message("  %d punctures, skin torn %g links, %d triangles live\n", np, latest(s, "skin.contact")[12], ntri);
+  assert_int_equal(np, 2);
+  assert_true(rows[0].side == 1 && rows[1].side == -1);
+  assert_true(rows[2].triangle == -1);
+  assert_true(result(s, "instruments.needle_punctures") == 2);
+  tx_scenario_free(s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_follows_the_hand_and_renders_the_weight),
       cmocka_unit_test(test_refuses_what_it_cannot_read),
       cmocka_unit_test(test_needle_is_published),
+      cmocka_unit_test(test_scissors_cut_the_thread),
+      cmocka_unit_test(test_forceps_grasp_the_thread),
+      cmocka_unit_test(test_needle_punctures_the_skin),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -1,0 +1,181 @@
+// The puncture and cut logic of physics.instruments, without ODE: the
+// nearest skin triangle and its barycentric coordinates; a tear after a
+// touch is a puncture, entry from the outside and exit from behind, a tear
+// running on at the hole is not another; scissors closing cut the thread
+// segment between their blades and nothing else.
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include "controllers/instruments/cut.h"
+#include "controllers/instruments/puncture.h"
+
+#include <math.h>
+#include <string.h>
+
+// a flat patch in y = 0, 4 x 4 cells of 1 cm from (-2, 0, -2) cm, normals +y
+#define N 5
+static float xs[N * N * 3];
+static int32_t tris[2 * (N - 1) * (N - 1) * 3];
+static int ntri;
+
+static int patch(void** state) {
+  (void)state;
+  for (int i = 0; i < N; i++)
+    for (int k = 0; k < N; k++) {
+      float* p = xs + 3 * (i * N + k);
+      p[0] = -0.02f + 0.01f * (float)k, p[1] = 0, p[2] = -0.02f + 0.01f * (float)i;
+    }
+  ntri = 0;
+  for (int i = 0; i + 1 < N; i++)
+    for (int k = 0; k + 1 < N; k++) {
+      int32_t a = i * N + k, b = a + 1, c = a + N, d = c + 1;
+      // (a, c, b): (c - a) x (b - a) = z x x = +y
+      int32_t t[6] = {a, c, b, b, c, d};
+      memcpy(tris + 3 * ntri, t, sizeof t);
+      ntri += 2;
+    }
+  return 0;
+}
+
+static void test_nearest_triangle(void** state) {
+  (void)state;
+  double p[3] = {0.0032, 0.004, -0.0071}, bary[3], q[3];
+  int row = tx_nearest_triangle(xs, N * N, tris, ntri, p, bary, q);
+  assert_true(row >= 0 && row < ntri);
+  // the point under p on the plane, inside its triangle
+  assert_true(fabs(q[0] - 0.0032) < 1e-7 && fabs(q[1]) < 1e-12 && fabs(q[2] + 0.0071) < 1e-7);
+  assert_true(fabs(bary[0] + bary[1] + bary[2] - 1) < 1e-12);
+  for (int k = 0; k < 3; k++) assert_true(bary[k] >= 0 && bary[k] <= 1);
+  double back[3] = {0};
+  for (int v = 0; v < 3; v++)
+    for (int k = 0; k < 3; k++) back[k] += bary[v] * xs[3 * tris[3 * row + v] + k];
+  for (int k = 0; k < 3; k++) assert_true(fabs(back[k] - q[k]) < 1e-7);
+  // outside the patch: its edge
+  double far[3] = {0.05, 0, 0};
+  row = tx_nearest_triangle(xs, N * N, tris, ntri, far, bary, q);
+  assert_true(row >= 0 && fabs(q[0] - 0.02) < 1e-7);
+  // no triangle, and indices outside skin.x: none
+  assert_int_equal(tx_nearest_triangle(xs, N * N, tris, 0, p, bary, q), -1);
+  int32_t bad[3] = {0, 1, N * N};
+  assert_int_equal(tx_nearest_triangle(xs, N * N, bad, 1, p, bary, q), -1);
+}
+
+static tx_skin_contact touch(double x, double z, double ny, double f, double torn) {
+  return (tx_skin_contact){.f = {0, ny * f, 0}, .x = {x, 0.002 * ny, z}, .n = {0, ny, 0}, .k = 100, .depth = 0.004,
+                           .touching = f > 0, .torn = torn};
+}
+
+static void test_entry_then_exit(void** state) {
+  (void)state;
+  tx_puncture_tracker t;
+  tx_puncture_tracker_init(&t, 0.003, 0.05, 0);
+  tx_puncture_found f;
+  tx_skin_contact c = touch(0.001, 0.0012, 1, 0.2, 0);
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f)); // touching, not torn
+  c = touch(0.001, 0.0012, 1, 0.4, 0);
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  c = touch(0.001, 0.0012, 1, 0, 3); // torn: the tip is through, the contact gone
+  assert_true(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  assert_int_equal(f.row.side, 1); // from above: an entry
+  assert_true(f.row.triangle >= 0 && f.row.triangle < ntri);
+  assert_true(fabs(f.row.bary[0] + f.row.bary[1] + f.row.bary[2] - 1) < 1e-12);
+  assert_true(fabs(f.point[0] - 0.001) < 1e-7 && fabs(f.point[2] - 0.0012) < 1e-7);
+  assert_true(fabs(f.force - 0.4) < 1e-12 && fabs(f.depth - 0.004) < 1e-12); // the largest force before the tear
+  for (int v = 0; v < 3; v++) assert_int_equal(f.verts[v], tris[3 * (int)f.row.triangle + v]);
+  // the tear runs on at the hole, the flaps touching the tip from below: the same puncture
+  c = touch(0.0015, 0.0012, -1, 0.1, 3);
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  c = touch(0.0015, 0.0012, -1, 0.1, 5);
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  // the tip drags the hole's flaps down 5 mm on: a tear from above again, not a second entry
+  c = touch(0.006, 0.0012, 1, 0.2, 5);
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  c = touch(0.006, 0.0012, 1, 0.2, 6);
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  // a tear with no touch since the last puncture: none
+  c = touch(0.012, 0.0012, 1, 0, 7);
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  // 1 cm away the tip comes up from below and tears: an exit
+  c = touch(0.011, 0.0012, -1, 0.3, 7);
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  c = touch(0.011, 0.0012, -1, 0.2, 8);
+  assert_true(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  assert_int_equal(f.row.side, -1);
+  assert_true(fabs(f.point[0] - 0.011) < 1e-7);
+  assert_true(fabs(f.row.bary[0] + f.row.bary[1] + f.row.bary[2] - 1) < 1e-12);
+  assert_true(fabs(f.force - 0.3) < 1e-12);
+  // out through the skin, the flaps cling to the tip; clear of them it comes
+  // back down 1 cm on: a flap flicking it (5 mN) as it tears is no entry,
+  // nor is a firm push while the flaps still cling; a push from clear is
+  c = touch(0.011, 0.0012, 1, 0.2, 9); // clinging, pushing from above
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  c = touch(0.018, 0.0012, 1, 0.3, 10);
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  c = touch(0.018, 0.0012, 1, 0, 10); // clear
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  c = touch(0.018, 0.0012, 1, 0.005, 11);
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  c = touch(0.018, 0.0012, 1, 0.2, 11);
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  c = touch(0.018, 0.0012, 1, 0, 12);
+  assert_true(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
+  assert_int_equal(f.row.side, 1);
+  // a skin with no triangle left: no puncture
+  tx_puncture_tracker_init(&t, 0.003, 0.05, 0);
+  c = touch(0, 0, 1, 0.2, 0);
+  tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f);
+  c = touch(0, 0, 1, 0.2, 1);
+  assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, 0, &f));
+}
+
+// a thread along z at x = 2 cm, nodes 5 mm apart from z = -2 cm
+static void thread(tx_thread_node* n, int count, double x) {
+  for (int i = 0; i < count; i++) n[i] = (tx_thread_node){.x = {x, 0, -0.02 + 0.005 * i}, .radius = 0.00025};
+}
+
+static void test_scissors_cut_between_the_blades(void** state) {
+  (void)state;
+  tx_thread_node n[9];
+  thread(n, 9, 0.02);
+  double pivot[3] = {0, 0, 0.0012}, dir[3] = {1, 0, 0}, point[3];
+  // blades 4 cm along x: the thread crosses them at z = 1.2 mm, in segment 4 (z from 0 to 5 mm)
+  int seg = tx_scissors_cut(pivot, dir, 0.04, 0.002, n, 9, point);
+  assert_int_equal(seg, 4);
+  assert_true(fabs(point[0] - 0.02) < 1e-12 && fabs(point[2] - 0.0012) < 1e-12);
+  // blades 1.5 cm long stop short of it
+  assert_int_equal(tx_scissors_cut(pivot, dir, 0.015, 0.002, n, 9, point), -1);
+  // a thread 3 mm above the blades' plane is out of their 2 mm reach; 1.5 mm above is in
+  for (int i = 0; i < 9; i++) n[i].x[1] = 0.003;
+  assert_int_equal(tx_scissors_cut(pivot, dir, 0.04, 0.002, n, 9, point), -1);
+  for (int i = 0; i < 9; i++) n[i].x[1] = 0.0015;
+  assert_int_equal(tx_scissors_cut(pivot, dir, 0.04, 0.002, n, 9, point), 4);
+  // behind the pivot: nothing between the blades
+  thread(n, 9, -0.01);
+  assert_int_equal(tx_scissors_cut(pivot, dir, 0.04, 0.002, n, 9, point), -1);
+  assert_int_equal(tx_scissors_cut(pivot, dir, 0.04, 0.002, n, 1, point), -1); // one node: no segment
+}
+
+static void test_blades_close_once(void** state) {
+  (void)state;
+  tx_blades b = {.open = 0.1, .closed = 0.03};
+  assert_int_equal(tx_blades_close(&b, 0), 0); // closed from the start: no cut
+  assert_int_equal(tx_blades_close(&b, 0.2), 0);
+  assert_int_equal(tx_blades_close(&b, 0.05), 0);
+  assert_int_equal(tx_blades_close(&b, 0.01), 1); // opened, then closed: one cut
+  assert_int_equal(tx_blades_close(&b, 0.0), 0);
+  assert_int_equal(tx_blades_close(&b, 0.05), 0); // half open is not open
+  assert_int_equal(tx_blades_close(&b, 0.0), 0);
+  assert_int_equal(tx_blades_close(&b, NAN), 0);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test_setup(test_nearest_triangle, patch),
+      cmocka_unit_test_setup(test_entry_then_exit, patch),
+      cmocka_unit_test(test_scissors_cut_between_the_blades),
+      cmocka_unit_test(test_blades_close_once),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
