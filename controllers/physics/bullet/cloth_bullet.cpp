@@ -57,6 +57,10 @@ struct tx_cloth {
   std::vector<btVector3> load;     // (n) N, external force on each particle
   int loaded;                      // particles with a non-zero load
   double peak_tension;             // N/m, largest averaged tension of the last step's checks
+  double sub_peak;                 // N/m, the same over the current substep's checks
+  double prev_peak;                // N/m, the same over the last substep's (the step before, across steps)
+  bool broke;                      // a link tore in the last step
+  double broke_at[3];              // m, the HIP centre where the criterion was first met in it
 
   // the implicit solver's work vectors, all made at create (Bullet's btConjugateGradient
   // allocates two arrays an iteration: its multAndAdd and sub return by value)
@@ -1199,6 +1203,7 @@ static void rupture(tx_cloth* c, const btVector3* near) {
     if (near && (base[p].m_x - *near).length2() > reach2) continue;
     const double t = membrane_tension(c, p);
     if (t > c->peak_tension) c->peak_tension = t;
+    if (t > c->sub_peak) c->sub_peak = t;
     if (t < tc) continue;
     int best = -1;
     float fbest = 0;
@@ -1337,9 +1342,12 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
   c->contact_held = 0;
   const btVector3 start((btScalar)c->hip_prev[0], (btScalar)c->hip_prev[1], (btScalar)c->hip_prev[2]);
   const btVector3 end((btScalar)c->hip[0], (btScalar)c->hip[1], (btScalar)c->hip[2]);
+  c->broke = false;
   for (int s = 0; s < substeps; s++) {
     btVector3 h0 = start.lerp(end, (btScalar)s / (btScalar)substeps);
     btVector3 h1 = start.lerp(end, (btScalar)(s + 1) / (btScalar)substeps);
+    const int torn0 = c->torn;
+    c->sub_peak = 0;
     predict(c, h);
     sweep_contact(c, h0, h1, h, true);
     if (c->def.solver == TX_CLOTH_IMPLICIT) solve_implicit(c, h);
@@ -1370,12 +1378,22 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
     if (!healthy(c)) {
       c->faults++;
       tx_cloth_restore(c);
+      c->broke = false; // the tear, if any, is undone with the step
       // the HIP's move that led here is not replayed: it starts the next step where it is
       for (int a = 0; a < 3; a++) c->hip_prev[a] = c->hip[a];
       return TX_CLOTH_FAULT;
     }
     measure_links(c, h);
     rupture(c, nullptr);
+    if (c->torn > torn0 && !c->broke) {
+      // the criterion crossed between the last substep's check and this one's: where, linear in the tension
+      const double tc = c->def.rupture_tension, d = c->sub_peak - c->prev_peak;
+      double u = d > 0 ? (tc - c->prev_peak) / d : 1;
+      u = u < 0 ? 0 : u > 1 ? 1 : u;
+      for (int a = 0; a < 3; a++) c->broke_at[a] = (double)h0[a] + u * ((double)h1[a] - (double)h0[a]);
+      c->broke = true;
+    }
+    c->prev_peak = c->sub_peak;
   }
   c->contact_held = link_reaction(c, dt, c->contact_force);
   for (int a = 0; a < 3; a++) {
@@ -1478,6 +1496,11 @@ extern "C" double tx_cloth_membrane_tension(const tx_cloth* c, int i) {
 }
 
 extern "C" double tx_cloth_peak_tension(const tx_cloth* c) { return c->peak_tension; }
+
+extern "C" bool tx_cloth_broke_at(const tx_cloth* c, double at[3]) {
+  for (int a = 0; a < 3; a++) at[a] = c->broke ? c->broke_at[a] : 0;
+  return c->broke;
+}
 
 extern "C" void tx_cloth_solve_stats(const tx_cloth* c, tx_cloth_solve_info* out) { *out = c->stats; }
 
