@@ -26,8 +26,9 @@
 // and physics.skin's default 1 N/m is a calibration of the unconverged
 // real-time skin. The sag: the skin alone under gravity, hanging for its
 // settle time and 1 s more; the sag is the deepest particle's depth, averaged
-// over the last 0.5 s (the patch still sways by some 1 % of its sag, and
-// one instant read the sway's phase, which turned the full path back). For
+// over the last 0.5 s (at 2.5 mm the patch still sways by some 1 % of its
+// sag, and one instant read the sway's phase; at 1.25 mm it sways by 10 %,
+// which the mean does not cure: docs/validation.md). For
 // each quantity the three finest levels give the observed order p and a
 // Richardson reference (skin_metrics.h, tx_converge); every level's error is
 // against it. The real-time default (suturing-skin's own settings: spacing
