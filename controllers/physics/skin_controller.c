@@ -18,7 +18,7 @@ typedef struct skin {
   double hip_radius;   // m, 0: no HIP
   double dt;           // s, one step at the instance's rate
   tx_port pose;        // read: the pose the HIP follows (f64 1 x 7)
-  tx_port x, tri, thickness, torn, contact; // written: skin.*
+  tx_port x, tri, thickness, torn, contact, rupture; // written: skin.*
   double prev_f, prev_w; // N, m: the reaction along its normal and the indentation of the last step in contact (0: none)
   double k;              // N/m, the last tangent stiffness
   tx_warning fault, bad_pose;
@@ -113,6 +113,7 @@ static int configure(tx_setup* s, void** self) {
   k->thickness = tx_setup_write(s, &TX_COMPONENT_OF("skin.thickness", tx_thickness, 1));
   k->torn = tx_setup_write(s, &TX_COMPONENT_OF("skin.torn", tx_torn, 1));
   k->contact = tx_setup_write(s, &TX_COMPONENT_OF("skin.contact", tx_skin_contact, 1));
+  k->rupture = tx_setup_write(s, &TX_COMPONENT_OF("skin.rupture", tx_skin_rupture, 1));
   k->fault = tx_setup_warning(s, "numerical_fault");
   k->bad_pose = tx_setup_warning(s, "bad_pose");
   k->torn_result = tx_setup_result(s, "torn_links");
@@ -166,6 +167,9 @@ static void publish(tx_ctx* c, skin* k) {
   ((tx_thickness*)tx_write(c, k->thickness))->m = tx_cloth_get_def(k->cloth)->thickness;
   ((tx_torn*)tx_write(c, k->torn))->links = tx_cloth_torn(k->cloth);
   publish_contact(c, k);
+  tx_skin_rupture* r = tx_write(c, k->rupture);
+  r->tension = tx_cloth_peak_tension(k->cloth);
+  r->broke = tx_cloth_broke_at(k->cloth, r->at) ? 1 : 0;
 }
 
 static int init(tx_ctx* c, void* self) {
@@ -201,7 +205,7 @@ static void fini(void* self) {
 
 const tx_controller_class tx_physics_skin = {
     .type = "physics.skin",
-    .summary = "suturing skin on a Bullet soft body: rupture, HIP contact; writes skin.x, skin.tri, skin.thickness, skin.torn, skin.contact",
+    .summary = "suturing skin on a Bullet soft body: rupture, HIP contact; writes skin.x, skin.tri, skin.thickness, skin.torn, skin.contact, skin.rupture",
     .configure = configure,
     .init = init,
     .step = step,

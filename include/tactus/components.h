@@ -170,6 +170,19 @@ typedef struct tx_torn {
 #define tx_torn_UNITS "1"
 TX_LAYOUT_ASSERT(tx_torn, int32_t);
 
+// SKIN.rupture (1 row): the rupture criterion over the last physics step, for
+// studies that resolve where the skin tore between steps
+typedef struct tx_skin_rupture {
+  double tension; // N/m, the largest averaged membrane tension the step's rupture checks found
+  double broke;   // 1 when a link tore in the step, else 0
+  double at[3];   // m, the HIP centre where the criterion was first met in the step: between the
+                  // substep before the tear and the tear's, linear in the tension (0 when broke is 0)
+} tx_skin_rupture;
+#define tx_skin_rupture_TYPE TX_F64
+#define tx_skin_rupture_COLS 5u
+#define tx_skin_rupture_UNITS "N/m, 1, m"
+TX_LAYOUT_ASSERT(tx_skin_rupture, double);
+
 // --- the voxel needle (voxel.needle) -----------------------------------------
 
 // needle.segments (1 row per segment), drawn by the graphics view

@@ -57,6 +57,10 @@ struct tx_cloth {
   std::vector<btVector3> load;     // (n) N, external force on each particle
   int loaded;                      // particles with a non-zero load
   double peak_tension;             // N/m, largest averaged tension of the last step's checks
+  double sub_peak;                 // N/m, the same over the current substep's checks
+  double prev_peak;                // N/m, the same over the last substep's (the step before, across steps)
+  bool broke;                      // a link tore in the last step
+  double broke_at[3];              // m, the HIP centre where the criterion was first met in it
 
   // the implicit solver's work vectors, all made at create (Bullet's btConjugateGradient
   // allocates two arrays an iteration: its multAndAdd and sub return by value)
@@ -102,7 +106,8 @@ struct tx_cloth {
   int contact_held;          // particles the contact holds at the end of the last step
   std::vector<float> rest_x; // (n x 3) m, the particles at rest (after settling): what the indentation is measured from
   std::vector<uint8_t> in_contact; // (n) the last substep's contact moved this particle
-  double contact_dir[3];     // 1, the pushes of the last substep's contact on the skin, summed (depth-weighted)
+  double contact_dir[3];     // 1, the pushes' unit directions of the last substep's contact on the skin, summed
+  int contact_pushes;        // how many were summed
   double max_edge;           // m, longest rest length of a stretch or shear link
   double reach_factor;       // 1, twice the longest live stretch or shear link after the last substep, over
                              // max_edge: a triangle in contact has a corner within rc + reach_factor max_edge
@@ -966,6 +971,7 @@ static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& fr
         for (int j = 0; j < 3; j++)
           if (w[j] > 0) c->in_contact[(size_t)(p[j] - &nodes[0])] = 1;
         for (int a = 0; a < 3; a++) c->contact_dir[a] += dir[a];
+        c->contact_pushes++;
       }
       btScalar wsum = 0;
       for (int j = 0; j < 3; j++) wsum += p[j]->m_im * w[j] * w[j];
@@ -1199,6 +1205,7 @@ static void rupture(tx_cloth* c, const btVector3* near) {
     if (near && (base[p].m_x - *near).length2() > reach2) continue;
     const double t = membrane_tension(c, p);
     if (t > c->peak_tension) c->peak_tension = t;
+    if (t > c->sub_peak) c->sub_peak = t;
     if (t < tc) continue;
     int best = -1;
     float fbest = 0;
@@ -1309,9 +1316,14 @@ static int link_reaction(const tx_cloth* c, double dt, double out[3]) {
     for (int e = 0; e < 3; e++) out[e] += s * d[e];
   }
   // a smooth sphere takes only the push along its contact normal: the rest is the held
-  // particles' own imbalance, which the solver has not yet spread (no pull either)
+  // particles' own imbalance, which the solver has not yet spread (no pull either).
+  // Once the skin wraps the sphere (pushed on every side: their mean direction is under
+  // half a push) that mean is no normal, and a few pushes above the centre turned it
+  // over (the force fell to 0 with 30 N in the links, 2.7 cm down over a particle): the
+  // links' reaction is then taken whole, a wrapped sphere taking a push from any side
   double n[3] = {-c->contact_dir[0], -c->contact_dir[1], -c->contact_dir[2]};
   double nl = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  if (c->contact_pushes > 0 && nl < 0.5 * c->contact_pushes) return held;
   double along = nl > 0 ? (out[0] * n[0] + out[1] * n[1] + out[2] * n[2]) / nl : 0;
   for (int e = 0; e < 3; e++) out[e] = along > 0 ? along * n[e] / nl : 0;
   return held;
@@ -1337,9 +1349,12 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
   c->contact_held = 0;
   const btVector3 start((btScalar)c->hip_prev[0], (btScalar)c->hip_prev[1], (btScalar)c->hip_prev[2]);
   const btVector3 end((btScalar)c->hip[0], (btScalar)c->hip[1], (btScalar)c->hip[2]);
+  c->broke = false;
   for (int s = 0; s < substeps; s++) {
     btVector3 h0 = start.lerp(end, (btScalar)s / (btScalar)substeps);
     btVector3 h1 = start.lerp(end, (btScalar)(s + 1) / (btScalar)substeps);
+    const int torn0 = c->torn;
+    c->sub_peak = 0;
     predict(c, h);
     sweep_contact(c, h0, h1, h, true);
     if (c->def.solver == TX_CLOTH_IMPLICIT) solve_implicit(c, h);
@@ -1353,6 +1368,7 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
     // the contact again after the links, with the velocities it implies
     std::fill(c->in_contact.begin(), c->in_contact.end(), 0);
     for (int a = 0; a < 3; a++) c->contact_dir[a] = 0;
+    c->contact_pushes = 0;
     project_contact(c, h1, h0, h, true, true);
     if (c->def.solver == TX_CLOTH_IMPLICIT) {
       // the solve's active set holds the HIP too: a vertex sliding across its sphere ends
@@ -1365,17 +1381,28 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
         const btScalar rl = r.length();
         if (rl > 0)
           for (int a = 0; a < 3; a++) c->contact_dir[a] += r[a] / rl;
+        if (rl > 0) c->contact_pushes++;
       }
     }
     if (!healthy(c)) {
       c->faults++;
       tx_cloth_restore(c);
+      c->broke = false; // the tear, if any, is undone with the step
       // the HIP's move that led here is not replayed: it starts the next step where it is
       for (int a = 0; a < 3; a++) c->hip_prev[a] = c->hip[a];
       return TX_CLOTH_FAULT;
     }
     measure_links(c, h);
     rupture(c, nullptr);
+    if (c->torn > torn0 && !c->broke) {
+      // the criterion crossed between the last substep's check and this one's: where, linear in the tension
+      const double tc = c->def.rupture_tension, d = c->sub_peak - c->prev_peak;
+      double u = d > 0 ? (tc - c->prev_peak) / d : 1;
+      u = u < 0 ? 0 : u > 1 ? 1 : u;
+      for (int a = 0; a < 3; a++) c->broke_at[a] = (double)h0[a] + u * ((double)h1[a] - (double)h0[a]);
+      c->broke = true;
+    }
+    c->prev_peak = c->sub_peak;
   }
   c->contact_held = link_reaction(c, dt, c->contact_force);
   for (int a = 0; a < 3; a++) {
@@ -1478,6 +1505,11 @@ extern "C" double tx_cloth_membrane_tension(const tx_cloth* c, int i) {
 }
 
 extern "C" double tx_cloth_peak_tension(const tx_cloth* c) { return c->peak_tension; }
+
+extern "C" bool tx_cloth_broke_at(const tx_cloth* c, double at[3]) {
+  for (int a = 0; a < 3; a++) at[a] = c->broke ? c->broke_at[a] : 0;
+  return c->broke;
+}
 
 extern "C" void tx_cloth_solve_stats(const tx_cloth* c, tx_cloth_solve_info* out) { *out = c->stats; }
 

@@ -112,6 +112,11 @@ static void publishes_the_contact(void** state) {
   assert_true(fabs(k->depth - (0.0025 - k->x[1])) < 3e-4);  // pushed from where it first touched
   assert_true(k->k >= f / k->depth * (1 - 1e-9) && k->k <= 3 * f / k->depth * (1 + 1e-9));
   assert_true(k->torn == ((const int*)latest_snapshot(s, "skin.torn").data)[0]);
+  // skin.rupture: the pressed skin under tension, below the rupture tension, not torn in the step
+  const tx_skin_rupture* r = latest_snapshot(s, "skin.rupture").data;
+  print_message("  peak membrane tension %.2f N/m\n", r->tension);
+  assert_true(r->tension > 0 && r->tension < 80 && r->broke == 0);
+  assert_true(r->at[0] == 0 && r->at[1] == 0 && r->at[2] == 0);
   tx_scenario_free(s);
 }
 
