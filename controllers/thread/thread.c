@@ -37,6 +37,9 @@ struct tx_thread {
   double* rhs;               // (3 nseg)
   double* dir;               // (nseg x 3) unit segment directions, x[i] - x[i+1]
   uint8_t* pinned;           // (n)
+  uint8_t* severed;          // (nseg) cut links: no distance, no bend across, no contacts
+  int first_cut;             // the lowest severed link: the head's piece is nodes 0..first_cut (nseg: none)
+  int cuts;
   double* pin;               // (n x 3) where pinned nodes are held, m
   int last_pin;              // the highest pinned node (0: the head alone)
   double head_from[3], head_to[3];
@@ -180,6 +183,8 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   t->rhs = malloc(sizeof(double) * 3 * nseg);
   t->dir = malloc(sizeof(double) * 3 * nseg);
   t->pinned = calloc((size_t)n, 1);
+  t->severed = calloc((size_t)nseg, 1);
+  t->first_cut = nseg;
   t->pin = calloc(3 * (size_t)n, sizeof(double));
   t->cell_start = malloc(sizeof(uint32_t) * (hsize + 1));
   t->cell_item = malloc(sizeof(uint32_t) * nseg);
@@ -188,7 +193,7 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   t->pairs = malloc(sizeof(pair) * t->pair_cap);
   t->colliding = calloc((size_t)nseg, 1);
   t->caps = malloc(sizeof(tx_thread_capsule) * (def->max_shapes + 1));
-  if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->v0 || !t->w || !t->wf || !t->lam || !t->band || !t->bend || !t->rhs || !t->dir || !t->pinned || !t->pin || !t->cell_start ||
+  if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->v0 || !t->w || !t->wf || !t->lam || !t->band || !t->bend || !t->rhs || !t->dir || !t->pinned || !t->severed || !t->pin || !t->cell_start ||
       !t->cell_item || !t->seg_cell || !t->seg_ijk || !t->pairs || !t->colliding || !t->caps)
     goto oom;
   if (def->max_triangles > 0) {
@@ -232,6 +237,7 @@ void tx_thread_destroy(tx_thread* t) {
   free(t->rhs);
   free(t->dir);
   free(t->pinned);
+  free(t->severed);
   free(t->pin);
   free(t->cell_start);
   free(t->cell_item);
@@ -254,16 +260,17 @@ int tx_thread_faults(const tx_thread* t) { return t->faults; }
 void tx_thread_last_contacts(const tx_thread* t, tx_thread_contacts* out) { *out = t->last; }
 void tx_thread_head_force(const tx_thread* t, double out[3]) { memcpy(out, t->head_force, sizeof t->head_force); }
 void tx_thread_tension(const tx_thread* t, double stiffness, double max_force, double f[3], double K[9]) {
-  int n = t->n;
+  int n = t->n, end = t->first_cut; // the head's piece: nodes 0..end
   const double* h = t->x;
-  const double* tail = t->x + 3 * (n - 1);
-  double sum[3], len = tx_thread_current_length(t);
+  const double* tail = t->x + 3 * end;
+  double sum[3], len = 0, rest = t->l0 * end;
+  for (int i = 0; i < end; i++) len += dist3(t->x + 3 * i, t->x + 3 * i + 3);
   memset(K, 0, sizeof(double) * 9);
   for (int a = 0; a < 3; a++) {
     f[a] = 0;
     sum[a] = tail[a] - h[a];
   }
-  if (t->pinned[n - 1]) { // the length runs on to the tail's pin
+  if (end == n - 1 && t->pinned[n - 1]) { // the length runs on to the tail's pin
     const double* pin = t->pin + 3 * (n - 1);
     len += dist3(pin, tail);
     for (int a = 0; a < 3; a++) sum[a] = pin[a] - h[a];
@@ -271,8 +278,8 @@ void tx_thread_tension(const tx_thread* t, double stiffness, double max_force, d
   double ls = sqrt(dot3(sum, sum));
   if (t->def.model == TX_THREAD_ROD) {
     memcpy(f, t->head_force, sizeof t->head_force);
-  } else if (ls > 0 && len > t->def.length) {
-    double mag = stiffness * (len - t->def.length);
+  } else if (ls > 0 && len > rest) {
+    double mag = stiffness * (len - rest);
     for (int a = 0; a < 3; a++) {
       f[a] = mag * sum[a] / ls;
       for (int b = 0; b < 3; b++) K[3 * a + b] = -stiffness * sum[a] * sum[b] / (ls * ls);
@@ -292,13 +299,15 @@ bool tx_thread_pin_of(const tx_thread* t, int i, double out[3]) {
 
 double tx_thread_current_length(const tx_thread* t) {
   double s = 0;
-  for (int i = 0; i < t->nseg; i++) s += dist3(t->x + 3 * i, t->x + 3 * i + 3);
+  for (int i = 0; i < t->nseg; i++)
+    if (!t->severed[i]) s += dist3(t->x + 3 * i, t->x + 3 * i + 3);
   return s;
 }
 
 double tx_thread_max_strain(const tx_thread* t) {
   double m = -1;
   for (int i = 0; i < t->nseg; i++) {
+    if (t->severed[i]) continue;
     double e = dist3(t->x + 3 * i, t->x + 3 * i + 3) / t->l0 - 1;
     if (e > m) m = e;
   }
@@ -372,6 +381,47 @@ tx_thread_status tx_thread_set_capsules(tx_thread* t, const tx_thread_capsule* c
   if (n) memcpy(t->caps, caps, sizeof *caps * n);
   t->ncaps = n;
   return TX_THREAD_OK;
+}
+
+int tx_thread_cut(tx_thread* t, int seg) {
+  if (seg < 0 || seg >= t->nseg) {
+    tx_set_error("thread: cut link %d, must be in [0, %d]", seg, t->nseg - 1);
+    return -1;
+  }
+  if (t->severed[seg]) return 0;
+  t->severed[seg] = 1;
+  t->cuts++;
+  if (seg < t->first_cut) t->first_cut = seg;
+  // the two new ends lose half a link's mass: each node carries half of each
+  // link it still has (a node left alone keeps half a link's)
+  double m = t->def.density * PI * t->def.radius * t->def.radius * t->l0;
+  for (int i = seg; i <= seg + 1; i++) {
+    int links = (i > 0 && !t->severed[i - 1]) + (i < t->nseg && !t->severed[i]);
+    t->wf[i] = 2 / (m * (links > 0 ? links : 1));
+  }
+  update_last_pin(t);
+  return 1;
+}
+
+const uint8_t* tx_thread_severed(const tx_thread* t) { return t->severed; }
+int tx_thread_cut_count(const tx_thread* t) { return t->cuts; }
+int tx_thread_head_piece_end(const tx_thread* t) { return t->first_cut; }
+
+int tx_thread_nearest_link(const tx_thread* t, const double p[3], double at[3]) {
+  int best = -1;
+  double bd = INFINITY;
+  for (int i = 0; i < t->nseg; i++) {
+    if (t->severed[i]) continue;
+    const double *a = t->x + 3 * i, *b = a + 3;
+    double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, ee = dot3(e, e), s = 0;
+    if (ee > 0) s = fmin(1, fmax(0, (dot3(p, e) - dot3(a, e)) / ee));
+    double q[3] = {a[0] + s * e[0], a[1] + s * e[1], a[2] + s * e[2]}, d = dist3(p, q);
+    if (d < bd) {
+      bd = d, best = i;
+      if (at) memcpy(at, q, sizeof q);
+    }
+  }
+  return best;
 }
 
 tx_thread_status tx_thread_set_mesh(tx_thread* t, const float* x, uint32_t nx, const int32_t* tri, uint32_t ntri,
@@ -473,6 +523,7 @@ static void broadphase(tx_thread* t, double margin) {
   t->npairs = 0;
   double reach = 2 * t->def.radius + margin;
   for (int i = 0; i < nseg; i++) {
+    if (t->severed[i]) continue;
     const double* p = x + 3 * i;
     const int64_t* c = t->seg_ijk + 3 * i;
     for (int dz = -1; dz <= 1; dz++)
@@ -484,7 +535,7 @@ static void broadphase(tx_thread* t, double margin) {
             int j = (int)t->cell_item[k];
             const int64_t* cj = t->seg_ijk + 3 * j;
             // only the bucket's items of this very cell: each pair once, no hash collisions
-            if (j <= i + t->skip || cj[0] != cx || cj[1] != cy || cj[2] != cz) continue;
+            if (j <= i + t->skip || cj[0] != cx || cj[1] != cy || cj[2] != cz || t->severed[j]) continue;
             t->last.broad_pairs++;
             tx_seg_closest cl;
             tx_seg_closest_points(p, p + 3, x + 3 * j, x + 3 * j + 3, &cl);
@@ -511,6 +562,7 @@ static void solve_capsules(tx_thread* t) {
     const tx_thread_capsule* cp = &t->caps[k];
     double reach = t->def.radius + cp->radius;
     for (int i = 0; i < t->nseg; i++) {
+      if (t->severed[i]) continue;
       tx_seg_closest c;
       tx_seg_closest_points(x + 3 * i, x + 3 * i + 3, cp->a, cp->b, &c);
       if (c.dist >= reach) continue;
@@ -708,7 +760,8 @@ int tx_thread_fix_near_mesh(tx_thread* t, int first, int last, double limit) {
 static void solve_mesh(tx_thread* t) {
   if (t->mntri == 0) return;
   t->move_first = true;
-  for (int i = 0; i < t->nseg; i++) solve_mesh_edges(t, i);
+  for (int i = 0; i < t->nseg; i++)
+    if (!t->severed[i]) solve_mesh_edges(t, i);
   for (int i = 0; i < t->n; i++)
     if (!t->pinned[i]) solve_mesh_node(t, i);
 }
@@ -746,8 +799,11 @@ static void follow(tx_thread* t, int i, int from) {
   if (!t->def.slack || dist3(t->x + 3 * i, t->x + 3 * from) > t->l0) place_after(t, i, from, t->l0);
 }
 
+// a piece behind a cut follows its own first node (the cut end), which
+// nothing pulls: it stays where it is unless a contact or a pin moves it
 static void ftl_forward(tx_thread* t) {
   for (int i = 1; i < t->n; i++) {
+    if (t->severed[i - 1]) continue;
     follow(t, i, i - 1);
     if (t->mntri) {
       t->move_first = false; // the leader is placed: only this node moves
@@ -765,7 +821,7 @@ static void ftl_solve(tx_thread* t) {
     for (int i = t->last_pin; i > 0; i--) {
       if (t->pinned[i])
         memcpy(t->x + 3 * i, t->pin + 3 * i, sizeof(double) * 3);
-      else
+      else if (!t->severed[i])
         follow(t, i, i + 1);
     }
     ftl_forward(t);
@@ -794,13 +850,16 @@ static void ftl_substep(tx_thread* t, double h, double margin) {
 static void cap_stretch(tx_thread* t) {
   for (int pass = 0; pass < 2; pass++) {
     for (int i = 1; i < t->n; i++)
-      if (!t->pinned[i] && dist3(t->x + 3 * i, t->x + 3 * i - 3) > t->lmax) place_after(t, i, i - 1, t->lmax);
+      if (!t->pinned[i] && !t->severed[i - 1] && dist3(t->x + 3 * i, t->x + 3 * i - 3) > t->lmax)
+        place_after(t, i, i - 1, t->lmax);
     if (t->last_pin == 0) break;
     for (int i = t->last_pin - 1; i > 0; i--)
-      if (!t->pinned[i] && dist3(t->x + 3 * i, t->x + 3 * i + 3) > t->lmax) place_after(t, i, i + 1, t->lmax);
+      if (!t->pinned[i] && !t->severed[i] && dist3(t->x + 3 * i, t->x + 3 * i + 3) > t->lmax)
+        place_after(t, i, i + 1, t->lmax);
   }
   for (int i = 1; i < t->n; i++)
-    if (!t->pinned[i] && dist3(t->x + 3 * i, t->x + 3 * i - 3) > t->lmax) place_after(t, i, i - 1, t->lmax);
+    if (!t->pinned[i] && !t->severed[i - 1] && dist3(t->x + 3 * i, t->x + 3 * i - 3) > t->lmax)
+      place_after(t, i, i - 1, t->lmax);
 }
 
 // Cholesky of a symmetric banded matrix in place: A[r (bw + 1) + k] holds
@@ -845,12 +904,22 @@ static void bend_factor(tx_thread* t, double h) {
   const double* w = t->w;
   double ab = t->alpha_b / (h * h);
   double* B = t->bend;
+  const uint8_t* cut = t->severed;
   for (int k = 0; k < nb; k++) {
     int i = k + 1;
     B[k * 3] = w[i - 1] + 4 * w[i] + w[i + 1] + ab;
     B[k * 3 + 1] = k >= 1 ? -2 * w[i - 1] - 2 * w[i] : 0;
     B[k * 3 + 2] = k >= 2 ? w[i - 1] : 0;
   }
+  // a bend across a cut (node i with link i - 1 or i severed) is no
+  // constraint: its row is the identity, uncoupled, and its rhs 0
+  if (t->cuts)
+    for (int k = 0; k < nb; k++)
+      if (cut[k] || cut[k + 1]) {
+        B[k * 3] = 1, B[k * 3 + 1] = B[k * 3 + 2] = 0;
+        if (k + 1 < nb) B[(k + 1) * 3 + 1] = 0;
+        if (k + 2 < nb) B[(k + 2) * 3 + 2] = 0;
+      }
   if (nb > 0 && isfinite(ab)) band_factor(B, nb, 2);
 }
 
@@ -877,6 +946,7 @@ static void rod_solve(tx_thread* t, double h) {
       int i = k + 1;
       for (int c = 0; c < 3; c++)
         y[3 * k + c] = -(x[3 * i - 3 + c] - 2 * x[3 * i + c] + x[3 * i + 3 + c]) - ab * lam_b[3 * k + c];
+      if (t->severed[k] || t->severed[k + 1]) y[3 * k] = y[3 * k + 1] = y[3 * k + 2] = 0;
     }
     for (int c = 0; c < 3; c++) band_solve(t->bend, nb, 2, y + c, 3);
     for (int k = 0; k < nb; k++) {
@@ -905,7 +975,8 @@ static void rod_solve(tx_thread* t, double h) {
     }
     y[k] = -(l - t->l0) - ad * lam_d[k];
     A[k * 2] = (w[k] + w[k + 1]) + ad;
-    A[k * 2 + 1] = k >= 1 ? -w[k] * dot3(u + 3 * k - 3, u + 3 * k) : 0;
+    A[k * 2 + 1] = k >= 1 && !t->severed[k - 1] ? -w[k] * dot3(u + 3 * k - 3, u + 3 * k) : 0;
+    if (t->severed[k]) y[k] = 0, A[k * 2] = 1, A[k * 2 + 1] = 0; // a cut link: no constraint, uncoupled
   }
   band_factor(A, nseg, 1);
   band_solve(A, nseg, 1, y, 1);
