@@ -12,6 +12,7 @@
 #include "tests/scenario_support.h"
 
 #include <tactus/components.h>
+#include <tactus/events.h>
 
 #include <math.h>
 #include <stdio.h>
@@ -193,6 +194,128 @@ static void rod_keeps_out_of_a_capsule(void** state) {
   }
 }
 
+// a test class that sends TX_EVENT_CUT events on tool.events at set steps,
+// and one that listens to thread.events and keeps the cuts it sees
+typedef struct cut_plan {
+  uint64_t step;
+  uint32_t source;
+  double point[3];
+} cut_plan;
+static cut_plan plan[4];
+static int nplan;
+static tx_port cutter_out, listener_in, listener_nodes;
+static double node30_at_800[3]; // node 30 as the listener read it at step 800
+static uint32_t heard[8];
+static int nheard;
+static int cutter_configure(tx_setup* s, void** self) {
+  *self = NULL;
+  cutter_out = tx_setup_emit(s, "tool.events", 16);
+  return 0;
+}
+static void cutter_step(tx_ctx* c, void* self) {
+  (void)self;
+  for (int i = 0; i < nplan; i++)
+    if (tx_step_index(c) == plan[i].step) {
+      tx_event e = {.kind = TX_EVENT_CUT, .source = plan[i].source};
+      memcpy(e.cut.point, plan[i].point, sizeof e.cut.point);
+      tx_emit(c, cutter_out, &e);
+      tx_event g = {.kind = TX_EVENT_GRASP, .source = 3}; // not a cut: ignored
+      tx_emit(c, cutter_out, &g);
+    }
+}
+static int listener_configure(tx_setup* s, void** self) {
+  *self = NULL;
+  listener_in = tx_setup_listen(s, "thread.events");
+  listener_nodes = TX_READ_OF(s, "thread.nodes", tx_thread_node);
+  return 0;
+}
+static void listener_step(tx_ctx* c, void* self) {
+  (void)self;
+  for (tx_event e; tx_next_event(c, listener_in, &e);)
+    if (e.kind == TX_EVENT_CUT && nheard < 8) heard[nheard++] = e.source;
+  tx_snapshot x = tx_read(c, listener_nodes);
+  if (tx_step_index(c) == 800 && x.rows > 30) memcpy(node30_at_800, ((const tx_thread_node*)x.data)[30].x, sizeof node30_at_800);
+}
+static const tx_controller_class cutter_class = {
+    .type = "test.cutter", .summary = "cut events", .configure = cutter_configure, .step = cutter_step};
+static const tx_controller_class listener_class = {
+    .type = "test.cut_listener", .summary = "hears cuts", .configure = listener_configure, .step = listener_step};
+
+static tx_scenario* load_with_cutter(const char* params) {
+  if (!tx_find_controller(cutter_class.type)) assert_int_equal(tx_register_controller(&cutter_class), 0);
+  if (!tx_find_controller(listener_class.type)) assert_int_equal(tx_register_controller(&listener_class), 0);
+  char text[2048];
+  snprintf(text, sizeof text,
+           "{\"name\":\"t\",\"controllers\":["
+           "{\"name\":\"tool\",\"type\":\"test.cutter\",\"rate_hz\":1000},"
+           "{\"name\":\"thread\",\"type\":\"physics.thread\",\"rate_hz\":1000,\"params\":{\"cut_events\":\"tool.events\",%s}},"
+           "{\"name\":\"hear\",\"type\":\"test.cut_listener\",\"rate_hz\":1000},"
+           "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:slide-x-over\"}}]}",
+           params);
+  nheard = 0;
+  return tx_scenario_load_text("test", text, strlen(text), NULL);
+}
+
+// ftl, 41 nodes: a cut at link 20, the same link again, then one named by
+// its point alone (source out of range) beyond the tail: link 39. The links
+// and the drawn segments mark them, each cut is sent once on thread.events,
+// and the piece behind the first cut stays where it lay while the head slides on
+static void ftl_cut_by_events(void** state) {
+  (void)state;
+  nplan = 3;
+  plan[0] = (cut_plan){500, 20, {0, 0, 0}};
+  plan[1] = (cut_plan){600, 20, {0, 0, 0}};
+  plan[2] = (cut_plan){700, UINT32_MAX, {-0.2, 0.01, 0}};
+  tx_scenario* s = load_with_cutter("\"nodes\":41,\"length_m\":0.04,\"tail_m\":[-0.1,0.01,0],\"draw\":true");
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 2.5); // the head slides 2 cm along +x after the cuts
+  tx_snapshot x = latest_snapshot(s, "thread.nodes"), ls = latest_snapshot(s, "thread.links"),
+              sg = latest_snapshot(s, "thread.segments");
+  assert_int_equal(ls.rows, 40);
+  assert_int_equal(ls.cols, 2);
+  const tx_thread_node* n = x.data;
+  const tx_thread_link* l = ls.data;
+  const tx_segment* g = sg.data;
+  for (int i = 0; i < 40; i++) {
+    bool cut = i == 20 || i == 39;
+    assert_true(l[i].severed == (cut ? 1 : 0));
+    assert_true(l[i].piece == (i <= 20 ? 0 : i <= 39 ? 1 : 2));
+    assert_true(g[i].r == (cut ? 0.0f : 0.00025f));
+  }
+  assert_true(node30_at_800[0] < -0.05); // read after the cuts, where the straight thread lay
+  for (int a = 0; a < 3; a++) assert_true(fabs(n[30].x[a] - node30_at_800[a]) < 1e-12); // behind the cut: still
+  print_message("the head's piece: its end at x %.4f (it lay at -0.05 m)\n", n[20].x[0]);
+  assert_true(n[20].x[0] > -0.04); // the head's piece went along with the head
+  const tx_pose* pose = (const tx_pose*)latest(s, "device0.pose");
+  for (int a = 0; a < 3; a++) assert_true(fabs(n[0].x[a] - pose->pos[a]) < 1e-3); // the head's piece: on it
+  assert_true(result(s, "thread.cuts") == 2);
+  assert_int_equal(nheard, 2);
+  assert_int_equal(heard[0], 20);
+  assert_int_equal(heard[1], 39);
+  assert_int_equal(warnings(s, "thread.bad_cut"), 0);
+  tx_scenario_free(s);
+}
+
+// the rod hangs from the still device; cut at link 10 its lower half falls
+// away while the upper half stays on the head
+static void rod_cut_by_an_event(void** state) {
+  (void)state;
+  nplan = 1;
+  plan[0] = (cut_plan){300, 10, {0, 0, 0}};
+  tx_scenario* s = load_with_cutter("\"model\":\"rod\",\"nodes\":21,\"length_m\":0.02,\"tail_m\":[-0.03,-0.1,0],\"damping\":20");
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 0.6);
+  const tx_thread_node* n = latest_snapshot(s, "thread.nodes").data;
+  const tx_pose* pose = (const tx_pose*)latest(s, "device0.pose");
+  print_message("rod cut: node 10 at y %.4f, node 20 at y %.4f (head %.4f)\n", n[10].x[1], n[20].x[1], pose->pos[1]);
+  assert_true(n[10].x[1] > pose->pos[1] - 0.0106);  // ten links, within the stretch cap
+  assert_true(n[20].x[1] < pose->pos[1] - 0.05);    // fell away
+  assert_true(result(s, "thread.cuts") == 1);
+  assert_int_equal(nheard, 1);
+  assert_int_equal(heard[0], 10);
+  tx_scenario_free(s);
+}
+
 static void bad_input_is_named(void** state) {
   (void)state;
   struct {
@@ -209,6 +332,8 @@ static void bad_input_is_named(void** state) {
       {"\"prefix\":\"\"", "params.prefix"},
       {"\"head\":\"nobody.pose\"", "nobody.pose"},
       {"\"capsules\":[\"nobody.capsules\"]", "nobody.capsules"},
+      {"\"cut_events\":\"nobody.events\"", "nobody.events"},
+      {"\"cut_events\":5", "cut_events"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
     tx_scenario* s = load(cases[i].params, "slide-x-over");
@@ -225,6 +350,8 @@ int main(void) {
       cmocka_unit_test(tension_of_a_thread_pulled_past_its_pin),
       cmocka_unit_test(rod_force_on_the_head),
       cmocka_unit_test(rod_keeps_out_of_a_capsule),
+      cmocka_unit_test(ftl_cut_by_events),
+      cmocka_unit_test(rod_cut_by_an_event),
       cmocka_unit_test(bad_input_is_named),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
