@@ -81,6 +81,11 @@ typedef struct tx_thread_def {
   double max_stretch;    // the stretch cap: (l - l0) / l0 of a segment, in [0, 1]; 0.05
   int max_shapes;        // room for capsules and spheres, in [0, 4096]; 16
   int max_triangles;     // room for mesh triangles, in [0, 10000000]; 0: no mesh
+  int max_punctures;     // room for puncture points, in [0, 1024]; 16
+  double puncture_friction; // N, in [0, 100]: the force along the thread a puncture holds it with
+                            // before it slides (and drags with while sliding); 0
+  double puncture_capture;  // m, in (0, 0.1]: the head has passed a puncture once the thread behind
+                            // it (not the head's end) comes this near it; 0.001
 } tx_thread_def;
 
 // a kinematic capsule: the points within radius of segment a b (a sphere when a == b)
@@ -149,6 +154,24 @@ int tx_thread_cut_count(const tx_thread* t); // links severed so far
 // the head's piece is nodes 0..this (N - 1 when uncut): its lowest cut link
 int tx_thread_head_piece_end(const tx_thread* t);
 
+// punctures: the points (n x 3, m, in order) the thread passes through,
+// for the next steps (copied; n in [0, max_punctures]). Once the head has
+// gone through point k (after points 0..k-1: the thread behind the head,
+// not its end, within puncture_capture of it), the thread runs through it:
+// it slides through and never leaves it (ftl: the link that holds it is put
+// through it; rod: a sliding constraint on the polyline, with Coulomb
+// friction puncture_friction along the thread; a link on a pinned node
+// turns about it through the point, without friction). The
+// skin's contacts are left out near a passed puncture. Points move between
+// steps (a skin that moves); a shorter list forgets those past its end.
+tx_thread_status tx_thread_set_punctures(tx_thread* t, const double* p, int n);
+int tx_thread_punctures_passed(const tx_thread* t); // how many the thread runs through
+// the material coordinate (m from the head, at rest) of the thread's point
+// at passed puncture k; -1 when k is not passed. It grows as the thread is pulled through.
+double tx_thread_puncture_arc(const tx_thread* t, int k);
+// the passed punctures the thread slid on through in the last step
+int tx_thread_punctures_slid(const tx_thread* t);
+
 // advances by dt (s, in (0, 1])
 tx_thread_status tx_thread_step(tx_thread* t, double dt);
 
@@ -187,7 +210,9 @@ void tx_thread_head_force(const tx_thread* t, double out[3]);
 // paper): ftl: (length - rest length) x stiffness (N/m) of the head's piece
 // (the whole thread when uncut) along the sum of its segments (from the head
 // towards its end), the length running on from the tail to its pin when the
-// tail is pinned and the thread uncut, K = -stiffness d d^T; rod: the
+// tail is pinned and the thread uncut, K = -stiffness d d^T, plus
+// puncture_friction for each puncture it slid through in the last step,
+// towards the first; rod: the
 // constraints' force on the head (tx_thread_head_force), K = 0. f (N) is
 // clamped to max_force (N) and never NaN.
 void tx_thread_tension(const tx_thread* t, double stiffness, double max_force, double f[3], double K[9]);
