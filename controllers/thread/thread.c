@@ -49,6 +49,7 @@ struct tx_thread {
   uint8_t* near_punct;       // (n) nodes near a passed puncture: no skin contact there
   double* arc_step;          // (max_punctures) arc at the start of the step
   double* arc_sub;           // (max_punctures) and of the substep, for a substep taken again
+  double* plam;              // (max_punctures) rod: the friction's multiplier along the thread in this substep
   double* pin;               // (n x 3) where pinned nodes are held, m
   int last_pin;              // the highest pinned node (0: the head alone)
   double head_from[3], head_to[3];
@@ -205,6 +206,7 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   t->near_punct = calloc((size_t)n, 1);
   t->arc_step = malloc(sizeof(double) * (def->max_punctures + 1));
   t->arc_sub = malloc(sizeof(double) * (def->max_punctures + 1));
+  t->plam = calloc((size_t)def->max_punctures + 1, sizeof(double));
   t->pin = calloc(3 * (size_t)n, sizeof(double));
   t->cell_start = malloc(sizeof(uint32_t) * (hsize + 1));
   t->cell_item = malloc(sizeof(uint32_t) * nseg);
@@ -213,7 +215,7 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   t->pairs = malloc(sizeof(pair) * t->pair_cap);
   t->colliding = calloc((size_t)nseg, 1);
   t->caps = malloc(sizeof(tx_thread_capsule) * (def->max_shapes + 1));
-  if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->v0 || !t->w || !t->wf || !t->lam || !t->band || !t->bend || !t->rhs || !t->dir || !t->pinned || !t->severed || !t->punct || !t->arc || !t->near_punct || !t->arc_step || !t->arc_sub || !t->pin || !t->cell_start ||
+  if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->v0 || !t->w || !t->wf || !t->lam || !t->band || !t->bend || !t->rhs || !t->dir || !t->pinned || !t->severed || !t->punct || !t->arc || !t->near_punct || !t->arc_step || !t->arc_sub || !t->plam || !t->pin || !t->cell_start ||
       !t->cell_item || !t->seg_cell || !t->seg_ijk || !t->pairs || !t->colliding || !t->caps)
     goto oom;
   if (def->max_triangles > 0) {
@@ -263,6 +265,7 @@ void tx_thread_destroy(tx_thread* t) {
   free(t->near_punct);
   free(t->arc_step);
   free(t->arc_sub);
+  free(t->plam);
   free(t->pin);
   free(t->cell_start);
   free(t->cell_item);
@@ -880,17 +883,18 @@ static void punctures_begin_substep(tx_thread* t) {
   }
 }
 
-// each passed puncture holds the thread's point at arc[k] on it. With
-// friction the drift along the thread in this substep is undone while the
-// force that takes, drift / (W h^2), is at most puncture_friction (it
-// sticks); beyond, the thread slides, the point held moving on along it,
-// and friction pulls back with that force. Without (friction false), the
-// point held is the nearest one and only the distance across the thread is
-// taken out: it slides freely and never leaves the puncture.
+// each passed puncture holds the thread's point at arc[k] on it. In the
+// iterations (friction true) the offset across the thread is undone, and
+// the drift along it as far as the friction's multiplier allows (XPBD
+// Coulomb friction: the multiplier along the thread, summed over the
+// iterations of the substep, stays within puncture_friction h^2, so the
+// force never exceeds it; within, it sticks); what is left slides, the
+// point held moving on along the thread. At the end of the substep
+// (friction false) the point held is put on the puncture whole: the thread
+// never leaves it.
 static void solve_punctures(tx_thread* t, double h, bool friction) {
   for (int k = 0; k < t->passed; k++) {
     const double* p = t->punct + 3 * k;
-    if (!friction) t->arc[k] = nearest_arc(t, p, t->arc[k]);
     int i;
     double u;
     arc_link(t, t->arc[k], &i, &u);
@@ -917,13 +921,18 @@ static void solve_punctures(tx_thread* t, double h, bool friction) {
     }
     double W = t->w[i] * (1 - u) * (1 - u) + t->w[i + 1] * u * u;
     if (!(W > 0)) continue;
-    double ct = dot3(C, tan), dmax = friction ? t->def.puncture_friction * W * h * h : 0, corr[3];
-    if (friction && fabs(ct) <= dmax) {
-      memcpy(corr, C, sizeof corr); // sticks
+    double ct = dot3(C, tan), corr[3];
+    if (!friction) {
+      memcpy(corr, C, sizeof corr); // the held point onto the puncture, whole
     } else {
-      double keep = copysign(dmax, ct);
-      for (int c = 0; c < 3; c++) corr[c] = C[c] - ct * tan[c] + keep * tan[c];
-      t->arc[k] = fmin(t->nseg * t->l0, fmax(0, t->arc[k] - (ct - keep)));
+      // the multiplier along the thread that would undo the drift, clamped
+      // to the friction's: the rest slides (the point held moves on)
+      double lim = t->def.puncture_friction * h * h, lt = t->plam[k] - ct / W;
+      if (fabs(lt) > lim) lt = copysign(lim, lt);
+      double dq = (lt - t->plam[k]) * W; // the move along the thread friction makes
+      t->plam[k] = lt;
+      for (int c = 0; c < 3; c++) corr[c] = C[c] - ct * tan[c] - dq * tan[c];
+      t->arc[k] = fmin(t->nseg * t->l0, fmax(0, t->arc[k] - (ct + dq)));
     }
     for (int c = 0; c < 3; c++) {
       a[c] -= t->w[i] * (1 - u) / W * corr[c];
@@ -1197,12 +1206,13 @@ static void rod_substep(tx_thread* t, double h, double margin) {
   bool self = d->self_collision && nseg > t->skip + 1;
   if (self) broadphase(t, margin);
   bend_factor(t, h);
+  if (t->passed) memset(t->plam, 0, sizeof(double) * t->passed);
   for (int it = 0; it < d->iterations; it++) {
     rod_solve(t, h);
     solve_capsules(t);
     if (self) solve_self(t);
+    if (t->passed) solve_punctures(t, h, true);
   }
-  if (t->passed) solve_punctures(t, h, true);
   cap_stretch(t);
   // a node moved by one cylinder's push can go back into its neighbour's
   // capsule: a second pass settles the pair

@@ -39,8 +39,8 @@ static void puncture_points(double time, double p[6]) {
   p[0] = 0.005, p[1] = 0.0004 * sin(4 * PI * time), p[2] = 0;
   p[3] = 0.015, p[4] = -0.0004 * sin(4 * PI * time), p[5] = 0;
 }
-static void head_at(double time, double h[3]) {
-  if (time <= 0.2) {
+static void head_at(double time, double h[3], bool straight) {
+  if (time <= 0.2 || straight) {
     h[0] = 0.1 * time, h[1] = 0;
   } else {
     double f = fmin(1, (time - 0.2) / 0.2);
@@ -56,7 +56,7 @@ typedef struct drag_result {
   double force_mean;  // N, the head force's mean magnitude while pulled through (rod) or the tension's (ftl)
 } drag_result;
 
-static drag_result drag(tx_thread_model model, double friction, bool count) {
+static drag_result drag(tx_thread_model model, double friction, bool count, bool straight, int iterations) {
   tx_thread_def d = tx_thread_def_default();
   d.model = model;
   d.nodes = 61;
@@ -65,6 +65,7 @@ static drag_result drag(tx_thread_model model, double friction, bool count) {
   d.puncture_friction = friction;
   d.gravity = 0;
   d.damping = 5;
+  d.iterations = iterations;
   tx_thread* t = tx_thread_create(&d);
   assert_non_null(t);
   drag_result r = {0, {-1, -1}, {0, 0}, 0};
@@ -74,7 +75,7 @@ static drag_result drag(tx_thread_model model, double friction, bool count) {
   for (int k = 1; k <= 400; k++) {
     double time = k * 1e-3, p[6], h[3];
     puncture_points(time, p);
-    head_at(time, h);
+    head_at(time, h, straight);
     assert_int_equal(tx_thread_set_punctures(t, p, 2), TX_THREAD_OK);
     assert_int_equal(tx_thread_set_head(t, h), TX_THREAD_OK);
     assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
@@ -101,7 +102,7 @@ static drag_result drag(tx_thread_model model, double friction, bool count) {
 static void test_slides_through_two_moving_punctures(void** state) {
   (void)state;
   for (int model = 0; model < 2; model++) {
-    drag_result r = drag((tx_thread_model)model, 0, model == 0);
+    drag_result r = drag((tx_thread_model)model, 0, model == 0, false, 2);
     print_message("%s: passed at steps %d, %d; arcs at the end %.2f, %.2f mm; worst distance %.3g mm\n",
                   model ? "rod" : "ftl", r.passed_at[0], r.passed_at[1], r.arc_end[0] * 1e3, r.arc_end[1] * 1e3,
                   r.worst * 1e3);
@@ -127,12 +128,14 @@ static void test_slides_through_two_moving_punctures(void** state) {
 static void test_friction_raises_the_head_force(void** state) {
   (void)state;
   for (int model = 0; model < 2; model++) {
-    drag_result free_ = drag((tx_thread_model)model, 0, false), held = drag((tx_thread_model)model, 0.02, false);
+    // pulled straight on through both: the rod is barely bent, its force on
+    // the head is what holds it back
+    drag_result free_ = drag((tx_thread_model)model, 0, false, true, 2), held = drag((tx_thread_model)model, 0.02, false, true, 2);
     print_message("%s: head force %.4g N without friction, %.4g N with 0.02 N a puncture\n", model ? "rod" : "ftl",
                   free_.force_mean, held.force_mean);
     if (model == TX_THREAD_FTL) // both slid at every step measured: 2 x 0.02 N on top
       assert_true(fabs(held.force_mean - free_.force_mean - 0.04) < 1e-9);
-    else // through the constraints: about a third of the nominal 0.04 N reaches the head here
+    else // through the constraints: at 2 iterations a quarter of the nominal 0.04 N reaches the head
       assert_true(held.force_mean > free_.force_mean + 0.005);
     assert_true(held.worst <= 0.00025); // still never leaves one
   }
