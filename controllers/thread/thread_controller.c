@@ -8,7 +8,7 @@
 // the thread collides with SKIN.x / SKIN.tri, and with the rigid capsules
 // (tx_capsule rows) of the components listed in capsules. With cut_events
 // it takes the TX_EVENT_CUT events of that stream: the link they name (or the
-// one nearest their point) is severed, PREFIX.links marks it and the pieces,
+// one nearest their point) is severed, PREFIX.cut_links marks it and the pieces,
 // and the cut is sent again on PREFIX.events. With punctures (tx_puncture
 // rows on the skin's triangles) the thread passes through them in order.
 #include "thread_controller.h"
@@ -45,7 +45,7 @@ typedef struct thread_ctl {
   bool draw;
   tx_port segments, spheres; // with draw: the thread as a tube for the graphics view
   tx_port caps[8];
-  tx_port cut_in, links;     // the cut events listened to (cut_in.id 0: none); PREFIX.links
+  tx_port cut_in, links;     // the cut events listened to (cut_in.id 0: none); PREFIX.cut_links
   tx_port punct_in;          // the puncture list (punct_in.id 0: none)
   double* punct;             // (max_punctures x 3) where they are this step, m
   int max_punct;
@@ -189,7 +189,7 @@ static int configure(tx_setup* s, void** self) {
   k->force = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_force_model, 1));
   snprintf(name, sizeof name, "%s.events", prefix);
   k->events = tx_setup_emit(s, name, 64);
-  snprintf(name, sizeof name, "%s.links", prefix);
+  snprintf(name, sizeof name, "%s.cut_links", prefix);
   k->links = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_thread_link, (uint32_t)d.nodes - 1));
   const char* cut_events = tx_table_str(s, "cut_events");
   if (!cut_events) return -1;
@@ -477,7 +477,7 @@ static void fini(void* self) {
 
 const tx_controller_class tx_physics_thread = {
     .type = "physics.thread",
-    .summary = "suture thread, ftl or XPBD rod, head on a pose: writes THREAD.nodes, THREAD.links, THREAD.force_model, THREAD.events (knots, cuts)",
+    .summary = "suture thread, ftl or XPBD rod, head on a pose: writes THREAD.nodes, THREAD.cut_links, THREAD.force_model, THREAD.events (knots, cuts)",
     .configure = configure,
     .init = init,
     .step = step,

@@ -229,7 +229,7 @@ typedef struct tx_thread_node {
 #define tx_thread_node_UNITS "m"
 TX_LAYOUT_ASSERT(tx_thread_node, double);
 
-// THREAD.links (N - 1 rows, link i joins nodes i and i + 1), written by
+// THREAD.cut_links (N - 1 rows, link i joins nodes i and i + 1), written by
 // physics.thread: how a cut splits the thread. A severed link joins nothing
 // (do not draw or collide it); the nodes on either side of it end two
 // pieces. Piece 0 holds the head (the needle); each cut along the thread

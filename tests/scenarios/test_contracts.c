@@ -35,7 +35,7 @@ static const layout layouts[] = {
     L(".state", tx_hip_state),          L(".spheres", tx_sphere),          L(".segments", tx_segment),
     L(".x", tx_vertex),                 L(".tri", tx_triangle),            L(".thickness", tx_thickness),
     L(".torn", tx_torn),                L(".damage", tx_damage),           L(".nodes", tx_thread_node),
-    L(".pointer", tx_pointer),          L(".contact", tx_skin_contact),
+    L(".pointer", tx_pointer),          L(".contact", tx_skin_contact),    L(".cut_links", tx_thread_link),
 };
 #undef L
 

@@ -269,7 +269,7 @@ static void ftl_cut_by_events(void** state) {
   tx_scenario* s = load_with_cutter("\"nodes\":41,\"length_m\":0.04,\"tail_m\":[-0.1,0.01,0],\"draw\":true");
   if (!s) fail_msg("%s", tx_error());
   run(s, 2.5); // the head slides 2 cm along +x after the cuts
-  tx_snapshot x = latest_snapshot(s, "thread.nodes"), ls = latest_snapshot(s, "thread.links"),
+  tx_snapshot x = latest_snapshot(s, "thread.nodes"), ls = latest_snapshot(s, "thread.cut_links"),
               sg = latest_snapshot(s, "thread.segments");
   assert_int_equal(ls.rows, 40);
   assert_int_equal(ls.cols, 2);
