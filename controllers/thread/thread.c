@@ -37,6 +37,19 @@ struct tx_thread {
   double* rhs;               // (3 nseg)
   double* dir;               // (nseg x 3) unit segment directions, x[i] - x[i+1]
   uint8_t* pinned;           // (n)
+  uint8_t* severed;          // (nseg) cut links: no distance, no bend across, no contacts
+  int first_cut;             // the lowest severed link: the head's piece is nodes 0..first_cut (nseg: none)
+  int cuts;
+  // punctures: points the thread passes through, in order
+  double* punct;             // (max_punctures x 3) where they are, m
+  double* arc;               // (max_punctures) the arc length from the head of the thread's point held at each, m
+  int npunct;                // points given
+  int passed;                // the first this many are passed by the head: the thread runs through them
+  int slid;                  // punctures the thread slid through in the last step
+  uint8_t* near_punct;       // (n) nodes near a passed puncture: no skin contact there
+  double* arc_step;          // (max_punctures) arc at the start of the step
+  double* arc_sub;           // (max_punctures) and of the substep, for a substep taken again
+  double* plam;              // (max_punctures) rod: the friction's multiplier along the thread in this substep
   double* pin;               // (n x 3) where pinned nodes are held, m
   int last_pin;              // the highest pinned node (0: the head alone)
   double head_from[3], head_to[3];
@@ -98,6 +111,9 @@ tx_thread_def tx_thread_def_default(void) {
   d.max_stretch = 0.05;
   d.max_shapes = 16;
   d.max_triangles = 0;
+  d.max_punctures = 16;
+  d.puncture_friction = 0;
+  d.puncture_capture = 0.001;
   return d;
 }
 
@@ -129,6 +145,9 @@ int tx_thread_def_check(const tx_thread_def* d) {
   if (range("max_stretch", d->max_stretch, 0, false, 1, false, "")) return -1;
   if (tx_check_count("thread", "max_shapes", d->max_shapes, 0, 4096)) return -1;
   if (tx_check_count("thread", "max_triangles", d->max_triangles, 0, 10000000)) return -1;
+  if (tx_check_count("thread", "max_punctures", d->max_punctures, 0, 1024)) return -1;
+  if (range("puncture_friction", d->puncture_friction, 0, false, 100, false, "N")) return -1;
+  if (range("puncture_capture", d->puncture_capture, 0, true, 0.1, false, "m")) return -1;
   return 0;
 }
 
@@ -180,6 +199,14 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   t->rhs = malloc(sizeof(double) * 3 * nseg);
   t->dir = malloc(sizeof(double) * 3 * nseg);
   t->pinned = calloc((size_t)n, 1);
+  t->severed = calloc((size_t)nseg, 1);
+  t->first_cut = nseg;
+  t->punct = malloc(sizeof(double) * 3 * (def->max_punctures + 1));
+  t->arc = malloc(sizeof(double) * (def->max_punctures + 1));
+  t->near_punct = calloc((size_t)n, 1);
+  t->arc_step = malloc(sizeof(double) * (def->max_punctures + 1));
+  t->arc_sub = malloc(sizeof(double) * (def->max_punctures + 1));
+  t->plam = calloc((size_t)def->max_punctures + 1, sizeof(double));
   t->pin = calloc(3 * (size_t)n, sizeof(double));
   t->cell_start = malloc(sizeof(uint32_t) * (hsize + 1));
   t->cell_item = malloc(sizeof(uint32_t) * nseg);
@@ -188,7 +215,7 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   t->pairs = malloc(sizeof(pair) * t->pair_cap);
   t->colliding = calloc((size_t)nseg, 1);
   t->caps = malloc(sizeof(tx_thread_capsule) * (def->max_shapes + 1));
-  if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->v0 || !t->w || !t->wf || !t->lam || !t->band || !t->bend || !t->rhs || !t->dir || !t->pinned || !t->pin || !t->cell_start ||
+  if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->v0 || !t->w || !t->wf || !t->lam || !t->band || !t->bend || !t->rhs || !t->dir || !t->pinned || !t->severed || !t->punct || !t->arc || !t->near_punct || !t->arc_step || !t->arc_sub || !t->plam || !t->pin || !t->cell_start ||
       !t->cell_item || !t->seg_cell || !t->seg_ijk || !t->pairs || !t->colliding || !t->caps)
     goto oom;
   if (def->max_triangles > 0) {
@@ -232,6 +259,13 @@ void tx_thread_destroy(tx_thread* t) {
   free(t->rhs);
   free(t->dir);
   free(t->pinned);
+  free(t->severed);
+  free(t->punct);
+  free(t->arc);
+  free(t->near_punct);
+  free(t->arc_step);
+  free(t->arc_sub);
+  free(t->plam);
   free(t->pin);
   free(t->cell_start);
   free(t->cell_item);
@@ -254,16 +288,17 @@ int tx_thread_faults(const tx_thread* t) { return t->faults; }
 void tx_thread_last_contacts(const tx_thread* t, tx_thread_contacts* out) { *out = t->last; }
 void tx_thread_head_force(const tx_thread* t, double out[3]) { memcpy(out, t->head_force, sizeof t->head_force); }
 void tx_thread_tension(const tx_thread* t, double stiffness, double max_force, double f[3], double K[9]) {
-  int n = t->n;
+  int n = t->n, end = t->first_cut; // the head's piece: nodes 0..end
   const double* h = t->x;
-  const double* tail = t->x + 3 * (n - 1);
-  double sum[3], len = tx_thread_current_length(t);
+  const double* tail = t->x + 3 * end;
+  double sum[3], len = 0, rest = t->l0 * end;
+  for (int i = 0; i < end; i++) len += dist3(t->x + 3 * i, t->x + 3 * i + 3);
   memset(K, 0, sizeof(double) * 9);
   for (int a = 0; a < 3; a++) {
     f[a] = 0;
     sum[a] = tail[a] - h[a];
   }
-  if (t->pinned[n - 1]) { // the length runs on to the tail's pin
+  if (end == n - 1 && t->pinned[n - 1]) { // the length runs on to the tail's pin
     const double* pin = t->pin + 3 * (n - 1);
     len += dist3(pin, tail);
     for (int a = 0; a < 3; a++) sum[a] = pin[a] - h[a];
@@ -271,11 +306,22 @@ void tx_thread_tension(const tx_thread* t, double stiffness, double max_force, d
   double ls = sqrt(dot3(sum, sum));
   if (t->def.model == TX_THREAD_ROD) {
     memcpy(f, t->head_force, sizeof t->head_force);
-  } else if (ls > 0 && len > t->def.length) {
-    double mag = stiffness * (len - t->def.length);
-    for (int a = 0; a < 3; a++) {
-      f[a] = mag * sum[a] / ls;
-      for (int b = 0; b < 3; b++) K[3 * a + b] = -stiffness * sum[a] * sum[b] / (ls * ls);
+  } else {
+    if (ls > 0 && len > rest) {
+      double mag = stiffness * (len - rest);
+      for (int a = 0; a < 3; a++) {
+        f[a] = mag * sum[a] / ls;
+        for (int b = 0; b < 3; b++) K[3 * a + b] = -stiffness * sum[a] * sum[b] / (ls * ls);
+      }
+    }
+    // the kinematic thread slides through punctures whatever the pull: the
+    // hand feels their friction, towards the first, for each it slid through
+    if (t->slid > 0 && t->passed > 0) {
+      double d[3], dl;
+      for (int a = 0; a < 3; a++) d[a] = t->punct[a] - h[a];
+      dl = sqrt(dot3(d, d));
+      if (dl > 0)
+        for (int a = 0; a < 3; a++) f[a] += t->def.puncture_friction * t->slid * d[a] / dl;
     }
   }
   double fm = sqrt(dot3(f, f));
@@ -292,13 +338,15 @@ bool tx_thread_pin_of(const tx_thread* t, int i, double out[3]) {
 
 double tx_thread_current_length(const tx_thread* t) {
   double s = 0;
-  for (int i = 0; i < t->nseg; i++) s += dist3(t->x + 3 * i, t->x + 3 * i + 3);
+  for (int i = 0; i < t->nseg; i++)
+    if (!t->severed[i]) s += dist3(t->x + 3 * i, t->x + 3 * i + 3);
   return s;
 }
 
 double tx_thread_max_strain(const tx_thread* t) {
   double m = -1;
   for (int i = 0; i < t->nseg; i++) {
+    if (t->severed[i]) continue;
     double e = dist3(t->x + 3 * i, t->x + 3 * i + 3) / t->l0 - 1;
     if (e > m) m = e;
   }
@@ -373,6 +421,64 @@ tx_thread_status tx_thread_set_capsules(tx_thread* t, const tx_thread_capsule* c
   t->ncaps = n;
   return TX_THREAD_OK;
 }
+
+int tx_thread_cut(tx_thread* t, int seg) {
+  if (seg < 0 || seg >= t->nseg) {
+    tx_set_error("thread: cut link %d, must be in [0, %d]", seg, t->nseg - 1);
+    return -1;
+  }
+  if (t->severed[seg]) return 0;
+  t->severed[seg] = 1;
+  t->cuts++;
+  if (seg < t->first_cut) t->first_cut = seg;
+  // the two new ends lose half a link's mass: each node carries half of each
+  // link it still has (a node left alone keeps half a link's)
+  double m = t->def.density * PI * t->def.radius * t->def.radius * t->l0;
+  for (int i = seg; i <= seg + 1; i++) {
+    int links = (i > 0 && !t->severed[i - 1]) + (i < t->nseg && !t->severed[i]);
+    t->wf[i] = 2 / (m * (links > 0 ? links : 1));
+  }
+  update_last_pin(t);
+  return 1;
+}
+
+const uint8_t* tx_thread_severed(const tx_thread* t) { return t->severed; }
+int tx_thread_cut_count(const tx_thread* t) { return t->cuts; }
+int tx_thread_head_piece_end(const tx_thread* t) { return t->first_cut; }
+
+int tx_thread_nearest_link(const tx_thread* t, const double p[3], double at[3]) {
+  int best = -1;
+  double bd = INFINITY;
+  for (int i = 0; i < t->nseg; i++) {
+    if (t->severed[i]) continue;
+    const double *a = t->x + 3 * i, *b = a + 3;
+    double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, ee = dot3(e, e), s = 0;
+    if (ee > 0) s = fmin(1, fmax(0, (dot3(p, e) - dot3(a, e)) / ee));
+    double q[3] = {a[0] + s * e[0], a[1] + s * e[1], a[2] + s * e[2]}, d = dist3(p, q);
+    if (d < bd) {
+      bd = d, best = i;
+      if (at) memcpy(at, q, sizeof q);
+    }
+  }
+  return best;
+}
+
+tx_thread_status tx_thread_set_punctures(tx_thread* t, const double* p, int n) {
+  if (n < 0 || n > t->def.max_punctures) {
+    tx_set_error("thread: %d punctures, must be in [0, %d] (max_punctures)", n, t->def.max_punctures);
+    return TX_THREAD_BAD;
+  }
+  for (int k = 0; k < n; k++)
+    if (check_point("puncture", p + 3 * k)) return TX_THREAD_BAD;
+  if (n) memcpy(t->punct, p, sizeof(double) * 3 * n);
+  t->npunct = n;
+  if (t->passed > n) t->passed = n; // a list that shrank: those past its end are gone
+  return TX_THREAD_OK;
+}
+
+int tx_thread_punctures_passed(const tx_thread* t) { return t->passed; }
+int tx_thread_punctures_slid(const tx_thread* t) { return t->slid; }
+double tx_thread_puncture_arc(const tx_thread* t, int k) { return k >= 0 && k < t->passed ? t->arc[k] : -1; }
 
 tx_thread_status tx_thread_set_mesh(tx_thread* t, const float* x, uint32_t nx, const int32_t* tri, uint32_t ntri,
                                     double thickness) {
@@ -473,6 +579,7 @@ static void broadphase(tx_thread* t, double margin) {
   t->npairs = 0;
   double reach = 2 * t->def.radius + margin;
   for (int i = 0; i < nseg; i++) {
+    if (t->severed[i]) continue;
     const double* p = x + 3 * i;
     const int64_t* c = t->seg_ijk + 3 * i;
     for (int dz = -1; dz <= 1; dz++)
@@ -484,7 +591,7 @@ static void broadphase(tx_thread* t, double margin) {
             int j = (int)t->cell_item[k];
             const int64_t* cj = t->seg_ijk + 3 * j;
             // only the bucket's items of this very cell: each pair once, no hash collisions
-            if (j <= i + t->skip || cj[0] != cx || cj[1] != cy || cj[2] != cz) continue;
+            if (j <= i + t->skip || cj[0] != cx || cj[1] != cy || cj[2] != cz || t->severed[j]) continue;
             t->last.broad_pairs++;
             tx_seg_closest cl;
             tx_seg_closest_points(p, p + 3, x + 3 * j, x + 3 * j + 3, &cl);
@@ -511,6 +618,7 @@ static void solve_capsules(tx_thread* t) {
     const tx_thread_capsule* cp = &t->caps[k];
     double reach = t->def.radius + cp->radius;
     for (int i = 0; i < t->nseg; i++) {
+      if (t->severed[i]) continue;
       tx_seg_closest c;
       tx_seg_closest_points(x + 3 * i, x + 3 * i + 3, cp->a, cp->b, &c);
       if (c.dist >= reach) continue;
@@ -705,12 +813,132 @@ int tx_thread_fix_near_mesh(tx_thread* t, int first, int last, double limit) {
   return 1;
 }
 
+// the thread passes through the skin at a puncture: the nodes near one
+// (near_punct) have no skin contact
 static void solve_mesh(tx_thread* t) {
   if (t->mntri == 0) return;
   t->move_first = true;
-  for (int i = 0; i < t->nseg; i++) solve_mesh_edges(t, i);
+  for (int i = 0; i < t->nseg; i++)
+    if (!t->severed[i] && !t->near_punct[i] && !t->near_punct[i + 1]) solve_mesh_edges(t, i);
   for (int i = 0; i < t->n; i++)
-    if (!t->pinned[i]) solve_mesh_node(t, i);
+    if (!t->pinned[i] && !t->near_punct[i]) solve_mesh_node(t, i);
+}
+
+// ---------------------------------------------------------------------------
+// punctures: the thread slides through each point its head has passed.
+// arc[k] is the thread's material coordinate held at puncture k: (i + u) l0
+// for the point at fraction u of link i.
+
+static void arc_link(const tx_thread* t, double arc, int* i, double* u) {
+  double f = arc / t->l0;
+  int k = (int)floor(f);
+  if (k < 0) k = 0;
+  if (k > t->nseg - 1) k = t->nseg - 1;
+  *i = k;
+  *u = fmin(1, fmax(0, f - k));
+}
+
+// the material coordinate of the thread's point nearest p among the whole
+// links within a few of guess (a sliding thread moves less than a link a substep)
+static double nearest_arc(const tx_thread* t, const double p[3], double guess) {
+  int c, lo, hi;
+  double u0, best = guess, bd = INFINITY;
+  arc_link(t, guess, &c, &u0);
+  lo = c - 3 < 0 ? 0 : c - 3;
+  hi = c + 3 > t->nseg - 1 ? t->nseg - 1 : c + 3;
+  for (int i = lo; i <= hi; i++) {
+    if (t->severed[i]) continue;
+    const double *a = t->x + 3 * i, *b = a + 3;
+    double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, ee = dot3(e, e), u = 0;
+    if (ee > 0) u = fmin(1, fmax(0, (dot3(p, e) - dot3(a, e)) / ee));
+    double q[3] = {a[0] + u * e[0], a[1] + u * e[1], a[2] + u * e[2]}, d = dist3(p, q);
+    if (d < bd) bd = d, best = (i + u) * t->l0;
+  }
+  return best;
+}
+
+// a puncture is passed once the head has gone through it: the thread
+// behind the head (not the head's end itself) comes within
+// puncture_capture of it, the earlier ones first; the nodes near a passed
+// one are marked
+static void punctures_begin_substep(tx_thread* t) {
+  while (t->passed < t->npunct) {
+    const double* p = t->punct + 3 * t->passed;
+    if (dist3(t->x, p) > t->def.puncture_capture + t->l0) break;
+    double arc = nearest_arc(t, p, 0);
+    int i;
+    double u, q[3];
+    arc_link(t, arc, &i, &u);
+    for (int c = 0; c < 3; c++) q[c] = t->x[3 * i + c] + u * (t->x[3 * i + 3 + c] - t->x[3 * i + c]);
+    if (!(arc > 1e-9 * t->l0) || dist3(q, p) > t->def.puncture_capture) break;
+    t->arc[t->passed++] = arc;
+  }
+  if (t->mntri == 0) return;
+  memset(t->near_punct, 0, (size_t)t->n);
+  int m = (int)ceil((t->thickness + 2 * t->def.radius) / t->l0) + 1;
+  for (int k = 0; k < t->passed; k++) {
+    int c = (int)floor(t->arc[k] / t->l0);
+    for (int i = c - m; i <= c + 1 + m; i++)
+      if (i >= 0 && i < t->n) t->near_punct[i] = 1;
+  }
+}
+
+// each passed puncture holds the thread's point at arc[k] on it. In the
+// iterations (friction true) the offset across the thread is undone, and
+// the drift along it as far as the friction's multiplier allows (XPBD
+// Coulomb friction: the multiplier along the thread, summed over the
+// iterations of the substep, stays within puncture_friction h^2, so the
+// force never exceeds it; within, it sticks); what is left slides, the
+// point held moving on along the thread. At the end of the substep
+// (friction false) the point held is put on the puncture whole: the thread
+// never leaves it.
+static void solve_punctures(tx_thread* t, double h, bool friction) {
+  for (int k = 0; k < t->passed; k++) {
+    const double* p = t->punct + 3 * k;
+    int i;
+    double u;
+    arc_link(t, t->arc[k], &i, &u);
+    if (t->severed[i]) continue;
+    double *a = t->x + 3 * i, *b = a + 3;
+    double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, le = sqrt(dot3(e, e)), C[3], tan[3] = {0, 0, 0};
+    for (int c = 0; c < 3; c++) {
+      C[c] = a[c] + u * e[c] - p[c];
+      if (le > 0) tan[c] = e[c] / le;
+    }
+    if (t->w[i] == 0 || t->w[i + 1] == 0) {
+      // a link on a pinned node (the head) cannot move the point at u
+      // without a lever of 1 / u: it turns about that node through the
+      // puncture instead, the point held sliding to |p - pinned node|
+      // along it (no friction on this link)
+      bool first = t->w[i] == 0;
+      double *o = first ? a : b, *m = first ? b : a, dp[3] = {p[0] - o[0], p[1] - o[1], p[2] - o[2]};
+      double dl = sqrt(dot3(dp, dp));
+      if (t->w[first ? i + 1 : i] == 0 || dl <= 1e-12 * t->l0) continue;
+      for (int c = 0; c < 3; c++) m[c] = o[c] + dp[c] / dl * le;
+      if (dl <= le) t->arc[k] = (i + (first ? dl / le : 1 - dl / le)) * t->l0;
+      else t->arc[k] = first ? (i + 1) * t->l0 : i * t->l0; // out of reach: the next link holds it
+      continue;
+    }
+    double W = t->w[i] * (1 - u) * (1 - u) + t->w[i + 1] * u * u;
+    if (!(W > 0)) continue;
+    double ct = dot3(C, tan), corr[3];
+    if (!friction) {
+      memcpy(corr, C, sizeof corr); // the held point onto the puncture, whole
+    } else {
+      // the multiplier along the thread that would undo the drift, clamped
+      // to the friction's: the rest slides (the point held moves on)
+      double lim = t->def.puncture_friction * h * h, lt = t->plam[k] - ct / W;
+      if (fabs(lt) > lim) lt = copysign(lim, lt);
+      double dq = (lt - t->plam[k]) * W; // the move along the thread friction makes
+      t->plam[k] = lt;
+      for (int c = 0; c < 3; c++) corr[c] = C[c] - ct * tan[c] - dq * tan[c];
+      t->arc[k] = fmin(t->nseg * t->l0, fmax(0, t->arc[k] - (ct + dq)));
+    }
+    for (int c = 0; c < 3; c++) {
+      a[c] -= t->w[i] * (1 - u) / W * corr[c];
+      b[c] -= t->w[i + 1] * u / W * corr[c];
+    }
+  }
 }
 
 // ---------------------------------------------------------------------------
@@ -746,10 +974,37 @@ static void follow(tx_thread* t, int i, int from) {
   if (!t->def.slack || dist3(t->x + 3 * i, t->x + 3 * from) > t->l0) place_after(t, i, from, t->l0);
 }
 
+// a piece behind a cut follows its own first node (the cut end), which
+// nothing pulls: it stays where it is unless a contact or a pin moves it
+//
+// Through punctures the thread is routed: the link that holds puncture k's
+// point (arc[k]) is put through it, its far node on the line from its near
+// node through the point; when the point is more than l0 away the node goes
+// straight towards it and the point held moves on to the next link. So the
+// thread passes through every passed puncture exactly, keeps its length and
+// slides through as the head pulls it.
 static void ftl_forward(tx_thread* t) {
+  // the last passed is the nearest the head along the thread: route from it back
+  int k = t->passed - 1;
   for (int i = 1; i < t->n; i++) {
-    follow(t, i, i - 1);
-    if (t->mntri) {
+    if (t->severed[i - 1]) continue;
+    if (k >= 0 && t->arc[k] <= i * t->l0 * (1 + 1e-12)) {
+      const double *l = t->x + 3 * (i - 1), *p = t->punct + 3 * k;
+      double d = dist3(l, p);
+      if (d > 1e-9 * t->l0) {
+        for (int c = 0; c < 3; c++) t->x[3 * i + c] = l[c] + (p[c] - l[c]) / d * t->l0;
+      } else {
+        place_after(t, i, i - 1, t->l0);
+      }
+      if (d <= t->l0) {
+        t->arc[k--] = (i - 1) * t->l0 + d;
+      } else {
+        t->arc[k] = i * t->l0;
+      }
+    } else {
+      follow(t, i, i - 1);
+    }
+    if (t->mntri && !t->near_punct[i] && !t->near_punct[i - 1]) {
       t->move_first = false; // the leader is placed: only this node moves
       solve_mesh_edges(t, i - 1);
       solve_mesh_node(t, i);
@@ -765,7 +1020,7 @@ static void ftl_solve(tx_thread* t) {
     for (int i = t->last_pin; i > 0; i--) {
       if (t->pinned[i])
         memcpy(t->x + 3 * i, t->pin + 3 * i, sizeof(double) * 3);
-      else
+      else if (!t->severed[i])
         follow(t, i, i + 1);
     }
     ftl_forward(t);
@@ -794,13 +1049,16 @@ static void ftl_substep(tx_thread* t, double h, double margin) {
 static void cap_stretch(tx_thread* t) {
   for (int pass = 0; pass < 2; pass++) {
     for (int i = 1; i < t->n; i++)
-      if (!t->pinned[i] && dist3(t->x + 3 * i, t->x + 3 * i - 3) > t->lmax) place_after(t, i, i - 1, t->lmax);
+      if (!t->pinned[i] && !t->severed[i - 1] && dist3(t->x + 3 * i, t->x + 3 * i - 3) > t->lmax)
+        place_after(t, i, i - 1, t->lmax);
     if (t->last_pin == 0) break;
     for (int i = t->last_pin - 1; i > 0; i--)
-      if (!t->pinned[i] && dist3(t->x + 3 * i, t->x + 3 * i + 3) > t->lmax) place_after(t, i, i + 1, t->lmax);
+      if (!t->pinned[i] && !t->severed[i] && dist3(t->x + 3 * i, t->x + 3 * i + 3) > t->lmax)
+        place_after(t, i, i + 1, t->lmax);
   }
   for (int i = 1; i < t->n; i++)
-    if (!t->pinned[i] && dist3(t->x + 3 * i, t->x + 3 * i - 3) > t->lmax) place_after(t, i, i - 1, t->lmax);
+    if (!t->pinned[i] && !t->severed[i - 1] && dist3(t->x + 3 * i, t->x + 3 * i - 3) > t->lmax)
+      place_after(t, i, i - 1, t->lmax);
 }
 
 // Cholesky of a symmetric banded matrix in place: A[r (bw + 1) + k] holds
@@ -845,12 +1103,22 @@ static void bend_factor(tx_thread* t, double h) {
   const double* w = t->w;
   double ab = t->alpha_b / (h * h);
   double* B = t->bend;
+  const uint8_t* cut = t->severed;
   for (int k = 0; k < nb; k++) {
     int i = k + 1;
     B[k * 3] = w[i - 1] + 4 * w[i] + w[i + 1] + ab;
     B[k * 3 + 1] = k >= 1 ? -2 * w[i - 1] - 2 * w[i] : 0;
     B[k * 3 + 2] = k >= 2 ? w[i - 1] : 0;
   }
+  // a bend across a cut (node i with link i - 1 or i severed) is no
+  // constraint: its row is the identity, uncoupled, and its rhs 0
+  if (t->cuts)
+    for (int k = 0; k < nb; k++)
+      if (cut[k] || cut[k + 1]) {
+        B[k * 3] = 1, B[k * 3 + 1] = B[k * 3 + 2] = 0;
+        if (k + 1 < nb) B[(k + 1) * 3 + 1] = 0;
+        if (k + 2 < nb) B[(k + 2) * 3 + 2] = 0;
+      }
   if (nb > 0 && isfinite(ab)) band_factor(B, nb, 2);
 }
 
@@ -877,6 +1145,7 @@ static void rod_solve(tx_thread* t, double h) {
       int i = k + 1;
       for (int c = 0; c < 3; c++)
         y[3 * k + c] = -(x[3 * i - 3 + c] - 2 * x[3 * i + c] + x[3 * i + 3 + c]) - ab * lam_b[3 * k + c];
+      if (t->severed[k] || t->severed[k + 1]) y[3 * k] = y[3 * k + 1] = y[3 * k + 2] = 0;
     }
     for (int c = 0; c < 3; c++) band_solve(t->bend, nb, 2, y + c, 3);
     for (int k = 0; k < nb; k++) {
@@ -905,7 +1174,8 @@ static void rod_solve(tx_thread* t, double h) {
     }
     y[k] = -(l - t->l0) - ad * lam_d[k];
     A[k * 2] = (w[k] + w[k + 1]) + ad;
-    A[k * 2 + 1] = k >= 1 ? -w[k] * dot3(u + 3 * k - 3, u + 3 * k) : 0;
+    A[k * 2 + 1] = k >= 1 && !t->severed[k - 1] ? -w[k] * dot3(u + 3 * k - 3, u + 3 * k) : 0;
+    if (t->severed[k]) y[k] = 0, A[k * 2] = 1, A[k * 2 + 1] = 0; // a cut link: no constraint, uncoupled
   }
   band_factor(A, nseg, 1);
   band_solve(A, nseg, 1, y, 1);
@@ -936,10 +1206,12 @@ static void rod_substep(tx_thread* t, double h, double margin) {
   bool self = d->self_collision && nseg > t->skip + 1;
   if (self) broadphase(t, margin);
   bend_factor(t, h);
+  if (t->passed) memset(t->plam, 0, sizeof(double) * t->passed);
   for (int it = 0; it < d->iterations; it++) {
     rod_solve(t, h);
     solve_capsules(t);
     if (self) solve_self(t);
+    if (t->passed) solve_punctures(t, h, true);
   }
   cap_stretch(t);
   // a node moved by one cylinder's push can go back into its neighbour's
@@ -952,6 +1224,7 @@ static void rod_substep(tx_thread* t, double h, double margin) {
   // towards the leader barely opens a contact again
   cap_stretch(t);
   solve_mesh(t);
+  for (int pass = 0; pass < 2 && t->passed; pass++) solve_punctures(t, h, false); // never leaves one
   for (int i = 0; i < n; i++)
     for (int a = 0; a < 3; a++) v[3 * i + a] = t->pinned[i] ? 0 : (x[3 * i + a] - t->x0[3 * i + a]) / h;
   // the force the constraints put on the (pinned) head: gradient x lambda /
@@ -973,6 +1246,8 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
   memcpy(t->vs, t->v, sizeof(double) * 3 * n);
   memset(t->colliding, 0, (size_t)t->nseg);
   memset(&t->last, 0, sizeof t->last);
+  int passed0 = t->passed;
+  if (passed0) memcpy(t->arc_step, t->arc, sizeof(double) * passed0);
   // substeps: the head and, by their last velocities, the nodes move no
   // more than 3 r / 4 in one
   double move = dist3(t->head_from, t->head_to);
@@ -1001,9 +1276,12 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
     double f = (tau + h) / dt;
     memcpy(t->x0, t->x, sizeof(double) * 3 * n);
     memcpy(t->v0, t->v, sizeof(double) * 3 * n);
+    int passed_sub = t->passed;
+    if (passed_sub) memcpy(t->arc_sub, t->arc, sizeof(double) * passed_sub);
     for (int a = 0; a < 3; a++) t->x[a] = t->head_from[a] + f * (t->head_to[a] - t->head_from[a]);
     for (int i = 1; i < n; i++)
       if (t->pinned[i]) memcpy(t->x + 3 * i, t->pin + 3 * i, sizeof(double) * 3);
+    if (t->npunct) punctures_begin_substep(t);
     double margin = 2 * d->radius + dist3(t->x, t->x0);
     if (d->model == TX_THREAD_FTL)
       ftl_substep(t, h, margin);
@@ -1019,6 +1297,8 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
     if (far2 > 0.81 * d->radius * d->radius && h > hmin * (1 + 1e-9) && ns < 4 * d->max_substeps) {
       memcpy(t->x, t->x0, sizeof(double) * 3 * n);
       memcpy(t->v, t->v0, sizeof(double) * 3 * n);
+      t->passed = passed_sub;
+      if (passed_sub) memcpy(t->arc, t->arc_sub, sizeof(double) * passed_sub);
       h = fmax(0.5 * h, hmin);
       t->last.retries++;
       continue;
@@ -1027,10 +1307,15 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
   }
   memcpy(t->head_from, t->head_to, sizeof(double) * 3);
   t->last.substeps = ns;
+  t->slid = 0; // punctures the thread went on through (pulled, not pushed back)
+  for (int k = 0; k < passed0; k++) t->slid += t->arc[k] > t->arc_step[k] + 1e-9 * t->l0;
   for (int i = 0; i < 3 * n; i++)
     if (!isfinite(t->x[i]) || !isfinite(t->v[i])) {
       memcpy(t->x, t->xs, sizeof(double) * 3 * n);
       memcpy(t->v, t->vs, sizeof(double) * 3 * n);
+      t->passed = passed0;
+      if (passed0) memcpy(t->arc, t->arc_step, sizeof(double) * passed0);
+      t->slid = 0;
       t->faults++;
       return TX_THREAD_FAULT;
     }

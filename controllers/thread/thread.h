@@ -81,6 +81,11 @@ typedef struct tx_thread_def {
   double max_stretch;    // the stretch cap: (l - l0) / l0 of a segment, in [0, 1]; 0.05
   int max_shapes;        // room for capsules and spheres, in [0, 4096]; 16
   int max_triangles;     // room for mesh triangles, in [0, 10000000]; 0: no mesh
+  int max_punctures;     // room for puncture points, in [0, 1024]; 16
+  double puncture_friction; // N, in [0, 100]: the force along the thread a puncture holds it with
+                            // before it slides (and drags with while sliding); 0
+  double puncture_capture;  // m, in (0, 0.1]: the head has passed a puncture once the thread behind
+                            // it (not the head's end) comes this near it; 0.001
 } tx_thread_def;
 
 // a kinematic capsule: the points within radius of segment a b (a sphere when a == b)
@@ -132,6 +137,41 @@ tx_thread_status tx_thread_set_capsules(tx_thread* t, const tx_thread_capsule* c
 tx_thread_status tx_thread_set_mesh(tx_thread* t, const float* x, uint32_t nx, const int32_t* tri, uint32_t ntri,
                                     double thickness);
 
+// cutting: severs link seg (node seg to seg + 1, in [0, N - 2]). The piece
+// that holds the head stays on it; the piece behind the cut has a free end
+// there (rod: it falls and moves on its own; ftl: it stays where it lies, a
+// chain that follows its cut end, which nothing pulls). A severed link has
+// no distance, no bend across it and no contacts; the two new ends carry
+// half a link's mass less. Returns 1 when cut now, 0 when it was already
+// cut, -1 (tx_error()) when seg is out of range. Never allocates.
+int tx_thread_cut(tx_thread* t, int seg);
+// the link (not severed) nearest p, m, and its point nearest p in at (may be
+// NULL); -1 when every link is severed
+int tx_thread_nearest_link(const tx_thread* t, const double p[3], double at[3]);
+// per link (N - 1 entries): 1 when it was cut
+const uint8_t* tx_thread_severed(const tx_thread* t);
+int tx_thread_cut_count(const tx_thread* t); // links severed so far
+// the head's piece is nodes 0..this (N - 1 when uncut): its lowest cut link
+int tx_thread_head_piece_end(const tx_thread* t);
+
+// punctures: the points (n x 3, m, in order) the thread passes through,
+// for the next steps (copied; n in [0, max_punctures]). Once the head has
+// gone through point k (after points 0..k-1: the thread behind the head,
+// not its end, within puncture_capture of it), the thread runs through it:
+// it slides through and never leaves it (ftl: the link that holds it is put
+// through it; rod: a sliding constraint on the polyline, with Coulomb
+// friction puncture_friction along the thread; a link on a pinned node
+// turns about it through the point, without friction). The
+// skin's contacts are left out near a passed puncture. Points move between
+// steps (a skin that moves); a shorter list forgets those past its end.
+tx_thread_status tx_thread_set_punctures(tx_thread* t, const double* p, int n);
+int tx_thread_punctures_passed(const tx_thread* t); // how many the thread runs through
+// the material coordinate (m from the head, at rest) of the thread's point
+// at passed puncture k; -1 when k is not passed. It grows as the thread is pulled through.
+double tx_thread_puncture_arc(const tx_thread* t, int k);
+// the passed punctures the thread slid on through in the last step
+int tx_thread_punctures_slid(const tx_thread* t);
+
 // advances by dt (s, in (0, 1])
 tx_thread_status tx_thread_step(tx_thread* t, double dt);
 
@@ -139,9 +179,9 @@ int tx_thread_node_count(const tx_thread* t);
 // out: (N x 3) positions, m
 void tx_thread_positions(const tx_thread* t, double* out);
 const double* tx_thread_position(const tx_thread* t, int i); // node i, m
-// the sum of the segment lengths, m
+// the sum of the segment lengths (severed links left out), m
 double tx_thread_current_length(const tx_thread* t);
-// the largest (l - l0) / l0 over the segments
+// the largest (l - l0) / l0 over the segments (severed links left out)
 double tx_thread_max_strain(const tx_thread* t);
 
 // a knot's fixing: when a node of cylinders first..last (a knot's, from
@@ -167,9 +207,12 @@ const uint8_t* tx_thread_colliding(const tx_thread* t);
 // the distance's pull and the first bend's (zero in ftl)
 void tx_thread_head_force(const tx_thread* t, double out[3]);
 // the tension at the head as a force model (step B of the conference
-// paper): ftl: (length - rest length) x stiffness (N/m) along the sum of the
-// segments (from the head towards the tail), the length running on from the
-// tail to its pin when the tail is pinned, K = -stiffness d d^T; rod: the
+// paper): ftl: (length - rest length) x stiffness (N/m) of the head's piece
+// (the whole thread when uncut) along the sum of its segments (from the head
+// towards its end), the length running on from the tail to its pin when the
+// tail is pinned and the thread uncut, K = -stiffness d d^T, plus
+// puncture_friction for each puncture it slid through in the last step,
+// towards the first; rod: the
 // constraints' force on the head (tx_thread_head_force), K = 0. f (N) is
 // clamped to max_force (N) and never NaN.
 void tx_thread_tension(const tx_thread* t, double stiffness, double max_force, double f[3], double K[9]);

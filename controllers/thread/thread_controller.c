@@ -6,7 +6,11 @@
 // (value[0..1]: its first and last cylinder, value[2]: 0) and when a knot
 // within fix_distance_m of the skin is fixed (value[2]: 1). With skin set,
 // the thread collides with SKIN.x / SKIN.tri, and with the rigid capsules
-// (tx_capsule rows) of the components listed in capsules.
+// (tx_capsule rows) of the components listed in capsules. With cut_events
+// it takes the TX_EVENT_CUT events of that stream: the link they name (or the
+// one nearest their point) is severed, PREFIX.cut_links marks it and the pieces,
+// and the cut is sent again on PREFIX.events. With punctures (tx_puncture
+// rows on the skin's triangles) the thread passes through them in order.
 #include "thread_controller.h"
 
 #include "knot.h"
@@ -41,6 +45,15 @@ typedef struct thread_ctl {
   bool draw;
   tx_port segments, spheres; // with draw: the thread as a tube for the graphics view
   tx_port caps[8];
+  tx_port cut_in, links;     // the cut events listened to (cut_in.id 0: none); PREFIX.cut_links
+  tx_port punct_in;          // the puncture list (punct_in.id 0: none)
+  double* punct;             // (max_punctures x 3) where they are this step, m
+  int max_punct;
+  tx_warning bad_puncture, too_many_punctures;
+  tx_result passed_result;
+  int cuts;
+  tx_warning bad_cut;
+  tx_result cuts_result;
   int ncaps;
   tx_thread_capsule* shapes; // (max_shapes) the capsules' rows gathered each step
   uint8_t* marks;
@@ -83,6 +96,11 @@ static const tx_param_def params[] = {
     {"draw", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "also write PREFIX.segments and PREFIX.spheres: the thread as a tube for the graphics view"},
     {"classify_every", TX_PARAM_INT, "1", 0, 100000, 0, NULL, "steps between two runs of the knot classifier (Gauss code, 32 projections); 0: never"},
     {"fix_distance_m", TX_PARAM_NUM, "m", 0, 1, 0.002, NULL, "a knot this near the skin is fixed"},
+    {"punctures", TX_PARAM_STR, NULL, 0, 0, 0, "", "a puncture list (tx_puncture rows on SKIN.tri: needle.punctures) the thread passes through in order; needs skin; empty: none"},
+    {"max_punctures", TX_PARAM_INT, "1", 0, 1024, 16, NULL, "room for the puncture list's rows"},
+    {"puncture_friction_n", TX_PARAM_NUM, "N", 0, 100, 0, NULL, "the force along the thread a puncture holds it with before it slides (Coulomb); ftl: felt at the hand only"},
+    {"puncture_capture_m", TX_PARAM_NUM, "m", 1e-6, 0.1, 0.001, NULL, "the head has gone through a puncture once the thread behind it is this near it"},
+    {"cut_events", TX_PARAM_STR, NULL, 0, 0, 0, "", "an event stream (instruments.events) whose TX_EVENT_CUT events cut the thread; empty: none"},
 };
 
 static int read_tail(tx_setup* s, double tail[3]) {
@@ -127,6 +145,9 @@ static int configure(tx_setup* s, void** self) {
   d.pin_tail = tx_table_bool(s, "pin_tail");
   d.slack = tx_table_bool(s, "slack");
   d.max_shapes = (int)tx_table_int(s, "max_shapes");
+  d.max_punctures = (int)tx_table_int(s, "max_punctures");
+  d.puncture_friction = tx_table_num(s, "puncture_friction_n");
+  d.puncture_capture = tx_table_num(s, "puncture_capture_m");
   k->tension_k = tx_table_num(s, "tension_n_per_m");
   k->max_force = tx_table_num(s, "max_force_n");
   k->knot_every = (int)tx_table_int(s, "knot_every");
@@ -168,6 +189,25 @@ static int configure(tx_setup* s, void** self) {
   k->force = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_force_model, 1));
   snprintf(name, sizeof name, "%s.events", prefix);
   k->events = tx_setup_emit(s, name, 64);
+  snprintf(name, sizeof name, "%s.cut_links", prefix);
+  k->links = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_thread_link, (uint32_t)d.nodes - 1));
+  const char* cut_events = tx_table_str(s, "cut_events");
+  if (!cut_events) return -1;
+  if (*cut_events) k->cut_in = tx_setup_listen(s, cut_events);
+  const char* punctures = tx_table_str(s, "punctures");
+  if (!punctures) return -1;
+  if (*punctures) {
+    if (!with_skin) return tx_setup_fail(s, "punctures", "'%s' needs skin: its rows are points on SKIN.tri", punctures);
+    k->punct_in = TX_READ_OF(s, punctures, tx_puncture);
+  }
+  k->max_punct = d.max_punctures;
+  k->punct = malloc(sizeof(double) * 3 * (size_t)(d.max_punctures + 1));
+  if (!k->punct) return tx_setup_fail(s, NULL, "out of memory");
+  k->bad_puncture = tx_setup_warning(s, "bad_puncture");
+  k->too_many_punctures = tx_setup_warning(s, "too_many_punctures");
+  k->passed_result = tx_setup_result(s, "punctures_passed");
+  k->bad_cut = tx_setup_warning(s, "bad_cut");
+  k->cuts_result = tx_setup_result(s, "cuts");
   k->draw = tx_table_bool(s, "draw");
   if (k->draw) {
     snprintf(name, sizeof name, "%s.segments", prefix);
@@ -214,6 +254,13 @@ static void publish(tx_ctx* c, thread_ctl* k) {
     memcpy(out[i].x, tx_thread_position(t, i), sizeof out[i].x);
     out[i].radius = r;
   }
+  const uint8_t* cut = tx_thread_severed(t);
+  tx_thread_link* ln = tx_write(c, k->links);
+  for (int i = 0, piece = 0; i + 1 < n; i++) {
+    ln[i].severed = cut[i];
+    ln[i].piece = piece;
+    piece += cut[i];
+  }
   if (k->draw) { // cylinders joined by spheres: a tube
     tx_segment* sg = tx_write(c, k->segments);
     tx_sphere* sp = tx_write(c, k->spheres);
@@ -223,7 +270,7 @@ static void publish(tx_ctx* c, thread_ctl* k) {
         if (i + 1 < n) sg[i].a[a] = sp[i].c[a], sg[i].b[a] = (float)tx_thread_position(t, i + 1)[a];
       }
       sp[i].r = (float)r;
-      if (i + 1 < n) sg[i].r = (float)r;
+      if (i + 1 < n) sg[i].r = cut[i] ? 0.0f : (float)r; // a cut link: radius 0, not drawn
     }
   }
   tx_force_model* m = tx_write(c, k->force);
@@ -245,6 +292,9 @@ static void check_knot(tx_ctx* c, thread_ctl* k) {
   int n = tx_thread_node_count(t);
   tx_knot_rule rule = tx_knot_rule_papers();
   tx_knot_contacts(tx_thread_position(t, 0), n, tx_thread_get_def(t)->radius, rule.min_gap, k->marks);
+  const uint8_t* cut = tx_thread_severed(t);
+  for (int i = 0; i + 1 < n; i++)
+    if (cut[i]) k->marks[i] = 0; // a cut link is no cylinder
   tx_knot_papers p;
   bool knot = tx_knot_papers_rule(k->marks, n - 1, &rule, &p);
   if (knot && !k->knotted) {
@@ -273,8 +323,78 @@ static void classify(tx_ctx* c, thread_ctl* k) {
   k->cls = d.cls;
 }
 
+// the cut events since the last step: the link named by source, or the one
+// nearest the blades' point when source is no link of this thread; each new
+// cut goes out again on PREFIX.events (source: the link, point: its point
+// nearest the blades)
+static void take_cuts(tx_ctx* c, thread_ctl* k) {
+  tx_thread* t = k->t;
+  int nseg = tx_thread_node_count(t) - 1;
+  for (tx_event e; tx_next_event(c, k->cut_in, &e);) {
+    if (e.kind != TX_EVENT_CUT) continue;
+    const double* p = e.cut.point;
+    bool finite = isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
+    double at[3];
+    int seg = e.source < (uint32_t)nseg ? (int)e.source : finite ? tx_thread_nearest_link(t, p, at) : -1;
+    if (seg < 0) {
+      tx_warn(c, k->bad_cut);
+      continue;
+    }
+    if (tx_thread_cut(t, seg) != 1) continue; // already cut
+    k->cuts++;
+    const double *a = tx_thread_position(t, seg), *b = tx_thread_position(t, seg + 1);
+    double u = 0.5, ee = 0, ep = 0;
+    for (int i = 0; i < 3 && finite; i++) {
+      ee += (b[i] - a[i]) * (b[i] - a[i]);
+      ep += (p[i] - a[i]) * (b[i] - a[i]);
+    }
+    if (finite && ee > 0) u = fmin(1, fmax(0, ep / ee));
+    tx_event out = {.kind = TX_EVENT_CUT, .source = (uint32_t)seg};
+    for (int i = 0; i < 3; i++) out.cut.point[i] = a[i] + u * (b[i] - a[i]);
+    tx_emit(c, k->events, &out);
+  }
+}
+
+// the puncture list's points where their triangles are now; it ends at the
+// first row with triangle -1. A malformed row (a triangle that is no row of
+// SKIN.tri, barycentric coordinates that are not finite or do not sum to 1)
+// ends it too, counted as bad_puncture.
+static void take_punctures(tx_ctx* c, thread_ctl* k, tx_snapshot sx, tx_snapshot st) {
+  tx_snapshot sp = tx_read(c, k->punct_in);
+  if (sp.seq == 0) return;
+  const tx_puncture* rows = sp.data;
+  const tx_vertex* vx = sx.data;
+  const tx_triangle* tri = st.data;
+  int n = 0;
+  for (uint32_t r = 0; r < sp.rows; r++) {
+    const tx_puncture* q = &rows[r];
+    if (q->triangle == -1) break;
+    double sum = q->bary[0] + q->bary[1] + q->bary[2];
+    bool ok = q->triangle >= 0 && q->triangle < st.rows && q->triangle == floor(q->triangle) && isfinite(sum) &&
+              fabs(sum - 1) <= 1e-6;
+    const int32_t* v = ok ? tri[(uint32_t)q->triangle].v : NULL;
+    for (int a = 0; ok && a < 3; a++) ok = v[a] >= 0 && (uint32_t)v[a] < sx.rows;
+    if (!ok) {
+      tx_warn(c, k->bad_puncture);
+      break;
+    }
+    if (n == k->max_punct) {
+      tx_warn(c, k->too_many_punctures);
+      break;
+    }
+    for (int a = 0; a < 3; a++) {
+      double p = 0;
+      for (int j = 0; j < 3; j++) p += q->bary[j] * vx[v[j]].x[a];
+      k->punct[3 * n + a] = p;
+    }
+    n++;
+  }
+  if (tx_thread_set_punctures(k->t, k->punct, n) != TX_THREAD_OK) tx_warn(c, k->bad_puncture);
+}
+
 static void step(tx_ctx* c, void* self) {
   thread_ctl* k = self;
+  if (k->cut_in.id) take_cuts(c, k);
   tx_snapshot p = tx_read(c, k->head);
   if (p.seq > 0) { // nothing published yet: the head waits
     const tx_pose* pose = p.data;
@@ -300,6 +420,7 @@ static void step(tx_ctx* c, void* self) {
     if (sx.seq > 0 && st.seq > 0 && sh.seq > 0 &&
         tx_thread_set_mesh(k->t, sx.data, sx.rows, st.data, st.rows, ((const tx_thickness*)sh.data)->m) != TX_THREAD_OK)
       tx_warn(c, k->bad_skin);
+    if (k->punct_in.id && sx.seq > 0 && st.seq > 0) take_punctures(c, k, sx, st);
   }
   if (k->ncaps) { // every capsule row, as far as there is room
     int m = 0, max = tx_thread_get_def(k->t)->max_shapes;
@@ -333,6 +454,8 @@ static int init(tx_ctx* c, void* self) {
 static void finish(tx_ctx* c, void* self) {
   thread_ctl* k = self;
   tx_set_result(c, k->knots_result, k->knots);
+  tx_set_result(c, k->cuts_result, k->cuts);
+  tx_set_result(c, k->passed_result, tx_thread_punctures_passed(k->t));
   tx_set_result(c, k->first_knot_result, k->first_knot_s);
   tx_set_result(c, k->faults_result, tx_thread_faults(k->t));
   tx_set_result(c, k->classified_result, k->classified);
@@ -348,12 +471,13 @@ static void fini(void* self) {
   free(k->marks);
   free(k->start);
   free(k->shapes);
+  free(k->punct);
   free(k);
 }
 
 const tx_controller_class tx_physics_thread = {
     .type = "physics.thread",
-    .summary = "suture thread, ftl or XPBD rod, head on a pose: writes THREAD.nodes, THREAD.force_model, THREAD.events (knots)",
+    .summary = "suture thread, ftl or XPBD rod, head on a pose: writes THREAD.nodes, THREAD.cut_links, THREAD.force_model, THREAD.events (knots, cuts)",
     .configure = configure,
     .init = init,
     .step = step,

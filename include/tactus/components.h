@@ -242,6 +242,20 @@ typedef struct tx_thread_node {
 #define tx_thread_node_UNITS "m"
 TX_LAYOUT_ASSERT(tx_thread_node, double);
 
+// THREAD.cut_links (N - 1 rows, link i joins nodes i and i + 1), written by
+// physics.thread: how a cut splits the thread. A severed link joins nothing
+// (do not draw or collide it); the nodes on either side of it end two
+// pieces. Piece 0 holds the head (the needle); each cut along the thread
+// starts the next piece. THREAD.segments draws a severed link at radius 0.
+typedef struct tx_thread_link {
+  double severed; // 1: cut, 0: whole
+  double piece;   // the piece this link belongs to: the number of cuts between it and the head
+} tx_thread_link;
+#define tx_thread_link_TYPE TX_F64
+#define tx_thread_link_COLS 2u
+#define tx_thread_link_UNITS "1"
+TX_LAYOUT_ASSERT(tx_thread_link, double);
+
 // INSTRUMENT.capsules, NEEDLE.capsules (N rows): rigid shapes the thread
 // keeps out of (instrument jaws, the needle), read by physics.thread
 typedef struct tx_capsule {

@@ -36,7 +36,7 @@ static const layout layouts[] = {
     L(".x", tx_vertex),                 L(".tri", tx_triangle),            L(".thickness", tx_thickness),
     L(".torn", tx_torn),                L(".damage", tx_damage),           L(".nodes", tx_thread_node),
     L(".pointer", tx_pointer),          L(".contact", tx_skin_contact),    L(".rupture", tx_skin_rupture),
-    L(".tip", tx_pose),                 L(".punctures", tx_puncture),
+    L(".tip", tx_pose),                 L(".punctures", tx_puncture),      L(".cut_links", tx_thread_link),
 };
 #undef L
 

@@ -564,6 +564,7 @@ void tx_renderer_upload(tx_renderer* r, const tx_scene* s) {
       const float* scalar = *it->scalar ? si->data[1] : NULL;
       uint32_t nscalar = *it->scalar ? si->rows[1] : 0;
       for (uint32_t i = 0; i < si->rows[0]; i++) {
+        if (sg[i].r == 0) continue; // a gap on purpose (a cut thread's severed link), not a bad row
         if (!finite_n(sg[i].a, 3) || !finite_n(sg[i].b, 3) || !isfinite(sg[i].r) || !(sg[i].r > 0)) {
           r->skipped++;
           continue;

@@ -12,6 +12,7 @@
 #include "tests/scenario_support.h"
 
 #include <tactus/components.h>
+#include <tactus/events.h>
 
 #include <math.h>
 #include <stdio.h>
@@ -193,6 +194,248 @@ static void rod_keeps_out_of_a_capsule(void** state) {
   }
 }
 
+// a test class that sends TX_EVENT_CUT events on tool.events at set steps,
+// and one that listens to thread.events and keeps the cuts it sees
+typedef struct cut_plan {
+  uint64_t step;
+  uint32_t source;
+  double point[3];
+} cut_plan;
+static cut_plan plan[4];
+static int nplan;
+static tx_port cutter_out, listener_in, listener_nodes;
+static double node30_at_800[3]; // node 30 as the listener read it at step 800
+static uint32_t heard[8];
+static int nheard;
+static int cutter_configure(tx_setup* s, void** self) {
+  *self = NULL;
+  cutter_out = tx_setup_emit(s, "tool.events", 16);
+  return 0;
+}
+static void cutter_step(tx_ctx* c, void* self) {
+  (void)self;
+  for (int i = 0; i < nplan; i++)
+    if (tx_step_index(c) == plan[i].step) {
+      tx_event e = {.kind = TX_EVENT_CUT, .source = plan[i].source};
+      memcpy(e.cut.point, plan[i].point, sizeof e.cut.point);
+      tx_emit(c, cutter_out, &e);
+      tx_event g = {.kind = TX_EVENT_GRASP, .source = 3}; // not a cut: ignored
+      tx_emit(c, cutter_out, &g);
+    }
+}
+static int listener_configure(tx_setup* s, void** self) {
+  *self = NULL;
+  listener_in = tx_setup_listen(s, "thread.events");
+  listener_nodes = TX_READ_OF(s, "thread.nodes", tx_thread_node);
+  return 0;
+}
+static void listener_step(tx_ctx* c, void* self) {
+  (void)self;
+  for (tx_event e; tx_next_event(c, listener_in, &e);)
+    if (e.kind == TX_EVENT_CUT && nheard < 8) heard[nheard++] = e.source;
+  tx_snapshot x = tx_read(c, listener_nodes);
+  if (tx_step_index(c) == 800 && x.rows > 30) memcpy(node30_at_800, ((const tx_thread_node*)x.data)[30].x, sizeof node30_at_800);
+}
+static const tx_controller_class cutter_class = {
+    .type = "test.cutter", .summary = "cut events", .configure = cutter_configure, .step = cutter_step};
+static const tx_controller_class listener_class = {
+    .type = "test.cut_listener", .summary = "hears cuts", .configure = listener_configure, .step = listener_step};
+
+static tx_scenario* load_with_cutter(const char* params) {
+  if (!tx_find_controller(cutter_class.type)) assert_int_equal(tx_register_controller(&cutter_class), 0);
+  if (!tx_find_controller(listener_class.type)) assert_int_equal(tx_register_controller(&listener_class), 0);
+  char text[2048];
+  snprintf(text, sizeof text,
+           "{\"name\":\"t\",\"controllers\":["
+           "{\"name\":\"tool\",\"type\":\"test.cutter\",\"rate_hz\":1000},"
+           "{\"name\":\"thread\",\"type\":\"physics.thread\",\"rate_hz\":1000,\"params\":{\"cut_events\":\"tool.events\",%s}},"
+           "{\"name\":\"hear\",\"type\":\"test.cut_listener\",\"rate_hz\":1000},"
+           "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:slide-x-over\"}}]}",
+           params);
+  nheard = 0;
+  return tx_scenario_load_text("test", text, strlen(text), NULL);
+}
+
+// ftl, 41 nodes: a cut at link 20, the same link again, then one named by
+// its point alone (source out of range) beyond the tail: link 39. The links
+// and the drawn segments mark them, each cut is sent once on thread.events,
+// and the piece behind the first cut stays where it lay while the head slides on
+static void ftl_cut_by_events(void** state) {
+  (void)state;
+  nplan = 3;
+  plan[0] = (cut_plan){500, 20, {0, 0, 0}};
+  plan[1] = (cut_plan){600, 20, {0, 0, 0}};
+  plan[2] = (cut_plan){700, UINT32_MAX, {-0.2, 0.01, 0}};
+  tx_scenario* s = load_with_cutter("\"nodes\":41,\"length_m\":0.04,\"tail_m\":[-0.1,0.01,0],\"draw\":true");
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 2.5); // the head slides 2 cm along +x after the cuts
+  tx_snapshot x = latest_snapshot(s, "thread.nodes"), ls = latest_snapshot(s, "thread.cut_links"),
+              sg = latest_snapshot(s, "thread.segments");
+  assert_int_equal(ls.rows, 40);
+  assert_int_equal(ls.cols, 2);
+  const tx_thread_node* n = x.data;
+  const tx_thread_link* l = ls.data;
+  const tx_segment* g = sg.data;
+  for (int i = 0; i < 40; i++) {
+    bool cut = i == 20 || i == 39;
+    assert_true(l[i].severed == (cut ? 1 : 0));
+    assert_true(l[i].piece == (i <= 20 ? 0 : i <= 39 ? 1 : 2));
+    assert_true(g[i].r == (cut ? 0.0f : 0.00025f));
+  }
+  assert_true(node30_at_800[0] < -0.05); // read after the cuts, where the straight thread lay
+  for (int a = 0; a < 3; a++) assert_true(fabs(n[30].x[a] - node30_at_800[a]) < 1e-12); // behind the cut: still
+  print_message("the head's piece: its end at x %.4f (it lay at -0.05 m)\n", n[20].x[0]);
+  assert_true(n[20].x[0] > -0.04); // the head's piece went along with the head
+  const tx_pose* pose = (const tx_pose*)latest(s, "device0.pose");
+  for (int a = 0; a < 3; a++) assert_true(fabs(n[0].x[a] - pose->pos[a]) < 1e-3); // the head's piece: on it
+  assert_true(result(s, "thread.cuts") == 2);
+  assert_int_equal(nheard, 2);
+  assert_int_equal(heard[0], 20);
+  assert_int_equal(heard[1], 39);
+  assert_int_equal(warnings(s, "thread.bad_cut"), 0);
+  tx_scenario_free(s);
+}
+
+// the rod hangs from the still device; cut at link 10 its lower half falls
+// away while the upper half stays on the head
+static void rod_cut_by_an_event(void** state) {
+  (void)state;
+  nplan = 1;
+  plan[0] = (cut_plan){300, 10, {0, 0, 0}};
+  tx_scenario* s = load_with_cutter("\"model\":\"rod\",\"nodes\":21,\"length_m\":0.02,\"tail_m\":[-0.03,-0.1,0],\"damping\":20");
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 0.6);
+  const tx_thread_node* n = latest_snapshot(s, "thread.nodes").data;
+  const tx_pose* pose = (const tx_pose*)latest(s, "device0.pose");
+  print_message("rod cut: node 10 at y %.4f, node 20 at y %.4f (head %.4f)\n", n[10].x[1], n[20].x[1], pose->pos[1]);
+  assert_true(n[10].x[1] > pose->pos[1] - 0.0106);  // ten links, within the stretch cap
+  assert_true(n[20].x[1] < pose->pos[1] - 0.05);    // fell away
+  assert_true(result(s, "thread.cuts") == 1);
+  assert_int_equal(nheard, 1);
+  assert_int_equal(heard[0], 10);
+  tx_scenario_free(s);
+}
+
+// a test class standing for the skin and the needle: two square skin
+// patches across the x axis at x = 5 and 15 mm, bobbing 0.4 mm in y at
+// 2 Hz, a puncture in each (a triangle row and barycentric coordinates,
+// then a row of triangle -1), and a hand that goes along +x through both,
+// then up and aside. It reads the thread back and keeps the largest
+// distance of a passed puncture from it.
+typedef struct skin_fixture {
+  tx_port x, tri, thick, punct, hand, nodes;
+  double worst;  // m
+  bool bad_row;  // publish a malformed second puncture (a triangle past SKIN.tri)
+} skin_fixture;
+static skin_fixture fixture;
+static int fixture_configure(tx_setup* s, void** self) {
+  *self = &fixture;
+  fixture.x = tx_setup_write(s, &TX_COMPONENT_OF("skin.x", tx_vertex, 8));
+  fixture.tri = tx_setup_write(s, &TX_COMPONENT_OF("skin.tri", tx_triangle, 4));
+  fixture.thick = tx_setup_write(s, &TX_COMPONENT_OF("skin.thickness", tx_thickness, 1));
+  fixture.punct = tx_setup_write(s, &TX_COMPONENT_OF("needle.punctures", tx_puncture, 4));
+  fixture.hand = tx_setup_write(s, &TX_COMPONENT_OF("hand.pose", tx_pose, 1));
+  fixture.nodes = TX_READ_OF(s, "thread.nodes", tx_thread_node);
+  return 0;
+}
+static void fixture_points(double time, double p[2][3]) {
+  for (int k = 0; k < 2; k++) {
+    double dy = (k ? -0.0004 : 0.0004) * sin(4 * 3.14159265358979 * time);
+    p[k][0] = k ? 0.015 : 0.005, p[k][1] = dy + 0.0002, p[k][2] = -0.0002;
+  }
+}
+static void fixture_step(tx_ctx* c, void* self) {
+  skin_fixture* f = self;
+  double time = (double)tx_step_index(c) * 1e-3;
+  tx_vertex* x = tx_write(c, f->x);
+  tx_triangle* tri = tx_write(c, f->tri);
+  for (int k = 0; k < 2; k++) {
+    double xk = k ? 0.015 : 0.005, dy = (k ? -0.0004 : 0.0004) * sin(4 * 3.14159265358979 * time);
+    const double yz[4][2] = {{-0.01, -0.01}, {0.01, -0.01}, {0.01, 0.01}, {-0.01, 0.01}};
+    for (int v = 0; v < 4; v++) x[4 * k + v] = (tx_vertex){{(float)xk, (float)(yz[v][0] + dy), (float)yz[v][1]}};
+    tri[2 * k] = (tx_triangle){{4 * k, 4 * k + 1, 4 * k + 2}};
+    tri[2 * k + 1] = (tx_triangle){{4 * k, 4 * k + 2, 4 * k + 3}};
+  }
+  ((tx_thickness*)tx_write(c, f->thick))->m = 0.001;
+  // (0.49, 0.02, 0.49) of triangle 2k: 0.2 mm from the patch's centre in y and z
+  tx_puncture* pu = tx_write(c, f->punct);
+  pu[0] = (tx_puncture){0, {0.49, 0.02, 0.49}, 1};
+  pu[1] = (tx_puncture){f->bad_row ? 9 : 2, {0.49, 0.02, 0.49}, -1};
+  pu[2] = (tx_puncture){-1, {0, 0, 0}, 0};
+  pu[3] = (tx_puncture){-1, {0, 0, 0}, 0};
+  tx_pose* h = tx_write(c, f->hand);
+  double g = fmin(1, fmax(0, (time - 0.2) / 0.2));
+  *h = (tx_pose){{time <= 0.2 ? 0.1 * time : 0.02 + 0.01 * g, 0.01 * g, 0}, {1, 0, 0, 0}};
+  // the thread against the points it has surely passed (the head 2 mm beyond)
+  tx_snapshot ns = tx_read(c, f->nodes);
+  const tx_thread_node* n = ns.data;
+  double p[2][3];
+  fixture_points(time, p);
+  for (int k = 0; k < 2 && ns.seq > 0; k++) {
+    if (n[0].x[0] < p[k][0] + 0.002) continue;
+    double best = 1;
+    for (uint32_t i = 0; i + 1 < ns.rows; i++) {
+      double e[3], ee = 0, u = 0, d = 0;
+      for (int a = 0; a < 3; a++) e[a] = n[i + 1].x[a] - n[i].x[a], ee += e[a] * e[a], u += (p[k][a] - n[i].x[a]) * e[a];
+      u = ee > 0 ? fmin(1, fmax(0, u / ee)) : 0;
+      for (int a = 0; a < 3; a++) d += pow(n[i].x[a] + u * e[a] - p[k][a], 2);
+      best = fmin(best, sqrt(d));
+    }
+    f->worst = fmax(f->worst, best);
+  }
+}
+static const tx_controller_class fixture_class = {
+    .type = "test.skin_punctures", .summary = "skin patches and punctures", .configure = fixture_configure, .step = fixture_step};
+
+static tx_scenario* load_with_fixture(const char* params) {
+  if (!tx_find_controller(fixture_class.type)) assert_int_equal(tx_register_controller(&fixture_class), 0);
+  char text[2048];
+  snprintf(text, sizeof text,
+           "{\"name\":\"t\",\"controllers\":["
+           "{\"name\":\"fixture\",\"type\":\"test.skin_punctures\",\"rate_hz\":1000},"
+           "{\"name\":\"thread\",\"type\":\"physics.thread\",\"rate_hz\":1000,\"params\":{\"head\":\"hand.pose\","
+           "\"nodes\":61,\"length_m\":0.06,\"tail_m\":[-1,0,0],\"gravity\":0,\"damping\":5,%s}}]}",
+           params);
+  fixture.worst = 0;
+  return tx_scenario_load_text("test", text, strlen(text), NULL);
+}
+
+// the thread passes through both punctures, in order, and stays within r
+// of each as it is pulled through, the patches moving, in both models
+static void passes_through_skin_punctures(void** state) {
+  (void)state;
+  for (int model = 0; model < 2; model++) {
+    fixture.bad_row = false;
+    tx_scenario* s = load_with_fixture(model ? "\"model\":\"rod\",\"skin\":\"skin\",\"punctures\":\"needle.punctures\""
+                                             : "\"skin\":\"skin\",\"punctures\":\"needle.punctures\"");
+    if (!s) fail_msg("%s", tx_error());
+    run(s, 0.4);
+    print_message("%s: %g punctures passed, worst distance %.4f mm\n", model ? "rod" : "ftl",
+                  result(s, "thread.punctures_passed"), fixture.worst * 1e3);
+    assert_true(result(s, "thread.punctures_passed") == 2);
+    assert_true(fixture.worst > 0 && fixture.worst <= 0.00025);
+    assert_int_equal(warnings(s, "thread.bad_puncture"), 0);
+    assert_int_equal(warnings(s, "thread.numerical_fault"), 0);
+    tx_scenario_free(s);
+  }
+  // a malformed row ends the list there, counted: the first puncture still holds
+  fixture.bad_row = true;
+  tx_scenario* s = load_with_fixture("\"skin\":\"skin\",\"punctures\":\"needle.punctures\"");
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 0.4);
+  assert_true(result(s, "thread.punctures_passed") == 1);
+  assert_true(warnings(s, "thread.bad_puncture") > 0);
+  tx_scenario_free(s);
+  // the list without the skin it lies on, or of another layout: refused at load, named
+  s = load_with_fixture("\"punctures\":\"needle.punctures\"");
+  assert_null(s);
+  assert_non_null(strstr(tx_error(), "params.punctures"));
+  s = load_with_fixture("\"skin\":\"skin\",\"punctures\":\"hand.pose\"");
+  assert_null(s);
+  assert_non_null(strstr(tx_error(), "hand.pose"));
+  assert_null(strchr(tx_error(), '\n'));
+}
+
 static void bad_input_is_named(void** state) {
   (void)state;
   struct {
@@ -209,6 +452,8 @@ static void bad_input_is_named(void** state) {
       {"\"prefix\":\"\"", "params.prefix"},
       {"\"head\":\"nobody.pose\"", "nobody.pose"},
       {"\"capsules\":[\"nobody.capsules\"]", "nobody.capsules"},
+      {"\"cut_events\":\"nobody.events\"", "nobody.events"},
+      {"\"cut_events\":5", "cut_events"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
     tx_scenario* s = load(cases[i].params, "slide-x-over");
@@ -225,6 +470,9 @@ int main(void) {
       cmocka_unit_test(tension_of_a_thread_pulled_past_its_pin),
       cmocka_unit_test(rod_force_on_the_head),
       cmocka_unit_test(rod_keeps_out_of_a_capsule),
+      cmocka_unit_test(ftl_cut_by_events),
+      cmocka_unit_test(rod_cut_by_an_event),
+      cmocka_unit_test(passes_through_skin_punctures),
       cmocka_unit_test(bad_input_is_named),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -307,12 +307,32 @@ static void sphere_depth_and_cut(void** state) {
   release(&f);
 }
 
+// a cut thread: a segment of radius 0 is a gap, not drawn and not counted
+// as a bad row; the segments on either side of it are drawn (two tubes)
+static void segments_with_a_gap(void** state) {
+  (void)state;
+  tx_view_def d = scene_def();
+  const float sg[21] = {-0.2f, 0, 0, -0.05f, 0, 0, 0.02f, -0.05f, 0, 0, 0.05f, 0, 0, 0, 0.05f, 0, 0, 0.2f, 0, 0, 0.02f};
+  d.items[0] = (tx_draw_item){.kind = TX_DRAW_SEGMENTS, .colour = {1, 1, 0}};
+  d.nitems = 1;
+  tx_scene s = {.count = 1};
+  s.items[0] = (tx_scene_item){&d.items[0], {sg}, {3}};
+  frame f = {0};
+  render(&f, &d, TX_STEREO_MONO, &s);
+  assert_int_equal(tx_renderer_skipped(f.r), 0);
+  int off = (int)(0.12 / tan(20 * M_PI / 180) * (H / 2)); // x = +-0.12 m on the image
+  assert_true(lit(at(&f, W / 2 - off, H / 2), -1) && lit(at(&f, W / 2 + off, H / 2), -1));
+  assert_false(lit(at(&f, W / 2, H / 2), -1)); // the gap
+  release(&f);
+}
+
 int main(void) {
   tx_osmesa_bound_threads(-1);
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(sphere_silhouette),        cmocka_unit_test(lit_sphere_centre_colour),
       cmocka_unit_test(stereo_layouts_disparity), cmocka_unit_test(mesh_and_bad_rows),
       cmocka_unit_test(colour_map_and_png),       cmocka_unit_test(sphere_depth_and_cut),
+      cmocka_unit_test(segments_with_a_gap),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

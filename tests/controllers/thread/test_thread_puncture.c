@@ -1,0 +1,176 @@
+// Punctures: the thread, pulled by its head, passes in order through two
+// points that move (a skin that breathes), slides through them and never
+// leaves one (each within r of the thread at every step), in both models;
+// friction through a puncture raises the force on the head; bad lists are
+// refused; stepping with punctures never allocates.
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include "tests/alloc_count.h"
+#include "controllers/thread/thread.h"
+#include "model/error.h"
+
+#include <math.h>
+#include <string.h>
+
+#define PI 3.14159265358979323846
+
+// the distance from p to the thread's polyline (its whole links)
+static double polyline_distance(const tx_thread* t, const double p[3]) {
+  double best = INFINITY;
+  const uint8_t* cut = tx_thread_severed(t);
+  for (int i = 0; i + 1 < tx_thread_node_count(t); i++) {
+    if (cut[i]) continue;
+    const double *a = tx_thread_position(t, i), *b = tx_thread_position(t, i + 1);
+    double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, ee = e[0] * e[0] + e[1] * e[1] + e[2] * e[2], u = 0, d = 0;
+    if (ee > 0) u = fmin(1, fmax(0, ((p[0] - a[0]) * e[0] + (p[1] - a[1]) * e[1] + (p[2] - a[2]) * e[2]) / ee));
+    for (int c = 0; c < 3; c++) d += pow(a[c] + u * e[c] - p[c], 2);
+    best = fmin(best, sqrt(d));
+  }
+  return best;
+}
+
+// two punctures at x = 5 and 15 mm, each bobbing 0.4 mm in y at 2 Hz (out
+// of phase); the head goes along +x through both (0.1 m/s for 0.2 s), then
+// up and on (to (30, 10, 0) mm in 0.2 s): the thread bends through them
+static void puncture_points(double time, double p[6]) {
+  p[0] = 0.005, p[1] = 0.0004 * sin(4 * PI * time), p[2] = 0;
+  p[3] = 0.015, p[4] = -0.0004 * sin(4 * PI * time), p[5] = 0;
+}
+static void head_at(double time, double h[3], bool straight) {
+  if (time <= 0.2 || straight) {
+    h[0] = 0.1 * time, h[1] = 0;
+  } else {
+    double f = fmin(1, (time - 0.2) / 0.2);
+    h[0] = 0.02 + 0.01 * f, h[1] = 0.01 * f;
+  }
+  h[2] = 0;
+}
+
+typedef struct drag_result {
+  double worst;       // m, the largest distance of a passed puncture from the thread
+  int passed_at[2];   // steps at which each was passed
+  double arc_end[2];  // m
+  double force_mean;  // N, the head force's mean magnitude while pulled through (rod) or the tension's (ftl)
+} drag_result;
+
+static drag_result drag(tx_thread_model model, double friction, bool count, bool straight, int iterations) {
+  tx_thread_def d = tx_thread_def_default();
+  d.model = model;
+  d.nodes = 61;
+  d.length = 0.06;
+  d.direction[0] = -1; // the thread trails behind the head
+  d.puncture_friction = friction;
+  d.gravity = 0;
+  d.damping = 5;
+  d.iterations = iterations;
+  tx_thread* t = tx_thread_create(&d);
+  assert_non_null(t);
+  drag_result r = {0, {-1, -1}, {0, 0}, 0};
+  double fsum = 0;
+  int fn = 0;
+  if (count) counting = 1;
+  for (int k = 1; k <= 400; k++) {
+    double time = k * 1e-3, p[6], h[3];
+    puncture_points(time, p);
+    head_at(time, h, straight);
+    assert_int_equal(tx_thread_set_punctures(t, p, 2), TX_THREAD_OK);
+    assert_int_equal(tx_thread_set_head(t, h), TX_THREAD_OK);
+    assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
+    int passed = tx_thread_punctures_passed(t);
+    for (int j = 0; j < passed; j++) {
+      if (r.passed_at[j] < 0) r.passed_at[j] = k;
+      r.worst = fmax(r.worst, polyline_distance(t, p + 3 * j));
+    }
+    if (time > 0.25) { // pulled through both, up and aside
+      double f[3], K[9];
+      if (model == TX_THREAD_ROD) tx_thread_head_force(t, f);
+      else tx_thread_tension(t, 0, 100, f, K);
+      fsum += sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+      fn++;
+    }
+  }
+  counting = 0;
+  for (int j = 0; j < 2; j++) r.arc_end[j] = tx_thread_puncture_arc(t, j);
+  r.force_mean = fsum / fn;
+  tx_thread_destroy(t);
+  return r;
+}
+
+static void test_slides_through_two_moving_punctures(void** state) {
+  (void)state;
+  for (int model = 0; model < 2; model++) {
+    drag_result r = drag((tx_thread_model)model, 0, model == 0, false, 2);
+    print_message("%s: passed at steps %d, %d; arcs at the end %.2f, %.2f mm; worst distance %.3g mm\n",
+                  model ? "rod" : "ftl", r.passed_at[0], r.passed_at[1], r.arc_end[0] * 1e3, r.arc_end[1] * 1e3,
+                  r.worst * 1e3);
+    // in order, as the head goes through: x = 5 mm at step 50, 15 mm at 150
+    assert_true(r.passed_at[0] >= 50 && r.passed_at[0] <= 52);
+    assert_true(r.passed_at[1] >= 150 && r.passed_at[1] <= 152);
+    // never left: within r = 0.25 mm at every step
+    assert_true(r.worst <= 0.00025);
+    // pulled through: the thread's point at the first puncture is the one
+    // about the head's path beyond it away (>= 15 mm along x plus the rise), and
+    // the first lies further along the thread than the second
+    assert_true(r.arc_end[0] > 0.025 && r.arc_end[0] < 0.06);
+    assert_true(r.arc_end[1] > 0.015 && r.arc_end[1] < r.arc_end[0] - 0.009);
+  }
+#ifndef TX_NO_ALLOC_COUNT
+  assert_int_equal(allocations, 0);
+#endif
+}
+
+// friction through the punctures: the head feels more force while the
+// thread is pulled through (rod: through the constraints; ftl: the friction
+// of each puncture it slid through, added to the tension)
+static void test_friction_raises_the_head_force(void** state) {
+  (void)state;
+  for (int model = 0; model < 2; model++) {
+    // pulled straight on through both: the rod is barely bent, its force on
+    // the head is what holds it back
+    drag_result free_ = drag((tx_thread_model)model, 0, false, true, 2), held = drag((tx_thread_model)model, 0.02, false, true, 2);
+    print_message("%s: head force %.4g N without friction, %.4g N with 0.02 N a puncture\n", model ? "rod" : "ftl",
+                  free_.force_mean, held.force_mean);
+    if (model == TX_THREAD_FTL) // both slid at every step measured: 2 x 0.02 N on top
+      assert_true(fabs(held.force_mean - free_.force_mean - 0.04) < 1e-9);
+    else // through the constraints: at 2 iterations a quarter of the nominal 0.04 N reaches the head
+      assert_true(held.force_mean > free_.force_mean + 0.005);
+    assert_true(held.worst <= 0.00025); // still never leaves one
+  }
+}
+
+static void test_bad_puncture_lists(void** state) {
+  (void)state;
+  tx_thread_def d = tx_thread_def_default();
+  d.max_punctures = 2;
+  tx_thread* t = tx_thread_create(&d);
+  assert_non_null(t);
+  double p[9] = {0, 0, 0, 0.01, 0, 0, 0.02, 0, 0};
+  assert_int_equal(tx_thread_set_punctures(t, p, 3), TX_THREAD_BAD);
+  assert_non_null(strstr(tx_error(), "max_punctures"));
+  p[4] = NAN;
+  assert_int_equal(tx_thread_set_punctures(t, p, 2), TX_THREAD_BAD);
+  assert_non_null(strstr(tx_error(), "puncture"));
+  assert_int_equal(tx_thread_punctures_passed(t), 0);
+  assert_true(tx_thread_puncture_arc(t, 0) == -1);
+  tx_thread_destroy(t);
+  d = tx_thread_def_default();
+  d.puncture_friction = -1;
+  assert_int_equal(tx_thread_def_check(&d), -1);
+  assert_non_null(strstr(tx_error(), "puncture_friction"));
+  d = tx_thread_def_default();
+  d.puncture_capture = 0;
+  assert_int_equal(tx_thread_def_check(&d), -1);
+  assert_non_null(strstr(tx_error(), "puncture_capture"));
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_slides_through_two_moving_punctures),
+      cmocka_unit_test(test_friction_raises_the_head_force),
+      cmocka_unit_test(test_bad_puncture_lists),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
