@@ -280,7 +280,7 @@ static int init(tx_ctx* c, void* self) {
   m->ncuts = m->nthread_grasps = 0;
   for (int i = 0; i < m->n; i++) m->blades[i].armed = 0, m->holds_thread[i] = false;
   m->contact_seq = 0;
-  for (int i = 0; i < TX_NEEDLE_PINS_MAX; i++) m->rows[i] = (tx_puncture){.triangle = -1};
+  for (int i = 0; i < TX_NEEDLE_PINS_MAX; i++) m->rows[i] = (tx_puncture){.v = {-1, -1, -1}};
   tx_puncture_tracker_init(&m->tracker, m->tracker.separation, m->tracker.min_force, 0);
   m->world = tx_instrument_world_create(&m->p, urdfs, m->n, (const double(*)[3])start);
   if (!m->world) {
@@ -321,7 +321,8 @@ static void pierce(tx_ctx* c, instruments* m) {
   m->rows[m->npins] = f.row;
   memcpy(m->pin_verts[m->npins], f.verts, sizeof f.verts);
   m->npins++;
-  tx_event e = {.kind = TX_EVENT_PUNCTURE, .source = (uint32_t)f.row.triangle};
+  // source: the skin.tri row at this publish (the next tear renumbers it; the row of needle.punctures keeps the particles)
+  tx_event e = {.kind = TX_EVENT_PUNCTURE, .source = (uint32_t)f.triangle};
   memcpy(e.puncture.point, f.point, sizeof f.point);
   e.puncture.force = f.force;
   e.puncture.depth = f.depth;

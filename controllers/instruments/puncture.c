@@ -109,8 +109,9 @@ bool tx_puncture_update(tx_puncture_tracker* t, const tx_skin_contact* c, const 
     return false;
   }
   t->next_side = -side;
-  *out = (tx_puncture_found){.row = {.triangle = row, .bary = {bary[0], bary[1], bary[2]}, .side = side},
+  *out = (tx_puncture_found){.row = {.v = {v[0], v[1], v[2]}, .bary = {bary[0], bary[1], bary[2]}, .side = side},
                              .verts = {v[0], v[1], v[2]},
+                             .triangle = row,
                              .point = {point[0], point[1], point[2]},
                              .force = t->peak_f,
                              .depth = t->peak_depth};

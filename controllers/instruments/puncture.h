@@ -34,8 +34,9 @@ void tx_puncture_tracker_init(tx_puncture_tracker* t, double separation, double 
 
 // what a puncture found: the row, its vertices, the point and the force
 typedef struct tx_puncture_found {
-  tx_puncture row;     // skin.tri row, barycentric coordinates, side
-  int32_t verts[3];    // the triangle's particles (rows of skin.x): they carry the point
+  tx_puncture row;     // the triangle's particles (rows of skin.x), barycentric coordinates, side
+  int32_t verts[3];    // the same particles, as integers: they carry the point
+  int triangle;        // its row of skin.tri at this publish (renumbered by the next tear)
   double point[3];     // m
   double force, depth; // the largest force on the tip before the tear (N), and the skin's indentation then (m)
 } tx_puncture_found;

@@ -10,7 +10,7 @@
 // it takes the TX_EVENT_CUT events of that stream: the link they name (or the
 // one nearest their point) is severed, PREFIX.cut_links marks it and the pieces,
 // and the cut is sent again on PREFIX.events. With punctures (tx_puncture
-// rows on the skin's triangles) the thread passes through them in order.
+// rows: points on triangles of the skin's particles) the thread passes through them in order.
 #include "thread_controller.h"
 
 #include "knot.h"
@@ -96,7 +96,7 @@ static const tx_param_def params[] = {
     {"draw", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "also write PREFIX.segments and PREFIX.spheres: the thread as a tube for the graphics view"},
     {"classify_every", TX_PARAM_INT, "1", 0, 100000, 0, NULL, "steps between two runs of the knot classifier (Gauss code, 32 projections); 0: never"},
     {"fix_distance_m", TX_PARAM_NUM, "m", 0, 1, 0.002, NULL, "a knot this near the skin is fixed"},
-    {"punctures", TX_PARAM_STR, NULL, 0, 0, 0, "", "a puncture list (tx_puncture rows on SKIN.tri: needle.punctures) the thread passes through in order; needs skin; empty: none"},
+    {"punctures", TX_PARAM_STR, NULL, 0, 0, 0, "", "a puncture list (tx_puncture rows: points on triangles of SKIN.x particles, e.g. needle.punctures) the thread passes through in order; needs skin; empty: none"},
     {"max_punctures", TX_PARAM_INT, "1", 0, 1024, 16, NULL, "room for the puncture list's rows"},
     {"puncture_friction_n", TX_PARAM_NUM, "N", 0, 100, 0, NULL, "the force along the thread a puncture holds it with before it slides (Coulomb); ftl: felt at the hand only"},
     {"puncture_capture_m", TX_PARAM_NUM, "m", 1e-6, 0.1, 0.001, NULL, "the head has gone through a puncture once the thread behind it is this near it"},
@@ -197,7 +197,7 @@ static int configure(tx_setup* s, void** self) {
   const char* punctures = tx_table_str(s, "punctures");
   if (!punctures) return -1;
   if (*punctures) {
-    if (!with_skin) return tx_setup_fail(s, "punctures", "'%s' needs skin: its rows are points on SKIN.tri", punctures);
+    if (!with_skin) return tx_setup_fail(s, "punctures", "'%s' needs skin: its rows are points on SKIN.x's triangles", punctures);
     k->punct_in = TX_READ_OF(s, punctures, tx_puncture);
   }
   k->max_punct = d.max_punctures;
@@ -355,25 +355,27 @@ static void take_cuts(tx_ctx* c, thread_ctl* k) {
   }
 }
 
-// the puncture list's points where their triangles are now; it ends at the
-// first row with triangle -1. A malformed row (a triangle that is no row of
-// SKIN.tri, barycentric coordinates that are not finite or do not sum to 1)
-// ends it too, counted as bad_puncture.
-static void take_punctures(tx_ctx* c, thread_ctl* k, tx_snapshot sx, tx_snapshot st) {
+// the puncture list's points where their triangles' particles are now
+// (rows of SKIN.x, which a tear never renumbers); it ends at the first row
+// with v[0] = -1. A malformed row (a corner that is no row of SKIN.x,
+// barycentric coordinates that are not finite or do not sum to 1) ends it
+// too, counted as bad_puncture.
+static void take_punctures(tx_ctx* c, thread_ctl* k, tx_snapshot sx) {
   tx_snapshot sp = tx_read(c, k->punct_in);
   if (sp.seq == 0) return;
   const tx_puncture* rows = sp.data;
   const tx_vertex* vx = sx.data;
-  const tx_triangle* tri = st.data;
   int n = 0;
   for (uint32_t r = 0; r < sp.rows; r++) {
     const tx_puncture* q = &rows[r];
-    if (q->triangle == -1) break;
+    if (q->v[0] == -1) break;
     double sum = q->bary[0] + q->bary[1] + q->bary[2];
-    bool ok = q->triangle >= 0 && q->triangle < st.rows && q->triangle == floor(q->triangle) && isfinite(sum) &&
-              fabs(sum - 1) <= 1e-6;
-    const int32_t* v = ok ? tri[(uint32_t)q->triangle].v : NULL;
-    for (int a = 0; ok && a < 3; a++) ok = v[a] >= 0 && (uint32_t)v[a] < sx.rows;
+    bool ok = isfinite(sum) && fabs(sum - 1) <= 1e-6;
+    uint32_t v[3] = {0, 0, 0};
+    for (int a = 0; ok && a < 3; a++) {
+      ok = q->v[a] >= 0 && q->v[a] < sx.rows && q->v[a] == floor(q->v[a]);
+      if (ok) v[a] = (uint32_t)q->v[a];
+    }
     if (!ok) {
       tx_warn(c, k->bad_puncture);
       break;
@@ -420,7 +422,7 @@ static void step(tx_ctx* c, void* self) {
     if (sx.seq > 0 && st.seq > 0 && sh.seq > 0 &&
         tx_thread_set_mesh(k->t, sx.data, sx.rows, st.data, st.rows, ((const tx_thickness*)sh.data)->m) != TX_THREAD_OK)
       tx_warn(c, k->bad_skin);
-    if (k->punct_in.id && sx.seq > 0 && st.seq > 0) take_punctures(c, k, sx, st);
+    if (k->punct_in.id && sx.seq > 0 && st.seq > 0) take_punctures(c, k, sx);
   }
   if (k->ncaps) { // every capsule row, as far as there is room
     int m = 0, max = tx_thread_get_def(k->t)->max_shapes;

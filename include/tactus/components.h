@@ -291,15 +291,17 @@ TX_LAYOUT_ASSERT(tx_device_grip, double);
 
 // NAME.punctures (N rows, in the order the needle made them), written by
 // physics.instruments, read by physics.thread: where the thread must pass
-// through the skin. Each point moves with its skin triangle (a row of
-// skin.tri); rows past the last puncture have triangle = -1.
+// through the skin. Each point moves with its skin triangle, named by its
+// three particles (rows of skin.x, which never renumber: skin.tri is packed
+// and a tear renumbers the rows after it); rows past the last puncture have
+// v[0] = -1.
 typedef struct tx_puncture {
-  double triangle; // row of skin.tri that was pierced (an integer), -1: no puncture in this row
-  double bary[3];  // barycentric coordinates of the point in that triangle (they sum to 1)
-  double side;     // +1: the needle entered here, -1: it came out here
+  double v[3];    // rows of skin.x: the pierced triangle's corners (integers); v[0] = -1: no puncture in this row
+  double bary[3]; // barycentric coordinates of the point, in the order of v (they sum to 1)
+  double side;    // +1: the needle entered here, -1: it came out here
 } tx_puncture;
 #define tx_puncture_TYPE TX_F64
-#define tx_puncture_COLS 5u
+#define tx_puncture_COLS 7u
 #define tx_puncture_UNITS "1"
 TX_LAYOUT_ASSERT(tx_puncture, double);
 

@@ -317,11 +317,14 @@ static void test_needle_punctures_the_skin(void** state) {
     const tx_event* e = &the_listener.got[i];
     if (e->kind != TX_EVENT_PUNCTURE) continue;
     const tx_puncture* r = &rows[np];
-    print_message("  puncture %d: triangle %u, side %+g, at (%.2f, %.2f, %.2f) mm, %.3f N, %.2f mm deep; bary (%.3f, %.3f, %.3f)\n",
-                  np, e->source, r->side, 1e3 * e->puncture.point[0], 1e3 * e->puncture.point[1],
+    print_message("  puncture %d: triangle %u (particles %g %g %g), side %+g, at (%.2f, %.2f, %.2f) mm, %.3f N, %.2f mm deep; bary (%.3f, %.3f, %.3f)\n",
+                  np, e->source, r->v[0], r->v[1], r->v[2], r->side, 1e3 * e->puncture.point[0], 1e3 * e->puncture.point[1],
                   1e3 * e->puncture.point[2], e->puncture.force, 1e3 * e->puncture.depth, r->bary[0], r->bary[1], r->bary[2]);
-    assert_true(r->triangle == e->source);
-    assert_true(r->triangle >= 0 && r->triangle < 2 * 41 * 41); // a row of the 42 x 42 patch's skin.tri
+    assert_true(e->source < 2 * 41 * 41); // a row of the 42 x 42 patch's skin.tri at that publish
+    for (int k = 0; k < 3; k++) { // the triangle by its three particles: distinct rows of skin.x
+      assert_true(r->v[k] >= 0 && r->v[k] < 42 * 42 && r->v[k] == floor(r->v[k]));
+      assert_true(r->v[k] != r->v[(k + 1) % 3]);
+    }
     assert_true(fabs(r->bary[0] + r->bary[1] + r->bary[2] - 1) < 1e-9);
     for (int k = 0; k < 3; k++) assert_true(r->bary[k] >= 0);
     assert_true(e->puncture.force > 0.01); // the tip felt the skin before it tore
@@ -330,7 +333,7 @@ static void test_needle_punctures_the_skin(void** state) {
   print_message("  %d punctures, skin torn %g links, %d triangles live\n", np, latest(s, "skin.contact")[12], ntri);
   assert_int_equal(np, 2);
   assert_true(rows[0].side == 1 && rows[1].side == -1);
-  assert_true(rows[2].triangle == -1);
+  assert_true(rows[2].v[0] == -1);
   assert_true(result(s, "instruments.needle_punctures") == 2);
   tx_scenario_free(s);
 }

@@ -79,11 +79,18 @@ static void test_entry_then_exit(void** state) {
   c = touch(0.001, 0.0012, 1, 0, 3); // torn: the tip is through, the contact gone
   assert_true(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
   assert_int_equal(f.row.side, 1); // from above: an entry
-  assert_true(f.row.triangle >= 0 && f.row.triangle < ntri);
+  assert_true(f.triangle >= 0 && f.triangle < ntri);
   assert_true(fabs(f.row.bary[0] + f.row.bary[1] + f.row.bary[2] - 1) < 1e-12);
   assert_true(fabs(f.point[0] - 0.001) < 1e-7 && fabs(f.point[2] - 0.0012) < 1e-7);
   assert_true(fabs(f.force - 0.4) < 1e-12 && fabs(f.depth - 0.004) < 1e-12); // the largest force before the tear
-  for (int v = 0; v < 3; v++) assert_int_equal(f.verts[v], tris[3 * (int)f.row.triangle + v]);
+  for (int v = 0; v < 3; v++) { // the row names the triangle by its particles, in the order of bary
+    assert_int_equal(f.verts[v], tris[3 * f.triangle + v]);
+    assert_true(f.row.v[v] == f.verts[v]);
+  }
+  double q[3] = {0};
+  for (int v = 0; v < 3; v++)
+    for (int k = 0; k < 3; k++) q[k] += f.row.bary[v] * xs[3 * f.verts[v] + k];
+  for (int k = 0; k < 3; k++) assert_true(fabs(q[k] - f.point[k]) < 1e-9); // and they carry the point
   // the tear runs on at the hole, the flaps touching the tip from below: the same puncture
   c = touch(0.0015, 0.0012, -1, 0.1, 3);
   assert_false(tx_puncture_update(&t, &c, xs, N * N, tris, ntri, &f));
