@@ -34,7 +34,7 @@ extern "C" {
 typedef enum tx_event_kind {
   TX_EVENT_GRASP = 1, // jaws closed on something: source = instrument, payload .grasp
   TX_EVENT_RELEASE,   // jaws opened: source = instrument
-  TX_EVENT_PUNCTURE,  // a surface was pierced: source = surface element, payload .puncture
+  TX_EVENT_PUNCTURE,  // a surface was pierced: source = surface element (for the skin: its skin.tri row at that publish), payload .puncture
   TX_EVENT_CUT,       // something was cut: source = element (thread segment, link), payload .cut
   TX_EVENT_BURN,      // tissue reached a damage temperature: source = node, value[0] = K
   TX_EVENT_KNOT,      // a knot formed or was fixed: source = knot index
