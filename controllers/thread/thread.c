@@ -1235,6 +1235,16 @@ static void rod_substep(tx_thread* t, double h, double margin) {
   }
 }
 
+tx_thread_status tx_thread_set_model(tx_thread* t, tx_thread_model model) {
+  if (model != TX_THREAD_FTL && model != TX_THREAD_ROD) {
+    tx_set_error("thread: model = %d, must be ftl (0) or rod (1)", (int)model);
+    return TX_THREAD_BAD;
+  }
+  t->def.model = model;
+  memset(t->v, 0, sizeof(double) * 3 * t->n);
+  return TX_THREAD_OK;
+}
+
 tx_thread_status tx_thread_step(tx_thread* t, double dt) {
   if (!(dt > 0 && dt <= 1)) {
     tx_set_error("thread: dt = %g s, must be in (0, 1]", dt);

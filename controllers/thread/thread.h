@@ -173,6 +173,10 @@ double tx_thread_puncture_arc(const tx_thread* t, int k);
 int tx_thread_punctures_slid(const tx_thread* t);
 
 // advances by dt (s, in (0, 1])
+// changes the model from the next step on, the nodes where they are and at
+// rest (e.g. a knot formed in ftl and pulled tight as a rod); TX_THREAD_BAD
+// on an unknown model
+tx_thread_status tx_thread_set_model(tx_thread* t, tx_thread_model model);
 tx_thread_status tx_thread_step(tx_thread* t, double dt);
 
 int tx_thread_node_count(const tx_thread* t);

@@ -139,6 +139,37 @@ static void test_ftl_reaches_a_pinned_tail(void** state) {
   tx_thread_destroy(t);
 }
 
+// a thread laid out in ftl and turned into a rod: ftl keeps it where it lies
+// (kinematic, nothing pulls), the rod then falls from the head under gravity
+// from rest, about g t^2 / 2 at its free end, within the stretch cap; an
+// unknown model is refused and changes nothing
+static void test_set_model_ftl_to_rod(void** state) {
+  (void)state;
+  tx_thread_def d = tx_thread_def_default();
+  d.nodes = 41;
+  d.length = 0.04;
+  d.bend_factor = 0;
+  d.damping = 0;
+  tx_thread* t = tx_thread_create(&d);
+  assert_non_null(t);
+  for (int k = 0; k < 50; k++) assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
+  assert_true(fabs(tx_thread_position(t, 40)[1]) < 1e-15);
+  assert_int_equal(tx_thread_set_model(t, (tx_thread_model)7), TX_THREAD_BAD);
+  assert_int_equal(tx_thread_get_def(t)->model, TX_THREAD_FTL);
+  assert_int_equal(tx_thread_set_model(t, TX_THREAD_ROD), TX_THREAD_OK);
+  assert_int_equal(tx_thread_get_def(t)->model, TX_THREAD_ROD);
+  for (int k = 0; k < 50; k++) assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
+  // 0.05 s from rest: g t^2 / 2 = 12.3 mm for a free fall. A chain held at
+  // one end swings down; its free end falls about that (12.4 mm: a pinned
+  // chain's end outruns g a little, and the step is first order), not more
+  // than 6 % beyond it, and more than half of it (it is no longer kinematic)
+  double y = tx_thread_position(t, 40)[1];
+  print_message("ftl then rod: end fell %.5f m\n", -y);
+  assert_true(y < -0.0062 && y > -0.013);
+  assert_true(tx_thread_max_strain(t) <= d.max_stretch * (1 + 1e-9));
+  tx_thread_destroy(t);
+}
+
 // slack (a string on a table): a head moving back towards its pinned tail
 // drags only the nodes it pulls; no segment is ever longer than l0, some are
 // shorter; pulled out of reach, every segment is l0 again
@@ -274,6 +305,7 @@ int main(void) {
       cmocka_unit_test(test_ftl_keeps_length_and_takes_the_heads_path),
       cmocka_unit_test(test_ftl_reaches_a_pinned_tail),
       cmocka_unit_test(test_ftl_slack_follows_only_when_pulled),
+      cmocka_unit_test(test_set_model_ftl_to_rod),
       cmocka_unit_test(test_rod_cantilever_matches_the_beam),
       cmocka_unit_test(test_rod_stretch_cap),
       cmocka_unit_test(test_rod_hangs_from_the_head),
