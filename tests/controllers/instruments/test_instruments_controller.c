@@ -397,6 +397,13 @@ static void test_button_switches_instruments(void** state) {
     assert_null(load(bad[i][0]));
     if (!strstr(tx_error(), bad[i][1])) fail_msg("'%s' lacks '%s'", tx_error(), bad[i][1]);
   }
+  // a scripted buttons column that is not a bit field: refused with its row
+  write_csv(csv, "0,0,0,0,1,0,0,0,0,0.5\n");
+  assert_null(load("\"hand0\":\"thumb_forceps metzenbaum_scissors\""));
+  print_message("  %s\n", tx_error());
+  if (!strstr(tx_error(), ":1: buttons: an integer")) fail_msg("'%s'", tx_error());
+  write_csv(csv, "t_s,x_m,y_m,z_m,qw,qx,qy,qz,grip_rad\n"
+                 "0,0,0,0,1,0,0,0,0\n0.5,0,0,0,1,0,0,0,0\n1.0,0.02,0,0,1,0,0,0,0.4\n"); // as setup() wrote it
 }
 
 int main(void) {
