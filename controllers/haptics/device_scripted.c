@@ -3,7 +3,8 @@
 // "scripted:NAME" plays a built-in motion of the suturing skin tests, or
 // "insert" of the needle-insertion scenario;
 // "scripted:FILE.csv" plays a waypoint file, one row per waypoint:
-//   t_s, x_m, y_m, z_m [, qw, qx, qy, qz] [, grip_rad]
+//   t_s, x_m, y_m, z_m [, qw, qx, qy, qz] [, grip_rad [, buttons]]
+// (buttons: the bits held from that row until the next, not interpolated)
 // A relative FILE that is not there from the working folder is looked up on
 // the scenario search path ($TACTUS_SCENARIO_PATH, then the source tree's
 // scenarios/), where a scenario keeps its files beside its JSON:
@@ -36,6 +37,7 @@ typedef struct waypoint {
   double pos[3];  // m
   double quat[4]; // w, x, y, z
   double grip;    // rad
+  double buttons; // bits held from this row on
 } waypoint;
 
 struct tx_device {
@@ -98,15 +100,15 @@ static tx_device* with_rows(size_t count) {
 static tx_device* from_motion(const tx_hand_motion* m) {
   tx_device* d = with_rows((size_t)m->count);
   for (int i = 0; d && i < m->count; i++)
-    d->w[i] = (waypoint){m->t_pos[i][0], {m->t_pos[i][1], m->t_pos[i][2], m->t_pos[i][3]}, {1, 0, 0, 0}, 0};
+    d->w[i] = (waypoint){m->t_pos[i][0], {m->t_pos[i][1], m->t_pos[i][2], m->t_pos[i][3]}, {1, 0, 0, 0}, 0, 0};
   return d;
 }
 
-// parse one row of 4, 5, 8 or 9 numbers; returns a message or NULL
+// parse one row of 4, 5, 8, 9 or 10 numbers; returns a message or NULL
 static const char* parse_row(char* line, waypoint* w) {
-  double v[10];
+  double v[11];
   int n = 0;
-  for (char* p = line; n < 10;) {
+  for (char* p = line; n < 11;) {
     char* end;
     errno = 0;
     v[n] = strtod(p, &end);
@@ -117,8 +119,9 @@ static const char* parse_row(char* line, waypoint* w) {
     else if (*end == 0 || *end == '\n' || *end == '\r') break;
     else return "expected ',' between numbers";
   }
-  if (n != 4 && n != 5 && n != 8 && n != 9) return "expected 4, 5, 8 or 9 columns: t, x, y, z [, qw, qx, qy, qz] [, grip]";
-  *w = (waypoint){v[0], {v[1], v[2], v[3]}, {1, 0, 0, 0}, 0};
+  if (n != 4 && n != 5 && n != 8 && n != 9 && n != 10)
+    return "expected 4, 5, 8 or 9 columns: t, x, y, z [, qw, qx, qy, qz] [, grip] (or a 10th: buttons)";
+  *w = (waypoint){v[0], {v[1], v[2], v[3]}, {1, 0, 0, 0}, 0, 0};
   if (n >= 8) {
     // scaled by the largest component first, so that a huge one cannot overflow the norm
     double m = fmax(fmax(fabs(v[4]), fabs(v[5])), fmax(fabs(v[6]), fabs(v[7])));
@@ -128,6 +131,8 @@ static const char* parse_row(char* line, waypoint* w) {
     for (int i = 0; i < 4; i++) w->quat[i] = v[4 + i] / m / sqrt(q);
   }
   if (n == 5 || n == 9) w->grip = v[n - 1];
+  if (n == 10) w->grip = v[8], w->buttons = v[9];
+  if (n == 10 && (v[9] < 0 || v[9] >= 4294967296.0 || v[9] != floor(v[9]))) return "buttons: an integer in [0, 2^32)";
   for (int i = 0; i < 3; i++)
     if (fabs(w->pos[i]) > 10) return "a position beyond 10 m (the file must be in metres)";
   return NULL;
@@ -236,7 +241,7 @@ static bool read_scripted(tx_device* d, double t, tx_device_state* s) {
   }
   for (int k = 0; k < 4; k++) s->quat[k] /= sqrt(q);
   s->grip = a->grip + u * (b->grip - a->grip);
-  s->buttons = 0;
+  s->buttons = (uint32_t)a->buttons; // held until the next row
   s->t_ns = (int64_t)llround(t * 1e9);
   return true;
 }

@@ -21,7 +21,8 @@ typedef struct instrument {
   dJointID joint[TX_INSTRUMENT_LINKS_MAX]; // joint j of the URDF
   dJointID orient; // the angular motor of the root
   double hand_force[3];
-  double start[3];
+  double start[3], start_q[4]; // where place() puts the root
+  bool parked; // out of the world (tx_instrument_world_park)
   double target[TX_INSTRUMENT_LINKS_MAX]; // the jaw motors' target angles this step
   bool touch[TX_INSTRUMENT_LINKS_MAX]; // links that touched the needle this step
   double touch_sum[3]; // the needle's contact points with it this step, summed
@@ -163,7 +164,7 @@ static void place(tx_instrument_world* w, instrument* in) {
   const tx_urdf* u = in->urdf;
   double lp[TX_INSTRUMENT_LINKS_MAX][3], lq[TX_INSTRUMENT_LINKS_MAX][4];
   memcpy(lp[0], in->start, sizeof lp[0]);
-  lq[0][0] = 1, lq[0][1] = lq[0][2] = lq[0][3] = 0;
+  memcpy(lq[0], in->start_q, sizeof lq[0]);
   for (int j = 0; j < u->njoints; j++) { // a joint's parent comes first (urdf.h)
     const tx_urdf_joint* jt = &u->joints[j];
     compose(lp[jt->parent], lq[jt->parent], jt->origin.p, jt->origin.q, lp[jt->child], lq[jt->child]);
@@ -377,6 +378,7 @@ tx_instrument_world* tx_instrument_world_create(const tx_instrument_sim_params* 
   for (int i = 0; i < n; i++) {
     w->ins[i].urdf = urdfs[i];
     memcpy(w->ins[i].start, start[i], sizeof w->ins[i].start);
+    w->ins[i].start_q[0] = 1;
     if (!build(w, &w->ins[i])) {
       tx_instrument_world_destroy(w);
       return NULL;
@@ -623,6 +625,7 @@ static void pin_hold(tx_instrument_world* w, int i, double dt) {
 
 void tx_instrument_world_step(tx_instrument_world* w, const tx_instrument_input* in, double dt) {
   for (int i = 0; i < w->n; i++) {
+    if (w->ins[i].parked) continue;
     couple(w, &w->ins[i], &in[i]);
     drive_jaws(w, &w->ins[i], in[i].grip);
   }
@@ -646,8 +649,9 @@ void tx_instrument_world_step(tx_instrument_world* w, const tx_instrument_input*
   dJointGroupEmpty(w->contacts);
   if (w->needle) needle_grasp(w);
   for (int i = 0; i < w->n; i++)
-    if (!finite_state(&w->ins[i])) { // start over at the device, jaws closed
+    if (!w->ins[i].parked && !finite_state(&w->ins[i])) { // start over at the device, jaws closed
       memcpy(w->ins[i].start, in[i].pos, sizeof w->ins[i].start);
+      w->ins[i].start_q[0] = 1, w->ins[i].start_q[1] = w->ins[i].start_q[2] = w->ins[i].start_q[3] = 0;
       if (!isfinite(in[i].pos[0]) || !isfinite(in[i].pos[1]) || !isfinite(in[i].pos[2]))
         memset(w->ins[i].start, 0, sizeof w->ins[i].start);
       place(w, &w->ins[i]);
@@ -665,6 +669,48 @@ void tx_instrument_world_step(tx_instrument_world* w, const tx_instrument_input*
     }
   }
 }
+
+// a parked instrument's bodies and geoms are disabled together: ODE neither
+// steps them nor collides them, and no joint ties them to an enabled body
+static void enable(instrument* in, bool on) {
+  for (int l = 0; l < in->urdf->nlinks; l++) {
+    if (on) dBodyEnable(in->body[l]);
+    else dBodyDisable(in->body[l]);
+    for (dGeomID g = dBodyGetFirstGeom(in->body[l]); g; g = dBodyGetNextGeom(g))
+      if (on) dGeomEnable(g);
+      else dGeomDisable(g);
+  }
+}
+
+void tx_instrument_world_park(tx_instrument_world* w, int i, const double pos[3]) {
+  instrument* in = &w->ins[i];
+  if (in->parked) return;
+  if (w->hold && w->held_by == i) dJointDestroy(w->hold), w->hold = NULL, w->held_by = -1, w->releases++;
+  in->was_on = false;
+  memcpy(in->start, pos, sizeof in->start);
+  in->start_q[0] = 1, in->start_q[1] = in->start_q[2] = in->start_q[3] = 0;
+  for (int j = 0; j < in->urdf->njoints; j++)
+    if (!in->urdf->joints[j].fixed) dJointSetHingeParam(in->joint[j], dParamVel, 0);
+  place(w, in);
+  memset(in->hand_force, 0, sizeof in->hand_force);
+  enable(in, false);
+  in->parked = true;
+}
+
+void tx_instrument_world_take(tx_instrument_world* w, int i, const double pos[3], const double quat[4]) {
+  instrument* in = &w->ins[i];
+  memcpy(in->start, pos, sizeof in->start);
+  double n = sqrt(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3]);
+  bool ok = isfinite(n) && n > 1e-9 && isfinite(pos[0] + pos[1] + pos[2]);
+  for (int k = 0; k < 4; k++) in->start_q[k] = ok ? quat[k] / n : k == 0;
+  if (!ok) memset(in->start, 0, sizeof in->start);
+  place(w, in);
+  memset(in->hand_force, 0, sizeof in->hand_force);
+  enable(in, true);
+  in->parked = false;
+}
+
+bool tx_instrument_world_parked(const tx_instrument_world* w, int i) { return w->ins[i].parked; }
 
 void tx_instrument_world_needle(const tx_instrument_world* w, double pos[3], double quat[4]) {
   const dReal* bp = dBodyGetPosition(w->needle);

@@ -16,7 +16,7 @@
 
 #include <stdbool.h>
 
-#define TX_INSTRUMENTS_MAX 2 // one per hand
+#define TX_INSTRUMENTS_MAX 4 // in one world: up to two per hand, one held, one parked
 #define TX_INSTRUMENT_LINKS_MAX 8
 
 // The curved needle: a circular arc of a steel wire, one rigid body. Its
@@ -103,6 +103,16 @@ int tx_instrument_world_resets(const tx_instrument_world* w);
 // and the deepest contact of the last step (m)
 int tx_instrument_world_bad_inputs(const tx_instrument_world* w);
 double tx_instrument_world_depth(const tx_instrument_world* w);
+// Switching instruments. Park: the instrument is put down at pos (identity
+// orientation, jaws at their closed stop) and taken out of the world: its
+// bodies do not move and its geoms touch nothing, it lets go of the needle
+// it held, and its hand force is zero. Take: it is back, its root at pos
+// and quat (a device's pose) at rest, so the coupling spring starts
+// unstretched. parked: whether it is parked now.
+void tx_instrument_world_park(tx_instrument_world* w, int instrument, const double pos[3]);
+void tx_instrument_world_take(tx_instrument_world* w, int instrument, const double pos[3], const double quat[4]);
+bool tx_instrument_world_parked(const tx_instrument_world* w, int instrument);
+
 // ODE's solver messages since start (an LCP it could not finish and recovered
 // from); they are counted, not printed
 int tx_instrument_ode_messages(void);

@@ -18,14 +18,24 @@
 #include <string.h>
 
 #define TX_THREAD_RELEASE_RAD 0.02 // jaws this much wider than closed let the thread go
+#define HANDS 2
+#define PER_HAND (TX_INSTRUMENTS_MAX / HANDS) // one held, the others parked
 
 typedef struct instruments {
   tx_instrument_sim_params p;
-  tx_instrument_desc* desc[TX_INSTRUMENTS_MAX];
-  int n;
+  tx_instrument_desc* desc[TX_INSTRUMENTS_MAX]; // per instrument in the world (a slot)
+  int n, nhands;
   tx_instrument_world* world;
-  tx_port dev_pose[TX_INSTRUMENTS_MAX], dev_vel[TX_INSTRUMENTS_MAX], dev_grip[TX_INSTRUMENTS_MAX];
-  tx_port pose[TX_INSTRUMENTS_MAX], links[TX_INSTRUMENTS_MAX], model[TX_INSTRUMENTS_MAX];
+  // each hand's instruments (slots), the one it holds (an index into its
+  // list), and its switch button as last read
+  int slot[HANDS][PER_HAND], nslot[HANDS], cur[HANDS], hand_of[TX_INSTRUMENTS_MAX];
+  uint32_t switch_bit;
+  bool button_was[HANDS];
+  tx_result switches;
+  int nswitches;
+  tx_port dev_pose[HANDS], dev_vel[HANDS], dev_grip[HANDS];
+  tx_port pose[HANDS], links[HANDS], model[HANDS];
+  int link_rows[HANDS];
   tx_warning bad_input, reset;
   tx_result contacts_max, force_max, grasps, releases;
   tx_port needle_pose, needle_swage, events;
@@ -58,6 +68,11 @@ static const tx_param_def params[] = {
     {"instrument0", TX_PARAM_STR, NULL, 0, 0, 0, "needle_holder",
      "held by device0: a name in assets/instruments/ or a path to a .urdf"},
     {"instrument1", TX_PARAM_STR, NULL, 0, 0, 0, "", "held by device1; \"\": none"},
+    {"hand0", TX_PARAM_STR, NULL, 0, 0, 0, "",
+     "device0's instruments, by name or path, separated by spaces (at most 2): it holds the first, its switch_button takes the next; \"\": instrument0 alone"},
+    {"hand1", TX_PARAM_STR, NULL, 0, 0, 0, "", "device1's instruments, as hand0; \"\": instrument1 alone"},
+    {"switch_button", TX_PARAM_INT, "1", 0, 31, 0, NULL,
+     "the device button (bit of deviceN.grip's buttons) whose press puts the held instrument down and takes the hand's next"},
     {"coupling_stiffness", TX_PARAM_NUM, "N/m", 0, 1e5, 200, NULL,
      "the virtual coupling's spring between a device and its instrument's root"},
     {"coupling_damping", TX_PARAM_NUM, "N s/m", 0, 1e3, 1, NULL, "the virtual coupling's damper"},
@@ -130,7 +145,7 @@ static void cut(tx_ctx* c, instruments* m, int i, double jaw) {
   if (!m->thread_nodes.id) return;
   if (m->holds_thread[i] && jaw > m->blades[i].closed + TX_THREAD_RELEASE_RAD) {
     m->holds_thread[i] = false;
-    tx_emit(c, m->events, &(tx_event){.kind = TX_EVENT_RELEASE, .source = (uint32_t)i});
+    tx_emit(c, m->events, &(tx_event){.kind = TX_EVENT_RELEASE, .source = (uint32_t)m->hand_of[i]});
   }
   if (!tx_blades_close(&m->blades[i], jaw)) return;
   if (!m->scissors[i] && m->p.needle.enabled && tx_instrument_world_needle_held_by(m->world) == i) return; // on the needle
@@ -143,7 +158,7 @@ static void cut(tx_ctx* c, instruments* m, int i, double jaw) {
   int seg = tx_scissors_cut(pivot, dir, m->blade_length[i], m->blade_reach[i], nodes.data, (int)nodes.rows, point);
   if (seg < 0) return;
   if (!m->scissors[i]) { // a grasp of the thread: its point is on the thread, between the jaws
-    tx_event e = {.kind = TX_EVENT_GRASP, .source = (uint32_t)i};
+    tx_event e = {.kind = TX_EVENT_GRASP, .source = (uint32_t)m->hand_of[i]};
     memcpy(e.grasp.point, point, sizeof point);
     e.grasp.jaw = jaw;
     tx_emit(c, m->events, &e);
@@ -207,33 +222,50 @@ static int configure(tx_setup* s, void** self) {
     m->skin_contact = TX_READ_OF(s, name, tx_skin_contact);
     tx_puncture_tracker_init(&m->tracker, tx_table_num(s, "puncture_separation_m"), tx_table_num(s, "puncture_min_force_n"), 0);
   }
-  for (int i = 0; i < TX_INSTRUMENTS_MAX; i++) {
-    char key[32], path[2048], name[TX_NAME_MAX];
-    snprintf(key, sizeof key, "instrument%d", i);
+  for (int h = 0; h < HANDS; h++) {
+    char key[32], hkey[32], path[2048], name[TX_NAME_MAX], list[1024];
+    snprintf(key, sizeof key, "instrument%d", h);
+    snprintf(hkey, sizeof hkey, "hand%d", h);
     const char* given = tx_table_str(s, key);
-    if (!given || !*given) continue;
-    if (i > m->n) return tx_setup_fail(s, key, "instrument%d is given without instrument%d", i, m->n);
-    resolve(given, path, sizeof path);
-    m->desc[i] = tx_instrument_desc_load(path);
-    if (!m->desc[i]) return tx_setup_fail(s, key, "%s", tx_error());
-    if (m->desc[i]->urdf->nlinks > TX_INSTRUMENT_LINKS_MAX)
-      return tx_setup_fail(s, key, "%s: more than %d links", path, TX_INSTRUMENT_LINKS_MAX);
-    m->n = i + 1;
-    snprintf(name, sizeof name, "device%d.pose", i);
-    m->dev_pose[i] = TX_READ_OF(s, name, tx_pose);
-    snprintf(name, sizeof name, "device%d.velocity", i);
-    m->dev_vel[i] = TX_READ_OF(s, name, tx_velocity);
-    snprintf(name, sizeof name, "device%d.grip", i);
-    m->dev_grip[i] = TX_READ_OF(s, name, tx_device_grip);
-    snprintf(name, sizeof name, "instrument%d.pose", i);
-    m->pose[i] = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_instrument_pose, 1));
-    snprintf(name, sizeof name, "instrument%d.links", i);
-    m->links[i] = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_pose, (uint32_t)m->desc[i]->urdf->nlinks));
-    snprintf(name, sizeof name, "instrument%d.force_model", i);
-    m->model[i] = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_force_model, 1));
+    const char* hand = tx_table_str(s, hkey);
+    if (!given || !hand) return -1;
+    const char* used = *hand ? hkey : key;
+    snprintf(list, sizeof list, "%s", *hand ? hand : given);
+    char* save = NULL;
+    for (char* nm = strtok_r(list, " \t", &save); nm; nm = strtok_r(NULL, " \t", &save)) {
+      if (h > m->nhands) return tx_setup_fail(s, used, "device%d has instruments but device%d has none", h, m->nhands);
+      if (m->nslot[h] == PER_HAND) return tx_setup_fail(s, used, "more than %d instruments in one hand", PER_HAND);
+      int i = m->n;
+      resolve(nm, path, sizeof path);
+      m->desc[i] = tx_instrument_desc_load(path);
+      if (!m->desc[i]) return tx_setup_fail(s, used, "%s", tx_error());
+      if (m->desc[i]->urdf->nlinks > TX_INSTRUMENT_LINKS_MAX)
+        return tx_setup_fail(s, used, "%s: more than %d links", path, TX_INSTRUMENT_LINKS_MAX);
+      m->hand_of[i] = h;
+      m->slot[h][m->nslot[h]++] = i;
+      m->n = i + 1;
+      if (m->desc[i]->urdf->nlinks > m->link_rows[h]) m->link_rows[h] = m->desc[i]->urdf->nlinks;
+    }
+    if (!m->nslot[h]) continue;
+    m->nhands = h + 1;
+    snprintf(name, sizeof name, "device%d.pose", h);
+    m->dev_pose[h] = TX_READ_OF(s, name, tx_pose);
+    snprintf(name, sizeof name, "device%d.velocity", h);
+    m->dev_vel[h] = TX_READ_OF(s, name, tx_velocity);
+    snprintf(name, sizeof name, "device%d.grip", h);
+    m->dev_grip[h] = TX_READ_OF(s, name, tx_device_grip);
+    snprintf(name, sizeof name, "instrument%d.pose", h);
+    m->pose[h] = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_instrument_pose, 1));
+    snprintf(name, sizeof name, "instrument%d.links", h);
+    m->links[h] = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_pose, (uint32_t)m->link_rows[h]));
+    snprintf(name, sizeof name, "instrument%d.force_model", h);
+    m->model[h] = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_force_model, 1));
   }
   if (m->n == 0) return tx_setup_fail(s, "instrument0", "no instrument: give instrument0");
-  if (nd->held_by >= m->n) return tx_setup_fail(s, "needle_in_jaws", "there is no instrument%d", nd->held_by);
+  if (nd->held_by >= m->nhands) return tx_setup_fail(s, "needle_in_jaws", "there is no instrument%d", nd->held_by);
+  if (nd->held_by >= 0) nd->held_by = m->slot[nd->held_by][0]; // the world counts slots
+  m->switch_bit = 1u << tx_table_int(s, "switch_button");
+  m->switches = tx_setup_result(s, "switches");
   const char* thread = tx_table_str(s, "thread");
   if (!thread) return -1;
   if (*thread) {
@@ -242,8 +274,8 @@ static int configure(tx_setup* s, void** self) {
     m->thread_nodes = TX_READ_OF(s, name, tx_thread_node);
     m->cuts = tx_setup_result(s, "thread_cuts");
     m->thread_grasps = tx_setup_result(s, "thread_grasps");
-    if (!nd->enabled) m->events = tx_setup_emit(s, "instruments.events", 64);
   }
+  if (*thread || nd->enabled || m->n > m->nhands) m->events = tx_setup_emit(s, "instruments.events", 64);
   for (int i = 0; i < m->n; i++) blades_of(m, i);
   m->bad_input = tx_setup_warning(s, "device_not_finite");
   m->reset = tx_setup_warning(s, "reset");
@@ -254,12 +286,23 @@ static int configure(tx_setup* s, void** self) {
     m->needle_tip = tx_setup_write(s, &TX_COMPONENT_OF("needle.tip", tx_pose, 1));
     m->punctures = tx_setup_write(s, &TX_COMPONENT_OF("needle.punctures", tx_puncture, TX_NEEDLE_PINS_MAX));
     m->npunct = tx_setup_result(s, "needle_punctures");
-    m->events = tx_setup_emit(s, "instruments.events", 64);
     m->grasps = tx_setup_result(s, "needle_grasps");
     m->releases = tx_setup_result(s, "needle_releases");
   }
   m->force_max = tx_setup_result(s, "coupling_force_max_n");
   return 0;
+}
+
+// a parked instrument waits a metre above the scene (it is out of the
+// world's collisions anyway), each at its own place
+static const double* park_at(int slot) {
+  static const double at[TX_INSTRUMENTS_MAX][3] = {{0, 1, 0}, {0.1, 1, 0}, {0.2, 1, 0}, {0.3, 1, 0}};
+  return at[slot];
+}
+
+static bool button(const instruments* m, const tx_device_grip* g) {
+  double b = g->buttons;
+  return isfinite(b) && b >= 0 && b < 4294967296.0 && ((uint32_t)b & m->switch_bit);
 }
 
 // the world is made on the thread that steps it: ODE keeps per-thread data
@@ -271,7 +314,7 @@ static int init(tx_ctx* c, void* self) {
   double start[TX_INSTRUMENTS_MAX][3] = {{0}};
   for (int i = 0; i < m->n; i++) {
     urdfs[i] = m->desc[i]->urdf;
-    tx_snapshot p = tx_read(c, m->dev_pose[i]);
+    tx_snapshot p = tx_read(c, m->dev_pose[m->hand_of[i]]);
     if (p.seq) memcpy(start[i], ((const tx_pose*)p.data)->pos, sizeof start[i]);
     for (int k = 0; k < 3; k++)
       if (!isfinite(start[i][k])) start[i][k] = 0;
@@ -287,7 +330,31 @@ static int init(tx_ctx* c, void* self) {
     tx_stop_run(c, "physics.instruments: %s", tx_error());
     return -1;
   }
+  m->nswitches = 0;
+  for (int h = 0; h < m->nhands; h++) { // each hand holds its first; a button held from the start is no press
+    m->cur[h] = 0;
+    for (int k = 1; k < m->nslot[h]; k++) tx_instrument_world_park(m->world, m->slot[h][k], park_at(m->slot[h][k]));
+    tx_snapshot g = tx_read(c, m->dev_grip[h]);
+    m->button_was[h] = g.seq && button(m, g.data);
+  }
   return 0;
+}
+
+// the press of the switch button (an edge) puts the hand's instrument down
+// and takes its next, at the device's pose, its coupling at rest
+static void switch_instrument(tx_ctx* c, instruments* m, int h, const tx_instrument_input* dev) {
+  int from = m->slot[h][m->cur[h]];
+  m->cur[h] = (m->cur[h] + 1) % m->nslot[h];
+  int to = m->slot[h][m->cur[h]];
+  tx_instrument_world_park(m->world, from, park_at(from));
+  tx_instrument_world_take(m->world, to, dev->pos, dev->quat);
+  m->holds_thread[from] = m->holds_thread[to] = false;
+  m->blades[to].armed = 0;
+  m->nswitches++;
+  tx_event e = {.kind = TX_EVENT_INSTRUMENT_SWITCH, .source = (uint32_t)h};
+  e.value[0] = m->cur[h];
+  e.value[1] = (m->cur[h] + m->nslot[h] - 1) % m->nslot[h];
+  tx_emit(c, m->events, &e);
 }
 
 // the skin against the tip: its contact pushes the tip; each puncture it
@@ -331,19 +398,25 @@ static void pierce(tx_ctx* c, instruments* m) {
 
 static void step(tx_ctx* c, void* self) {
   instruments* m = self;
-  tx_instrument_input in[TX_INSTRUMENTS_MAX];
-  for (int i = 0; i < m->n; i++) {
-    tx_snapshot p = tx_read(c, m->dev_pose[i]), v = tx_read(c, m->dev_vel[i]), g = tx_read(c, m->dev_grip[i]);
-    in[i] = (tx_instrument_input){.quat = {1, 0, 0, 0}};
+  tx_instrument_input in[TX_INSTRUMENTS_MAX], dev[HANDS];
+  for (int i = 0; i < m->n; i++) in[i] = (tx_instrument_input){.quat = {1, 0, 0, 0}}; // parked: unread
+  for (int h = 0; h < m->nhands; h++) {
+    int i = m->slot[h][m->cur[h]];
+    tx_snapshot p = tx_read(c, m->dev_pose[h]), v = tx_read(c, m->dev_vel[h]), g = tx_read(c, m->dev_grip[h]);
+    dev[h] = (tx_instrument_input){.quat = {1, 0, 0, 0}};
     if (p.seq) {
-      memcpy(in[i].pos, ((const tx_pose*)p.data)->pos, sizeof in[i].pos);
-      memcpy(in[i].quat, ((const tx_pose*)p.data)->quat, sizeof in[i].quat);
+      memcpy(dev[h].pos, ((const tx_pose*)p.data)->pos, sizeof dev[h].pos);
+      memcpy(dev[h].quat, ((const tx_pose*)p.data)->quat, sizeof dev[h].quat);
     } else { // no device yet: hold the instrument where it is
       double q[4];
-      tx_instrument_world_link(m->world, i, 0, in[i].pos, q);
+      tx_instrument_world_link(m->world, i, 0, dev[h].pos, q);
     }
-    if (v.seq) memcpy(in[i].vel, ((const tx_velocity*)v.data)->v, sizeof in[i].vel);
-    in[i].grip = g.seq ? ((const tx_device_grip*)g.data)->grip : 0;
+    if (v.seq) memcpy(dev[h].vel, ((const tx_velocity*)v.data)->v, sizeof dev[h].vel);
+    dev[h].grip = g.seq ? ((const tx_device_grip*)g.data)->grip : 0;
+    bool pressed = g.seq && button(m, g.data);
+    if (pressed && !m->button_was[h] && m->nslot[h] > 1) switch_instrument(c, m, h, &dev[h]);
+    m->button_was[h] = pressed;
+    in[m->slot[h][m->cur[h]]] = dev[h];
   }
   if (m->skin) pierce(c, m);
   tx_instrument_world_step(m->world, in, 1.0 / tx_rate(c));
@@ -363,23 +436,25 @@ static void step(tx_ctx* c, void* self) {
     memcpy(tx_write(c, m->punctures), m->rows, sizeof m->rows);
     int held = tx_instrument_world_needle_held_by(m->world);
     if (tx_instrument_world_needle_grasps(m->world) > m->grasps_seen) {
-      tx_event e = {.kind = TX_EVENT_GRASP, .source = (uint32_t)held};
+      tx_event e = {.kind = TX_EVENT_GRASP, .source = (uint32_t)m->hand_of[held]};
       tx_instrument_world_needle_grasp_point(m->world, e.grasp.point);
       e.grasp.jaw = 0;
       for (int j = 0; j < m->desc[held]->urdf->njoints; j++) e.grasp.jaw += tx_instrument_world_joint(m->world, held, j);
       tx_emit(c, m->events, &e);
     }
     if (tx_instrument_world_needle_releases(m->world) > m->releases_seen)
-      tx_emit(c, m->events, &(tx_event){.kind = TX_EVENT_RELEASE, .source = (uint32_t)m->last_holder});
+      tx_emit(c, m->events, &(tx_event){.kind = TX_EVENT_RELEASE, .source = (uint32_t)m->hand_of[m->last_holder]});
     if (held >= 0) m->last_holder = held;
     m->grasps_seen = tx_instrument_world_needle_grasps(m->world);
     m->releases_seen = tx_instrument_world_needle_releases(m->world);
   }
-  for (int i = 0; i < m->n; i++) {
+  for (int h = 0; h < m->nhands; h++) { // each hand's component show the instrument it holds
+    int i = m->slot[h][m->cur[h]];
     const tx_urdf* u = m->desc[i]->urdf;
-    tx_pose* links = tx_write(c, m->links[i]);
-    for (int l = 0; l < u->nlinks; l++) tx_instrument_world_link(m->world, i, l, links[l].pos, links[l].quat);
-    tx_instrument_pose* ip = tx_write(c, m->pose[i]);
+    tx_pose* links = tx_write(c, m->links[h]);
+    for (int l = 0; l < m->link_rows[h]; l++) // rows past its links repeat its root
+      tx_instrument_world_link(m->world, i, l < u->nlinks ? l : 0, links[l].pos, links[l].quat);
+    tx_instrument_pose* ip = tx_write(c, m->pose[h]);
     memcpy(ip->pos, links[0].pos, sizeof ip->pos);
     memcpy(ip->quat, links[0].quat, sizeof ip->quat);
     ip->jaw = 0;
@@ -387,10 +462,10 @@ static void step(tx_ctx* c, void* self) {
     cut(c, m, i, ip->jaw);
     // F = f0 + K (x - x0) at the haptics rate: the coupling's spring about
     // where the hand was, unless the clamp holds it (then a constant)
-    tx_force_model* fm = tx_write(c, m->model[i]);
+    tx_force_model* fm = tx_write(c, m->model[h]);
     memset(fm, 0, sizeof *fm);
     tx_instrument_world_hand_force(m->world, i, fm->f0);
-    memcpy(fm->x0, in[i].pos, sizeof fm->x0);
+    memcpy(fm->x0, dev[h].pos, sizeof fm->x0);
     double f = sqrt(fm->f0[0] * fm->f0[0] + fm->f0[1] * fm->f0[1] + fm->f0[2] * fm->f0[2]);
     if (f > m->force_most) m->force_most = f;
     if (f < m->p.max_force * (1 - 1e-9))
@@ -411,6 +486,7 @@ static void finish(tx_ctx* c, void* self) {
   m->world = NULL;
   if (m->thread_nodes.id) tx_set_result(c, m->cuts, m->ncuts), tx_set_result(c, m->thread_grasps, m->nthread_grasps);
   tx_set_result(c, m->contacts_max, m->contacts_most);
+  tx_set_result(c, m->switches, m->nswitches);
   tx_set_result(c, m->force_max, m->force_most);
 }
 

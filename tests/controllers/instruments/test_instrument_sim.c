@@ -582,6 +582,63 @@ static void test_needle_taken_from_foam(void** state) {
   tx_instrument_desc_free(d);
 }
 
+// switching: a parked instrument laid half through the table touches nothing and
+// stays put; taken at a device's pose, its coupling starts at rest: the first
+// step's force is zero (the spring unstretched, the root at rest),
+// and the spring's settling under the weight (m g, 0.21 N for the scissors,
+// damping ratio b / 2 sqrt(k m) = 0.24: an overshoot of about 46 %) stays
+// below twice the weight, where a spring taken 1 cm off would pull k x 1 cm = 2 N
+static void test_park_and_take(void** state) {
+  (void)state;
+  tx_instrument_desc* a = load("thumb_forceps");
+  tx_instrument_desc* b = load("metzenbaum_scissors");
+  tx_instrument_sim_params p = tx_instrument_sim_defaults();
+  const tx_urdf* u[2] = {a->urdf, b->urdf};
+  double start[2][3] = {{0, 0.02, 0}, {0, p.table_height, 0}};
+  tx_instrument_world* w = tx_instrument_world_create(&p, u, 2, start);
+  assert_non_null(w);
+  tx_instrument_input in[2] = {at(0, 0.02, 0, 0), at(0, p.table_height, 0, 0)};
+  tx_instrument_world_step(w, in, 1e-3);
+  assert_true(tx_instrument_world_contacts(w) > 0); // held there, it touches the table
+  tx_instrument_world_destroy(w);
+  w = tx_instrument_world_create(&p, u, 2, start);
+  tx_instrument_world_park(w, 1, start[1]); // parked there
+  assert_true(tx_instrument_world_parked(w, 1) && !tx_instrument_world_parked(w, 0));
+  for (int i = 0; i < 100; i++) {
+    tx_instrument_world_step(w, in, 1e-3);
+    assert_int_equal(tx_instrument_world_contacts(w), 0);
+  }
+  double pos[3], q[4], f[3];
+  tx_instrument_world_link(w, 1, 0, pos, q);
+  assert_true(dist(pos, start[1]) < 1e-12); // gravity does not move it
+  tx_instrument_world_hand_force(w, 1, f);
+  assert_true(f[0] == 0 && f[1] == 0 && f[2] == 0);
+  // the hand puts the forceps down and takes the scissors, turned 0.3 rad about z
+  double dev[3] = {0.05, 0.03, 0.01}, dq[4] = {cos(0.15), 0, 0, sin(0.15)};
+  tx_instrument_world_park(w, 0, (double[3]){1, 1, 0});
+  tx_instrument_world_take(w, 1, dev, dq);
+  assert_false(tx_instrument_world_parked(w, 1));
+  tx_instrument_world_link(w, 1, 0, pos, q);
+  assert_true(dist(pos, dev) < 1e-12 && fabs(q[0] - dq[0]) < 1e-12 && fabs(q[3] - dq[3]) < 1e-12);
+  in[1] = (tx_instrument_input){.pos = {dev[0], dev[1], dev[2]}, .quat = {dq[0], 0, 0, dq[3]}};
+  tx_instrument_world_step(w, in, 1e-3);
+  tx_instrument_world_hand_force(w, 1, f);
+  double first = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]), most = first;
+  double mass = 0;
+  for (int l = 0; l < b->urdf->nlinks; l++) mass += b->urdf->links[l].mass;
+  for (int i = 0; i < 300; i++) {
+    tx_instrument_world_step(w, in, 1e-3);
+    tx_instrument_world_hand_force(w, 1, f);
+    most = fmax(most, sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]));
+  }
+  print_message("  taken: %.3g N at the first step, at most %.3g N (weight %.3g N)\n", first, most, mass * 9.81);
+  assert_true(first < 0.01);
+  assert_true(most < 2 * mass * 9.81);
+  tx_instrument_world_destroy(w);
+  tx_instrument_desc_free(a);
+  tx_instrument_desc_free(b);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_links_start_where_the_urdf_puts_them),
@@ -599,6 +656,7 @@ int main(void) {
       cmocka_unit_test(test_tip_contact_reaches_the_hand),
       cmocka_unit_test(test_pinned_needle_slides_along_and_resists_across),
       cmocka_unit_test(test_needle_taken_from_foam),
+      cmocka_unit_test(test_park_and_take),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

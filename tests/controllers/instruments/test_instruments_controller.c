@@ -338,6 +338,74 @@ static void test_needle_punctures_the_skin(void** state) {
   tx_scenario_free(s);
 }
 
+// hand0 = "thumb_forceps metzenbaum_scissors": the button pressed at 0.3 s
+// and held to 0.8 s switches once, to the scissors, taken at the device's
+// pose (weightless and still, the coupling force stays under 0.05 N all run;
+// the parked scissors, 1 m up, would pull with the 3.3 N clamp if taken from
+// there); they open over the thread and cut it; a second press at 2.1 s puts
+// them down and takes the forceps back
+static void test_button_switches_instruments(void** state) {
+  (void)state;
+  register_tests();
+  char path[64];
+  snprintf(path, sizeof path, "/tmp/tx-switch-XXXXXX.csv");
+  int fd = mkstemps(path, 4);
+  assert_true(fd >= 0);
+  close(fd);
+  write_csv(path, "t_s,x_m,y_m,z_m,qw,qx,qy,qz,grip_rad,buttons\n"
+                  "0,0,0,0.0012,1,0,0,0,0,0\n0.3,0,0,0.0012,1,0,0,0,0,1\n0.8,0,0,0.0012,1,0,0,0,0,0\n"
+                  "1.0,0,0,0.0012,1,0,0,0,0,0\n1.3,0,0,0.0012,1,0,0,0,0.6,0\n1.6,0,0,0.0012,1,0,0,0,0.6,0\n"
+                  "1.9,0,0,0.0012,1,0,0,0,0,0\n2.1,0,0,0.0012,1,0,0,0,0,1\n2.2,0,0,0.0012,1,0,0,0,0,0\n");
+  char text[2048];
+  snprintf(text, sizeof text,
+           "{\"name\":\"t\",\"controllers\":["
+           "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:%s\","
+           "\"force_model\":\"instrument0.force_model\"}},"
+           "{\"name\":\"thread\",\"type\":\"test.thread\",\"rate_hz\":100},"
+           "{\"name\":\"instruments\",\"type\":\"physics.instruments\",\"rate_hz\":1000,\"params\":{"
+           "\"hand0\":\"thumb_forceps metzenbaum_scissors\",\"thread\":\"thread\",\"gravity_m_s2\":0}},"
+           "{\"name\":\"listener\",\"type\":\"test.listener\",\"rate_hz\":1000}]}",
+           path);
+  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 2.5);
+  unlink(path);
+  print_message("  %d events; switches %g, cuts %g, coupling force at most %.3g N\n", the_listener.n,
+                result(s, "instruments.switches"), result(s, "instruments.thread_cuts"),
+                result(s, "instruments.coupling_force_max_n"));
+  assert_int_equal(the_listener.n, 3);
+  assert_int_equal(the_listener.got[0].kind, TX_EVENT_USER + 1); // TX_EVENT_INSTRUMENT_SWITCH
+  assert_int_equal(the_listener.got[0].source, 0);
+  assert_true(the_listener.got[0].value[0] == 1 && the_listener.got[0].value[1] == 0);
+  assert_int_equal(the_listener.got[1].kind, TX_EVENT_CUT); // the scissors in hand
+  assert_int_equal(the_listener.got[1].source, 4);
+  assert_int_equal(the_listener.got[2].kind, TX_EVENT_USER + 1);
+  assert_true(the_listener.got[2].value[0] == 0 && the_listener.got[2].value[1] == 1);
+  assert_true(result(s, "instruments.switches") == 2);
+  assert_true(result(s, "instruments.coupling_force_max_n") < 0.05);
+  const double* dev = latest(s, "device0.pose");
+  const double* ins = latest(s, "instrument0.pose");
+  assert_true(fabs(ins[0] - dev[0]) < 1e-4 && fabs(ins[1] - dev[1]) < 1e-4 && fabs(ins[2] - dev[2]) < 1e-4);
+  tx_scenario_free(s);
+  // a list too long, a name it cannot read: refused naming hand0
+  static const char* const bad[][2] = {
+      {"\"hand0\":\"thumb_forceps lap_grasper lap_scissors\"", "params.hand0: more than 2 instruments"},
+      {"\"hand0\":\"thumb_forceps no_such\"", "params.hand0: "},
+      {"\"instrument0\":\"\",\"hand1\":\"lap_grasper\"", "params.hand1: device1 has instruments but device0"},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    assert_null(load(bad[i][0]));
+    if (!strstr(tx_error(), bad[i][1])) fail_msg("'%s' lacks '%s'", tx_error(), bad[i][1]);
+  }
+  // a scripted buttons column that is not a bit field: refused with its row
+  write_csv(csv, "0,0,0,0,1,0,0,0,0,0.5\n");
+  assert_null(load("\"hand0\":\"thumb_forceps metzenbaum_scissors\""));
+  print_message("  %s\n", tx_error());
+  if (!strstr(tx_error(), ":1: buttons: an integer")) fail_msg("'%s'", tx_error());
+  write_csv(csv, "t_s,x_m,y_m,z_m,qw,qx,qy,qz,grip_rad\n"
+                 "0,0,0,0,1,0,0,0,0\n0.5,0,0,0,1,0,0,0,0\n1.0,0.02,0,0,1,0,0,0,0.4\n"); // as setup() wrote it
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_follows_the_hand_and_renders_the_weight),
@@ -346,6 +414,7 @@ int main(void) {
       cmocka_unit_test(test_scissors_cut_the_thread),
       cmocka_unit_test(test_forceps_grasp_the_thread),
       cmocka_unit_test(test_needle_punctures_the_skin),
+      cmocka_unit_test(test_button_switches_instruments),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }
