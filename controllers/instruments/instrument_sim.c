@@ -51,6 +51,7 @@ struct tx_instrument_world {
   double tip_f[3], tip_x[3], tip_n[3], tip_k; // the skin's contact on the tip (tx_instrument_world_needle_tip_contact)
   double tip_force[3]; // what it put on the tip in the last step
   double pin[TX_NEEDLE_PINS_MAX][3]; // puncture points, world
+  bool pin_through[TX_NEEDLE_PINS_MAX]; // the swage has passed it: the needle has left that hole for good
   int npins;
   double needle_mass;
   double depth; // deepest contact of the last step, m
@@ -94,7 +95,8 @@ tx_instrument_sim_params tx_instrument_sim_defaults(void) {
                                     .cfm = 1e-7,
                                     .pin_stiffness = 200,
                                     .pin_damping = 0.1,
-                                    .pin_friction = 0.02};
+                                    .pin_friction = 0.02,
+                                    .pin_reach = 0.005};
 }
 
 // ---- poses: position and unit quaternion (w, x, y, z)
@@ -598,9 +600,18 @@ static double pin_locate(const tx_instrument_world* w, int i, double c[3], doubl
 // pin_friction in newtons whatever the normal force: the sliding along the arc
 static void pin_hold(tx_instrument_world* w, int i, double dt) {
   double c[3], t[3], e[3];
+  if (w->pin_through[i]) return;
   double phi = pin_locate(w, i, c, t, e);
-  if (phi < 0 || phi > w->p.needle.arc) return; // the needle is not through it
+  // the swage gone past the point: the needle is out of that hole, and stays
+  // out wherever it is taken (the point, met again by the arc metres away,
+  // would otherwise pull it back as a spring stretched that far)
+  if (phi < 0) {
+    w->pin_through[i] = true;
+    return;
+  }
+  if (phi > w->p.needle.arc) return; // the tip is not through it yet
   double gap = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+  if (gap > w->p.pin_reach) return; // let go: a spring stretched that far would fling the needle
   dContact ct = {0};
   ct.surface.mode = dContactSoftERP | dContactSoftCFM | dContactFDir1;
   ct.surface.mu = w->p.pin_friction;
@@ -764,6 +775,7 @@ int tx_instrument_world_needle_pin(tx_instrument_world* w, const double point[3]
   for (int k = 0; k < 3; k++)
     if (!isfinite(point[k])) return -1;
   memcpy(w->pin[w->npins], point, sizeof w->pin[0]);
+  w->pin_through[w->npins] = false;
   return w->npins++;
 }
 void tx_instrument_world_needle_pin_move(tx_instrument_world* w, int i, const double point[3]) {
@@ -771,6 +783,9 @@ void tx_instrument_world_needle_pin_move(tx_instrument_world* w, int i, const do
   memcpy(w->pin[i], point, sizeof w->pin[0]);
 }
 int tx_instrument_world_needle_pins(const tx_instrument_world* w) { return w->npins; }
+bool tx_instrument_world_needle_pin_through(const tx_instrument_world* w, int i) {
+  return i >= 0 && i < w->npins && w->pin_through[i];
+}
 double tx_instrument_world_needle_pin_gap(const tx_instrument_world* w, int i, double* angle) {
   double c[3], t[3], e[3];
   double phi = pin_locate(w, i, c, t, e);

@@ -63,6 +63,7 @@ typedef struct tx_instrument_sim_params {
   double pin_stiffness; // N/m, across the arc
   double pin_damping; // N s/m, across the arc
   double pin_friction; // N, along the arc
+  double pin_reach; // m: a pin farther than this off the arc holds nothing (the skin there has let go of the needle)
 
 } tx_instrument_sim_params;
 
@@ -149,11 +150,15 @@ void tx_instrument_world_needle_tip_force(const tx_instrument_world* w, double f
 // its index, or -1 when TX_NEEDLE_PINS_MAX are pinned. Move it where the
 // skin carries it. While the point lies within the arc's angles, the arc is
 // held on it across the arc (pin_stiffness, pin_damping) and slides along it
-// against at most pin_friction; past the swage or the tip it holds nothing.
+// against at most pin_friction; before the tip reaches it it holds nothing,
+// and once the swage has passed it (pulled through) it ends for good.
 #define TX_NEEDLE_PINS_MAX 16
 int tx_instrument_world_needle_pin(tx_instrument_world* w, const double point[3]);
 void tx_instrument_world_needle_pin_move(tx_instrument_world* w, int pin, const double point[3]);
 int tx_instrument_world_needle_pins(const tx_instrument_world* w);
+// whether the needle has been pulled through a pin: its swage passed the
+// point, after which that pin holds nothing ever again
+bool tx_instrument_world_needle_pin_through(const tx_instrument_world* w, int pin);
 // a pin's distance from the arc across it (m), and the arc's angle at the
 // point nearest it (rad from the swage; outside [0, arc] when it holds nothing)
 double tx_instrument_world_needle_pin_gap(const tx_instrument_world* w, int pin, double* angle);

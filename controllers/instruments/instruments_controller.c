@@ -45,13 +45,17 @@ typedef struct instruments {
   // the skin the needle's tip pierces (SKIN.x, SKIN.tri, SKIN.contact)
   bool skin;
   tx_port skin_x, skin_tri, skin_contact, needle_tip, punctures;
-  tx_result npunct;
+  tx_result npunct, pulled_through;
   uint64_t contact_seq;
   tx_puncture_tracker tracker;
   tx_puncture rows[TX_NEEDLE_PINS_MAX];
   int32_t pin_verts[TX_NEEDLE_PINS_MAX][3]; // the particles that carry each puncture point
   double pin_offset[TX_NEEDLE_PINS_MAX][3]; // from the skin's point to the pin: the tip where it tore through
+  double pin_origin[TX_NEEDLE_PINS_MAX][3]; // where each puncture was made
   int npins;
+  double pin_capture; // m: a puncture's skin point this far off the needle's arc is anchored afresh
+  tx_result reanchors;
+  int nreanchors;
   // the thread the scissors cut (THREAD.nodes)
   tx_port thread_nodes;
   tx_result cuts;
@@ -60,8 +64,9 @@ typedef struct instruments {
   double blade_length[TX_INSTRUMENTS_MAX], blade_reach[TX_INSTRUMENTS_MAX];
   tx_blades blades[TX_INSTRUMENTS_MAX];
   bool holds_thread[TX_INSTRUMENTS_MAX]; // jaws closed on the thread (not scissors)
-  tx_result thread_grasps;
+  tx_result thread_grasps, cut_height;
   int nthread_grasps;
+  double last_cut_y;
 } instruments;
 
 static const tx_param_def params[] = {
@@ -111,6 +116,8 @@ static const tx_param_def params[] = {
      "a puncture holds the needle's arc on its point across the arc with this spring"},
     {"pin_damping", TX_PARAM_NUM, "N s/m", 0, 1e3, 0.1, NULL, "and this damper"},
     {"pin_friction_n", TX_PARAM_NUM, "N", 0, 100, 0.02, NULL, "the most force a puncture puts against the needle sliding along its arc"},
+    {"pin_capture_m", TX_PARAM_NUM, "m", 1e-4, 0.05, 0.005, NULL,
+     "a puncture's point farther than this off the needle's arc holds nothing (a torn flap the tip carried off); the puncture moves to where the arc crosses the skin"},
 };
 
 // a bare name is a shipped instrument; anything else is a path
@@ -170,6 +177,7 @@ static void cut(tx_ctx* c, instruments* m, int i, double jaw) {
   memcpy(e.cut.point, point, sizeof point);
   tx_emit(c, m->events, &e);
   m->ncuts++;
+  m->last_cut_y = point[1];
 }
 
 static int configure(tx_setup* s, void** self) {
@@ -208,6 +216,7 @@ static int configure(tx_setup* s, void** self) {
   m->p.pin_stiffness = tx_table_num(s, "pin_stiffness");
   m->p.pin_damping = tx_table_num(s, "pin_damping");
   m->p.pin_friction = tx_table_num(s, "pin_friction_n");
+  m->pin_capture = m->p.pin_reach = tx_table_num(s, "pin_capture_m");
   const char* skin = tx_table_str(s, "skin");
   if (!skin) return -1;
   if (*skin && !nd->enabled) return tx_setup_fail(s, "skin", "a skin to pierce needs the needle (needle: true)");
@@ -274,6 +283,7 @@ static int configure(tx_setup* s, void** self) {
     m->thread_nodes = TX_READ_OF(s, name, tx_thread_node);
     m->cuts = tx_setup_result(s, "thread_cuts");
     m->thread_grasps = tx_setup_result(s, "thread_grasps");
+    m->cut_height = tx_setup_result(s, "thread_cut_y_m");
   }
   if (*thread || nd->enabled || m->n > m->nhands) m->events = tx_setup_emit(s, "instruments.events", 64);
   for (int i = 0; i < m->n; i++) blades_of(m, i);
@@ -286,6 +296,8 @@ static int configure(tx_setup* s, void** self) {
     m->needle_tip = tx_setup_write(s, &TX_COMPONENT_OF("needle.tip", tx_pose, 1));
     m->punctures = tx_setup_write(s, &TX_COMPONENT_OF("needle.punctures", tx_puncture, TX_NEEDLE_PINS_MAX));
     m->npunct = tx_setup_result(s, "needle_punctures");
+    m->pulled_through = tx_setup_result(s, "needle_pulled_through");
+    if (*skin) m->reanchors = tx_setup_result(s, "needle_reanchors");
     m->grasps = tx_setup_result(s, "needle_grasps");
     m->releases = tx_setup_result(s, "needle_releases");
   }
@@ -319,7 +331,7 @@ static int init(tx_ctx* c, void* self) {
     for (int k = 0; k < 3; k++)
       if (!isfinite(start[i][k])) start[i][k] = 0;
   }
-  m->npins = 0;
+  m->npins = m->nreanchors = 0;
   m->ncuts = m->nthread_grasps = 0;
   for (int i = 0; i < m->n; i++) m->blades[i].armed = 0, m->holds_thread[i] = false;
   m->contact_seq = 0;
@@ -357,6 +369,50 @@ static void switch_instrument(tx_ctx* c, instruments* m, int h, const tx_instrum
   tx_emit(c, m->events, &e);
 }
 
+// the point on the needle's arc at angle a (rad from the swage), world
+static void arc_point(const instruments* m, double a, double out[3]) {
+  double o[3], q[4], R = m->p.needle.radius, v[3] = {R * cos(a), R * sin(a), 0};
+  tx_instrument_world_needle(m->world, o, q);
+  double t[3] = {2 * (q[2] * v[2] - q[3] * v[1]), 2 * (q[3] * v[0] - q[1] * v[2]), 2 * (q[1] * v[1] - q[2] * v[0])};
+  out[0] = o[0] + v[0] + q[0] * t[0] + (q[2] * t[2] - q[3] * t[1]);
+  out[1] = o[1] + v[1] + q[0] * t[1] + (q[3] * t[0] - q[1] * t[2]);
+  out[2] = o[2] + v[2] + q[0] * t[2] + (q[1] * t[1] - q[2] * t[0]);
+}
+
+// A puncture's particles can be a flap torn loose around the hole, which the
+// tip carries off: its point then leaves the needle (the pin lets go of the
+// arc beyond pin_capture). The hole itself is where the arc crosses the skin
+// sheet: once the point is pin_capture off the arc, the puncture moves to the
+// skin nearest the arc within pin_capture of it, of such places the nearest
+// where it was made; its row of needle.punctures follows, for the thread.
+// Rare (a flap carried off), so the search along the arc is affordable.
+#define REANCHOR_SAMPLES 64
+static void reanchor(instruments* m, int i, const float* xs, int nx, const int32_t* tri, int ntri) {
+  double angle, gap = tx_instrument_world_needle_pin_gap(m->world, i, &angle);
+  if (tx_instrument_world_needle_pin_through(m->world, i) || gap <= m->pin_capture) return;
+  double best = INFINITY, best_c[3] = {0}, best_point[3] = {0}, best_bary[3] = {0};
+  int best_t = -1;
+  for (int k = 0; k <= REANCHOR_SAMPLES; k++) {
+    double c[3], bary[3], point[3], d = 0, o = 0;
+    arc_point(m, m->p.needle.arc * k / REANCHOR_SAMPLES, c);
+    int t = tx_nearest_triangle(xs, nx, tri, ntri, c, bary, point);
+    if (t < 0) continue;
+    for (int j = 0; j < 3; j++) d += (point[j] - c[j]) * (point[j] - c[j]), o += (c[j] - m->pin_origin[i][j]) * (c[j] - m->pin_origin[i][j]);
+    if (sqrt(d) > m->pin_capture || o >= best) continue;
+    best = o, best_t = t;
+    memcpy(best_c, c, sizeof c), memcpy(best_point, point, sizeof point), memcpy(best_bary, bary, sizeof bary);
+  }
+  if (best_t < 0) return;
+  for (int v = 0; v < 3; v++) {
+    m->pin_verts[i][v] = tri[3 * best_t + v];
+    m->rows[i].v[v] = tri[3 * best_t + v];
+    m->rows[i].bary[v] = best_bary[v];
+  }
+  for (int k = 0; k < 3; k++) m->pin_offset[i][k] = best_c[k] - best_point[k];
+  tx_instrument_world_needle_pin_move(m->world, i, best_c);
+  m->nreanchors++;
+}
+
 // the skin against the tip: its contact pushes the tip; each puncture it
 // tears pins the needle's arc there, is an event and a row of needle.punctures
 static void pierce(tx_ctx* c, instruments* m) {
@@ -377,6 +433,8 @@ static void pierce(tx_ctx* c, instruments* m) {
   }
   if (ct.seq == m->contact_seq) return; // one look at each of the skin's publishes
   m->contact_seq = ct.seq;
+  if (tri.seq)
+    for (int i = 0; i < m->npins; i++) reanchor(m, i, xs, (int)x.rows, tri.data, (int)tri.rows);
   tx_puncture_found f;
   if (!tri.seq || !tx_puncture_update(&m->tracker, sc, xs, (int)x.rows, tri.data, (int)tri.rows, &f)) return;
   // the pin starts at the tip, which is on the arc (the hole's rim, where the
@@ -385,6 +443,7 @@ static void pierce(tx_ctx* c, instruments* m) {
   tx_instrument_world_needle_tip(m->world, tip);
   if (m->npins >= TX_NEEDLE_PINS_MAX || tx_instrument_world_needle_pin(m->world, tip) < 0) return;
   for (int k = 0; k < 3; k++) m->pin_offset[m->npins][k] = tip[k] - f.point[k];
+  memcpy(m->pin_origin[m->npins], f.point, sizeof f.point);
   m->rows[m->npins] = f.row;
   memcpy(m->pin_verts[m->npins], f.verts, sizeof f.verts);
   m->npins++;
@@ -480,11 +539,18 @@ static void finish(tx_ctx* c, void* self) {
     tx_set_result(c, m->grasps, m->grasps_seen);
     tx_set_result(c, m->releases, m->releases_seen);
     tx_set_result(c, m->npunct, m->npins);
+    int through = 0;
+    for (int i = 0; i < m->npins; i++) through += tx_instrument_world_needle_pin_through(m->world, i);
+    tx_set_result(c, m->pulled_through, through);
+    if (m->skin) tx_set_result(c, m->reanchors, m->nreanchors);
   }
   // the world goes on the thread that made and stepped it, with ODE's data for that thread
   tx_instrument_world_destroy(m->world);
   m->world = NULL;
-  if (m->thread_nodes.id) tx_set_result(c, m->cuts, m->ncuts), tx_set_result(c, m->thread_grasps, m->nthread_grasps);
+  if (m->thread_nodes.id) {
+    tx_set_result(c, m->cuts, m->ncuts), tx_set_result(c, m->thread_grasps, m->nthread_grasps);
+    if (m->ncuts) tx_set_result(c, m->cut_height, m->last_cut_y);
+  }
   tx_set_result(c, m->contacts_max, m->contacts_most);
   tx_set_result(c, m->switches, m->nswitches);
   tx_set_result(c, m->force_max, m->force_most);

@@ -548,6 +548,74 @@ static void test_pinned_needle_slides_along_and_resists_across(void** state) {
   tx_instrument_desc_free(d);
 }
 
+// pulled through: a pin 0.3 rad from the swage, the holder turns the needle
+// on by 0.6 rad: while the arc slides through the point the hand feels the
+// pin's drag (its friction, 0.02 N), once the swage has passed it the pin has
+// ended (through) and the hand feels nothing of it; taken 4 mm across the
+// arc's plane and turned back so that the arc's angles cover the point again,
+// the needle is not pulled back (a pin still holding would pull 0.4 N)
+static void test_needle_pulled_through_leaves_the_pin(void** state) {
+  (void)state;
+  tx_instrument_desc* d;
+  tx_instrument_sim_params p;
+  tx_instrument_world* w = held_needle(&d, &p);
+  tx_instrument_input in = at(0, 0, 0, 0);
+  for (int i = 0; i < 300; i++) tx_instrument_world_step(w, &in, 1e-3);
+  double o[3], q[4], R = p.needle.radius, angle;
+  tx_instrument_world_needle(w, o, q);
+  // 0.3 rad along the arc from the swage: 0.1 rad in the world (the needle is turned by -0.2)
+  double pin[3] = {o[0] + R * cos(0.1), o[1] + R * sin(0.1), o[2]};
+  assert_int_equal(tx_instrument_world_needle_pin(w, pin), 0);
+  assert_true(tx_instrument_world_needle_pin_gap(w, 0, &angle) < 1e-4 && fabs(angle - 0.3) < 0.02);
+  // the hand turns the holder about the needle's centre by +0.6 rad in 1 s:
+  // the swage comes through the point at 0.5 s (0.6 s: the coupling lags)
+  double drag = 0, after = 0, om = 0.6, p0[3] = {0, 0, 0}, th = 0;
+  int through_at = -1;
+  for (int i = 1; i <= 1300; i++) {
+    th = om * fmin(i, 1000) / 1000;
+    double r[3] = {p0[0] - o[0], p0[1] - o[1], 0}, v = i <= 1000 ? om : 0;
+    in.pos[0] = o[0] + cos(th) * r[0] - sin(th) * r[1], in.pos[1] = o[1] + sin(th) * r[0] + cos(th) * r[1], in.pos[2] = 0;
+    in.vel[0] = -v * (in.pos[1] - o[1]), in.vel[1] = v * (in.pos[0] - o[0]), in.vel[2] = 0;
+    in.quat[0] = cos(th / 2), in.quat[1] = in.quat[2] = 0, in.quat[3] = sin(th / 2);
+    tx_instrument_world_step(w, &in, 1e-3);
+    double hf[3];
+    tx_instrument_world_hand_force(w, 0, hf);
+    if (through_at < 0 && tx_instrument_world_needle_pin_through(w, 0)) through_at = i;
+    if (i > 100 && i < 400) drag = fmax(drag, norm3(hf)); // pinned, after the start's jerk
+    if (i > 700 && i < 1000) after = fmax(after, norm3(hf)); // out of the hole, still turning
+  }
+  print_message("  pulled through: the swage passed the point at %.3f s; the hand felt %.4f N of drag, %.5f N after\n",
+                1e-3 * through_at, drag, after);
+  assert_true(through_at > 400 && through_at < 600);
+  assert_true(drag > 0.01 && drag < 0.04); // pin_friction 0.02 N
+  assert_true(after < 0.006); // what is left turns the holder itself
+  assert_int_equal(tx_instrument_world_needle_held_by(w), 0);
+  // 4 mm across the plane (within pin_reach), then turned back 0.6 rad: the point is within the
+  // arc's angles again, 4 mm off it, and holds nothing
+  double most = 0, z0 = in.pos[2];
+  for (int i = 1; i <= 1800; i++) {
+    double t = fmin(1, i / 500.0);
+    in.pos[2] = z0 + 0.004 * t;
+    double back = i <= 500 ? th : th - 0.6 * fmin(1, (i - 500) / 700.0);
+    double r[3] = {p0[0] - o[0], p0[1] - o[1], 0};
+    in.pos[0] = o[0] + cos(back) * r[0] - sin(back) * r[1], in.pos[1] = o[1] + sin(back) * r[0] + cos(back) * r[1];
+    in.quat[0] = cos(back / 2), in.quat[3] = sin(back / 2);
+    memset(in.vel, 0, sizeof in.vel);
+    tx_instrument_world_step(w, &in, 1e-3);
+    double hf[3];
+    tx_instrument_world_hand_force(w, 0, hf);
+    if (i > 1500) most = fmax(most, norm3(hf));
+  }
+  double gap = tx_instrument_world_needle_pin_gap(w, 0, &angle);
+  print_message("  turned back 4 mm off: the point %.2f mm off the arc at %.2f rad, the hand feels %.5f N\n", 1e3 * gap,
+                angle, most);
+  assert_true(angle > 0.1 && angle < p.needle.arc && gap > 0.003 && gap < p.pin_reach);
+  assert_true(most < 0.01); // a pin holding: 200 and 200 N/m in series x 4 mm = 0.4 N
+  assert_true(tx_instrument_world_needle_pin_through(w, 0));
+  tx_instrument_world_destroy(w);
+  tx_instrument_desc_free(d);
+}
+
 // in foam the needle stands still under gravity until the holder closes on
 // it, which takes it out (one grasp) and lifts it
 static void test_needle_taken_from_foam(void** state) {
@@ -655,6 +723,7 @@ int main(void) {
       cmocka_unit_test(test_needle_starts_in_the_jaws),
       cmocka_unit_test(test_tip_contact_reaches_the_hand),
       cmocka_unit_test(test_pinned_needle_slides_along_and_resists_across),
+      cmocka_unit_test(test_needle_pulled_through_leaves_the_pin),
       cmocka_unit_test(test_needle_taken_from_foam),
       cmocka_unit_test(test_park_and_take),
   };
