@@ -47,6 +47,21 @@ int tx_scissors_cut(const double pivot[3], const double dir[3], double length, d
   return best;
 }
 
+int tx_jaws_pinch(const double pivot[3], const double dir[3], double length, double reach, const float* x, int n,
+                  double point[3]) {
+  int best = -1;
+  double best_d = INFINITY;
+  for (int i = 0; i < n; i++) {
+    double p[3] = {x[3 * i], x[3 * i + 1], x[3 * i + 2]}, s = 0, d2 = 0;
+    if (!isfinite(p[0] + p[1] + p[2])) continue;
+    for (int k = 0; k < 3; k++) s += (p[k] - pivot[k]) * dir[k];
+    if (s <= 0 || s > length) continue; // behind the pivot or past the tips: not between the jaws
+    for (int k = 0; k < 3; k++) d2 += (p[k] - pivot[k] - s * dir[k]) * (p[k] - pivot[k] - s * dir[k]);
+    if (d2 <= reach * reach && d2 < best_d) best_d = d2, best = i, point[0] = p[0], point[1] = p[1], point[2] = p[2];
+  }
+  return best;
+}
+
 int tx_blades_close(tx_blades* b, double jaw) {
   if (!isfinite(jaw)) return 0;
   if (jaw > b->open) b->armed = 1;

@@ -64,6 +64,9 @@ typedef struct instruments {
   double blade_length[TX_INSTRUMENTS_MAX], blade_reach[TX_INSTRUMENTS_MAX];
   tx_blades blades[TX_INSTRUMENTS_MAX];
   bool holds_thread[TX_INSTRUMENTS_MAX]; // jaws closed on the thread (not scissors)
+  bool holds_skin[TX_INSTRUMENTS_MAX];   // jaws closed on the skin (not scissors)
+  tx_result skin_grasps;
+  int nskin_grasps;
   tx_result thread_grasps, cut_height;
   int nthread_grasps;
   double last_cut_y;
@@ -147,37 +150,43 @@ static void blades_of(instruments* m, int i) {
 }
 
 // scissors closing on the thread cut it between their blades; other jaws
-// closing on it grasp it (until they open again)
+// closing on it grasp it, or else grasp the skin between them (until they
+// open again)
 static void cut(tx_ctx* c, instruments* m, int i, double jaw) {
-  if (!m->thread_nodes.id) return;
-  if (m->holds_thread[i] && jaw > m->blades[i].closed + TX_THREAD_RELEASE_RAD) {
-    m->holds_thread[i] = false;
+  if (!m->thread_nodes.id && !m->skin) return;
+  if ((m->holds_thread[i] || m->holds_skin[i]) && jaw > m->blades[i].closed + TX_THREAD_RELEASE_RAD) {
+    m->holds_thread[i] = m->holds_skin[i] = false;
     tx_emit(c, m->events, &(tx_event){.kind = TX_EVENT_RELEASE, .source = (uint32_t)m->hand_of[i]});
   }
   if (!tx_blades_close(&m->blades[i], jaw)) return;
   if (!m->scissors[i] && m->p.needle.enabled && tx_instrument_world_needle_held_by(m->world) == i) return; // on the needle
-  tx_snapshot nodes = tx_read(c, m->thread_nodes);
-  if (!nodes.seq) return;
   double pivot[3], q[4], dir[3], point[3];
   tx_instrument_world_link(m->world, i, 0, pivot, q);
   // the root's x axis: the closed blades
   dir[0] = 1 - 2 * (q[2] * q[2] + q[3] * q[3]), dir[1] = 2 * (q[1] * q[2] + q[0] * q[3]), dir[2] = 2 * (q[1] * q[3] - q[0] * q[2]);
-  int seg = tx_scissors_cut(pivot, dir, m->blade_length[i], m->blade_reach[i], nodes.data, (int)nodes.rows, point);
-  if (seg < 0) return;
-  if (!m->scissors[i]) { // a grasp of the thread: its point is on the thread, between the jaws
-    tx_event e = {.kind = TX_EVENT_GRASP, .source = (uint32_t)m->hand_of[i]};
-    memcpy(e.grasp.point, point, sizeof point);
-    e.grasp.jaw = jaw;
+  tx_snapshot nodes = m->thread_nodes.id ? tx_read(c, m->thread_nodes) : (tx_snapshot){0};
+  int seg = nodes.seq ? tx_scissors_cut(pivot, dir, m->blade_length[i], m->blade_reach[i], nodes.data, (int)nodes.rows, point) : -1;
+  if (seg >= 0 && m->scissors[i]) {
+    tx_event e = {.kind = TX_EVENT_CUT, .source = (uint32_t)seg};
+    memcpy(e.cut.point, point, sizeof point);
     tx_emit(c, m->events, &e);
-    m->holds_thread[i] = true;
-    m->nthread_grasps++;
+    m->ncuts++;
+    m->last_cut_y = point[1];
     return;
   }
-  tx_event e = {.kind = TX_EVENT_CUT, .source = (uint32_t)seg};
-  memcpy(e.cut.point, point, sizeof point);
+  if (m->scissors[i]) return;
+  if (seg < 0) { // not on the thread: on the skin?
+    tx_snapshot x = m->skin ? tx_read(c, m->skin_x) : (tx_snapshot){0};
+    if (!x.seq || tx_jaws_pinch(pivot, dir, m->blade_length[i], m->blade_reach[i], x.data, (int)x.rows, point) < 0) return;
+  }
+  // a grasp: its point on the thread or the skin, between the jaws; the
+  // thread and the skin each take the grasp whose point is theirs
+  tx_event e = {.kind = TX_EVENT_GRASP, .source = (uint32_t)m->hand_of[i]};
+  memcpy(e.grasp.point, point, sizeof point);
+  e.grasp.jaw = jaw;
   tx_emit(c, m->events, &e);
-  m->ncuts++;
-  m->last_cut_y = point[1];
+  if (seg >= 0) m->holds_thread[i] = true, m->nthread_grasps++;
+  else m->holds_skin[i] = true, m->nskin_grasps++;
 }
 
 static int configure(tx_setup* s, void** self) {
@@ -285,6 +294,7 @@ static int configure(tx_setup* s, void** self) {
     m->thread_grasps = tx_setup_result(s, "thread_grasps");
     m->cut_height = tx_setup_result(s, "thread_cut_y_m");
   }
+  if (*skin) m->skin_grasps = tx_setup_result(s, "skin_grasps");
   if (*thread || nd->enabled || m->n > m->nhands) m->events = tx_setup_emit(s, "instruments.events", 64);
   for (int i = 0; i < m->n; i++) blades_of(m, i);
   m->bad_input = tx_setup_warning(s, "device_not_finite");
@@ -332,8 +342,8 @@ static int init(tx_ctx* c, void* self) {
       if (!isfinite(start[i][k])) start[i][k] = 0;
   }
   m->npins = m->nreanchors = 0;
-  m->ncuts = m->nthread_grasps = 0;
-  for (int i = 0; i < m->n; i++) m->blades[i].armed = 0, m->holds_thread[i] = false;
+  m->ncuts = m->nthread_grasps = m->nskin_grasps = 0;
+  for (int i = 0; i < m->n; i++) m->blades[i].armed = 0, m->holds_thread[i] = m->holds_skin[i] = false;
   m->contact_seq = 0;
   for (int i = 0; i < TX_NEEDLE_PINS_MAX; i++) m->rows[i] = (tx_puncture){.v = {-1, -1, -1}};
   tx_puncture_tracker_init(&m->tracker, m->tracker.separation, m->tracker.min_force, 0);
@@ -360,7 +370,9 @@ static void switch_instrument(tx_ctx* c, instruments* m, int h, const tx_instrum
   int to = m->slot[h][m->cur[h]];
   tx_instrument_world_park(m->world, from, park_at(from));
   tx_instrument_world_take(m->world, to, dev->pos, dev->quat);
-  m->holds_thread[from] = m->holds_thread[to] = false;
+  if (m->holds_thread[from] || m->holds_skin[from]) // put down: what it held is let go
+    tx_emit(c, m->events, &(tx_event){.kind = TX_EVENT_RELEASE, .source = (uint32_t)h});
+  m->holds_thread[from] = m->holds_thread[to] = m->holds_skin[from] = m->holds_skin[to] = false;
   m->blades[to].armed = 0;
   m->nswitches++;
   tx_event e = {.kind = TX_EVENT_INSTRUMENT_SWITCH, .source = (uint32_t)h};
@@ -542,7 +554,7 @@ static void finish(tx_ctx* c, void* self) {
     int through = 0;
     for (int i = 0; i < m->npins; i++) through += tx_instrument_world_needle_pin_through(m->world, i);
     tx_set_result(c, m->pulled_through, through);
-    if (m->skin) tx_set_result(c, m->reanchors, m->nreanchors);
+    if (m->skin) tx_set_result(c, m->reanchors, m->nreanchors), tx_set_result(c, m->skin_grasps, m->nskin_grasps);
   }
   // the world goes on the thread that made and stepped it, with ODE's data for that thread
   tx_instrument_world_destroy(m->world);

@@ -160,9 +160,33 @@ static void thread_step(tx_ctx* c, void* self) {
 static const tx_controller_class thread_class = {
     .type = "test.thread", .summary = "a still thread", .configure = thread_configure, .step = thread_step};
 
+// a test class that writes a still skin: 9 x 9 particles 2.5 mm apart in
+// the y = 0 plane, x from 1 to 3 cm, z from -1 to 1 cm (row 9 i + j: x
+// index i, z index j), two triangles, and no contact
+static tx_port skin_ports[3];
+static int skin_configure(tx_setup* s, void** self) {
+  *self = skin_ports;
+  skin_ports[0] = tx_setup_write(s, &TX_COMPONENT_OF("skin.x", tx_vertex, 81));
+  skin_ports[1] = tx_setup_write(s, &TX_COMPONENT_OF("skin.tri", tx_triangle, 2));
+  skin_ports[2] = tx_setup_write(s, &TX_COMPONENT_OF("skin.contact", tx_skin_contact, 1));
+  return 0;
+}
+static void skin_step(tx_ctx* c, void* self) {
+  tx_port* p = self;
+  tx_vertex* x = tx_write(c, p[0]);
+  for (int i = 0; i < 9; i++)
+    for (int j = 0; j < 9; j++) x[9 * i + j] = (tx_vertex){.x = {0.01f + 0.0025f * (float)i, 0, -0.01f + 0.0025f * (float)j}};
+  tx_triangle* t = tx_write(c, p[1]);
+  t[0] = (tx_triangle){.v = {0, 1, 9}}, t[1] = (tx_triangle){.v = {1, 10, 9}};
+  memset(tx_write(c, p[2]), 0, sizeof(tx_skin_contact));
+}
+static const tx_controller_class skin_class = {
+    .type = "test.skin", .summary = "a still skin", .configure = skin_configure, .step = skin_step};
+
 static void register_tests(void) {
   if (!tx_find_controller(listener_class.type)) assert_int_equal(tx_register_controller(&listener_class), 0);
   if (!tx_find_controller(thread_class.type)) assert_int_equal(tx_register_controller(&thread_class), 0);
+  if (!tx_find_controller(skin_class.type)) assert_int_equal(tx_register_controller(&skin_class), 0);
 }
 
 static void write_csv(const char* path, const char* text) {
@@ -253,6 +277,55 @@ static void test_forceps_grasp_the_thread(void** state) {
   assert_int_equal(the_listener.got[1].kind, TX_EVENT_RELEASE);
   assert_int_equal(the_listener.got[1].source, 0);
   assert_true(result(s, "instruments.thread_grasps") == 1 && result(s, "instruments.thread_cuts") == 0);
+  tx_scenario_free(s);
+}
+
+// the thumb forceps, jaws along x from a pivot at (-10, 1, 1.2) cm (their
+// 118 mm blades reach x = 3 cm), open 1 mm over the skin and close: a grasp
+// (source = the hand), its point a particle of skin.x in the row z = 0
+// (1.56 mm from the jaws' line, within their 2.9 mm half width; the row at
+// z = 2.5 mm is 1.64 mm off), then they open: a release; lifted 3 cm, opened
+// and closed: nothing between the jaws, no grasp. Counted by skin_grasps.
+static void test_forceps_grasp_the_skin(void** state) {
+  (void)state;
+  register_tests();
+  char path[64];
+  snprintf(path, sizeof path, "/tmp/tx-sgrasp-XXXXXX.csv");
+  int fd = mkstemps(path, 4);
+  assert_true(fd >= 0);
+  close(fd);
+  write_csv(path, "t_s,x_m,y_m,z_m,qw,qx,qy,qz,grip_rad\n"
+                  "0,-0.1,0.001,0.0012,1,0,0,0,0\n0.3,-0.1,0.001,0.0012,1,0,0,0,0.14\n0.6,-0.1,0.001,0.0012,1,0,0,0,0.14\n"
+                  "0.9,-0.1,0.001,0.0012,1,0,0,0,0\n1.2,-0.1,0.001,0.0012,1,0,0,0,0\n1.5,-0.1,0.001,0.0012,1,0,0,0,0.14\n"
+                  "1.8,-0.1,0.031,0.0012,1,0,0,0,0.14\n2.1,-0.1,0.031,0.0012,1,0,0,0,0\n");
+  char text[2048];
+  snprintf(text, sizeof text,
+           "{\"name\":\"t\",\"controllers\":["
+           "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:%s\","
+           "\"force_model\":\"instrument0.force_model\"}},"
+           "{\"name\":\"skin\",\"type\":\"test.skin\",\"rate_hz\":60},"
+           "{\"name\":\"instruments\",\"type\":\"physics.instruments\",\"rate_hz\":1000,\"params\":{"
+           "\"instrument0\":\"thumb_forceps\",\"skin\":\"skin\",\"needle\":true,\"gravity_m_s2\":0}},"
+           "{\"name\":\"listener\",\"type\":\"test.listener\",\"rate_hz\":1000}]}",
+           path);
+  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 2.4);
+  unlink(path);
+  print_message("  %d events: skin grasps %g\n", the_listener.n, result(s, "instruments.skin_grasps"));
+  assert_int_equal(the_listener.n, 2);
+  const tx_event* g = &the_listener.got[0];
+  print_message("  grasp by %u at (%.4f, %.4f, %.4f) m, jaws %.4f rad; then kind %u\n", g->source, g->grasp.point[0],
+                g->grasp.point[1], g->grasp.point[2], g->grasp.jaw, the_listener.got[1].kind);
+  assert_int_equal(g->kind, TX_EVENT_GRASP);
+  assert_int_equal(g->source, 0);
+  // a particle: on the grid, in the skin's plane, in the row z = 0
+  double i = (g->grasp.point[0] - 0.01) / 0.0025;
+  assert_true(fabs(i - round(i)) < 1e-4 && i > -0.5 && i < 8.5);
+  assert_true(g->grasp.point[1] == 0 && fabs(g->grasp.point[2]) < 1e-9);
+  assert_int_equal(the_listener.got[1].kind, TX_EVENT_RELEASE);
+  assert_int_equal(the_listener.got[1].source, 0);
+  assert_true(result(s, "instruments.skin_grasps") == 1);
   tx_scenario_free(s);
 }
 
@@ -413,6 +486,7 @@ int main(void) {
       cmocka_unit_test(test_needle_is_published),
       cmocka_unit_test(test_scissors_cut_the_thread),
       cmocka_unit_test(test_forceps_grasp_the_thread),
+      cmocka_unit_test(test_forceps_grasp_the_skin),
       cmocka_unit_test(test_needle_punctures_the_skin),
       cmocka_unit_test(test_button_switches_instruments),
   };

@@ -164,6 +164,38 @@ static void test_scissors_cut_between_the_blades(void** state) {
   assert_int_equal(tx_scissors_cut(pivot, dir, 0.04, 0.002, n, 1, point), -1); // one node: no segment
 }
 
+// jaws closing on the skin: a 5 x 5 grid of particles 2.5 mm apart in the
+// y = 0 plane (x, z from -5 to 5 mm); closed jaws along x from a pivot at
+// (-20, 1, 1.5) mm: the particle nearest their line within reach, between
+// the pivot and the jaws' length
+static void test_jaws_pinch_the_skin(void** state) {
+  (void)state;
+  float x[25 * 3];
+  for (int i = 0; i < 5; i++)
+    for (int j = 0; j < 5; j++) {
+      float* p = x + 3 * (5 * i + j);
+      p[0] = -0.005f + 0.0025f * (float)i, p[1] = 0, p[2] = -0.005f + 0.0025f * (float)j;
+    }
+  double pivot[3] = {-0.02, 0.001, 0.0015}, dir[3] = {1, 0, 0}, point[3];
+  // the line runs 1 mm above the skin at z = 1.5 mm: the particles at z = 2.5 mm
+  // are 1.41 mm off it, those at z = 0 are 1.80 mm: the first row of z = 2.5 mm wins
+  int r = tx_jaws_pinch(pivot, dir, 0.03, 0.002, x, 25, point);
+  assert_int_equal(r, 3);
+  assert_true(fabs(point[0] + 0.005) < 1e-9 && fabs(point[2] - 0.0025) < 1e-9 && point[1] == 0);
+  // 1 mm reach: nothing between the jaws
+  assert_int_equal(tx_jaws_pinch(pivot, dir, 0.03, 0.001, x, 25, point), -1);
+  // jaws 12 mm long end before the grid (x from -5 mm), 16 mm reach in
+  assert_int_equal(tx_jaws_pinch(pivot, dir, 0.012, 0.002, x, 25, point), -1);
+  assert_int_equal(tx_jaws_pinch(pivot, dir, 0.016, 0.002, x, 25, point), 3);
+  // pointing away: the skin is behind the pivot
+  double back[3] = {-1, 0, 0};
+  assert_int_equal(tx_jaws_pinch(pivot, back, 0.03, 0.002, x, 25, point), -1);
+  // a particle that is not finite is skipped
+  x[3 * 3] = NAN;
+  r = tx_jaws_pinch(pivot, dir, 0.03, 0.002, x, 25, point);
+  assert_true(r == 8 && fabs(point[0] + 0.0025) < 1e-9);
+}
+
 static void test_blades_close_once(void** state) {
   (void)state;
   tx_blades b = {.open = 0.1, .closed = 0.03};
@@ -182,6 +214,7 @@ int main(void) {
       cmocka_unit_test_setup(test_nearest_triangle, patch),
       cmocka_unit_test_setup(test_entry_then_exit, patch),
       cmocka_unit_test(test_scissors_cut_between_the_blades),
+      cmocka_unit_test(test_jaws_pinch_the_skin),
       cmocka_unit_test(test_blades_close_once),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
