@@ -20,6 +20,7 @@
 #define TX_THREAD_RELEASE_RAD 0.02 // jaws this much wider than closed let the thread go
 #define HANDS 2
 #define PER_HAND (TX_INSTRUMENTS_MAX / HANDS) // one held, the others parked
+#define NEEDLE_CHORDS 16 // needle.segments: the arc drawn as this many chords
 
 typedef struct instruments {
   tx_instrument_sim_params p;
@@ -34,11 +35,11 @@ typedef struct instruments {
   tx_result switches;
   int nswitches;
   tx_port dev_pose[HANDS], dev_vel[HANDS], dev_grip[HANDS];
-  tx_port pose[HANDS], links[HANDS], model[HANDS];
+  tx_port pose[HANDS], links[HANDS], model[HANDS], held[HANDS];
   int link_rows[HANDS];
   tx_warning bad_input, reset;
   tx_result contacts_max, force_max, grasps, releases;
-  tx_port needle_pose, needle_swage, events;
+  tx_port needle_pose, needle_swage, needle_segments, events;
   int grasps_seen, releases_seen, last_holder;
   int bad_seen, resets_seen, contacts_most;
   double force_most;
@@ -278,6 +279,8 @@ static int configure(tx_setup* s, void** self) {
     m->links[h] = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_pose, (uint32_t)m->link_rows[h]));
     snprintf(name, sizeof name, "instrument%d.force_model", h);
     m->model[h] = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_force_model, 1));
+    snprintf(name, sizeof name, "instrument%d.held", h);
+    m->held[h] = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_instrument_held, 1));
   }
   if (m->n == 0) return tx_setup_fail(s, "instrument0", "no instrument: give instrument0");
   if (nd->held_by >= m->nhands) return tx_setup_fail(s, "needle_in_jaws", "there is no instrument%d", nd->held_by);
@@ -304,6 +307,7 @@ static int configure(tx_setup* s, void** self) {
     m->needle_pose = tx_setup_write(s, &TX_COMPONENT_OF("needle.pose", tx_pose, 1));
     m->needle_swage = tx_setup_write(s, &TX_COMPONENT_OF("needle.swage", tx_pose, 1));
     m->needle_tip = tx_setup_write(s, &TX_COMPONENT_OF("needle.tip", tx_pose, 1));
+    m->needle_segments = tx_setup_write(s, &TX_COMPONENT_OF("needle.segments", tx_segment, NEEDLE_CHORDS));
     m->punctures = tx_setup_write(s, &TX_COMPONENT_OF("needle.punctures", tx_puncture, TX_NEEDLE_PINS_MAX));
     m->npunct = tx_setup_result(s, "needle_punctures");
     m->pulled_through = tx_setup_result(s, "needle_pulled_through");
@@ -505,6 +509,14 @@ static void step(tx_ctx* c, void* self) {
     tx_instrument_world_needle_tip(m->world, tip->pos);
     memcpy(tip->quat, np->quat, sizeof tip->quat);
     memcpy(tx_write(c, m->punctures), m->rows, sizeof m->rows);
+    tx_segment* seg = tx_write(c, m->needle_segments);
+    for (int k = 0; k < NEEDLE_CHORDS; k++) { // swage to tip
+      double a[3], b[3];
+      arc_point(m, m->p.needle.arc * k / NEEDLE_CHORDS, a);
+      arc_point(m, m->p.needle.arc * (k + 1) / NEEDLE_CHORDS, b);
+      for (int j = 0; j < 3; j++) seg[k].a[j] = (float)a[j], seg[k].b[j] = (float)b[j];
+      seg[k].r = (float)(m->p.needle.wire_diameter / 2);
+    }
     int held = tx_instrument_world_needle_held_by(m->world);
     if (tx_instrument_world_needle_grasps(m->world) > m->grasps_seen) {
       tx_event e = {.kind = TX_EVENT_GRASP, .source = (uint32_t)m->hand_of[held]};
@@ -525,6 +537,7 @@ static void step(tx_ctx* c, void* self) {
     tx_pose* links = tx_write(c, m->links[h]);
     for (int l = 0; l < m->link_rows[h]; l++) // rows past its links repeat its root
       tx_instrument_world_link(m->world, i, l < u->nlinks ? l : 0, links[l].pos, links[l].quat);
+    ((tx_instrument_held*)tx_write(c, m->held[h]))->index = m->cur[h];
     tx_instrument_pose* ip = tx_write(c, m->pose[h]);
     memcpy(ip->pos, links[0].pos, sizeof ip->pos);
     memcpy(ip->quat, links[0].quat, sizeof ip->quat);

@@ -311,9 +311,19 @@ TX_LAYOUT_ASSERT(tx_puncture, double);
 //   INSTRUMENT.links (one row per URDF link, root first, tx_pose): each link frame
 //   INSTRUMENT.force_model (1 row, tx_force_model): the virtual coupling as the
 //     hand feels it, for the haptics controller to render (docs/instruments.md)
+//   INSTRUMENT.held (1 row, tx_instrument_held): which of the hand's
+//     instruments (handN) it is, for a view to draw the right meshes
 // and, with the needle: needle.pose, needle.swage (tx_pose: its frame, its
 // swage end for the thread's head), needle.tip (tx_pose: the tip, the skin's
-// HIP when physics.skin's pose names it) and needle.punctures (tx_puncture)
+// HIP when physics.skin's pose names it), needle.punctures (tx_puncture) and
+// needle.segments (tx_segment: the arc as chords, for a view)
+typedef struct tx_instrument_held {
+  double index; // in handN's list, from 0 (0 without handN)
+} tx_instrument_held;
+#define tx_instrument_held_TYPE TX_F64
+#define tx_instrument_held_COLS 1u
+#define tx_instrument_held_UNITS "1"
+TX_LAYOUT_ASSERT(tx_instrument_held, double);
 
 // --- gastric banding: the organs ---------------------------------------------
 

@@ -77,7 +77,7 @@ typedef struct view {
 #define KIND(suffix, T) {suffix, T##_TYPE, T##_COLS}
 static const struct { const char* suffix; tx_type type; uint32_t cols; } kinds[] = {
     KIND(".x", tx_vertex), KIND(".tri", tx_triangle), KIND(".spheres", tx_sphere), KIND(".segments", tx_segment),
-    KIND(".pose", tx_pose), KIND(".force", tx_force)};
+    KIND(".pose", tx_pose), KIND(".force", tx_force), KIND(".links", tx_pose), KIND(".held", tx_instrument_held)};
 #undef KIND
 
 // the type and width a drawn component must have: by its suffix, and scalars are f32 N x 1
@@ -147,6 +147,11 @@ static int configure(tx_setup* s, void** self) {
   (void)threads;
   // every component an item draws, with the schema it must have
   for (int i = 0; i < v->def.nitems; i++) {
+    if (v->def.items[i].kind == TX_DRAW_INSTRUMENT) { // its meshes readable now: bad input at load, not at the first frame
+      tx_instrument_mesh* im = tx_instrument_mesh_load(v->def.items[i].urdf);
+      if (!im) return tx_setup_fail(s, "view", "draw[%d].urdf: %s", i, tx_error());
+      tx_instrument_mesh_free(im);
+    }
     char comps[3][TX_NAME_MAX];
     int n = tx_draw_item_components(&v->def.items[i], comps);
     for (int k = 0; k < n; k++) {

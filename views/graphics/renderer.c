@@ -41,6 +41,8 @@ struct tx_renderer {
   double lo[3], hi[3];
   bool any;
   uint64_t skipped;
+  tx_instrument_mesh* instruments[TX_DRAW_MAX]; // read at the first frame that draws each
+  const tx_draw_item* instrument_of[TX_DRAW_MAX];
 };
 
 // per-pixel Blinn-Phong with the viewer at infinity (as fixed-function GL's
@@ -343,6 +345,7 @@ void tx_renderer_destroy(tx_renderer* r) {
     if (r->sphere_prog) gl->DeleteProgram(r->sphere_prog);
     if (r->cyl_prog) gl->DeleteProgram(r->cyl_prog);
   }
+  for (int i = 0; i < TX_DRAW_MAX; i++) tx_instrument_mesh_free(r->instruments[i]);
   free(r->spheres);
   free(r->cyls);
   free(r);
@@ -573,6 +576,28 @@ void tx_renderer_upload(tx_renderer* r, const tx_scene* s) {
         scalar_colour(it, scalar, nscalar, i, colour);
         add_cylinder(r, sg[i].a, sg[i].b, sg[i].r, colour);
       }
+      break;
+    }
+    case TX_DRAW_INSTRUMENT: {
+      if (r->instrument_of[k] != it) { // a new view: its meshes (checked when the view was configured)
+        tx_instrument_mesh_free(r->instruments[k]);
+        r->instruments[k] = tx_instrument_mesh_load(it->urdf);
+        r->instrument_of[k] = it;
+      }
+      const float* x;
+      const int32_t* tri;
+      uint32_t nv, nt;
+      const tx_instrument_held* held = si->data[1];
+      if (!si->rows[0] || !si->rows[1]) break; // not published yet
+      if (!r->instruments[k] || !tx_instrument_mesh_place(r->instruments[k], held->index, si->data[0], si->rows[0], &x, &nv, &tri, &nt)) {
+        r->skipped++;
+        break;
+      }
+      mesh_slot* m = slot(r);
+      fill_mesh(r, m, x, nv, tri, nt);
+      memcpy(m->colour, it->colour, sizeof m->colour);
+      m->textured = false;
+      upload_mesh(r, m);
       break;
     }
     case TX_DRAW_TOOL: {

@@ -14,6 +14,8 @@
 #include "gl.h"
 #include "view_def.h"
 
+#include <tactus/components.h>
+
 #include <stdint.h>
 
 // the lighting model, shared with the tests that check a lit pixel:
@@ -36,6 +38,19 @@ typedef struct tx_scene {
 } tx_scene;
 
 typedef struct tx_renderer tx_renderer;
+
+// Instruments drawn from their URDF visual meshes (instrument_mesh.c): the
+// instruments of one hand ("needle_holder metzenbaum_scissors", names in
+// assets/instruments or .urdf paths); NULL with tx_error() set for one that
+// cannot be read (or a build without urdfdom and assimp). Place: the one
+// at index `held` at the link frames `links` (a pose per URDF link, root
+// first): its vertices (m, world) and triangles, valid until the next call;
+// false for an index out of the list, too few or non-finite links.
+typedef struct tx_instrument_mesh tx_instrument_mesh;
+tx_instrument_mesh* tx_instrument_mesh_load(const char* list);
+void tx_instrument_mesh_free(tx_instrument_mesh* m);
+bool tx_instrument_mesh_place(tx_instrument_mesh* m, double held, const tx_pose* links, uint32_t nlinks,
+                              const float** x, uint32_t* nv, const int32_t** tri, uint32_t* nt);
 
 tx_renderer* tx_renderer_create(tx_gl_loader load);
 void tx_renderer_destroy(tx_renderer* r);

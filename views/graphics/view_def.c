@@ -122,20 +122,21 @@ static int read_camera(const json_t* cam, tx_view_def* d) {
 }
 
 static int read_item(size_t i, const json_t* e, tx_draw_item* it) {
-  static const char* const keys[] = {"mesh", "spheres", "segments", "tool", "plane", "colour", "colour_by",
-                                     "range", "texture", "radius_m", "show_force", "force_scale_m_per_n", "cut", NULL};
+  static const char* const keys[] = {"mesh", "spheres", "segments", "tool", "plane", "instrument", "urdf", "colour",
+                                     "colour_by", "range", "texture", "radius_m", "show_force", "force_scale_m_per_n",
+                                     "cut", NULL};
   char at[48], key[96];
   snprintf(at, sizeof at, "draw[%zu]", i);
   if (!json_is_object(e)) return bad(at, "expected an object, got %s", tx_json_kind(e));
   if (check_keys(at, e, keys)) return -1;
   static const struct { const char* key; tx_draw_kind kind; } kinds[] = {
       {"mesh", TX_DRAW_MESH}, {"spheres", TX_DRAW_SPHERES}, {"segments", TX_DRAW_SEGMENTS}, {"tool", TX_DRAW_TOOL},
-      {"plane", TX_DRAW_PLANE}};
+      {"plane", TX_DRAW_PLANE}, {"instrument", TX_DRAW_INSTRUMENT}};
   *it = (tx_draw_item){.colour = {0.8f, 0.8f, 0.8f}, .range = {0, 1}, .radius = 0.005f, .force_scale = 0.01f};
   for (size_t k = 0; k < sizeof kinds / sizeof kinds[0]; k++) {
     const json_t* v = json_object_get(e, kinds[k].key);
     if (!v) continue;
-    if (it->kind) return bad(at, "expected exactly one of mesh, spheres, segments, tool, plane");
+    if (it->kind) return bad(at, "expected exactly one of mesh, spheres, segments, tool, plane, instrument");
     it->kind = kinds[k].kind;
     snprintf(key, sizeof key, "%s.%s", at, kinds[k].key);
     if (it->kind == TX_DRAW_PLANE) {
@@ -155,7 +156,7 @@ static int read_item(size_t i, const json_t* e, tx_draw_item* it) {
       return bad(key, "expected a component prefix of 1-%d characters of a-z 0-9 _ .", TX_NAME_MAX - 10);
     snprintf(it->name, sizeof it->name, "%s", json_string_value(v));
   }
-  if (!it->kind) return bad(at, "expected one of mesh, spheres, segments, tool, plane");
+  if (!it->kind) return bad(at, "expected one of mesh, spheres, segments, tool, plane, instrument");
   double tmp[3];
   const json_t* v;
   snprintf(key, sizeof key, "%s.colour", at);
@@ -166,6 +167,19 @@ static int read_item(size_t i, const json_t* e, tx_draw_item* it) {
     it->colour[0] = 0.85f, it->colour[1] = 0.25f, it->colour[2] = 0.2f;
   } else if (it->kind == TX_DRAW_PLANE) {
     it->colour[0] = 0.45f, it->colour[1] = 0.5f, it->colour[2] = 0.6f;
+  } else if (it->kind == TX_DRAW_INSTRUMENT) { // steel
+    it->colour[0] = 0.72f, it->colour[1] = 0.74f, it->colour[2] = 0.78f;
+  }
+  snprintf(key, sizeof key, "%s.urdf", at);
+  if ((v = json_object_get(e, "urdf"))) { // read and checked by the graphics view (it needs the readers)
+    if (it->kind != TX_DRAW_INSTRUMENT) return bad(key, "only instruments take a urdf");
+    const char* u = json_string_value(v);
+    if (!u || !*u || strlen(u) >= sizeof it->urdf)
+      return bad(key, "expected the hand's instruments: names or .urdf paths separated by spaces, at most %d characters",
+                 (int)sizeof it->urdf - 1);
+    snprintf(it->urdf, sizeof it->urdf, "%s", u);
+  } else if (it->kind == TX_DRAW_INSTRUMENT) {
+    return bad(key, "an instrument needs its urdf (as physics.instruments' handN or instrumentN)");
   }
   snprintf(key, sizeof key, "%s.colour_by", at);
   if ((v = json_object_get(e, "colour_by"))) {
@@ -358,6 +372,10 @@ int tx_draw_item_components(const tx_draw_item* it, char out[3][TX_NAME_MAX]) {
     if (it->show_force) join(out[n++], it->name, ".force");
     break;
   case TX_DRAW_PLANE: break;
+  case TX_DRAW_INSTRUMENT:
+    join(out[n++], it->name, ".links");
+    join(out[n++], it->name, ".held");
+    break;
   }
   if (*it->scalar) join(out[n++], it->scalar, "");
   return n;

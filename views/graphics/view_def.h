@@ -12,6 +12,8 @@
 //   segments NAME  NAME.segments (f32 N x 7: x0 y0 z0 x1 y1 z1 radius, m)
 //   tool NAME      NAME.pose (f64 1 x 7: x y z m, qw qx qy qz), optional NAME.force (f64 1 x 3, N)
 //   plane          a fixed square (no component): point, normal and size in the view itself
+//   instrument NAME  NAME.links (f64 N x 7: each URDF link's frame) and NAME.held (f64 1 x 1: which of
+//                  the entry's "urdf" list the hand holds), drawn from the URDFs' visual meshes
 #ifndef TX_VIEWS_GRAPHICS_VIEW_DEF_H
 #define TX_VIEWS_GRAPHICS_VIEW_DEF_H
 
@@ -26,7 +28,17 @@
 #define TX_DRAW_MAX 16     // draw entries of one view
 #define TX_VIEW_SIDE_MAX 4096 // px, largest width or height of one eye
 
-typedef enum tx_draw_kind { TX_DRAW_MESH = 1, TX_DRAW_SPHERES, TX_DRAW_SEGMENTS, TX_DRAW_TOOL, TX_DRAW_PLANE } tx_draw_kind;
+#define TX_DRAW_URDF_MAX 512     // the instruments named by one instrument entry, as text
+#define TX_DRAW_INSTRUMENT_LINKS 8 // links of one drawn instrument
+
+typedef enum tx_draw_kind {
+  TX_DRAW_MESH = 1,
+  TX_DRAW_SPHERES,
+  TX_DRAW_SEGMENTS,
+  TX_DRAW_TOOL,
+  TX_DRAW_PLANE,
+  TX_DRAW_INSTRUMENT
+} tx_draw_kind;
 
 typedef struct tx_draw_item {
   tx_draw_kind kind;
@@ -41,6 +53,7 @@ typedef struct tx_draw_item {
   float plane[7];           // planes: point (m), unit normal, half size (m)
   bool has_cut;             // spheres: a cutaway plane is given
   float cut[6];             // spheres: point (m) and unit normal of the cutaway; centres on the normal's side are not drawn
+  char urdf[TX_DRAW_URDF_MAX]; // instruments: the hand's instruments, names in assets/instruments or .urdf paths, by spaces
 } tx_draw_item;
 
 typedef struct tx_view_def {

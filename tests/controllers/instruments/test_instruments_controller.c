@@ -116,6 +116,19 @@ static void test_needle_is_published(void** state) {
   print_message("  needle centre (%.4f, %.4f, %.4f) m, swage %.4f mm from it (R = %.4f mm)\n", np[0], np[1], np[2], 1e3 * d, 1e3 * R);
   assert_true(fabs(np[0] - 0.05) < 1e-4 && fabs(np[1] - (-0.05 + 0.0003)) < 1e-4);
   assert_true(fabs(d - R) < 1e-9);
+  // needle.segments: the arc as 16 chords from the swage to the tip, each
+  // 2 R sin(pi / 32) long (half a circle), end to end, the wire's radius
+  const float* seg = latest_snapshot(s, "needle.segments").data;
+  const double* tip = latest(s, "needle.tip");
+  double chord = 2 * R * sin(M_PI / 32);
+  for (int k = 0; k < 16; k++) {
+    const float* g = seg + 7 * k;
+    double l = sqrt((g[3] - g[0]) * (g[3] - g[0]) + (g[4] - g[1]) * (g[4] - g[1]) + (g[5] - g[2]) * (g[5] - g[2]));
+    assert_true(fabs(l - chord) < 1e-6 && fabs(g[6] - 0.0003) < 1e-9);
+    if (k) assert_true(g[0] == seg[7 * k - 4] && g[1] == seg[7 * k - 3] && g[2] == seg[7 * k - 2]);
+  }
+  for (int c = 0; c < 3; c++) assert_true(fabs(seg[c] - sw[c]) < 1e-6 && fabs(seg[7 * 15 + 3 + c] - tip[c]) < 1e-6);
+  assert_true(latest(s, "instrument0.held")[0] == 0);
   assert_true(result(s, "instruments.needle_grasps") == 0);
   tx_scenario_free(s);
   assert_null(load("\"needle\":true,\"needle_wire_diameter_m\":0.003,\"needle_length_m\":0.003"));

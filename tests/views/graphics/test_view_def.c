@@ -119,7 +119,25 @@ static void errors_name_the_key(void** state) {
   expect_error("{\"draw\": [{\"tool\": \"device0\", \"show_force\": 1}]}", "draw[0].show_force", "true or false");
   expect_error("{\"draw\": [{\"plane\": {\"normal\": [0, 0, 0]}}]}", "draw[0].plane.normal", "non-zero");
   expect_error("{\"draw\": [{\"plane\": {\"size\": 1}}]}", "draw[0].plane.size", "unknown key");
+  expect_error("{\"draw\": [{\"instrument\": \"instrument0\"}]}", "draw[0].urdf", "needs its urdf");
+  expect_error("{\"draw\": [{\"instrument\": \"instrument0\", \"urdf\": \"\"}]}", "draw[0].urdf", "the hand's instruments");
+  expect_error("{\"draw\": [{\"instrument\": \"instrument0\", \"urdf\": 3}]}", "draw[0].urdf", "the hand's instruments");
+  expect_error("{\"draw\": [{\"mesh\": \"skin\", \"urdf\": \"needle_holder\"}]}", "draw[0].urdf", "only instruments");
   expect_error("[1]", "", "an object");
+}
+
+// an instrument entry: its components (links, held), its list of URDFs, steel by default
+static void instrument_entry(void** state) {
+  (void)state;
+  tx_view_def d;
+  assert_int_equal(parse("{\"draw\": [{\"instrument\": \"instrument1\", \"urdf\": \"needle_holder metzenbaum_scissors\"}]}", &d), 0);
+  assert_int_equal(d.items[0].kind, TX_DRAW_INSTRUMENT);
+  assert_string_equal(d.items[0].urdf, "needle_holder metzenbaum_scissors");
+  char comps[3][TX_NAME_MAX];
+  assert_int_equal(tx_draw_item_components(&d.items[0], comps), 2);
+  assert_string_equal(comps[0], "instrument1.links");
+  assert_string_equal(comps[1], "instrument1.held");
+  assert_true(d.items[0].colour[0] > 0.7f && d.items[0].colour[2] > d.items[0].colour[0]);
 }
 
 // a value of the wrong type is named in the words of the parameter readers (tx_json_kind)
@@ -175,6 +193,7 @@ int main(void) {
       cmocka_unit_test(wrong_types_named_as_parameters_name_them),
       cmocka_unit_test(automatic_draw_list),
       cmocka_unit_test(from_text),
+      cmocka_unit_test(instrument_entry),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
