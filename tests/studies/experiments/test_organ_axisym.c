@@ -41,7 +41,7 @@ static void test_hertz_limit_and_finite_body(void** state) {
   const double R = 0.02, E = 5e3, nu = 0.45;
   tx_axisym* a = tx_axisym_create(R, E, nu, 16, 2);
   assert_non_null(a);
-  double f, prev = 0;
+  double f = 0, prev = 0;
   const double dr[] = {0.0005, 0.003, 0.02, 0.1};
   for (int i = 0; i < 4; i++) {
     assert_true(tx_axisym_indent(a, dr[i] * R, &f));
@@ -61,7 +61,7 @@ static void test_hertz_limit_and_finite_body(void** state) {
   }
   tx_axisym_destroy(a);
   // converged: twice the elements change the force at d/R = 0.1 by under 1 %
-  double f8, f16;
+  double f8 = 0, f16 = 0;
   tx_axisym* c = tx_axisym_create(R, E, nu, 8, 2);
   tx_axisym* d = tx_axisym_create(R, E, nu, 16, 2);
   assert_true(c && d && tx_axisym_indent(c, 0.1 * R, &f8) && tx_axisym_indent(d, 0.1 * R, &f16));
@@ -81,7 +81,7 @@ static void test_bad_arguments(void** state) {
   assert_null(tx_axisym_create(0.02, 5e3, 0.45, 1, 2));
   assert_null(tx_axisym_create(0.02, 5e3, 0.45, 8, 4));
   tx_axisym* a = tx_axisym_create(0.02, 5e3, 0.45, 4, 2);
-  double f;
+  double f = 0;
   assert_false(tx_axisym_indent(a, 0.9 * 0.02, &f));  // the contact past the nodes kept
   tx_axisym_destroy(a);
 }
