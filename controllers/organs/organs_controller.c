@@ -58,7 +58,7 @@ static const char* const names[SOFT] = {"liver", "stomach"};
 // E, nu, density: see docs/lagb.md for the sources
 static const tx_param_def params[] = {
     {"mode", TX_PARAM_STR, NULL, 0, 0, 0, "fem", "\"fem\": Bullet's FEM deformables; \"links\": its classic soft body"},
-    {"model", TX_PARAM_STR, NULL, 0, 0, 0, "neohookean", "fem mode: \"neohookean\" or \"corotated\" (about 1.5 times slower: Bullet extracts each rotation iteratively)"},
+    {"model", TX_PARAM_STR, NULL, 0, 0, 0, "neohookean", "fem mode: \"neohookean\" or \"corotated\" (about 4 times slower: a polar decomposition per tetrahedron and substep)"},
     {"assets", TX_PARAM_STR, NULL, 0, 0, 0, "lagb",
      "folder of ORGAN.node/.ele/.obj: a name in assets/ or a path (with a /)"},
     {"liver_young_pa", TX_PARAM_NUM, "Pa", 100, 1e7, 5000, NULL, "liver's Young's modulus (transient elastography)"},

@@ -4,6 +4,7 @@
 
 #include "../../model/error.h"
 
+#include "laparoscope.h"
 #include "window_input.h"
 
 #include <tactus/components.h>
@@ -25,6 +26,8 @@ struct tx_window {
   uint32_t buttons;
   double last_x, last_y; // px, the cursor at the last event
   bool dragging;
+  bool turning;      // the right button: the laparoscope
+  double scope[3];   // its moves not yet taken: yaw, pitch (rad), insertion (m)
 };
 
 static char glfw_error[256];
@@ -42,6 +45,10 @@ static void on_button(GLFWwindow* w, int button, int action, int mods) {
     t->dragging = action == GLFW_PRESS;
     glfwGetCursorPos(w, &t->last_x, &t->last_y);
   }
+  if (button == GLFW_MOUSE_BUTTON_RIGHT) {
+    t->turning = action == GLFW_PRESS;
+    glfwGetCursorPos(w, &t->last_x, &t->last_y);
+  }
 }
 
 static void on_cursor(GLFWwindow* w, double x, double y) {
@@ -51,6 +58,10 @@ static void on_cursor(GLFWwindow* w, double x, double y) {
     t->tool[2] += (y - t->last_y) * DRAG_M_PER_PX; // down the screen is towards the viewer
     publish(t);
   }
+  if (t->turning) { // the view follows the hand: drag right to look right, up to look up
+    t->scope[0] -= (x - t->last_x) * TX_SCOPE_RAD_PER_PX;
+    t->scope[1] -= (y - t->last_y) * TX_SCOPE_RAD_PER_PX;
+  }
   t->last_x = x;
   t->last_y = y;
 }
@@ -58,6 +69,10 @@ static void on_cursor(GLFWwindow* w, double x, double y) {
 static void on_scroll(GLFWwindow* w, double dx, double dy) {
   (void)dx;
   tx_window* t = glfwGetWindowUserPointer(w);
+  if (glfwGetKey(w, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS || glfwGetKey(w, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS) {
+    t->scope[2] += dy * TX_SCOPE_M_PER_SCROLL;
+    return;
+  }
   t->tool[1] += dy * SCROLL_M;
   publish(t);
 }
@@ -154,4 +169,8 @@ bool tx_window_present(tx_window* t) {
   glfwSwapBuffers(t->w);
   glfwPollEvents();
   return !glfwWindowShouldClose(t->w);
+}
+
+void tx_window_take_scope(tx_window* t, double move[3]) {
+  for (int i = 0; i < 3; i++) move[i] = t->scope[i], t->scope[i] = 0;
 }

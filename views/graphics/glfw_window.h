@@ -5,6 +5,9 @@
 //   scroll wheel, Q / E         y (up, down)
 //   arrow keys, W A S D         x and z in steps
 //   space                       button 0 (held)
+// and, where the view has a laparoscope (laparoscope.h), move it about its port:
+//   drag with the right button  turn it (yaw, pitch)
+//   Ctrl + scroll wheel         slide it in and out
 //   Esc or closing the window   ends the run (as Ctrl-C does)
 // GLFW is used from the view's rendering thread, after the probe at load.
 #ifndef TX_VIEWS_GRAPHICS_GLFW_WINDOW_H
@@ -32,5 +35,7 @@ void tx_window_set_title(tx_window* w, const char* title);
 void tx_window_resize(tx_window* w, int width, int height);
 // show the frame and handle input; false once the window asked to close
 bool tx_window_present(tx_window* w);
+// the laparoscope's moves since the last call: yaw, pitch (rad), insertion (m)
+void tx_window_take_scope(tx_window* w, double move[3]);
 
 #endif

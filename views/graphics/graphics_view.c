@@ -369,11 +369,28 @@ static void teardown(render_state* rs) {
   tx_contact_sheet_free(&rs->sheet);
 }
 
+// the laparoscope, moved by the window's mouse, places the camera; a
+// headlight shines along the view
+static void view_hooks(view* v, render_state* rs) {
+  tx_view_def* d = &v->def;
+  if (d->scope) {
+#if TX_WITH_GLFW
+    double move[3];
+    if (rs->win) tx_window_take_scope(rs->win, move), tx_laparoscope_move(&d->laparoscope, move[0], move[1], move[2]);
+#else
+    (void)rs;
+#endif
+    tx_laparoscope_camera(&d->laparoscope, &d->camera);
+  }
+  if (d->headlight) tx_headlight(&d->camera, d->light_dir);
+}
+
 // one frame: draw every pass, read back, and write it when its turn comes
 static void render_frame(view* v, render_state* rs) {
   int64_t t0 = tx_mono_ns(), c0 = thread_cpu_ns();
   tx_renderer_upload(rs->r, &v->scene);
   if (v->def.auto_camera) auto_camera(v, rs->r);
+  view_hooks(v, rs);
   const tx_gl* gl = tx_renderer_gl(rs->r);
   int w = v->def.width, h = v->def.height;
 #if TX_WITH_GLFW

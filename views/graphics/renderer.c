@@ -1,6 +1,8 @@
 // GL 3.3 core drawing of meshes, spheres, cylinders, tools and planes.
 #include "renderer.h"
 
+#include "organ_texture.h"
+
 #include "../../model/error.h"
 
 #include <tactus/components.h>
@@ -11,6 +13,8 @@
 #include <string.h>
 
 #define CYL_SIDES 16
+#define STR_(x) #x
+#define STR(x) STR_(x) // a macro's value as a string, for the shaders
 #define SKIN_TEX 512
 
 typedef struct mesh_slot {
@@ -22,7 +26,7 @@ typedef struct mesh_slot {
   float uv_basis[6]; // planar projection of the first frame: origin (u, v) and axes
   uint32_t uv_for;  // vertex count the basis was made for
   float colour[3];
-  bool textured;
+  int textured; // 0: the colour; 1: the skin texture; 2: the colour times the tissue texture
 } mesh_slot;
 
 struct tx_renderer {
@@ -30,7 +34,7 @@ struct tx_renderer {
   GLuint mesh_prog, sphere_prog, cyl_prog;
   GLuint sphere_vao, sphere_vbo, sphere_inst;
   GLuint cyl_vao, cyl_vbo, cyl_inst;
-  GLuint skin_tex;
+  GLuint skin_tex, tissue_tex;
   int cyl_nverts;
   mesh_slot meshes[TX_DRAW_MAX + TX_DRAW_MAX];
   int nmeshes;
@@ -62,12 +66,14 @@ static const char* const fs_src =
     "#version 330 core\n"
     "in vec3 v_normal; flat in vec3 v_colour; in vec2 v_uv;\n"
     "uniform int u_textured; uniform sampler2D u_tex;\n"
+    "const float TISSUE_LO = " STR(TX_TISSUE_LO) "; const float TISSUE_SPAN = " STR(TX_TISSUE_SPAN) ";\n"
     SHADE_GLSL
     "out vec4 frag;\n"
     "void main() {\n"
     "  vec3 n = normalize(v_normal);\n"
     "  if (dot(n, u_view_dir) < 0.0) n = -n;\n" // two-sided: a cloth is seen from both sides
-    "  vec3 base = u_textured != 0 ? texture(u_tex, v_uv).rgb : v_colour;\n"
+    "  vec3 base = u_textured == 1 ? texture(u_tex, v_uv).rgb\n"
+    "            : u_textured == 2 ? v_colour * (TISSUE_LO + TISSUE_SPAN * texture(u_tex, v_uv).rgb) : v_colour;\n"
     "  frag = vec4(shade(n, base), 1.0);\n"
     "}\n";
 
@@ -307,16 +313,20 @@ tx_renderer* tx_renderer_create(tx_gl_loader load) {
     tx_renderer_destroy(r);
     return tx_set_error("out of memory"), NULL;
   }
-  tx_skin_texture(tex, SKIN_TEX);
-  gl->GenTextures(1, &r->skin_tex);
-  gl->BindTexture(GL_TEXTURE_2D, r->skin_tex);
-  gl->PixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  gl->TexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, SKIN_TEX, SKIN_TEX, 0, GL_RGB, GL_UNSIGNED_BYTE, tex);
-  gl->GenerateMipmap(GL_TEXTURE_2D);
-  gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
-  gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
-  gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  for (int k = 0; k < 2; k++) {
+    GLuint* id = k == 0 ? &r->skin_tex : &r->tissue_tex;
+    if (k == 0) tx_skin_texture(tex, SKIN_TEX);
+    else tx_tissue_texture(tex, SKIN_TEX);
+    gl->GenTextures(1, id);
+    gl->BindTexture(GL_TEXTURE_2D, *id);
+    gl->PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    gl->TexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, SKIN_TEX, SKIN_TEX, 0, GL_RGB, GL_UNSIGNED_BYTE, tex);
+    gl->GenerateMipmap(GL_TEXTURE_2D);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  }
   free(tex);
   if (gl->GetError() != GL_NO_ERROR) {
     tx_renderer_destroy(r);
@@ -341,6 +351,7 @@ void tx_renderer_destroy(tx_renderer* r) {
     for (int i = 0; i < 4; i++)
       if (bufs[i]) gl->DeleteBuffers(1, &bufs[i]);
     if (r->skin_tex) gl->DeleteTextures(1, &r->skin_tex);
+    if (r->tissue_tex) gl->DeleteTextures(1, &r->tissue_tex);
     if (r->mesh_prog) gl->DeleteProgram(r->mesh_prog);
     if (r->sphere_prog) gl->DeleteProgram(r->sphere_prog);
     if (r->cyl_prog) gl->DeleteProgram(r->cyl_prog);
@@ -517,7 +528,7 @@ void tx_renderer_upload(tx_renderer* r, const tx_scene* s) {
       mesh_slot* m = slot(r);
       fill_mesh(r, m, si->data[0], si->rows[0], si->data[1], si->rows[1]);
       memcpy(m->colour, it->colour, sizeof m->colour);
-      m->textured = it->skin_texture;
+      m->textured = it->skin_texture ? 1 : it->tissue_texture ? 2 : 0;
       upload_mesh(r, m);
       break;
     }
@@ -538,7 +549,7 @@ void tx_renderer_upload(tx_renderer* r, const tx_scene* s) {
       mesh_slot* m = slot(r);
       fill_mesh(r, m, x, 4, tri, 2);
       memcpy(m->colour, it->colour, sizeof m->colour);
-      m->textured = false;
+      m->textured = 0;
       upload_mesh(r, m);
       break;
     }
@@ -705,6 +716,7 @@ void tx_renderer_draw(tx_renderer* r, const tx_view_def* d, const tx_camera* c, 
     if (!m->nidx) continue;
     gl->Uniform3fv(colour_at, 1, m->colour);
     gl->Uniform1i(textured_at, m->textured);
+    gl->BindTexture(GL_TEXTURE_2D, m->textured == 2 ? r->tissue_tex : r->skin_tex);
     gl->BindVertexArray(m->vao);
     gl->DrawElements(GL_TRIANGLES, (GLsizei)m->nidx, GL_UNSIGNED_INT, 0);
   }

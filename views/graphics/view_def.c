@@ -121,6 +121,30 @@ static int read_camera(const json_t* cam, tx_view_def* d) {
   return 0;
 }
 
+// a laparoscope through a port, aimed at the camera's target; the camera's
+// eye becomes the scope's tip
+static int read_laparoscope(const json_t* lap, const json_t* cam, tx_view_def* d) {
+  static const char* const keys[] = {"port", "insertion_m", NULL};
+  if (!json_is_object(lap)) return bad("laparoscope", "expected an object, got %s", tx_json_kind(lap));
+  if (check_keys("laparoscope", lap, keys)) return -1;
+  if (!cam || !json_object_get(cam, "target")) return bad("laparoscope", "needs a camera with the target it is aimed at");
+  double port[3], ins = 0.05, dist = 0;
+  const json_t* v = json_object_get(lap, "port");
+  if (!v) return bad("laparoscope.port", "missing: where the scope passes the abdominal wall");
+  if (numbers("laparoscope.port", v, 3, -1e4, 1e4, port)) return -1;
+  if ((v = json_object_get(lap, "insertion_m")) && number("laparoscope.insertion_m", v, 0, 1, false, &ins)) return -1;
+  for (int i = 0; i < 3; i++) dist += pow(d->camera.target[i] - port[i], 2);
+  if (!(sqrt(dist) > ins + 0.005))
+    return bad("laparoscope.insertion_m", "the tip (%g m in) must stop short of the camera's target (%g m from the port)", ins,
+               sqrt(dist));
+  tx_laparoscope_aim(&d->laparoscope, port, d->camera.target, ins);
+  tx_laparoscope_camera(&d->laparoscope, &d->camera);
+  d->camera.convergence = d->laparoscope.focus;
+  d->scope = true;
+  if (tx_camera_check(&d->camera)) return bad("laparoscope", "%s", tx_error());
+  return 0;
+}
+
 static int read_item(size_t i, const json_t* e, tx_draw_item* it) {
   static const char* const keys[] = {"mesh", "spheres", "segments", "tool", "plane", "instrument", "urdf", "colour",
                                      "colour_by", "range", "texture", "radius_m", "show_force", "force_scale_m_per_n",
@@ -201,8 +225,10 @@ static int read_item(size_t i, const json_t* e, tx_draw_item* it) {
   if ((v = json_object_get(e, "texture"))) {
     if (it->kind != TX_DRAW_MESH) return bad(key, "only meshes take a texture");
     const char* t = json_string_value(v);
-    if (!t || (strcmp(t, "skin") != 0 && strcmp(t, "none") != 0)) return bad(key, "expected \"skin\" or \"none\"");
+    if (!t || (strcmp(t, "skin") != 0 && strcmp(t, "tissue") != 0 && strcmp(t, "none") != 0))
+      return bad(key, "expected \"skin\", \"tissue\" or \"none\"");
     it->skin_texture = strcmp(t, "skin") == 0;
+    it->tissue_texture = strcmp(t, "tissue") == 0;
   }
   double x = 0; // set by number() whenever it returns 0
   snprintf(key, sizeof key, "%s.radius_m", at);
@@ -238,7 +264,7 @@ static int read_item(size_t i, const json_t* e, tx_draw_item* it) {
 }
 
 int tx_view_def_from_json(const json_t* view, tx_view_def* d) {
-  static const char* const keys[] = {"rate_hz", "width", "height", "frame_every", "camera", "stereo",
+  static const char* const keys[] = {"rate_hz", "width", "height", "frame_every", "camera", "laparoscope", "stereo",
                                      "background", "light", "draw", NULL};
   if (!json_is_object(view)) return bad("", "expected an object, got %s", tx_json_kind(view));
   if (check_keys("", view, keys)) return -1;
@@ -252,6 +278,7 @@ int tx_view_def_from_json(const json_t* view, tx_view_def* d) {
   if ((v = json_object_get(view, "frame_every")) && integer("frame_every", v, 1, 1000000, &d->frame_every))
     return -1;
   if ((v = json_object_get(view, "camera")) && read_camera(v, d)) return -1;
+  if ((v = json_object_get(view, "laparoscope")) && read_laparoscope(v, json_object_get(view, "camera"), d)) return -1;
   if ((v = json_object_get(view, "stereo"))) {
     static const char* const skeys[] = {"interaxial_m", "convergence_m", NULL};
     if (!json_is_object(v)) return bad("stereo", "expected an object, got %s", tx_json_kind(v));
@@ -270,7 +297,10 @@ int tx_view_def_from_json(const json_t* view, tx_view_def* d) {
     if (numbers("background", v, 3, 0, 1, c)) return -1;
     for (int i = 0; i < 3; i++) d->background[i] = (float)c[i];
   }
-  if ((v = json_object_get(view, "light"))) {
+  if ((v = json_object_get(view, "light")) && json_is_string(v)) {
+    if (strcmp(json_string_value(v), "headlight") != 0) return bad("light", "expected a direction or \"headlight\"");
+    d->headlight = true;
+  } else if (v) {
     if (numbers("light", v, 3, -1e4, 1e4, c)) return -1;
     double l = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
     if (!(l > 1e-6)) return bad("light", "expected a non-zero direction");

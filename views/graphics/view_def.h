@@ -17,6 +17,7 @@
 #ifndef TX_VIEWS_GRAPHICS_VIEW_DEF_H
 #define TX_VIEWS_GRAPHICS_VIEW_DEF_H
 
+#include "laparoscope.h"
 #include "stereo.h"
 
 #include <tactus/model.h>
@@ -47,6 +48,7 @@ typedef struct tx_draw_item {
   float colour[3];          // 1, linear RGB in [0, 1]
   float range[2];           // scalar values mapped to the ends of the colour map
   bool skin_texture;        // meshes: the procedural skin texture instead of the plain colour
+  bool tissue_texture;      // meshes: the colour modulated by the procedural tissue texture (organ_texture.h)
   bool show_force;          // tools: a line along NAME.force
   float radius;             // m, tools: radius of the HIP sphere
   float force_scale;        // m/N, tools: length of the force line per newton
@@ -65,6 +67,9 @@ typedef struct tx_view_def {
   int frame_every;        // png: write every Nth rendered frame (and the last)
   float background[3];    // 1, linear RGB
   float light_dir[3];     // 1, direction the light shines from (towards the scene), unit
+  bool headlight;         // the light shines along the view, from the eye (set each frame)
+  bool scope;             // the camera is a laparoscope's on a pivot (the window's mouse moves it)
+  tx_laparoscope laparoscope;
   tx_draw_item items[TX_DRAW_MAX];
   int nitems;
 } tx_view_def;

@@ -1,8 +1,10 @@
 // Internal: a tetrahedral soft body on Bullet, behind a C interface, for the
 // organs (liver, stomach) and the organ-hemisphere check.
 //
-// Two models: Bullet's FEM deformables (btDeformableMultiBodyDynamicsWorld
-// with the corotated or the stable Neo-Hookean force, explicit integration:
+// Two models: Bullet's FEM deformables (its corotated or stable Neo-Hookean
+// force on a btSoftBody's tetrahedra, integrated explicitly by symplectic
+// Euler here rather than by stepping btDeformableMultiBodyDynamicsWorld, whose
+// step also recomputes every tetrahedron's rotation, unused by these forces;
 // setImplicit(true) has been seen to diverge at 1-5 ms steps on a small test
 // where explicit steps were stable), or Bullet's classic soft body (links along the tetrahedra's edges
 // and volume conservation, solved by iterations: the closest open analogue of

@@ -37,6 +37,7 @@ struct tx_fem {
   btDeformableMultiBodyConstraintSolver* solver;
   btDeformableMultiBodyDynamicsWorld* world;
   btDeformableLagrangianForce* force;
+  btAlignedObjectArray<btVector3> elastic;  // (nv) N, the elastic force of the explicit step
   btSoftBodyWorldInfo info;  // the links body's world
   btSoftBody* body;
   std::vector<double> mass;  // (nv) kg, lumped
@@ -251,6 +252,9 @@ extern "C" tx_fem* tx_fem_create(const tx_fem_def* d, const double* nodes, int n
         b->force = new btDeformableNeoHookeanForce((btScalar)(4.0 / 3.0 * mu), (btScalar)(lambda + 5.0 / 6.0 * mu), 0);
       }
       b->world->addForce(s, b->force);
+      // the force reads the nodes by index; the world, which is never stepped (fem_step), would number them so
+      for (int i = 0; i < nv; i++) s->m_nodes[i].index = i;
+      b->elastic.resize(nv);
       // gravity is applied in tx_fem_step, to the true mass only: mass
       // scaling must not make the organs heavier
       b->world->getWorldInfo().m_gravity.setValue(0, 0, 0);
@@ -294,6 +298,41 @@ static void links_step(tx_fem* b) {
   s->predictMotion((btScalar)b->dt);
   s->solveConstraints();
   s->integrateMotion();
+}
+
+// One explicit step of the FEM body: Bullet's elastic force (the model's, on
+// each tetrahedron's deformation gradient), then symplectic Euler, as the
+// deformable world's explicit path does (v += dt f / m, then x += dt v). The
+// world itself is not stepped: its step recomputes every tetrahedron's
+// rotation (btSoftBody::updateDeformation, an iterative extraction started
+// from the identity each time) that neither the Neo-Hookean nor the
+// corotated force reads, and refits collision trees that are not used here;
+// together over half of the step's time.
+static void fem_step(tx_fem* b) {
+  btSoftBody* s = b->body;
+  for (int t = 0; t < s->m_tetras.size(); t++) {
+    btSoftBody::Tetra& e = s->m_tetras[t];
+    const btVector3 c1 = e.m_n[1]->m_x - e.m_n[0]->m_x, c2 = e.m_n[2]->m_x - e.m_n[0]->m_x,
+                    c3 = e.m_n[3]->m_x - e.m_n[0]->m_x;
+    btMatrix3x3 ds(c1.getX(), c2.getX(), c3.getX(), c1.getY(), c2.getY(), c3.getY(), c1.getZ(), c2.getZ(), c3.getZ());
+    e.m_F = ds * e.m_Dm_inverse;
+    btSoftBody::TetraScratch& sc = s->m_tetraScratches[t];
+    sc.m_F = e.m_F;
+    sc.m_J = e.m_F.determinant();
+    const btMatrix3x3 c = e.m_F.transpose() * e.m_F;
+    sc.m_trace = c[0].getX() + c[1].getY() + c[2].getZ();
+    sc.m_cofF = e.m_F.adjoint().transpose();
+  }
+  for (int i = 0; i < b->nv; i++) b->elastic[i].setZero();
+  b->force->addScaledExplicitForce(1, b->elastic);
+  const btScalar dt = (btScalar)b->dt;
+  for (int i = 0; i < b->nv; i++) {
+    btSoftBody::Node& n = s->m_nodes[i];
+    if (!(n.m_im > 0)) continue;
+    n.m_v += b->elastic[i] * (n.m_im * dt);
+    n.m_q = n.m_x;
+    n.m_x += n.m_v * dt;
+  }
 }
 
 // the point of triangle abc closest to p, as barycentric weights (Ericson,
@@ -395,7 +434,7 @@ extern "C" bool tx_fem_step(tx_fem* b, int steps) {
     if (heavy)
       for (int i = 0; i < b->nv; i++)
         if (nodes[i].m_im > 0) nodes[i].m_v += dv * (btScalar)b->weight[(size_t)i];
-    if (b->world) b->world->stepSimulation((btScalar)b->dt, 0);
+    if (b->world) fem_step(b);
     else links_step(b);
     if (b->has_tool) tool += tool_contact(b, touched);
     int on = 0;

@@ -114,7 +114,7 @@ static void errors_name_the_key(void** state) {
   expect_error("{\"draw\": [{\"spheres\": \"t\", \"range\": [0, 1]}]}", "draw[0].range", "needs colour_by");
   expect_error("{\"draw\": [{\"spheres\": \"t\", \"colour_by\": \"t.d\", \"range\": [1, 1]}]}", "draw[0].range", "low < high");
   expect_error("{\"draw\": [{\"spheres\": \"t\", \"texture\": \"skin\"}]}", "draw[0].texture", "only meshes");
-  expect_error("{\"draw\": [{\"mesh\": \"s\", \"texture\": \"wood\"}]}", "draw[0].texture", "\"skin\" or \"none\"");
+  expect_error("{\"draw\": [{\"mesh\": \"s\", \"texture\": \"wood\"}]}", "draw[0].texture", "\"tissue\" or \"none\"");
   expect_error("{\"draw\": [{\"tool\": \"device0\", \"radius_m\": 0}]}", "draw[0].radius_m", "(0, 1]");
   expect_error("{\"draw\": [{\"tool\": \"device0\", \"show_force\": 1}]}", "draw[0].show_force", "true or false");
   expect_error("{\"draw\": [{\"plane\": {\"normal\": [0, 0, 0]}}]}", "draw[0].plane.normal", "non-zero");
