@@ -16,6 +16,7 @@
 
 typedef struct pair {
   int32_t i, j; // cylinders i < j
+  double d0;    // m, their distance when listed
 } pair;
 
 struct tx_thread {
@@ -59,6 +60,7 @@ struct tx_thread {
   int32_t* order;            // (nseg) cylinders by their box's low end on the sweep axis
   int32_t* order_tmp;        // (nseg) a merge sort's buffer
   double* key;               // (nseg) the low ends, in that order
+  double* xb;                // (n x 3) the positions the pairs were listed at
   int axis;                  // the sweep axis; -1: order not sorted yet
   pair* pairs;               // candidate pairs of the substep
   int npairs, pair_cap;
@@ -82,6 +84,10 @@ struct tx_thread {
 // small vector helpers
 
 static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static double dist3_sq(const double a[3], const double b[3]) {
+  double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+  return dot3(d, d);
+}
 static double dist3(const double a[3], const double b[3]) {
   double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
   return sqrt(dot3(d, d));
@@ -210,12 +216,13 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   t->order = malloc(sizeof(int32_t) * nseg);
   t->order_tmp = malloc(sizeof(int32_t) * nseg);
   t->key = malloc(sizeof(double) * nseg);
+  t->xb = malloc(sizeof(double) * 3 * n);
   t->axis = -1;
   t->pairs = malloc(sizeof(pair) * t->pair_cap);
   t->colliding = calloc((size_t)nseg, 1);
   t->caps = malloc(sizeof(tx_thread_capsule) * (def->max_shapes + 1));
   if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->v0 || !t->w || !t->wf || !t->lam || !t->band || !t->bend || !t->rhs || !t->dir || !t->pinned || !t->severed || !t->punct || !t->arc || !t->near_punct || !t->arc_step || !t->arc_sub || !t->plam || !t->pin || !t->box ||
-      !t->order || !t->order_tmp || !t->key || !t->pairs || !t->colliding || !t->caps)
+      !t->order || !t->order_tmp || !t->key || !t->xb || !t->pairs || !t->colliding || !t->caps)
     goto oom;
   if (def->max_triangles > 0) {
     if (tx_tri_bvh_init(&t->bvh, (uint32_t)def->max_triangles)) goto oom;
@@ -271,6 +278,7 @@ void tx_thread_destroy(tx_thread* t) {
   free(t->order);
   free(t->order_tmp);
   free(t->key);
+  free(t->xb);
   free(t->pairs);
   free(t->colliding);
   free(t->caps);
@@ -610,6 +618,7 @@ static void broadphase(tx_thread* t, double margin) {
   sort_boxes(t, axis);
   int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
   t->npairs = 0;
+  memcpy(t->xb, x, sizeof(double) * 3 * t->n);
   for (int p = 0; p < nseg; p++) {
     int i = t->order[p];
     if (t->severed[i]) continue;
@@ -625,7 +634,7 @@ static void broadphase(tx_thread* t, double margin) {
       tx_seg_closest cl;
       tx_seg_closest_points(x + 3 * lo_i, x + 3 * lo_i + 3, x + 3 * hi_j, x + 3 * hi_j + 3, &cl);
       if (cl.dist >= reach) continue;
-      if (t->npairs < t->pair_cap) t->pairs[t->npairs++] = (pair){lo_i, hi_j};
+      if (t->npairs < t->pair_cap) t->pairs[t->npairs++] = (pair){lo_i, hi_j, cl.dist};
       // held apart at exactly 2 r, touching cylinders stay marked
       if (cl.dist < 2 * t->def.radius * 1.01) {
         t->last.self_pairs++;
@@ -635,8 +644,18 @@ static void broadphase(tx_thread* t, double margin) {
   }
 }
 
+// a pair listed d0 apart is still at least d0 - 2 D apart when no node
+// moved more than D since: such pairs, most of those a few cylinders apart
+// along the thread, are skipped without their closest points
 static void solve_self(tx_thread* t) {
-  for (int k = 0; k < t->npairs; k++) solve_self_pair(t, t->pairs[k].i, t->pairs[k].j);
+  double m2 = 0;
+  for (int i = 0; i < t->n; i++) {
+    double s = dist3_sq(t->x + 3 * i, t->xb + 3 * i);
+    if (s > m2) m2 = s;
+  }
+  double far = 2 * t->def.radius + 2 * sqrt(m2);
+  for (int k = 0; k < t->npairs; k++)
+    if (t->pairs[k].d0 < far) solve_self_pair(t, t->pairs[k].i, t->pairs[k].j);
 }
 
 // every cylinder against every capsule: the thread moves out to r + R
@@ -1074,11 +1093,6 @@ static void ftl_substep(tx_thread* t, double h, double margin) {
 }
 
 // no segment longer than lmax: from the head along the thread, then back from the last pin
-static double dist3_sq(const double a[3], const double b[3]) {
-  double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
-  return dot3(d, d);
-}
-
 static void cap_stretch(tx_thread* t) {
   double l2 = t->lmax * t->lmax; // squared: no root per segment and pass
   for (int pass = 0; pass < 2; pass++) {
