@@ -51,7 +51,11 @@ struct tx_thread {
   double* arc_step;          // (max_punctures) arc at the start of the step
   double* arc_sub;           // (max_punctures) and of the substep, for a substep taken again
   double* plam;              // (max_punctures) rod: the friction's multiplier along the thread in this substep
-  double* pin;               // (n x 3) where pinned nodes are held, m
+  double* pin;               // (n x 3) where pinned nodes are held, m (a held node: in this substep)
+  uint8_t* held;             // (n) grasped: 1 pinned by the grasp, 2 pinned before it (a release keeps that pin)
+  double* hold_from;         // (n x 3) a held node's place at the start of the step, m
+  double* hold_to;           // (n x 3) and at its end
+  int nheld;                 // nodes held
   int last_pin;              // the highest pinned node (0: the head alone)
   double head_from[3], head_to[3];
   // the self-contact broadphase: sort and sweep of the cylinders' boxes
@@ -212,6 +216,9 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   t->arc_sub = malloc(sizeof(double) * (def->max_punctures + 1));
   t->plam = calloc((size_t)def->max_punctures + 1, sizeof(double));
   t->pin = calloc(3 * (size_t)n, sizeof(double));
+  t->held = calloc((size_t)n, 1);
+  t->hold_from = calloc(3 * (size_t)n, sizeof(double));
+  t->hold_to = calloc(3 * (size_t)n, sizeof(double));
   t->box = malloc(sizeof(double) * 6 * nseg);
   t->order = malloc(sizeof(int32_t) * nseg);
   t->order_tmp = malloc(sizeof(int32_t) * nseg);
@@ -221,7 +228,7 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   t->pairs = malloc(sizeof(pair) * t->pair_cap);
   t->colliding = calloc((size_t)nseg, 1);
   t->caps = malloc(sizeof(tx_thread_capsule) * (def->max_shapes + 1));
-  if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->v0 || !t->w || !t->wf || !t->lam || !t->band || !t->bend || !t->rhs || !t->dir || !t->pinned || !t->severed || !t->punct || !t->arc || !t->near_punct || !t->arc_step || !t->arc_sub || !t->plam || !t->pin || !t->box ||
+  if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->v0 || !t->w || !t->wf || !t->lam || !t->band || !t->bend || !t->rhs || !t->dir || !t->pinned || !t->severed || !t->punct || !t->arc || !t->near_punct || !t->arc_step || !t->arc_sub || !t->plam || !t->pin || !t->held || !t->hold_from || !t->hold_to || !t->box ||
       !t->order || !t->order_tmp || !t->key || !t->xb || !t->pairs || !t->colliding || !t->caps)
     goto oom;
   if (def->max_triangles > 0) {
@@ -274,6 +281,9 @@ void tx_thread_destroy(tx_thread* t) {
   free(t->arc_sub);
   free(t->plam);
   free(t->pin);
+  free(t->held);
+  free(t->hold_from);
+  free(t->hold_to);
   free(t->box);
   free(t->order);
   free(t->order_tmp);
@@ -384,6 +394,8 @@ tx_thread_status tx_thread_pin(tx_thread* t, int i, const double pos[3]) {
   }
   if (check_point("pin", pos)) return TX_THREAD_BAD;
   t->pinned[i] = 1;
+  t->nheld -= t->held[i] != 0;
+  t->held[i] = 0; // a plain pin now
   memcpy(t->pin + 3 * i, pos, sizeof(double) * 3);
   memcpy(t->x + 3 * i, pos, sizeof(double) * 3);
   memset(t->v + 3 * i, 0, sizeof(double) * 3);
@@ -397,9 +409,44 @@ tx_thread_status tx_thread_unpin(tx_thread* t, int i) {
     return TX_THREAD_BAD;
   }
   t->pinned[i] = 0;
+  t->nheld -= t->held[i] != 0;
+  t->held[i] = 0;
   update_last_pin(t);
   return TX_THREAD_OK;
 }
+
+tx_thread_status tx_thread_hold(tx_thread* t, int i, const double pos[3]) {
+  if (i <= 0 || i >= t->n) {
+    tx_set_error("thread: hold node %d, must be in [1, %d]", i, t->n - 1);
+    return TX_THREAD_BAD;
+  }
+  if (check_point("hold", pos)) return TX_THREAD_BAD;
+  if (!t->held[i]) { // from where it is now
+    t->held[i] = t->pinned[i] ? 2 : 1;
+    t->nheld++;
+    t->pinned[i] = 1;
+    memcpy(t->pin + 3 * i, t->x + 3 * i, sizeof(double) * 3);
+    memcpy(t->hold_from + 3 * i, t->x + 3 * i, sizeof(double) * 3);
+    update_last_pin(t);
+  }
+  memcpy(t->hold_to + 3 * i, pos, sizeof(double) * 3);
+  return TX_THREAD_OK;
+}
+
+tx_thread_status tx_thread_release(tx_thread* t, int i) {
+  if (i <= 0 || i >= t->n) {
+    tx_set_error("thread: release node %d, must be in [1, %d]", i, t->n - 1);
+    return TX_THREAD_BAD;
+  }
+  if (!t->held[i]) return TX_THREAD_OK;
+  if (t->held[i] == 1) t->pinned[i] = 0;
+  t->held[i] = 0;
+  t->nheld--;
+  update_last_pin(t);
+  return TX_THREAD_OK;
+}
+
+bool tx_thread_is_held(const tx_thread* t, int i) { return i >= 0 && i < t->n && t->held[i]; }
 
 tx_thread_status tx_thread_set_positions(tx_thread* t, const double* x) {
   for (int i = 0; i < 3 * t->n; i++)
@@ -411,6 +458,11 @@ tx_thread_status tx_thread_set_positions(tx_thread* t, const double* x) {
   memset(t->v, 0, sizeof(double) * 3 * t->n);
   for (int i = 0; i < t->n; i++)
     if (t->pinned[i]) memcpy(t->pin + 3 * i, x + 3 * i, sizeof(double) * 3);
+  for (int i = 0; i < t->n; i++)
+    if (t->held[i]) {
+      memcpy(t->hold_from + 3 * i, x + 3 * i, sizeof(double) * 3);
+      memcpy(t->hold_to + 3 * i, x + 3 * i, sizeof(double) * 3);
+    }
   memcpy(t->head_from, x, sizeof(double) * 3);
   memcpy(t->head_to, x, sizeof(double) * 3);
   return TX_THREAD_OK;
@@ -853,6 +905,8 @@ int tx_thread_fix_near_mesh(tx_thread* t, int first, int last, double limit) {
   for (int i = first; i <= last + 1; i++)
     if (i > 0) {
       t->pinned[i] = 1;
+      t->nheld -= t->held[i] != 0;
+      t->held[i] = 0; // fixed: no grasp moves it now
       memcpy(t->pin + 3 * i, t->x + 3 * i, sizeof(double) * 3);
       memset(t->v + 3 * i, 0, sizeof(double) * 3);
     }
@@ -1034,6 +1088,12 @@ static void ftl_forward(tx_thread* t) {
   // the last passed is the nearest the head along the thread: route from it back
   int k = t->passed - 1;
   for (int i = 1; i < t->n; i++) {
+    if (t->held[i]) { // in the jaws, exactly: the thread behind follows it
+      memcpy(t->x + 3 * i, t->pin + 3 * i, sizeof(double) * 3);
+      // a puncture on the link into the jaws stays on it: both its ends are placed
+      while (k >= 0 && t->arc[k] <= i * t->l0 * (1 + 1e-12)) k--;
+      continue;
+    }
     if (t->severed[i - 1]) continue;
     if (k >= 0 && t->arc[k] <= i * t->l0 * (1 + 1e-12)) {
       const double *l = t->x + 3 * (i - 1), *p = t->punct + 3 * k;
@@ -1307,7 +1367,8 @@ static void rod_substep(tx_thread* t, double h, double margin) {
   solve_mesh(t);
   for (int pass = 0; pass < 2 && t->passed; pass++) solve_punctures(t, h, false); // never leaves one
   for (int i = 0; i < n; i++)
-    for (int a = 0; a < 3; a++) v[3 * i + a] = t->pinned[i] ? 0 : (x[3 * i + a] - t->x0[3 * i + a]) / h;
+    for (int a = 0; a < 3; a++)
+      v[3 * i + a] = t->pinned[i] && !t->held[i] ? 0 : (x[3 * i + a] - t->x0[3 * i + a]) / h; // a held node lets go at the jaws' speed
   // the force the constraints put on the (pinned) head: gradient x lambda /
   // h^2 of the first distance and of the bend at node 1 (its coefficient at node 0 is 1)
   for (int a = 0; a < 3; a++) {
@@ -1341,7 +1402,10 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
   if (passed0) memcpy(t->arc_step, t->arc, sizeof(double) * passed0);
   // substeps: the head and, by their last velocities, the nodes move no
   // more than 3 r / 4 in one
-  double move = dist3(t->head_from, t->head_to);
+  double move = dist3(t->head_from, t->head_to), held_move = 0;
+  for (int i = 1; i < n && t->nheld; i++)
+    if (t->held[i]) held_move = fmax(held_move, dist3(t->hold_from + 3 * i, t->hold_to + 3 * i));
+  if (held_move > move) move = held_move;
   if (d->model == TX_THREAD_ROD) {
     double vmax2 = 0;
     for (int i = 0; i < n; i++) {
@@ -1370,10 +1434,13 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
     int passed_sub = t->passed;
     if (passed_sub) memcpy(t->arc_sub, t->arc, sizeof(double) * passed_sub);
     for (int a = 0; a < 3; a++) t->x[a] = t->head_from[a] + f * (t->head_to[a] - t->head_from[a]);
-    for (int i = 1; i < n; i++)
+    for (int i = 1; i < n; i++) {
+      if (t->held[i]) // a held node moves in a straight line over the step, as the head
+        for (int a = 0; a < 3; a++) t->pin[3 * i + a] = t->hold_from[3 * i + a] + f * (t->hold_to[3 * i + a] - t->hold_from[3 * i + a]);
       if (t->pinned[i]) memcpy(t->x + 3 * i, t->pin + 3 * i, sizeof(double) * 3);
+    }
     if (t->npunct) punctures_begin_substep(t);
-    double margin = 2 * d->radius + dist3(t->x, t->x0);
+    double margin = 2 * d->radius + fmax(dist3(t->x, t->x0), held_move * h / dt);
     if (d->model == TX_THREAD_FTL)
       ftl_substep(t, h, margin);
     else
@@ -1397,6 +1464,8 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
     tau += h;
   }
   memcpy(t->head_from, t->head_to, sizeof(double) * 3);
+  for (int i = 1; i < n && t->nheld; i++)
+    if (t->held[i]) memcpy(t->hold_from + 3 * i, t->hold_to + 3 * i, sizeof(double) * 3);
   t->last.substeps = ns;
   t->slid = 0; // punctures the thread went on through (pulled, not pushed back)
   for (int k = 0; k < passed0; k++) t->slid += t->arc[k] > t->arc_step[k] + 1e-9 * t->l0;

@@ -123,6 +123,20 @@ tx_thread_status tx_thread_set_head(tx_thread* t, const double pos[3]);
 // pins node i (0 < i < N) at pos; tx_thread_unpin frees it (not the head)
 tx_thread_status tx_thread_pin(tx_thread* t, int i, const double pos[3]);
 tx_thread_status tx_thread_unpin(tx_thread* t, int i);
+// grasping: node i (0 < i < N) held by jaws at pos (each coordinate
+// finite, in [-10, 10] m). The first call holds it where it is; each call
+// sets where the next step takes it, in a straight line over the step's
+// substeps (as the head), so a step holds it at pos. A held node is pinned:
+// in the rod it has no inverse mass (the constraints pull on the jaws, not
+// it); in ftl it is where it is held,
+// exactly, the thread behind it (towards the tail) follows it, and the part
+// between the head and it is solved from both ends (passes from the head
+// and back from it, the last from the head). tx_thread_release lets it go
+// (a node pinned before the grasp stays pinned); tx_thread_pin and
+// tx_thread_unpin end a hold too.
+tx_thread_status tx_thread_hold(tx_thread* t, int i, const double pos[3]);
+tx_thread_status tx_thread_release(tx_thread* t, int i);
+bool tx_thread_is_held(const tx_thread* t, int i);
 // puts every node at x (N x 3, m) at rest (zero velocity); the head and the
 // pins move there too. For reference shapes and tests.
 tx_thread_status tx_thread_set_positions(tx_thread* t, const double* x);
