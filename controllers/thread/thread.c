@@ -125,6 +125,7 @@ tx_thread_def tx_thread_def_default(void) {
   d.max_punctures = 16;
   d.puncture_friction = 0;
   d.puncture_capture = 0.001;
+  d.self_friction = 0;
   return d;
 }
 
@@ -159,6 +160,7 @@ int tx_thread_def_check(const tx_thread_def* d) {
   if (tx_check_count("thread", "max_punctures", d->max_punctures, 0, 1024)) return -1;
   if (range("puncture_friction", d->puncture_friction, 0, false, 100, false, "N")) return -1;
   if (range("puncture_capture", d->puncture_capture, 0, true, 0.1, false, "m")) return -1;
+  if (range("self_friction", d->self_friction, 0, false, 10, false, "")) return -1;
   return 0;
 }
 
@@ -594,12 +596,38 @@ static void solve_self_pair(tx_thread* t, int i, int j) {
   double wi = t->w[i] * (1 - c.t), wi1 = t->w[i + 1] * c.t, wj = t->w[j] * (1 - c.s), wj1 = t->w[j + 1] * c.s;
   double den = wi * (1 - c.t) + wi1 * c.t + wj * (1 - c.s) + wj1 * c.s;
   if (den <= 0) return;
-  double dl = (d2r - c.dist) / den;
+  double depth = d2r - c.dist, dl = depth / den, f[3];
+  for (int a = 0; a < 3; a++) f[a] = dl * n[a];
+  // Coulomb friction (rod), position-based (Macklin et al. 2014): the
+  // contact points' relative move across n since the start of the substep
+  // is undone while it is within mu times the depth pushed out (sticking),
+  // and cut by that much when beyond (sliding)
+  double mu = t->def.self_friction;
+  if (mu > 0 && t->def.model == TX_THREAD_ROD) {
+    const double* y = t->x0;
+    double rel[3], rn = 0;
+    for (int a = 0; a < 3; a++) {
+      double pa = x[3 * i + a] + c.t * (x[3 * i + 3 + a] - x[3 * i + a]) - (y[3 * i + a] + c.t * (y[3 * i + 3 + a] - y[3 * i + a]));
+      double pb = x[3 * j + a] + c.s * (x[3 * j + 3 + a] - x[3 * j + a]) - (y[3 * j + a] + c.s * (y[3 * j + 3 + a] - y[3 * j + a]));
+      rel[a] = pa - pb;
+      rn += rel[a] * n[a];
+    }
+    double tl = 0;
+    for (int a = 0; a < 3; a++) {
+      rel[a] -= rn * n[a];
+      tl += rel[a] * rel[a];
+    }
+    tl = sqrt(tl);
+    if (tl > 0) {
+      double k = tl <= mu * depth ? 1 : mu * depth / tl;
+      for (int a = 0; a < 3; a++) f[a] -= k * rel[a] / den;
+    }
+  }
   for (int a = 0; a < 3; a++) {
-    x[3 * i + a] += wi * dl * n[a];
-    x[3 * i + 3 + a] += wi1 * dl * n[a];
-    x[3 * j + a] -= wj * dl * n[a];
-    x[3 * j + 3 + a] -= wj1 * dl * n[a];
+    x[3 * i + a] += wi * f[a];
+    x[3 * i + 3 + a] += wi1 * f[a];
+    x[3 * j + a] -= wj * f[a];
+    x[3 * j + 3 + a] -= wj1 * f[a];
   }
 }
 

@@ -86,6 +86,9 @@ typedef struct tx_thread_def {
                             // before it slides (and drags with while sliding); 0
   double puncture_capture;  // m, in (0, 0.1]: the head has passed a puncture once the thread behind
                             // it (not the head's end) comes this near it; 0.001
+  double self_friction;   // rod: Coulomb coefficient of the thread's contacts with itself, in [0, 10]; 0
+                          // (position-based: a contact's sliding across it is undone up to this times
+                          // the depth pushed out in that solve)
 } tx_thread_def;
 
 // a kinematic capsule: the points within radius of segment a b (a sphere when a == b)

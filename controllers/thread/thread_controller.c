@@ -81,6 +81,8 @@ typedef struct thread_ctl {
   double rod_after_s; // > 0: the thread turns into a rod then
   int knot_first, knot_last; // the cylinders of the last knot counted (-1: none)
   double max_strain;         // the largest segment strain seen
+  int knot_lost;             // times the papers' rule lost a knot it had found
+  tx_result held_result, lost_result;
   tx_result strain_result;
 } thread_ctl;
 
@@ -100,6 +102,7 @@ static const tx_param_def params[] = {
     {"max_substeps", TX_PARAM_INT, "1", 1, 10000, 64, NULL, "at most this many substeps a step"},
     {"max_stretch", TX_PARAM_NUM, "1", 0, 1, 0.05, NULL, "rod: no segment longer than (1 + this) its rest length"},
     {"self_collision", TX_PARAM_BOOL, NULL, 0, 0, 1, NULL, "cylinders of the thread push each other apart"},
+    {"self_friction", TX_PARAM_NUM, "1", 0, 10, 0, NULL, "rod: Coulomb friction coefficient of the thread's contacts with itself"},
     {"slack", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "ftl: a node follows only when pulled (no segment longer than its rest length, some shorter)"},
     {"pin_tail", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "the tail stays where it starts"},
     {"tail_m", TX_PARAM_JSON, NULL, 0, 0, 0, NULL, "[x, y, z], m: where the thread starts straight towards from the head; [0.2, 0, 0] by default"},
@@ -165,6 +168,7 @@ static int configure(tx_setup* s, void** self) {
   d.max_substeps = (int)tx_table_int(s, "max_substeps");
   d.max_stretch = tx_table_num(s, "max_stretch");
   d.self_collision = tx_table_bool(s, "self_collision");
+  d.self_friction = tx_table_num(s, "self_friction");
   d.pin_tail = tx_table_bool(s, "pin_tail");
   d.slack = tx_table_bool(s, "slack");
   d.max_shapes = (int)tx_table_int(s, "max_shapes");
@@ -234,6 +238,8 @@ static int configure(tx_setup* s, void** self) {
   }
   k->bad_grasp = tx_setup_warning(s, "bad_grasp");
   k->grasps_result = tx_setup_result(s, "grasps");
+  k->held_result = tx_setup_result(s, "knot_held");
+  k->lost_result = tx_setup_result(s, "knot_lost");
   const char* punctures = tx_table_str(s, "punctures");
   if (!punctures) return -1;
   if (*punctures) {
@@ -352,6 +358,7 @@ static void check_knot(tx_ctx* c, thread_ctl* k) {
     k->fixed = true;
     emit_knot(c, k, &p, true);
   }
+  if (k->knotted && !knot) k->knot_lost++;
   k->knotted = knot;
 }
 
@@ -583,6 +590,8 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, k->knots_result, k->knots);
   tx_set_result(c, k->cuts_result, k->cuts);
   tx_set_result(c, k->grasps_result, k->grasps);
+  tx_set_result(c, k->held_result, k->knotted ? 1 : 0);
+  tx_set_result(c, k->lost_result, k->knot_lost);
   tx_set_result(c, k->passed_result, tx_thread_punctures_passed(k->t));
   tx_set_result(c, k->first_knot_result, k->first_knot_s);
   tx_set_result(c, k->strain_result, k->max_strain);
