@@ -27,8 +27,8 @@
 //         constraint-by-constraint sweeps would need O(N^2).
 //
 // Both models share the contacts (step 2 of the thread's issue): self
-// contact between cylinders (|AB| < 2 r, segment.h) found through a uniform
-// grid, kinematic capsules and spheres, and a triangle mesh (the skin's
+// contact between cylinders (|AB| < 2 r, segment.h) found through a
+// sort and sweep of their boxes, kinematic capsules and spheres, and a triangle mesh (the skin's
 // SKIN.x / SKIN.tri arrays). A step is split into substeps short enough
 // that the head and, by its last velocity, every node move no more than
 // 3 r / 4 in one; a substep in which a free node still moved more than
@@ -217,7 +217,7 @@ typedef struct tx_thread_contacts {
   int shape_hits;  // node or cylinder contacts with capsules
   int mesh_hits;   // node contacts with triangles
   int substeps;    // substeps the step took
-  int broad_pairs; // cylinder pairs the grid proposed (the broadphase's work)
+  int broad_pairs; // cylinder pairs the broadphase proposed (the broadphase's work)
   int retries;     // substeps taken again shorter because a node moved more than r
 } tx_thread_contacts;
 void tx_thread_last_contacts(const tx_thread* t, tx_thread_contacts* out);
