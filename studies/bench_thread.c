@@ -2,7 +2,7 @@
 // (controllers/thread/thread.h), follow-the-leader and rod, at 100 and 1000
 // nodes of 1 mm (a 0.5 mm thread). The thread hangs doubled: its head and
 // its pinned tail 2 r apart, two legs side by side down to a loop, so the
-// grid and the self contacts have work at every step (the legs touch over
+// broadphase and the self contacts have work at every step (the legs touch over
 // their upper part); it settles for 2 s first (rod), then the head circles at
 // 5 cm/s on a 2 mm circle, gravity on (--duration S: S seconds a row and
 // S of settling, instead of 2 s and 0.5 s after 2 s). Each step is timed on the wall clock
@@ -29,7 +29,7 @@ typedef struct thread_row {
   tx_percentiles step;  // ns, wall clock
   tx_percentiles cpu;   // ns, the thread's CPU time
   double self_pairs;    // touching cylinder pairs per step, mean
-  double broad_pairs;   // pairs the grid proposed per step, mean
+  double broad_pairs;   // pairs the broadphase proposed per step, mean
   double substeps;      // mean
 } thread_row;
 
@@ -118,13 +118,13 @@ int tx_bench_thread(double duration_s) {
     for (int s = 0; s < 2; s++)
       if (run_row(sizes[s], (tx_thread_model)m, steps[s], settle, &rows[2 * m + s])) return 1;
   printf("  %-6s %-6s %10s %10s %10s %10s %10s %10s %9s\n", "model", "nodes", "cpu p50", "cpu p99", "wall p50",
-         "wall p99", "touching", "grid pairs", "substeps");
+         "wall p99", "touching", "broad pairs", "substeps");
   for (int i = 0; i < 4; i++)
     printf("  %-6s %-6d %7.1f us %7.1f us %7.1f us %7.1f us %10.1f %10.0f %9.2f\n",
            rows[i].model == TX_THREAD_ROD ? "rod" : "ftl", rows[i].nodes, rows[i].cpu.p50 * 1e-3,
            rows[i].cpu.p99 * 1e-3, rows[i].step.p50 * 1e-3, rows[i].step.p99 * 1e-3, rows[i].self_pairs,
            rows[i].broad_pairs, rows[i].substeps);
-  printf("\n  touching: cylinder pairs within 2 r per step; grid pairs: the pairs the broadphase proposed\n");
+  printf("\n  touching: cylinder pairs within 2 r per step; broad pairs: the pairs the broadphase proposed\n");
   printf("\ntargets:\n");
   tx_bench_target_us("step, ftl, 100 nodes, self collision, cpu p99", rows[0].cpu.p99 * 1e-3, 100);
   tx_bench_target_us("step, ftl, 1000 nodes, self collision, cpu p99", rows[1].cpu.p99 * 1e-3, 1000);

@@ -16,6 +16,7 @@
 
 typedef struct pair {
   int32_t i, j; // cylinders i < j
+  double d0;    // m, their distance when listed
 } pair;
 
 struct tx_thread {
@@ -50,15 +51,21 @@ struct tx_thread {
   double* arc_step;          // (max_punctures) arc at the start of the step
   double* arc_sub;           // (max_punctures) and of the substep, for a substep taken again
   double* plam;              // (max_punctures) rod: the friction's multiplier along the thread in this substep
-  double* pin;               // (n x 3) where pinned nodes are held, m
+  double* pin;               // (n x 3) where pinned nodes are held, m (a held node: in this substep)
+  uint8_t* held;             // (n) grasped: 1 pinned by the grasp, 2 pinned before it (a release keeps that pin)
+  double* hold_from;         // (n x 3) a held node's place at the start of the step, m
+  double* hold_to;           // (n x 3) and at its end
+  int nheld;                 // nodes held
   int last_pin;              // the highest pinned node (0: the head alone)
   double head_from[3], head_to[3];
-  // the self-contact broadphase: a hashed uniform grid over cylinder midpoints
-  uint32_t hash_mask;
-  uint32_t* cell_start;      // (hash size + 1)
-  uint32_t* cell_item;       // (nseg) cylinders sorted by cell
-  uint32_t* seg_cell;        // (nseg) each cylinder's bucket
-  int64_t* seg_ijk;          // (nseg x 3) each cylinder's cell
+  // the self-contact broadphase: sort and sweep of the cylinders' boxes
+  // along one axis, the order kept from substep to substep
+  double* box;               // (nseg x 6) each cylinder's box, lo then hi, grown by half the reach
+  int32_t* order;            // (nseg) cylinders by their box's low end on the sweep axis
+  int32_t* order_tmp;        // (nseg) a merge sort's buffer
+  double* key;               // (nseg) the low ends, in that order
+  double* xb;                // (n x 3) the positions the pairs were listed at
+  int axis;                  // the sweep axis; -1: order not sorted yet
   pair* pairs;               // candidate pairs of the substep
   int npairs, pair_cap;
   uint8_t* colliding;        // (nseg)
@@ -81,6 +88,10 @@ struct tx_thread {
 // small vector helpers
 
 static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static double dist3_sq(const double a[3], const double b[3]) {
+  double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+  return dot3(d, d);
+}
 static double dist3(const double a[3], const double b[3]) {
   double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
   return sqrt(dot3(d, d));
@@ -114,6 +125,7 @@ tx_thread_def tx_thread_def_default(void) {
   d.max_punctures = 16;
   d.puncture_friction = 0;
   d.puncture_capture = 0.001;
+  d.self_friction = 0;
   return d;
 }
 
@@ -148,6 +160,7 @@ int tx_thread_def_check(const tx_thread_def* d) {
   if (tx_check_count("thread", "max_punctures", d->max_punctures, 0, 1024)) return -1;
   if (range("puncture_friction", d->puncture_friction, 0, false, 100, false, "N")) return -1;
   if (range("puncture_capture", d->puncture_capture, 0, true, 0.1, false, "m")) return -1;
+  if (range("self_friction", d->self_friction, 0, false, 10, false, "")) return -1;
   return 0;
 }
 
@@ -181,9 +194,6 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   double area = PI * def->radius * def->radius, inertia = PI * pow(def->radius, 4) / 4;
   t->alpha_d = t->l0 / (def->youngs_modulus * area);
   t->alpha_b = def->bend_factor > 0 ? pow(t->l0, 3) / (def->bend_factor * def->youngs_modulus * inertia) : INFINITY;
-  uint32_t hsize = 16;
-  while (hsize < 2u * (uint32_t)nseg) hsize <<= 1;
-  t->hash_mask = hsize - 1;
   t->pair_cap = 16 * nseg + 64;
   t->x = malloc(sizeof(double) * 3 * n);
   t->x0 = malloc(sizeof(double) * 3 * n);
@@ -208,15 +218,20 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   t->arc_sub = malloc(sizeof(double) * (def->max_punctures + 1));
   t->plam = calloc((size_t)def->max_punctures + 1, sizeof(double));
   t->pin = calloc(3 * (size_t)n, sizeof(double));
-  t->cell_start = malloc(sizeof(uint32_t) * (hsize + 1));
-  t->cell_item = malloc(sizeof(uint32_t) * nseg);
-  t->seg_cell = malloc(sizeof(uint32_t) * nseg);
-  t->seg_ijk = malloc(sizeof(int64_t) * 3 * nseg);
+  t->held = calloc((size_t)n, 1);
+  t->hold_from = calloc(3 * (size_t)n, sizeof(double));
+  t->hold_to = calloc(3 * (size_t)n, sizeof(double));
+  t->box = malloc(sizeof(double) * 6 * nseg);
+  t->order = malloc(sizeof(int32_t) * nseg);
+  t->order_tmp = malloc(sizeof(int32_t) * nseg);
+  t->key = malloc(sizeof(double) * nseg);
+  t->xb = malloc(sizeof(double) * 3 * n);
+  t->axis = -1;
   t->pairs = malloc(sizeof(pair) * t->pair_cap);
   t->colliding = calloc((size_t)nseg, 1);
   t->caps = malloc(sizeof(tx_thread_capsule) * (def->max_shapes + 1));
-  if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->v0 || !t->w || !t->wf || !t->lam || !t->band || !t->bend || !t->rhs || !t->dir || !t->pinned || !t->severed || !t->punct || !t->arc || !t->near_punct || !t->arc_step || !t->arc_sub || !t->plam || !t->pin || !t->cell_start ||
-      !t->cell_item || !t->seg_cell || !t->seg_ijk || !t->pairs || !t->colliding || !t->caps)
+  if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->v0 || !t->w || !t->wf || !t->lam || !t->band || !t->bend || !t->rhs || !t->dir || !t->pinned || !t->severed || !t->punct || !t->arc || !t->near_punct || !t->arc_step || !t->arc_sub || !t->plam || !t->pin || !t->held || !t->hold_from || !t->hold_to || !t->box ||
+      !t->order || !t->order_tmp || !t->key || !t->xb || !t->pairs || !t->colliding || !t->caps)
     goto oom;
   if (def->max_triangles > 0) {
     if (tx_tri_bvh_init(&t->bvh, (uint32_t)def->max_triangles)) goto oom;
@@ -229,6 +244,7 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   for (int i = 0; i < n; i++)
     for (int a = 0; a < 3; a++) t->x[3 * i + a] = def->head[a] + def->direction[a] / dl * t->l0 * i;
   for (int a = 0; a < 3; a++) t->head_from[a] = t->head_to[a] = def->head[a];
+  for (int i = 0; i < nseg; i++) t->order[i] = i;
   t->pinned[0] = 1;
   memcpy(t->pin, t->x, sizeof(double) * 3);
   if (def->pin_tail) {
@@ -267,10 +283,14 @@ void tx_thread_destroy(tx_thread* t) {
   free(t->arc_sub);
   free(t->plam);
   free(t->pin);
-  free(t->cell_start);
-  free(t->cell_item);
-  free(t->seg_cell);
-  free(t->seg_ijk);
+  free(t->held);
+  free(t->hold_from);
+  free(t->hold_to);
+  free(t->box);
+  free(t->order);
+  free(t->order_tmp);
+  free(t->key);
+  free(t->xb);
   free(t->pairs);
   free(t->colliding);
   free(t->caps);
@@ -376,6 +396,8 @@ tx_thread_status tx_thread_pin(tx_thread* t, int i, const double pos[3]) {
   }
   if (check_point("pin", pos)) return TX_THREAD_BAD;
   t->pinned[i] = 1;
+  t->nheld -= t->held[i] != 0;
+  t->held[i] = 0; // a plain pin now
   memcpy(t->pin + 3 * i, pos, sizeof(double) * 3);
   memcpy(t->x + 3 * i, pos, sizeof(double) * 3);
   memset(t->v + 3 * i, 0, sizeof(double) * 3);
@@ -389,9 +411,44 @@ tx_thread_status tx_thread_unpin(tx_thread* t, int i) {
     return TX_THREAD_BAD;
   }
   t->pinned[i] = 0;
+  t->nheld -= t->held[i] != 0;
+  t->held[i] = 0;
   update_last_pin(t);
   return TX_THREAD_OK;
 }
+
+tx_thread_status tx_thread_hold(tx_thread* t, int i, const double pos[3]) {
+  if (i <= 0 || i >= t->n) {
+    tx_set_error("thread: hold node %d, must be in [1, %d]", i, t->n - 1);
+    return TX_THREAD_BAD;
+  }
+  if (check_point("hold", pos)) return TX_THREAD_BAD;
+  if (!t->held[i]) { // from where it is now
+    t->held[i] = t->pinned[i] ? 2 : 1;
+    t->nheld++;
+    t->pinned[i] = 1;
+    memcpy(t->pin + 3 * i, t->x + 3 * i, sizeof(double) * 3);
+    memcpy(t->hold_from + 3 * i, t->x + 3 * i, sizeof(double) * 3);
+    update_last_pin(t);
+  }
+  memcpy(t->hold_to + 3 * i, pos, sizeof(double) * 3);
+  return TX_THREAD_OK;
+}
+
+tx_thread_status tx_thread_release(tx_thread* t, int i) {
+  if (i <= 0 || i >= t->n) {
+    tx_set_error("thread: release node %d, must be in [1, %d]", i, t->n - 1);
+    return TX_THREAD_BAD;
+  }
+  if (!t->held[i]) return TX_THREAD_OK;
+  if (t->held[i] == 1) t->pinned[i] = 0;
+  t->held[i] = 0;
+  t->nheld--;
+  update_last_pin(t);
+  return TX_THREAD_OK;
+}
+
+bool tx_thread_is_held(const tx_thread* t, int i) { return i >= 0 && i < t->n && t->held[i]; }
 
 tx_thread_status tx_thread_set_positions(tx_thread* t, const double* x) {
   for (int i = 0; i < 3 * t->n; i++)
@@ -403,6 +460,11 @@ tx_thread_status tx_thread_set_positions(tx_thread* t, const double* x) {
   memset(t->v, 0, sizeof(double) * 3 * t->n);
   for (int i = 0; i < t->n; i++)
     if (t->pinned[i]) memcpy(t->pin + 3 * i, x + 3 * i, sizeof(double) * 3);
+  for (int i = 0; i < t->n; i++)
+    if (t->held[i]) {
+      memcpy(t->hold_from + 3 * i, x + 3 * i, sizeof(double) * 3);
+      memcpy(t->hold_to + 3 * i, x + 3 * i, sizeof(double) * 3);
+    }
   memcpy(t->head_from, x, sizeof(double) * 3);
   memcpy(t->head_to, x, sizeof(double) * 3);
   return TX_THREAD_OK;
@@ -534,81 +596,146 @@ static void solve_self_pair(tx_thread* t, int i, int j) {
   double wi = t->w[i] * (1 - c.t), wi1 = t->w[i + 1] * c.t, wj = t->w[j] * (1 - c.s), wj1 = t->w[j + 1] * c.s;
   double den = wi * (1 - c.t) + wi1 * c.t + wj * (1 - c.s) + wj1 * c.s;
   if (den <= 0) return;
-  double dl = (d2r - c.dist) / den;
+  double depth = d2r - c.dist, dl = depth / den, f[3];
+  for (int a = 0; a < 3; a++) f[a] = dl * n[a];
+  // Coulomb friction (rod), position-based (Macklin et al. 2014): the
+  // contact points' relative move across n since the start of the substep
+  // is undone while it is within mu times the depth pushed out (sticking),
+  // and cut by that much when beyond (sliding)
+  double mu = t->def.self_friction;
+  if (mu > 0 && t->def.model == TX_THREAD_ROD) {
+    const double* y = t->x0;
+    double rel[3], rn = 0;
+    for (int a = 0; a < 3; a++) {
+      double pa = x[3 * i + a] + c.t * (x[3 * i + 3 + a] - x[3 * i + a]) - (y[3 * i + a] + c.t * (y[3 * i + 3 + a] - y[3 * i + a]));
+      double pb = x[3 * j + a] + c.s * (x[3 * j + 3 + a] - x[3 * j + a]) - (y[3 * j + a] + c.s * (y[3 * j + 3 + a] - y[3 * j + a]));
+      rel[a] = pa - pb;
+      rn += rel[a] * n[a];
+    }
+    double tl = 0;
+    for (int a = 0; a < 3; a++) {
+      rel[a] -= rn * n[a];
+      tl += rel[a] * rel[a];
+    }
+    tl = sqrt(tl);
+    if (tl > 0) {
+      double k = tl <= mu * depth ? 1 : mu * depth / tl;
+      for (int a = 0; a < 3; a++) f[a] -= k * rel[a] / den;
+    }
+  }
   for (int a = 0; a < 3; a++) {
-    x[3 * i + a] += wi * dl * n[a];
-    x[3 * i + 3 + a] += wi1 * dl * n[a];
-    x[3 * j + a] -= wj * dl * n[a];
-    x[3 * j + 3 + a] -= wj1 * dl * n[a];
+    x[3 * i + a] += wi * f[a];
+    x[3 * i + 3 + a] += wi1 * f[a];
+    x[3 * j + a] -= wj * f[a];
+    x[3 * j + 3 + a] -= wj1 * f[a];
   }
 }
 
-static uint32_t cell_hash(int64_t ix, int64_t iy, int64_t iz, uint32_t mask) {
-  uint64_t h = (uint64_t)ix * 73856093u ^ (uint64_t)iy * 19349663u ^ (uint64_t)iz * 83492791u;
-  return (uint32_t)(h ^ (h >> 32)) & mask;
+// sorts order by the boxes' low ends on the axis: insertion sort, near
+// linear on the last substep's order; a merge sort (no allocation: its
+// buffer is the thread's) when the axis changed or the order is far off
+static void sort_boxes(tx_thread* t, int axis) {
+  int n = t->nseg;
+  int32_t* o = t->order;
+  const double* box = t->box;
+  long budget = t->axis == axis ? 8L * n + 64 : 0;
+  t->axis = axis;
+  for (int p = 1; p < n && budget > 0; p++) {
+    int32_t it = o[p];
+    double k = box[6 * it + axis];
+    int q = p;
+    while (q > 0 && box[6 * o[q - 1] + axis] > k && budget-- > 0) {
+      o[q] = o[q - 1];
+      q--;
+    }
+    o[q] = it;
+  }
+  if (budget <= 0) {
+    int32_t *src = o, *dst = t->order_tmp;
+    for (int wdt = 1; wdt < n; wdt *= 2) {
+      for (int lo = 0; lo < n; lo += 2 * wdt) {
+        int mid = lo + wdt < n ? lo + wdt : n, hi = lo + 2 * wdt < n ? lo + 2 * wdt : n;
+        int i = lo, j = mid, k = lo;
+        while (i < mid && j < hi) dst[k++] = box[6 * src[j] + axis] < box[6 * src[i] + axis] ? src[j++] : src[i++];
+        while (i < mid) dst[k++] = src[i++];
+        while (j < hi) dst[k++] = src[j++];
+      }
+      int32_t* sw = src;
+      src = dst, dst = sw;
+    }
+    if (src != o) memcpy(o, src, sizeof(int32_t) * n);
+  }
+  for (int p = 0; p < n; p++) t->key[p] = box[6 * o[p] + axis];
 }
 
-// the candidate pairs of the substep: cylinders whose midpoints lie in
-// neighbouring cells of a grid whose cell is longer than any cylinder plus
-// the contact distance and a margin, so that every pair that can come within
-// 2 r during the substep is listed once
+// the candidate pairs of the substep: cylinders whose boxes, grown by the
+// contact distance and a margin, overlap (sort and sweep along the axis of
+// the thread's longest extent), so that every pair that can come within 2 r
+// during the substep is listed once
 static void broadphase(tx_thread* t, double margin) {
   const double* x = t->x;
   int nseg = t->nseg;
-  double lmax = 0;
+  double reach = 2 * t->def.radius + margin, g = 0.5 * reach;
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (int i = 0; i < nseg; i++) {
-    double l = dist3(x + 3 * i, x + 3 * i + 3);
-    if (l > lmax) lmax = l;
+    const double *p = x + 3 * i, *q = p + 3;
+    double* b = t->box + 6 * i;
+    for (int a = 0; a < 3; a++) {
+      double l = p[a] < q[a] ? p[a] : q[a], h = p[a] < q[a] ? q[a] : p[a];
+      b[a] = l - g, b[a + 3] = h + g;
+      if (l < lo[a]) lo[a] = l;
+      if (h > hi[a]) hi[a] = h;
+    }
   }
-  double cell = lmax + 2 * t->def.radius + margin, inv = 1 / cell;
-  uint32_t hsize = t->hash_mask + 1;
-  memset(t->cell_start, 0, sizeof(uint32_t) * (hsize + 1));
-  for (int i = 0; i < nseg; i++) {
-    const double* p = x + 3 * i;
-    int64_t* c = t->seg_ijk + 3 * i;
-    for (int a = 0; a < 3; a++) c[a] = (int64_t)floor((p[a] + p[a + 3]) * 0.5 * inv);
-    uint32_t h = cell_hash(c[0], c[1], c[2], t->hash_mask);
-    t->seg_cell[i] = h;
-    t->cell_start[h + 1]++;
-  }
-  for (uint32_t h = 0; h < hsize; h++) t->cell_start[h + 1] += t->cell_start[h];
-  // fill with cell_start as the running cursor, then shift it back
-  for (int i = 0; i < nseg; i++) t->cell_item[t->cell_start[t->seg_cell[i]]++] = (uint32_t)i;
-  for (uint32_t h = hsize; h > 0; h--) t->cell_start[h] = t->cell_start[h - 1];
-  t->cell_start[0] = 0;
+  // the axis of the longest extent; kept unless another is clearly longer
+  // (a change costs a full sort)
+  int axis = t->axis < 0 ? 0 : t->axis;
+  for (int a = 0; a < 3; a++)
+    if (hi[a] - lo[a] > 1.25 * (hi[axis] - lo[axis])) axis = a;
+  if (t->axis < 0)
+    for (int a = 0; a < 3; a++)
+      if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
+  sort_boxes(t, axis);
+  int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
   t->npairs = 0;
-  double reach = 2 * t->def.radius + margin;
-  for (int i = 0; i < nseg; i++) {
+  memcpy(t->xb, x, sizeof(double) * 3 * t->n);
+  for (int p = 0; p < nseg; p++) {
+    int i = t->order[p];
     if (t->severed[i]) continue;
-    const double* p = x + 3 * i;
-    const int64_t* c = t->seg_ijk + 3 * i;
-    for (int dz = -1; dz <= 1; dz++)
-      for (int dy = -1; dy <= 1; dy++)
-        for (int dx = -1; dx <= 1; dx++) {
-          int64_t cx = c[0] + dx, cy = c[1] + dy, cz = c[2] + dz;
-          uint32_t h = cell_hash(cx, cy, cz, t->hash_mask);
-          for (uint32_t k = t->cell_start[h]; k < t->cell_start[h + 1]; k++) {
-            int j = (int)t->cell_item[k];
-            const int64_t* cj = t->seg_ijk + 3 * j;
-            // only the bucket's items of this very cell: each pair once, no hash collisions
-            if (j <= i + t->skip || cj[0] != cx || cj[1] != cy || cj[2] != cz || t->severed[j]) continue;
-            t->last.broad_pairs++;
-            tx_seg_closest cl;
-            tx_seg_closest_points(p, p + 3, x + 3 * j, x + 3 * j + 3, &cl);
-            if (cl.dist >= reach) continue;
-            if (t->npairs < t->pair_cap) t->pairs[t->npairs++] = (pair){i, j};
-            // held apart at exactly 2 r, touching cylinders stay marked
-            if (cl.dist < 2 * t->def.radius * 1.01) {
-              t->last.self_pairs++;
-              t->colliding[i] = t->colliding[j] = 1;
-            }
-          }
-        }
+    const double* bi = t->box + 6 * i;
+    double end = bi[axis + 3];
+    for (int q = p + 1; q < nseg && t->key[q] <= end; q++) {
+      int j = t->order[q];
+      const double* bj = t->box + 6 * j;
+      if (bj[a1] > bi[a1 + 3] || bi[a1] > bj[a1 + 3] || bj[a2] > bi[a2 + 3] || bi[a2] > bj[a2 + 3]) continue;
+      int lo_i = i < j ? i : j, hi_j = i < j ? j : i;
+      if (hi_j <= lo_i + t->skip || t->severed[j]) continue;
+      t->last.broad_pairs++;
+      tx_seg_closest cl;
+      tx_seg_closest_points(x + 3 * lo_i, x + 3 * lo_i + 3, x + 3 * hi_j, x + 3 * hi_j + 3, &cl);
+      if (cl.dist >= reach) continue;
+      if (t->npairs < t->pair_cap) t->pairs[t->npairs++] = (pair){lo_i, hi_j, cl.dist};
+      // held apart at exactly 2 r, touching cylinders stay marked
+      if (cl.dist < 2 * t->def.radius * 1.01) {
+        t->last.self_pairs++;
+        t->colliding[lo_i] = t->colliding[hi_j] = 1;
+      }
+    }
   }
 }
 
+// a pair listed d0 apart is still at least d0 - 2 D apart when no node
+// moved more than D since: such pairs, most of those a few cylinders apart
+// along the thread, are skipped without their closest points
 static void solve_self(tx_thread* t) {
-  for (int k = 0; k < t->npairs; k++) solve_self_pair(t, t->pairs[k].i, t->pairs[k].j);
+  double m2 = 0;
+  for (int i = 0; i < t->n; i++) {
+    double s = dist3_sq(t->x + 3 * i, t->xb + 3 * i);
+    if (s > m2) m2 = s;
+  }
+  double far = 2 * t->def.radius + 2 * sqrt(m2);
+  for (int k = 0; k < t->npairs; k++)
+    if (t->pairs[k].d0 < far) solve_self_pair(t, t->pairs[k].i, t->pairs[k].j);
 }
 
 // every cylinder against every capsule: the thread moves out to r + R
@@ -806,6 +933,8 @@ int tx_thread_fix_near_mesh(tx_thread* t, int first, int last, double limit) {
   for (int i = first; i <= last + 1; i++)
     if (i > 0) {
       t->pinned[i] = 1;
+      t->nheld -= t->held[i] != 0;
+      t->held[i] = 0; // fixed: no grasp moves it now
       memcpy(t->pin + 3 * i, t->x + 3 * i, sizeof(double) * 3);
       memset(t->v + 3 * i, 0, sizeof(double) * 3);
     }
@@ -987,6 +1116,12 @@ static void ftl_forward(tx_thread* t) {
   // the last passed is the nearest the head along the thread: route from it back
   int k = t->passed - 1;
   for (int i = 1; i < t->n; i++) {
+    if (t->held[i]) { // in the jaws, exactly: the thread behind follows it
+      memcpy(t->x + 3 * i, t->pin + 3 * i, sizeof(double) * 3);
+      // a puncture on the link into the jaws stays on it: both its ends are placed
+      while (k >= 0 && t->arc[k] <= i * t->l0 * (1 + 1e-12)) k--;
+      continue;
+    }
     if (t->severed[i - 1]) continue;
     if (k >= 0 && t->arc[k] <= i * t->l0 * (1 + 1e-12)) {
       const double *l = t->x + 3 * (i - 1), *p = t->punct + 3 * k;
@@ -1047,53 +1182,86 @@ static void ftl_substep(tx_thread* t, double h, double margin) {
 
 // no segment longer than lmax: from the head along the thread, then back from the last pin
 static void cap_stretch(tx_thread* t) {
+  double l2 = t->lmax * t->lmax; // squared: no root per segment and pass
   for (int pass = 0; pass < 2; pass++) {
     for (int i = 1; i < t->n; i++)
-      if (!t->pinned[i] && !t->severed[i - 1] && dist3(t->x + 3 * i, t->x + 3 * i - 3) > t->lmax)
+      if (!t->pinned[i] && !t->severed[i - 1] && dist3_sq(t->x + 3 * i, t->x + 3 * i - 3) > l2)
         place_after(t, i, i - 1, t->lmax);
     if (t->last_pin == 0) break;
     for (int i = t->last_pin - 1; i > 0; i--)
-      if (!t->pinned[i] && !t->severed[i] && dist3(t->x + 3 * i, t->x + 3 * i + 3) > t->lmax)
+      if (!t->pinned[i] && !t->severed[i] && dist3_sq(t->x + 3 * i, t->x + 3 * i + 3) > l2)
         place_after(t, i, i + 1, t->lmax);
   }
   for (int i = 1; i < t->n; i++)
-    if (!t->pinned[i] && !t->severed[i - 1] && dist3(t->x + 3 * i, t->x + 3 * i - 3) > t->lmax)
+    if (!t->pinned[i] && !t->severed[i - 1] && dist3_sq(t->x + 3 * i, t->x + 3 * i - 3) > l2)
       place_after(t, i, i - 1, t->lmax);
 }
 
-// Cholesky of a symmetric banded matrix in place: A[r (bw + 1) + k] holds
-// A(r, r - k), k = 0..bw, and then L(r, r - k), with 1 / L(r, r) on the
-// diagonal (the solves multiply: a chain of divisions is slow)
-static void band_factor(double* A, int rows, int bw) {
-  int w = bw + 1;
+// LDL^T of the symmetric banded systems in place, written out for the two
+// bandwidths (a generic band loop cost a third of a rod step; no square
+// root): row r holds A(r, r), A(r, r - 1) [, A(r, r - 2)] at r w, then
+// 1 / D(r) and L's unit lower entries (the solves multiply: a chain of
+// divisions is slow)
+static double inv_pivot(double d) { return 1 / (d > 1e-300 ? d : 1e-300); }
+
+// pentadiagonal (w = 3)
+static void penta_factor(double* A, int rows) {
+  double d1 = 0, d2 = 0; // D(r - 1), D(r - 2)
   for (int r = 0; r < rows; r++) {
-    int c0 = r - bw < 0 ? 0 : r - bw;
-    for (int c = c0; c <= r; c++) {
-      double sum = A[r * w + (r - c)];
-      int m0 = c - bw > c0 ? c - bw : c0;
-      for (int m = m0; m < c; m++) sum -= A[r * w + (r - m)] * A[c * w + (c - m)];
-      if (c == r)
-        A[r * w] = 1 / sqrt(sum > 1e-300 ? sum : 1e-300);
-      else
-        A[r * w + (r - c)] = sum * A[c * w];
-    }
+    double* R = A + 3 * r;
+    double l2 = 0, l1 = 0;
+    if (r >= 2) l2 = R[2] = R[2] * A[3 * (r - 2)];
+    if (r >= 1) l1 = R[1] = (R[1] - l2 * A[3 * (r - 1) + 1] * d2) * A[3 * (r - 1)];
+    double d = R[0] - l1 * l1 * d1 - l2 * l2 * d2;
+    d = d > 1e-300 ? d : 1e-300;
+    R[0] = inv_pivot(d);
+    d2 = d1, d1 = d;
   }
 }
 
-// solves L L^T y = b in place; stride: the distance between y's entries
-static void band_solve(const double* L, int rows, int bw, double* y, int stride) {
-  int w = bw + 1;
-  for (int r = 0; r < rows; r++) {
-    int m0 = r - bw < 0 ? 0 : r - bw;
-    double sum = y[r * stride];
-    for (int m = m0; m < r; m++) sum -= L[r * w + (r - m)] * y[m * stride];
-    y[r * stride] = sum * L[r * w];
+// solves L D L^T y = b for three right-hand sides at once, y (rows x 3)
+// interleaved: three independent chains keep the pipeline busy
+static void penta_solve3(const double* L, int rows, double* y) {
+  for (int r = 1; r < rows; r++) {
+    const double* R = L + 3 * r;
+    double* yr = y + 3 * r;
+    yr[0] -= R[1] * yr[-3], yr[1] -= R[1] * yr[-2], yr[2] -= R[1] * yr[-1];
+    if (r >= 2) yr[0] -= R[2] * yr[-6], yr[1] -= R[2] * yr[-5], yr[2] -= R[2] * yr[-4];
   }
   for (int r = rows - 1; r >= 0; r--) {
-    int m1 = r + bw >= rows ? rows - 1 : r + bw;
-    double sum = y[r * stride];
-    for (int m = r + 1; m <= m1; m++) sum -= L[m * w + (m - r)] * y[m * stride];
-    y[r * stride] = sum * L[r * w];
+    double* yr = y + 3 * r;
+    double d = L[3 * r];
+    double s0 = yr[0] * d, s1 = yr[1] * d, s2 = yr[2] * d;
+    if (r + 1 < rows) {
+      double l = L[3 * (r + 1) + 1];
+      s0 -= l * yr[3], s1 -= l * yr[4], s2 -= l * yr[5];
+    }
+    if (r + 2 < rows) {
+      double l = L[3 * (r + 2) + 2];
+      s0 -= l * yr[6], s1 -= l * yr[7], s2 -= l * yr[8];
+    }
+    yr[0] = s0, yr[1] = s1, yr[2] = s2;
+  }
+}
+
+// tridiagonal (w = 2): factors and solves in one forward and one backward pass
+static void tri_factor_solve(double* A, int rows, double* y) {
+  double d1 = 0; // D(r - 1)
+  for (int r = 0; r < rows; r++) {
+    double* R = A + 2 * r;
+    double l1 = 0;
+    if (r >= 1) {
+      l1 = R[1] = R[1] * A[2 * (r - 1)];
+      y[r] -= l1 * y[r - 1];
+    }
+    double d = R[0] - l1 * l1 * d1;
+    d = d > 1e-300 ? d : 1e-300;
+    R[0] = inv_pivot(d);
+    d1 = d;
+  }
+  for (int r = rows - 1; r >= 0; r--) {
+    y[r] *= A[2 * r];
+    if (r + 1 < rows) y[r] -= A[2 * (r + 1) + 1] * y[r + 1];
   }
 }
 
@@ -1119,7 +1287,7 @@ static void bend_factor(tx_thread* t, double h) {
         if (k + 1 < nb) B[(k + 1) * 3 + 1] = 0;
         if (k + 2 < nb) B[(k + 2) * 3 + 2] = 0;
       }
-  if (nb > 0 && isfinite(ab)) band_factor(B, nb, 2);
+  if (nb > 0 && isfinite(ab)) penta_factor(B, nb);
 }
 
 // one XPBD iteration, the bends then the distances, each group solved
@@ -1147,7 +1315,7 @@ static void rod_solve(tx_thread* t, double h) {
         y[3 * k + c] = -(x[3 * i - 3 + c] - 2 * x[3 * i + c] + x[3 * i + 3 + c]) - ab * lam_b[3 * k + c];
       if (t->severed[k] || t->severed[k + 1]) y[3 * k] = y[3 * k + 1] = y[3 * k + 2] = 0;
     }
-    for (int c = 0; c < 3; c++) band_solve(t->bend, nb, 2, y + c, 3);
+    penta_solve3(t->bend, nb, y);
     for (int k = 0; k < nb; k++) {
       int i = k + 1;
       for (int c = 0; c < 3; c++) {
@@ -1177,8 +1345,7 @@ static void rod_solve(tx_thread* t, double h) {
     A[k * 2 + 1] = k >= 1 && !t->severed[k - 1] ? -w[k] * dot3(u + 3 * k - 3, u + 3 * k) : 0;
     if (t->severed[k]) y[k] = 0, A[k * 2] = 1, A[k * 2 + 1] = 0; // a cut link: no constraint, uncoupled
   }
-  band_factor(A, nseg, 1);
-  band_solve(A, nseg, 1, y, 1);
+  tri_factor_solve(A, nseg, y);
   for (int k = 0; k < nseg; k++) {
     lam_d[k] += y[k];
     for (int a = 0; a < 3; a++) {
@@ -1215,18 +1382,21 @@ static void rod_substep(tx_thread* t, double h, double margin) {
   }
   cap_stretch(t);
   // a node moved by one cylinder's push can go back into its neighbour's
-  // capsule: a second pass settles the pair
+  // capsule: a second pass settles the pair; the rigid shapes last, as a
+  // thread's own push must not drive it into one
   for (int pass = 0; pass < 2; pass++) {
-    solve_capsules(t);
     if (self) solve_self(t);
+    solve_capsules(t);
   }
   // the cap again: pushes in a crowded knot can stretch a segment; shortening
   // towards the leader barely opens a contact again
   cap_stretch(t);
+  solve_capsules(t);
   solve_mesh(t);
   for (int pass = 0; pass < 2 && t->passed; pass++) solve_punctures(t, h, false); // never leaves one
   for (int i = 0; i < n; i++)
-    for (int a = 0; a < 3; a++) v[3 * i + a] = t->pinned[i] ? 0 : (x[3 * i + a] - t->x0[3 * i + a]) / h;
+    for (int a = 0; a < 3; a++)
+      v[3 * i + a] = t->pinned[i] && !t->held[i] ? 0 : (x[3 * i + a] - t->x0[3 * i + a]) / h; // a held node lets go at the jaws' speed
   // the force the constraints put on the (pinned) head: gradient x lambda /
   // h^2 of the first distance and of the bend at node 1 (its coefficient at node 0 is 1)
   for (int a = 0; a < 3; a++) {
@@ -1260,7 +1430,10 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
   if (passed0) memcpy(t->arc_step, t->arc, sizeof(double) * passed0);
   // substeps: the head and, by their last velocities, the nodes move no
   // more than 3 r / 4 in one
-  double move = dist3(t->head_from, t->head_to);
+  double move = dist3(t->head_from, t->head_to), held_move = 0;
+  for (int i = 1; i < n && t->nheld; i++)
+    if (t->held[i]) held_move = fmax(held_move, dist3(t->hold_from + 3 * i, t->hold_to + 3 * i));
+  if (held_move > move) move = held_move;
   if (d->model == TX_THREAD_ROD) {
     double vmax2 = 0;
     for (int i = 0; i < n; i++) {
@@ -1289,10 +1462,13 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
     int passed_sub = t->passed;
     if (passed_sub) memcpy(t->arc_sub, t->arc, sizeof(double) * passed_sub);
     for (int a = 0; a < 3; a++) t->x[a] = t->head_from[a] + f * (t->head_to[a] - t->head_from[a]);
-    for (int i = 1; i < n; i++)
+    for (int i = 1; i < n; i++) {
+      if (t->held[i]) // a held node moves in a straight line over the step, as the head
+        for (int a = 0; a < 3; a++) t->pin[3 * i + a] = t->hold_from[3 * i + a] + f * (t->hold_to[3 * i + a] - t->hold_from[3 * i + a]);
       if (t->pinned[i]) memcpy(t->x + 3 * i, t->pin + 3 * i, sizeof(double) * 3);
+    }
     if (t->npunct) punctures_begin_substep(t);
-    double margin = 2 * d->radius + dist3(t->x, t->x0);
+    double margin = 2 * d->radius + fmax(dist3(t->x, t->x0), held_move * h / dt);
     if (d->model == TX_THREAD_FTL)
       ftl_substep(t, h, margin);
     else
@@ -1316,6 +1492,8 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
     tau += h;
   }
   memcpy(t->head_from, t->head_to, sizeof(double) * 3);
+  for (int i = 1; i < n && t->nheld; i++)
+    if (t->held[i]) memcpy(t->hold_from + 3 * i, t->hold_to + 3 * i, sizeof(double) * 3);
   t->last.substeps = ns;
   t->slid = 0; // punctures the thread went on through (pulled, not pushed back)
   for (int k = 0; k < passed0; k++) t->slid += t->arc[k] > t->arc_step[k] + 1e-9 * t->l0;

@@ -27,8 +27,8 @@
 //         constraint-by-constraint sweeps would need O(N^2).
 //
 // Both models share the contacts (step 2 of the thread's issue): self
-// contact between cylinders (|AB| < 2 r, segment.h) found through a uniform
-// grid, kinematic capsules and spheres, and a triangle mesh (the skin's
+// contact between cylinders (|AB| < 2 r, segment.h) found through a
+// sort and sweep of their boxes, kinematic capsules and spheres, and a triangle mesh (the skin's
 // SKIN.x / SKIN.tri arrays). A step is split into substeps short enough
 // that the head and, by its last velocity, every node move no more than
 // 3 r / 4 in one; a substep in which a free node still moved more than
@@ -86,6 +86,9 @@ typedef struct tx_thread_def {
                             // before it slides (and drags with while sliding); 0
   double puncture_capture;  // m, in (0, 0.1]: the head has passed a puncture once the thread behind
                             // it (not the head's end) comes this near it; 0.001
+  double self_friction;   // rod: Coulomb coefficient of the thread's contacts with itself, in [0, 10]; 0
+                          // (position-based: a contact's sliding across it is undone up to this times
+                          // the depth pushed out in that solve)
 } tx_thread_def;
 
 // a kinematic capsule: the points within radius of segment a b (a sphere when a == b)
@@ -123,6 +126,20 @@ tx_thread_status tx_thread_set_head(tx_thread* t, const double pos[3]);
 // pins node i (0 < i < N) at pos; tx_thread_unpin frees it (not the head)
 tx_thread_status tx_thread_pin(tx_thread* t, int i, const double pos[3]);
 tx_thread_status tx_thread_unpin(tx_thread* t, int i);
+// grasping: node i (0 < i < N) held by jaws at pos (each coordinate
+// finite, in [-10, 10] m). The first call holds it where it is; each call
+// sets where the next step takes it, in a straight line over the step's
+// substeps (as the head), so a step holds it at pos. A held node is pinned:
+// in the rod it has no inverse mass (the constraints pull on the jaws, not
+// it); in ftl it is where it is held,
+// exactly, the thread behind it (towards the tail) follows it, and the part
+// between the head and it is solved from both ends (passes from the head
+// and back from it, the last from the head). tx_thread_release lets it go
+// (a node pinned before the grasp stays pinned); tx_thread_pin and
+// tx_thread_unpin end a hold too.
+tx_thread_status tx_thread_hold(tx_thread* t, int i, const double pos[3]);
+tx_thread_status tx_thread_release(tx_thread* t, int i);
+bool tx_thread_is_held(const tx_thread* t, int i);
 // puts every node at x (N x 3, m) at rest (zero velocity); the head and the
 // pins move there too. For reference shapes and tests.
 tx_thread_status tx_thread_set_positions(tx_thread* t, const double* x);
@@ -200,7 +217,7 @@ typedef struct tx_thread_contacts {
   int shape_hits;  // node or cylinder contacts with capsules
   int mesh_hits;   // node contacts with triangles
   int substeps;    // substeps the step took
-  int broad_pairs; // cylinder pairs the grid proposed (the broadphase's work)
+  int broad_pairs; // cylinder pairs the broadphase proposed (the broadphase's work)
   int retries;     // substeps taken again shorter because a node moved more than r
 } tx_thread_contacts;
 void tx_thread_last_contacts(const tx_thread* t, tx_thread_contacts* out);

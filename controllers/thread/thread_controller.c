@@ -11,6 +11,9 @@
 // one nearest their point) is severed, PREFIX.cut_links marks it and the pieces,
 // and the cut is sent again on PREFIX.events. With punctures (tx_puncture
 // rows: points on triangles of the skin's particles) the thread passes through them in order.
+// With grasp_events, a TX_EVENT_GRASP from hand h whose point is on the
+// thread holds the nearest node in the jaws' frame (instrument<h>.pose)
+// until a TX_EVENT_RELEASE from h.
 #include "thread_controller.h"
 
 #include "knot.h"
@@ -24,6 +27,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#define TX_THREAD_HANDS 8 // grasp_hands at most
 
 typedef struct thread_ctl {
   tx_thread* t;
@@ -46,6 +51,16 @@ typedef struct thread_ctl {
   tx_port segments, spheres; // with draw: the thread as a tube for the graphics view
   tx_port caps[8];
   tx_port cut_in, links;     // the cut events listened to (cut_in.id 0: none); PREFIX.cut_links
+  tx_port grasp_in;          // the grasp events (grasp_in.id 0: none)
+  bool grasp_shared;         // grasp_in is cut_in: one stream for both
+  int hands;                 // grasp_hands: instrument0.pose .. instrument<hands - 1>.pose
+  tx_port jaws[TX_THREAD_HANDS];
+  int hold_node[TX_THREAD_HANDS]; // the node hand h holds (-1: none)
+  double hold_off[TX_THREAD_HANDS][3]; // m, that node in the jaws' frame
+  double grasp_capture;      // m
+  int grasps;
+  tx_warning bad_grasp;
+  tx_result grasps_result;
   tx_port punct_in;          // the puncture list (punct_in.id 0: none)
   double* punct;             // (max_punctures x 3) where they are this step, m
   int max_punct;
@@ -66,6 +81,8 @@ typedef struct thread_ctl {
   double rod_after_s; // > 0: the thread turns into a rod then
   int knot_first, knot_last; // the cylinders of the last knot counted (-1: none)
   double max_strain;         // the largest segment strain seen
+  int knot_lost;             // times the papers' rule lost a knot it had found
+  tx_result held_result, lost_result;
   tx_result strain_result;
 } thread_ctl;
 
@@ -85,6 +102,7 @@ static const tx_param_def params[] = {
     {"max_substeps", TX_PARAM_INT, "1", 1, 10000, 64, NULL, "at most this many substeps a step"},
     {"max_stretch", TX_PARAM_NUM, "1", 0, 1, 0.05, NULL, "rod: no segment longer than (1 + this) its rest length"},
     {"self_collision", TX_PARAM_BOOL, NULL, 0, 0, 1, NULL, "cylinders of the thread push each other apart"},
+    {"self_friction", TX_PARAM_NUM, "1", 0, 10, 0, NULL, "rod: Coulomb friction coefficient of the thread's contacts with itself"},
     {"slack", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "ftl: a node follows only when pulled (no segment longer than its rest length, some shorter)"},
     {"pin_tail", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "the tail stays where it starts"},
     {"tail_m", TX_PARAM_JSON, NULL, 0, 0, 0, NULL, "[x, y, z], m: where the thread starts straight towards from the head; [0.2, 0, 0] by default"},
@@ -106,6 +124,9 @@ static const tx_param_def params[] = {
     {"puncture_friction_n", TX_PARAM_NUM, "N", 0, 100, 0, NULL, "the force along the thread a puncture holds it with before it slides (Coulomb); ftl: felt at the hand only"},
     {"puncture_capture_m", TX_PARAM_NUM, "m", 1e-6, 0.1, 0.001, NULL, "the head has gone through a puncture once the thread behind it is this near it"},
     {"cut_events", TX_PARAM_STR, NULL, 0, 0, 0, "", "an event stream (instruments.events) whose TX_EVENT_CUT events cut the thread; empty: none"},
+    {"grasp_events", TX_PARAM_STR, NULL, 0, 0, 0, "", "an event stream (instruments.events) whose TX_EVENT_GRASP from hand h holds the thread's nearest node in instrument<h>.pose's frame until h's TX_EVENT_RELEASE; empty: none"},
+    {"grasp_capture_m", TX_PARAM_NUM, "m", 0, 0.1, 0.001, NULL, "a grasp holds the thread when its point is this near the thread (farther: another thing in the jaws, e.g. the needle)"},
+    {"grasp_hands", TX_PARAM_INT, "1", 1, TX_THREAD_HANDS, 2, NULL, "with grasp_events: the jaws' frames read, instrument0.pose .. instrument<this - 1>.pose"},
 };
 
 static int read_tail(tx_setup* s, double tail[3]) {
@@ -147,6 +168,7 @@ static int configure(tx_setup* s, void** self) {
   d.max_substeps = (int)tx_table_int(s, "max_substeps");
   d.max_stretch = tx_table_num(s, "max_stretch");
   d.self_collision = tx_table_bool(s, "self_collision");
+  d.self_friction = tx_table_num(s, "self_friction");
   d.pin_tail = tx_table_bool(s, "pin_tail");
   d.slack = tx_table_bool(s, "slack");
   d.max_shapes = (int)tx_table_int(s, "max_shapes");
@@ -200,6 +222,24 @@ static int configure(tx_setup* s, void** self) {
   const char* cut_events = tx_table_str(s, "cut_events");
   if (!cut_events) return -1;
   if (*cut_events) k->cut_in = tx_setup_listen(s, cut_events);
+  const char* grasp_events = tx_table_str(s, "grasp_events");
+  if (!grasp_events) return -1;
+  k->grasp_capture = tx_table_num(s, "grasp_capture_m");
+  k->hands = (int)tx_table_int(s, "grasp_hands");
+  for (int h = 0; h < TX_THREAD_HANDS; h++) k->hold_node[h] = -1;
+  if (*grasp_events) {
+    // one stream for both: one reader, each event taken once
+    k->grasp_shared = *cut_events && strcmp(cut_events, grasp_events) == 0;
+    k->grasp_in = k->grasp_shared ? k->cut_in : tx_setup_listen(s, grasp_events);
+    for (int h = 0; h < k->hands; h++) {
+      snprintf(name, sizeof name, "instrument%d.pose", h);
+      k->jaws[h] = TX_READ_OF(s, name, tx_instrument_pose);
+    }
+  }
+  k->bad_grasp = tx_setup_warning(s, "bad_grasp");
+  k->grasps_result = tx_setup_result(s, "grasps");
+  k->held_result = tx_setup_result(s, "knot_held");
+  k->lost_result = tx_setup_result(s, "knot_lost");
   const char* punctures = tx_table_str(s, "punctures");
   if (!punctures) return -1;
   if (*punctures) {
@@ -318,6 +358,7 @@ static void check_knot(tx_ctx* c, thread_ctl* k) {
     k->fixed = true;
     emit_knot(c, k, &p, true);
   }
+  if (k->knotted && !knot) k->knot_lost++;
   k->knotted = knot;
 }
 
@@ -339,10 +380,13 @@ static void classify(tx_ctx* c, thread_ctl* k) {
 // nearest the blades' point when source is no link of this thread; each new
 // cut goes out again on PREFIX.events (source: the link, point: its point
 // nearest the blades)
+static void take_grasp(tx_ctx* c, thread_ctl* k, const tx_event* e);
+
 static void take_cuts(tx_ctx* c, thread_ctl* k) {
   tx_thread* t = k->t;
   int nseg = tx_thread_node_count(t) - 1;
   for (tx_event e; tx_next_event(c, k->cut_in, &e);) {
+    if (k->grasp_shared && (e.kind == TX_EVENT_GRASP || e.kind == TX_EVENT_RELEASE)) take_grasp(c, k, &e);
     if (e.kind != TX_EVENT_CUT) continue;
     const double* p = e.cut.point;
     bool finite = isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
@@ -364,6 +408,74 @@ static void take_cuts(tx_ctx* c, thread_ctl* k) {
     tx_event out = {.kind = TX_EVENT_CUT, .source = (uint32_t)seg};
     for (int i = 0; i < 3; i++) out.cut.point[i] = a[i] + u * (b[i] - a[i]);
     tx_emit(c, k->events, &out);
+  }
+}
+
+// v rotated by the unit quaternion q (w, x, y, z), or by its inverse
+static void rotate(const double q[4], const double v[3], bool inverse, double out[3]) {
+  double w = q[0], x = inverse ? -q[1] : q[1], y = inverse ? -q[2] : q[2], z = inverse ? -q[3] : q[3];
+  double tx = 2 * (y * v[2] - z * v[1]), ty = 2 * (z * v[0] - x * v[2]), tz = 2 * (x * v[1] - y * v[0]);
+  out[0] = v[0] + w * tx + y * tz - z * ty;
+  out[1] = v[1] + w * ty + z * tx - x * tz;
+  out[2] = v[2] + w * tz + x * ty - y * tx;
+}
+
+// a grasp from hand h whose point is within grasp_capture of the thread
+// (a link not cut) holds that link's node nearer the point, at its place
+// in the jaws' frame, until a release from h. A hand's latest grasp is
+// what its jaws hold: any grasp from h ends h's hold first. Grasps of other
+// things (the needle) are farther from the thread, or nearest its head
+// (which is on the needle's swage): they hold no node.
+static void take_grasp(tx_ctx* c, thread_ctl* k, const tx_event* e) {
+  tx_thread* t = k->t;
+  int h = (int)e->source;
+  if (h < 0 || h >= k->hands) {
+    tx_warn(c, k->bad_grasp);
+    return;
+  }
+  if (k->hold_node[h] >= 0) tx_thread_release(t, k->hold_node[h]);
+  k->hold_node[h] = -1;
+  if (e->kind == TX_EVENT_RELEASE) return;
+  const double* p = e->grasp.point;
+  if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) {
+    tx_warn(c, k->bad_grasp);
+    return;
+  }
+  double at[3];
+  int seg = tx_thread_nearest_link(t, p, at);
+  if (seg < 0) return;
+  double d = 0;
+  for (int a = 0; a < 3; a++) d += (at[a] - p[a]) * (at[a] - p[a]);
+  if (sqrt(d) > k->grasp_capture) return; // not the thread
+  const double *a0 = tx_thread_position(t, seg), *a1 = tx_thread_position(t, seg + 1);
+  double d0 = 0, d1 = 0;
+  for (int a = 0; a < 3; a++) d0 += (a0[a] - p[a]) * (a0[a] - p[a]), d1 += (a1[a] - p[a]) * (a1[a] - p[a]);
+  int node = d1 <= d0 ? seg + 1 : seg;
+  if (node == 0) return; // at the head: the needle's swage
+  tx_snapshot js = tx_read(c, k->jaws[h]);
+  if (js.seq == 0) return; // no jaws to hold it in yet
+  const tx_instrument_pose* jp = js.data;
+  const double* x = tx_thread_position(t, node);
+  double rel[3] = {x[0] - jp->pos[0], x[1] - jp->pos[1], x[2] - jp->pos[2]};
+  rotate(jp->quat, rel, true, k->hold_off[h]);
+  k->hold_node[h] = node;
+  k->grasps++;
+}
+
+// each held node where its jaws are now
+static void follow_jaws(tx_ctx* c, thread_ctl* k) {
+  for (int h = 0; h < k->hands; h++) {
+    if (k->hold_node[h] < 0) continue;
+    tx_snapshot js = tx_read(c, k->jaws[h]);
+    if (js.seq == 0) continue;
+    const tx_instrument_pose* jp = js.data;
+    double q[4], n = 0, at[3];
+    for (int a = 0; a < 4; a++) n += jp->quat[a] * jp->quat[a];
+    n = sqrt(n);
+    for (int a = 0; a < 4; a++) q[a] = n > 0 ? jp->quat[a] / n : a == 0;
+    rotate(q, k->hold_off[h], false, at);
+    for (int a = 0; a < 3; a++) at[a] += jp->pos[a];
+    if (tx_thread_hold(k->t, k->hold_node[h], at) != TX_THREAD_OK) tx_warn(c, k->bad_grasp);
   }
 }
 
@@ -409,6 +521,9 @@ static void take_punctures(tx_ctx* c, thread_ctl* k, tx_snapshot sx) {
 static void step(tx_ctx* c, void* self) {
   thread_ctl* k = self;
   if (k->cut_in.id) take_cuts(c, k);
+  if (k->grasp_in.id && !k->grasp_shared)
+    for (tx_event e; tx_next_event(c, k->grasp_in, &e);)
+      if (e.kind == TX_EVENT_GRASP || e.kind == TX_EVENT_RELEASE) take_grasp(c, k, &e);
   tx_snapshot p = tx_read(c, k->head);
   if (p.seq > 0) { // nothing published yet: the head waits
     const tx_pose* pose = p.data;
@@ -453,6 +568,7 @@ static void step(tx_ctx* c, void* self) {
     }
     if (tx_thread_set_capsules(k->t, k->shapes, m) != TX_THREAD_OK) tx_warn(c, k->bad_capsule);
   }
+  if (k->grasp_in.id) follow_jaws(c, k);
   if (k->rod_after_s > 0 && tx_thread_get_def(k->t)->model == TX_THREAD_FTL && tx_sim_ns(c) * 1e-9 >= k->rod_after_s)
     tx_thread_set_model(k->t, TX_THREAD_ROD);
   if (tx_thread_step(k->t, k->dt) == TX_THREAD_FAULT) tx_warn(c, k->fault);
@@ -473,6 +589,9 @@ static void finish(tx_ctx* c, void* self) {
   thread_ctl* k = self;
   tx_set_result(c, k->knots_result, k->knots);
   tx_set_result(c, k->cuts_result, k->cuts);
+  tx_set_result(c, k->grasps_result, k->grasps);
+  tx_set_result(c, k->held_result, k->knotted ? 1 : 0);
+  tx_set_result(c, k->lost_result, k->knot_lost);
   tx_set_result(c, k->passed_result, tx_thread_punctures_passed(k->t));
   tx_set_result(c, k->first_knot_result, k->first_knot_s);
   tx_set_result(c, k->strain_result, k->max_strain);

@@ -1,4 +1,4 @@
-// The thread's contacts: the grid's self contacts against every pair tested
+// The thread's contacts: the broadphase's self contacts against every pair tested
 // by brute force, two crossing strands pushed to 2 r apart, the thread
 // draped on a capsule and on a triangle patch, and the 1 m/s sweeps: the head
 // drags the thread around a 0.5 mm thread (a capsule, then a pinned strand of
@@ -36,10 +36,10 @@ static double min_self_distance(const tx_thread* t, int skip) {
 }
 
 // a random walk of rest-length steps crumpled into a 12 mm box: every
-// cylinder the grid marks touching is one that brute force finds within
+// cylinder the broadphase marks touching is one that brute force finds within
 // 2 r (and none is missed). A compliant rod with no gravity does not move
 // before the marks are taken.
-static void test_grid_finds_every_touching_pair(void** state) {
+static void test_broadphase_finds_every_touching_pair(void** state) {
   (void)state;
   tx_thread_def d = tx_thread_def_default();
   d.model = TX_THREAD_ROD;
@@ -87,10 +87,10 @@ static void test_grid_finds_every_touching_pair(void** state) {
     assert_int_equal(got[i], want[i]);
     marked += got[i];
   }
-  print_message("%d touching pairs, %d cylinders marked; the grid proposed %d pairs of %d\n", pairs, marked,
+  print_message("%d touching pairs, %d cylinders marked; the broadphase proposed %d pairs of %d\n", pairs, marked,
                 c.broad_pairs, (d.nodes - 1) * (d.nodes - 2) / 2);
   assert_true(pairs > 20);
-  // even crumpled this tight, the grid proposes fewer than half of all pairs
+  // even crumpled this tight, the broadphase proposes fewer than half of all pairs
   assert_true(c.broad_pairs < (d.nodes - 1) * (d.nodes - 2) / 4);
   free(want);
   free(x);
@@ -102,7 +102,7 @@ static void test_grid_finds_every_touching_pair(void** state) {
   assert_non_null(t);
   assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
   tx_thread_last_contacts(t, &c);
-  print_message("straight, %d nodes: the grid proposed %d pairs\n", d.nodes, c.broad_pairs);
+  print_message("straight, %d nodes: the broadphase proposed %d pairs\n", d.nodes, c.broad_pairs);
   assert_true(c.broad_pairs < 8 * d.nodes);
   tx_thread_destroy(t);
 }
@@ -375,7 +375,7 @@ static void test_bad_shapes_and_mesh_refused(void** state) {
 
 int main(void) {
   const struct CMUnitTest tests[] = {
-      cmocka_unit_test(test_grid_finds_every_touching_pair),
+      cmocka_unit_test(test_broadphase_finds_every_touching_pair),
       cmocka_unit_test(test_crossing_strands_are_pushed_apart),
       cmocka_unit_test(test_rod_drapes_over_a_capsule),
       cmocka_unit_test(test_sweep_around_a_capsule_thread),

@@ -464,6 +464,96 @@ static void puncture_survives_renumbering(void** state) {
   tx_scenario_free(s);
 }
 
+// a test class standing for physics.instruments: a still head (jaws.head),
+// the jaws of hands 0 and 1 (instrument0.pose, instrument1.pose) and their
+// events on tool.events (the stream the cuts come on too). At step 100
+// hand 0 closes on the thread at node 30 (its point 1 mm below the jaws)
+// and hand 1 on the needle, 2 cm away (ignored); hand 0's jaws then go
+// 5 mm along -x and +z while turning 90 degrees about z, stop at step 350,
+// let go at step 400 and go on 5 mm along +z. The class reads node 30 back.
+static tx_port jaws_out[2], jaws_head, jaws_events, jaws_nodes;
+static double jaws_worst_moving, node30_at_399[3], node30_at_600[3], jaws_at[3];
+static void jaws_pose(int64_t k, double pos[3], double q[4]) {
+  double f = k < 100 ? 0 : k > 350 ? 1 : (k - 100) / 250.0, g = k > 400 ? (k - 400) / 200.0 : 0;
+  double th = f * 3.14159265358979323846 / 2;
+  pos[0] = 0.03 - 0.005 * f, pos[1] = 0.001, pos[2] = 0.005 * f + 0.005 * fmin(1, g);
+  q[0] = cos(th / 2), q[1] = q[2] = 0, q[3] = sin(th / 2);
+}
+static int jaws_configure(tx_setup* s, void** self) {
+  *self = NULL;
+  jaws_out[0] = tx_setup_write(s, &TX_COMPONENT_OF("instrument0.pose", tx_instrument_pose, 1));
+  jaws_out[1] = tx_setup_write(s, &TX_COMPONENT_OF("instrument1.pose", tx_instrument_pose, 1));
+  jaws_head = tx_setup_write(s, &TX_COMPONENT_OF("jaws.head", tx_pose, 1));
+  jaws_events = tx_setup_emit(s, "tool.events", 16);
+  jaws_nodes = TX_READ_OF(s, "thread.nodes", tx_thread_node);
+  return 0;
+}
+static void jaws_step(tx_ctx* c, void* self) {
+  (void)self;
+  int64_t k = (int64_t)tx_step_index(c);
+  tx_pose* head = tx_write(c, jaws_head);
+  *head = (tx_pose){{0, 0, 0}, {1, 0, 0, 0}};
+  tx_instrument_pose* ip = tx_write(c, jaws_out[0]);
+  jaws_pose(k, ip->pos, ip->quat);
+  ip->jaw = 0;
+  tx_instrument_pose* other = tx_write(c, jaws_out[1]);
+  *other = (tx_instrument_pose){{0, 0.02, 0}, {1, 0, 0, 0}, 0};
+  if (k == 100) {
+    tx_event g = {.kind = TX_EVENT_GRASP, .source = 0, .grasp = {{0.03, 0, 0}, 0, 0}};
+    tx_emit(c, jaws_events, &g);
+    tx_event n = {.kind = TX_EVENT_GRASP, .source = 1, .grasp = {{0, 0.02, 0}, 0, 0}}; // the needle
+    tx_emit(c, jaws_events, &n);
+  }
+  if (k == 400) tx_emit(c, jaws_events, &(tx_event){.kind = TX_EVENT_RELEASE, .source = 0});
+  if (k == 450) tx_emit(c, jaws_events, &(tx_event){.kind = TX_EVENT_RELEASE, .source = 1}); // the needle's
+  tx_snapshot x = tx_read(c, jaws_nodes);
+  if (x.rows < 31) return;
+  const double* n30 = ((const tx_thread_node*)x.data)[30].x;
+  // where node 30 should be: 1 mm below the jaws in their frame, turned with them
+  double pos[3], q[4];
+  jaws_pose(k, pos, q);
+  double th = 2 * atan2(q[3], q[0]), want[3] = {pos[0] + 0.001 * sin(th), pos[1] - 0.001 * cos(th), pos[2]};
+  if (k > 110 && k < 400) {
+    double d = sqrt(pow(n30[0] - want[0], 2) + pow(n30[1] - want[1], 2) + pow(n30[2] - want[2], 2));
+    jaws_worst_moving = fmax(jaws_worst_moving, d);
+  }
+  if (k == 399) memcpy(node30_at_399, n30, sizeof node30_at_399), memcpy(jaws_at, want, sizeof jaws_at);
+  if (k == 600) memcpy(node30_at_600, n30, sizeof node30_at_600);
+}
+static const tx_controller_class jaws_class = {
+    .type = "test.jaws", .summary = "jaws that grasp", .configure = jaws_configure, .step = jaws_step};
+
+// ftl, 41 nodes of 1 mm from the still head along +x: the jaws' grasp holds
+// node 30 at its place in their frame (within a step's move while they move,
+// exactly once they stop), the needle's grasp 2 cm away is ignored, and once
+// let go the node stays where it was left while the jaws go on
+static void ftl_held_by_grasping_jaws(void** state) {
+  (void)state;
+  if (!tx_find_controller(jaws_class.type)) assert_int_equal(tx_register_controller(&jaws_class), 0);
+  const char* text =
+      "{\"name\":\"t\",\"controllers\":["
+      "{\"name\":\"tool\",\"type\":\"test.jaws\",\"rate_hz\":1000},"
+      "{\"name\":\"thread\",\"type\":\"physics.thread\",\"rate_hz\":1000,\"params\":{\"head\":\"jaws.head\","
+      "\"nodes\":41,\"length_m\":0.04,\"cut_events\":\"tool.events\",\"grasp_events\":\"tool.events\"}}]}";
+  jaws_worst_moving = 0;
+  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 0.65);
+  double at_rest = sqrt(pow(node30_at_399[0] - jaws_at[0], 2) + pow(node30_at_399[1] - jaws_at[1], 2) +
+                        pow(node30_at_399[2] - jaws_at[2], 2));
+  double after = sqrt(pow(node30_at_600[0] - node30_at_399[0], 2) + pow(node30_at_600[1] - node30_at_399[1], 2) +
+                      pow(node30_at_600[2] - node30_at_399[2], 2));
+  print_message("grasp: node 30 within %.3f mm of the moving jaws' hold, %.1e m at rest; %.1e m after the release\n",
+                jaws_worst_moving * 1e3, at_rest, after);
+  assert_true(jaws_worst_moving < 0.05e-3); // a step's move of the jaws is 0.03 mm
+  assert_true(at_rest < 1e-9);
+  assert_true(fabs(node30_at_399[0] - 0.026) < 1e-9); // turned: 1 mm along +x of the jaws at x = 25 mm
+  assert_true(after < 1e-12);
+  assert_true(result(s, "thread.grasps") == 1);
+  assert_int_equal(warnings(s, "thread.bad_grasp"), 0);
+  tx_scenario_free(s);
+}
+
 static void bad_input_is_named(void** state) {
   (void)state;
   struct {
@@ -482,6 +572,9 @@ static void bad_input_is_named(void** state) {
       {"\"capsules\":[\"nobody.capsules\"]", "nobody.capsules"},
       {"\"cut_events\":\"nobody.events\"", "nobody.events"},
       {"\"cut_events\":5", "cut_events"},
+      {"\"grasp_events\":\"nobody.events\"", "instrument0.pose"}, // no jaws' frame
+      {"\"grasp_hands\":9", "params.grasp_hands"},
+      {"\"grasp_capture_m\":-1", "params.grasp_capture_m"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
     tx_scenario* s = load(cases[i].params, "slide-x-over");
@@ -502,6 +595,7 @@ int main(void) {
       cmocka_unit_test(rod_cut_by_an_event),
       cmocka_unit_test(passes_through_skin_punctures),
       cmocka_unit_test(puncture_survives_renumbering),
+      cmocka_unit_test(ftl_held_by_grasping_jaws),
       cmocka_unit_test(bad_input_is_named),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
