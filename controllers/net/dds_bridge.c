@@ -14,6 +14,8 @@
 #include "../system_internal.h"
 #include "net.h"
 
+#include <tactus/stats.h>
+
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
@@ -62,6 +64,8 @@ typedef struct inbound {
   tx_stream* ring;       // after init
   dds_entity_t reader;
   uint64_t last_seq;     // streams: the sender's last event seq, for gaps
+  tx_hist* latency;      // components: mirror publish - the writer's publish, ns (one host: one clock)
+  tx_result r_p50, r_p99;
 } inbound;
 
 struct bridge {
@@ -110,6 +114,12 @@ static int read_receive(tx_setup* s, bridge* b, const char* const* fast, int nfa
     in->def = (tx_component_def){in->name, type, (uint32_t)json_integer_value(rows), (uint32_t)json_integer_value(cols), in->units};
     in->port = tx_setup_write(s, &in->def);
     in->fast = listed(fast, nfast, name);
+    if (!(in->latency = calloc(1, sizeof *in->latency))) return -1;
+    char key[TX_NAME_MAX + 24];
+    snprintf(key, sizeof key, "%s.latency_p50_us", name);
+    in->r_p50 = tx_setup_result(s, key);
+    snprintf(key, sizeof key, "%s.latency_p99_us", name);
+    in->r_p99 = tx_setup_result(s, key);
   }
   list = tx_param_json(s, "receive_streams");
   if (list && !json_is_array(list)) return tx_setup_fail(s, "receive_streams", "expected an array of {name, capacity}");
@@ -196,6 +206,7 @@ static void on_component(dds_entity_t reader, void* arg) {
       memcpy(back, newest->data._buffer, newest->data._length);
       tx_model_set_rows(b->model, in->comp, newest->rows);
       tx_model_publish(b->model, in->comp, newest->sim_ns); // the sender's simulation time
+      tx_hist_add(in->latency, tx_mono_ns() - newest->mono_ns);
       pthread_mutex_unlock(&b->lock);
       atomic_fetch_add_explicit(&b->received, 1, memory_order_relaxed);
     }
@@ -273,6 +284,8 @@ static int init(tx_ctx* c, void* self) {
       return -1;
     }
   }
+  for (int k = 0; k < b->nin; k++)
+    if (b->in[k].latency) tx_hist_clear(b->in[k].latency), tx_prefault(b->in[k].latency, sizeof *b->in[k].latency);
   atomic_store_explicit(&b->live, true, memory_order_release);
   return 0;
 }
@@ -309,6 +322,11 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, b->r_received, (double)atomic_load(&b->received));
   tx_set_result(c, b->r_events_sent, (double)atomic_load(&b->events_sent));
   tx_set_result(c, b->r_events_received, (double)atomic_load(&b->events_received));
+  for (int k = 0; k < b->nin; k++)
+    if (b->in[k].latency && b->in[k].latency->count) {
+      tx_set_result(c, b->in[k].r_p50, tx_hist_percentile(b->in[k].latency, 0.5) / 1e3);
+      tx_set_result(c, b->in[k].r_p99, tx_hist_percentile(b->in[k].latency, 0.99) / 1e3);
+    }
 }
 
 static void fini(void* self) {
@@ -317,6 +335,7 @@ static void fini(void* self) {
   atomic_store(&b->live, false);
   if (b->participant > 0) dds_delete(b->participant); // its readers, writers and topics; waits for listeners
   pthread_mutex_destroy(&b->lock);
+  for (int k = 0; k < b->nin; k++) free(b->in[k].latency);
   free(b);
 }
 

@@ -108,7 +108,7 @@ void tx_net_pack(tx_net_Snapshot* out, uint64_t tag, const char* name, tx_type t
   snprintf(out->name, sizeof out->name, "%s", name);
   out->seq = snap->seq;
   out->sim_ns = snap->sim_ns;
-  out->mono_ns = tx_mono_ns();
+  out->mono_ns = snap->mono_ns; // the writer's publish: the mirror's added latency is measured from it
   out->type = (uint8_t)type;
   out->rows = snap->rows;
   out->cols = snap->cols;
