@@ -111,6 +111,13 @@ static int apply_sets(const char* file, json_t* root, const tx_load_options* o, 
       if (json_is_string(json_object_get(c, "name")) && strcmp(json_string_value(json_object_get(c, "name")), key) == 0)
         found = (int)index;
     }
+    if (found < 0 && *param && strcmp(key, "net") == 0) { // the net section: net.domain, net.peers, ...
+      json_t* net = json_object_get(root, "net");
+      if (!net) json_object_set_new(root, "net", net = json_object());
+      if (!json_is_object(net)) return json_decref(value), fail("%s: net: expected an object", file);
+      json_object_set_new(net, param, value);
+      continue;
+    }
     if (found < 0 || !*param) {
       json_decref(value);
       if (!*param) return fail("--set %s: expected CONTROLLER.PARAM=VALUE", text);
@@ -622,6 +629,8 @@ static tx_scenario* load_root(const char* file, const char* dir, json_t* root, c
   if (!rc && role < 0) rc = declare_model(file, s->system, json_object_get(root, "model"));
   else if (!rc) rc = declare_role_model(file, s->system, json_object_get(root, "model"), full, role_of, role);
   if (!rc) rc = add_controllers(file, s->system, part ? part : controllers, origins, norigins, part ? map : NULL);
+  if (!rc && bridge && !tx_find_controller("net.dds"))
+    rc = fail("--role %s: %s crosses processes, and this build has no DDS bridge (configure with -DTX_WITH_DDS=ON)", o->role, file);
   if (!rc && bridge) {
     json_t* rate = json_object_get(net, "rate_hz");
     rc = tx_system_add(s->system, NET_INSTANCE, "net.dds", rate ? json_number_value(rate) : 1000, bp);
