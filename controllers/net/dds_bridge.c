@@ -5,9 +5,10 @@
 // publish (a changed seq) as a sample of its topic; events it listens to go
 // out one sample each. Receiving: a DDS listener, on Cyclone's receive thread,
 // writes each sample into the local model at once (the bridge is the one
-// writer of a mirrored component there), stamped with the sender's
-// simulation time, so a reader sees it as any publish, without waiting for
-// the bridge's next tick. Foreign (another session) and malformed samples are
+// writer of a mirrored component there), stamped with the local simulation
+// time of its arrival, so a reader sees it as any publish, without waiting for
+// the bridge's next tick, and its age says how long ago the peer last spoke
+// (the haptics watchdog fades a force model from a lost peer to zero). Foreign (another session) and malformed samples are
 // dropped and counted, never written.
 #include "dds_bridge.h"
 
@@ -82,6 +83,7 @@ struct bridge {
   dds_entity_t participant;
   pthread_mutex_t lock;  // one listener call at a time writes the model
   _Atomic bool live;     // init done, finish not yet: the listener may write
+  _Atomic int64_t clock_offset; // CLOCK_MONOTONIC - local simulation time, ns: its least value seen
   tx_warning foreign, malformed, lost, send_failed;
   tx_result r_sent, r_received, r_events_sent, r_events_received;
   _Atomic uint64_t sent, received, events_sent, events_received;
@@ -205,8 +207,11 @@ static void on_component(dds_entity_t reader, void* arg) {
       void* back = tx_model_back(b->model, in->comp);
       memcpy(back, newest->data._buffer, newest->data._length);
       tx_model_set_rows(b->model, in->comp, newest->rows);
-      tx_model_publish(b->model, in->comp, newest->sim_ns); // the sender's simulation time
-      tx_hist_add(in->latency, tx_mono_ns() - newest->mono_ns);
+      // stamped with the local simulation time of the arrival: the two processes'
+      // clocks started apart, so the sender's time would make the age meaningless
+      int64_t now = tx_mono_ns(), local = now - atomic_load_explicit(&b->clock_offset, memory_order_relaxed);
+      tx_model_publish(b->model, in->comp, local > 0 ? local : 0);
+      tx_hist_add(in->latency, now - newest->mono_ns);
       pthread_mutex_unlock(&b->lock);
       atomic_fetch_add_explicit(&b->received, 1, memory_order_relaxed);
     }
@@ -237,6 +242,8 @@ static void on_event(dds_entity_t reader, void* arg) {
       if (s->seq > in->last_seq) in->last_seq = s->seq;
       tx_event e;
       tx_net_unpack_event(s, &e);
+      int64_t local = tx_mono_ns() - atomic_load_explicit(&b->clock_offset, memory_order_relaxed);
+      e.sim_ns = local > 0 ? local : 0; // as for components: the local time of the arrival
       if (tx_stream_push(in->ring, &e)) atomic_fetch_add_explicit(&b->events_received, 1, memory_order_relaxed);
     }
     pthread_mutex_unlock(&b->lock);
@@ -248,6 +255,7 @@ static int init(tx_ctx* c, void* self) {
   bridge* b = self;
   b->ctx = c;
   b->model = c->sys->model;
+  atomic_store(&b->clock_offset, tx_mono_ns() - tx_sim_ns(c)); // about the run's time 0, until the first step says
   b->participant = tx_net_participant(b->domain, b->peers, b->npeers);
   if (b->participant < 0) return tx_stop_run(c, "%s", tx_error()), -1;
   for (int k = 0; k < b->nout + b->nin; k++) {
@@ -290,8 +298,17 @@ static int init(tx_ctx* c, void* self) {
   return 0;
 }
 
+// the local simulation time that CLOCK_MONOTONIC now stands for: the least
+// offset seen is the tick that ran least late
+static void track_clock(tx_ctx* c, bridge* b) {
+  int64_t offset = tx_mono_ns() - tx_sim_ns(c);
+  if (tx_step_index(c) == 0 || offset < atomic_load_explicit(&b->clock_offset, memory_order_relaxed))
+    atomic_store_explicit(&b->clock_offset, offset, memory_order_relaxed);
+}
+
 static void step(tx_ctx* c, void* self) {
   bridge* b = self;
+  track_clock(c, b);
   for (int k = 0; k < b->nout; k++) {
     outbound* o = &b->out[k];
     if (o->stream) {
