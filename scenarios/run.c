@@ -217,6 +217,8 @@ int tx_cmd_run(int argc, char** argv) {
     if ((strcmp(devices[i], "mouse") == 0 || strncmp(devices[i], "mouse:", 6) == 0) && strcmp(view, "window") != 0)
       return tx_bad_input("--device %s: the mouse drives the tool through a window: add --view window", devices[i]);
 
+  // the processes of a session meet in real time: a virtual clock cannot be shared
+  if (role && cfg.lockstep) return tx_bad_input("--role %s: a session runs in real time; leave out --lockstep", role);
   if (tx_out_check(cfg.out, force)) return TX_EXIT_BAD_INPUT;
 
   tx_scenario* sc = NULL;
