@@ -375,11 +375,14 @@ static int check_roles(const char* file, json_t* roles, json_t* controllers, int
 static int check_net(const char* file, json_t* net) {
   if (!net) return 0;
   if (!json_is_object(net)) return fail("%s: net: expected an object", file);
-  static const char* const keys[] = {"domain", "peers", "rate_hz", "fast", "state", "streams", NULL};
+  static const char* const keys[] = {"domain", "peers", "rate_hz", "poll_us", "fast", "state", "streams", NULL};
   if (check_keys(file, "net", net, keys)) return -1;
   json_t* domain = json_object_get(net, "domain");
   if (domain && (!json_is_integer(domain) || json_integer_value(domain) < 0 || json_integer_value(domain) > NET_DOMAIN_MAX))
     return fail("%s: net.domain: expected an integer in [0, %d] (a DDS domain id)", file, NET_DOMAIN_MAX);
+  json_t* poll = json_object_get(net, "poll_us");
+  if (poll && (!json_is_integer(poll) || json_integer_value(poll) < 0 || json_integer_value(poll) > 100000))
+    return fail("%s: net.poll_us: expected an integer in [0, 100000] (us; 0: send from the bridge's step)", file);
   json_t* rate = json_object_get(net, "rate_hz");
   if (rate && (!json_is_number(rate) || !(json_number_value(rate) >= 1 && json_number_value(rate) <= TX_RATE_MAX_HZ)))
     return fail("%s: net.rate_hz: expected a number in [1, %g]", file, TX_RATE_MAX_HZ);
@@ -507,6 +510,8 @@ static json_t* bridge_params(const char* file, const char* scenario, json_t* net
   json_t* peers = json_object_get(net, "peers");
   json_object_set_new(params, "peers", peers ? json_deep_copy(peers) : json_array());
   json_object_set_new(params, "session", json_string(scenario));
+  json_t* poll = json_object_get(net, "poll_us");
+  json_object_set_new(params, "poll_us", json_integer(poll ? json_integer_value(poll) : 0));
   json_object_set_new(params, "send", send);
   json_object_set_new(params, "receive", receive);
   json_object_set_new(params, "send_streams", send_streams);

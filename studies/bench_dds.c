@@ -173,7 +173,7 @@ static int run_role(const char* text, const char* role, double seconds, tx_run_r
   return 0;
 }
 
-int tx_bench_dds(double duration_s, double net_hz, double sim_hz) {
+int tx_bench_dds(double duration_s, double net_hz, double sim_hz, int poll_us) {
   for (size_t i = 0; i < sizeof classes / sizeof classes[0]; i++)
     if (!tx_find_controller(classes[i].type)) tx_register_controller(&classes[i]);
   double seconds = duration_s > 0 ? duration_s : 5;
@@ -181,13 +181,14 @@ int tx_bench_dds(double duration_s, double net_hz, double sim_hz) {
   char text[1024];
   snprintf(text, sizeof text,
            "{\"name\": \"bench-dds-%d\", \"roles\": {\"device\": [\"device\", \"mesh\"], \"sim\": [\"sim\"]},"
-           " \"net\": {\"domain\": %d, \"rate_hz\": %g, \"fast\": [\"bench.pose\", \"bench.force\"], \"state\": [\"bench.mesh\"]},"
+           " \"net\": {\"domain\": %d, \"rate_hz\": %g, \"poll_us\": %d, \"fast\": [\"bench.pose\", \"bench.force\"], \"state\": [\"bench.mesh\"]},"
            " \"controllers\": [{\"name\": \"device\", \"type\": \"bench.dds_device\", \"rate_hz\": 1000},"
            " {\"name\": \"mesh\", \"type\": \"bench.dds_mesh\", \"rate_hz\": 60},"
            " {\"name\": \"sim\", \"type\": \"bench.dds_sim\", \"rate_hz\": %g}]}",
-           (int)getpid(), domain, net_hz, sim_hz);
-  printf("bench dds: two processes on loopback (domain %d), %g s; bridges at %g Hz, the echoing sim at %g Hz\n", domain,
-         seconds, net_hz, sim_hz);
+           (int)getpid(), domain, net_hz, poll_us, sim_hz);
+  printf("bench dds: two processes on loopback (domain %d), %g s; bridges at %g Hz, %s; the echoing sim at %g Hz\n", domain,
+         seconds, net_hz, poll_us ? "a sender thread polling" : "sending from their steps", sim_hz);
+  if (poll_us) printf("  the sender threads poll every %d us\n", poll_us);
   fflush(stdout);
 
   // the raw floor first, so that the session below runs alone. Both ends are
@@ -276,8 +277,8 @@ int tx_bench_dds(double duration_s, double net_hz, double sim_hz) {
 
 #include <stdio.h>
 
-int tx_bench_dds(double duration_s, double net_hz, double sim_hz) {
-  (void)duration_s, (void)net_hz, (void)sim_hz;
+int tx_bench_dds(double duration_s, double net_hz, double sim_hz, int poll_us) {
+  (void)duration_s, (void)net_hz, (void)sim_hz, (void)poll_us;
   fprintf(stderr, "tactus: bench dds: this build has no DDS (configure with -DTX_WITH_DDS=ON)\n");
   return 2;
 }

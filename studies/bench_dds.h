@@ -6,7 +6,8 @@
 #ifndef TX_STUDIES_BENCH_DDS_H
 #define TX_STUDIES_BENCH_DDS_H
 
-// duration_s: seconds of the session (0: 5); net_hz: the bridges' rate; sim_hz: the echoing sim's rate
-int tx_bench_dds(double duration_s, double net_hz, double sim_hz);
+// duration_s: seconds of the session (0: 5); net_hz: the bridges' rate; sim_hz: the echoing sim's rate;
+// poll_us: the bridges' sender threads (0: they send from their steps)
+int tx_bench_dds(double duration_s, double net_hz, double sim_hz, int poll_us);
 
 #endif

@@ -18,6 +18,7 @@
 #include <tactus/stats.h>
 
 #include <pthread.h>
+#include <time.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -36,6 +37,8 @@ static const tx_param_def params[] = {
      "components mirrored in: [{name, type, rows, cols, units}], the writer's schema"},
     {"send_streams", TX_PARAM_STRS, NULL, 0, SEND_MAX, 0, NULL, "event streams this process emits and the others mirror"},
     {"receive_streams", TX_PARAM_JSON, NULL, 0, 0, 0, NULL, "event streams mirrored in: [{name, capacity}]"},
+    {"poll_us", TX_PARAM_INT, "us", 0, 100000, 0, NULL,
+     "0: components are sent from the bridge's step; else a thread of its own polls them this often (less latency, a CPU share)"},
     {"best_effort", TX_PARAM_STRS, NULL, 0, SEND_MAX, 0, NULL,
      "components that are poses or forces: best effort, keep last 1 (the rest: reliable, transient-local)"},
 };
@@ -46,6 +49,7 @@ typedef struct outbound {
   char name[TX_NAME_MAX];
   bool stream;
   tx_port port;          // read (component) or listen (stream)
+  tx_reader reader;      // components: the port's hazard slot, for the sender thread
   tx_type type;          // components
   bool fast;             // best effort, keep last 1 (else reliable, transient-local)
   uint64_t last_seq;     // last publish sent
@@ -83,6 +87,10 @@ struct bridge {
   dds_entity_t participant;
   pthread_mutex_t lock;  // one listener call at a time writes the model
   _Atomic bool live;     // init done, finish not yet: the listener may write
+  int poll_us;           // > 0: the sender thread polls the sent components
+  pthread_t sender;
+  bool sender_started;
+  _Atomic bool sender_stop;
   _Atomic int64_t clock_offset; // CLOCK_MONOTONIC - local simulation time, ns: its least value seen
   tx_warning foreign, malformed, lost, send_failed;
   tx_result r_sent, r_received, r_events_sent, r_events_received;
@@ -149,6 +157,7 @@ static int configure(tx_setup* s, void** self) {
   b->npeers = tx_table_strs(s, "peers", b->peers, TX_NET_PEERS_MAX);
   for (int i = 0; i < b->npeers; i++)
     if (!tx_net_peer_valid(b->peers[i])) return tx_setup_fail(s, "peers", "entry %d: %s", i, tx_error());
+  b->poll_us = (int)tx_table_int(s, "poll_us");
   const char* session = tx_table_str(s, "session");
   b->tag = tx_net_session_tag(session ? session : "tactus", b->domain);
   const char* fast[SEND_MAX];
@@ -251,6 +260,8 @@ static void on_event(dds_entity_t reader, void* arg) {
   dds_return_loan(reader, samples, n);
 }
 
+static void* sender(void* arg);
+
 static int init(tx_ctx* c, void* self) {
   bridge* b = self;
   b->ctx = c;
@@ -274,6 +285,7 @@ static int init(tx_ctx* c, void* self) {
       if (!o->stream) {
         const port* pt = &c->in->ports[o->port.id - 1];
         o->type = tx_model_def(b->model, pt->comp)->type;
+        o->reader = pt->reader;
       }
     } else if (topic >= 0) {
       inbound* in = &b->in[k - b->nout];
@@ -295,7 +307,42 @@ static int init(tx_ctx* c, void* self) {
   for (int k = 0; k < b->nin; k++)
     if (b->in[k].latency) tx_hist_clear(b->in[k].latency), tx_prefault(b->in[k].latency, sizeof *b->in[k].latency);
   atomic_store_explicit(&b->live, true, memory_order_release);
+  if (b->poll_us) {
+    if (pthread_create(&b->sender, NULL, sender, b) != 0) return tx_stop_run(c, "net: cannot start the sender thread"), -1;
+    b->sender_started = true;
+  }
   return 0;
+}
+
+// send a component's publish if it is new; the thread that owns o's hazard slot calls it
+static void send_component(bridge* b, outbound* o, const tx_snapshot* snap) {
+  if (snap->seq == 0 || snap->seq == o->last_seq) return; // nothing new
+  o->last_seq = snap->seq;
+  tx_net_Snapshot s;
+  tx_net_pack(&s, b->tag, o->name, o->type, snap);
+  if (dds_write(o->writer, &s) < 0) tx_warn(b->ctx, b->send_failed);
+  else atomic_fetch_add_explicit(&b->sent, 1, memory_order_relaxed);
+}
+
+// poll_us > 0: sends each publish within poll_us of it, not at the bridge's next tick
+static void* sender(void* arg) {
+  bridge* b = arg;
+  struct timespec next;
+  clock_gettime(CLOCK_MONOTONIC, &next);
+  while (!atomic_load_explicit(&b->sender_stop, memory_order_acquire)) {
+    for (int k = 0; k < b->nout; k++)
+      if (!b->out[k].stream) {
+        tx_snapshot snap = tx_model_acquire(b->model, b->out[k].reader);
+        send_component(b, &b->out[k], &snap);
+      }
+    next.tv_nsec += (long)b->poll_us * 1000;
+    while (next.tv_nsec >= 1000000000) next.tv_nsec -= 1000000000, next.tv_sec++;
+    struct timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    if (now.tv_sec > next.tv_sec || (now.tv_sec == next.tv_sec && now.tv_nsec > next.tv_nsec)) next = now; // late: no catching up
+    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, NULL);
+  }
+  return NULL;
 }
 
 // the local simulation time that CLOCK_MONOTONIC now stands for: the least
@@ -320,18 +367,22 @@ static void step(tx_ctx* c, void* self) {
       }
       continue;
     }
+    if (b->poll_us) continue; // the sender thread's
     tx_snapshot snap = tx_read(c, o->port);
-    if (snap.seq == 0 || snap.seq == o->last_seq) continue; // nothing new
-    o->last_seq = snap.seq;
-    tx_net_Snapshot s;
-    tx_net_pack(&s, b->tag, o->name, o->type, &snap);
-    if (dds_write(o->writer, &s) < 0) tx_warn(c, b->send_failed);
-    else atomic_fetch_add_explicit(&b->sent, 1, memory_order_relaxed);
+    send_component(b, o, &snap);
   }
+}
+
+static void stop_sender(bridge* b) {
+  if (!b->sender_started) return;
+  atomic_store_explicit(&b->sender_stop, true, memory_order_release);
+  pthread_join(b->sender, NULL);
+  b->sender_started = false;
 }
 
 static void finish(tx_ctx* c, void* self) {
   bridge* b = self;
+  stop_sender(b);
   atomic_store_explicit(&b->live, false, memory_order_release);
   pthread_mutex_lock(&b->lock); // a listener call under way ends first
   pthread_mutex_unlock(&b->lock);
@@ -350,6 +401,7 @@ static void fini(void* self) {
   bridge* b = self;
   if (!b) return;
   atomic_store(&b->live, false);
+  stop_sender(b); // a run whose init failed later never finished
   if (b->participant > 0) dds_delete(b->participant); // its readers, writers and topics; waits for listeners
   pthread_mutex_destroy(&b->lock);
   for (int k = 0; k < b->nin; k++) free(b->in[k].latency);

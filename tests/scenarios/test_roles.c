@@ -116,7 +116,8 @@ static void bad_net(void** state) {
   expect(good, "one", "net.fast=[\"skin.x\"]", "s.json: net.fast[0]: 'skin.x' is not in the model (no controller writes it)");
   expect(good, NULL, "net.streams=[\"p.x\"]", "s.json: net.streams[0]: 'p.x' is not an event stream any controller emits");
   expect(good, NULL, "net.rate_hz=0", "s.json: net.rate_hz: expected a number in [1, 100000]");
-  expect(good, NULL, "net.port=1", "s.json: net.port: unknown key (known: domain, peers, rate_hz, fast, state, streams)");
+  expect(good, NULL, "net.poll_us=-5", "s.json: net.poll_us: expected an integer in [0, 100000] (us; 0: send from the bridge's step)");
+  expect(good, NULL, "net.port=1", "s.json: net.port: unknown key (known: domain, peers, rate_hz, poll_us, fast, state, streams)");
   tx_scenario* s = load_role(good, NULL, "net.peers=[\"10.0.0.2\", \"sim-host\"]");
   assert_non_null(s);
   tx_scenario_free(s);

@@ -196,7 +196,7 @@ static const char* scenario_text(int domain) {
   static char text[1024];
   snprintf(text, sizeof text,
            "{\"name\": \"net-test-%d\", \"roles\": {\"a\": [\"src\"], \"b\": [\"dst\"]},"
-           " \"net\": {\"domain\": %d, \"rate_hz\": 2000, \"state\": [\"t.val\"], \"streams\": [\"t.ev\"]},"
+           " \"net\": {\"domain\": %d, \"rate_hz\": 2000, \"poll_us\": 100, \"state\": [\"t.val\"], \"streams\": [\"t.ev\"]},"
            " \"controllers\": [{\"name\": \"src\", \"type\": \"t.src\", \"rate_hz\": 500},"
            " {\"name\": \"dst\", \"type\": \"t.dst\", \"rate_hz\": 1000}]}",
            (int)getpid(), domain);
