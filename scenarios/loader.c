@@ -111,6 +111,13 @@ static int apply_sets(const char* file, json_t* root, const tx_load_options* o, 
       if (json_is_string(json_object_get(c, "name")) && strcmp(json_string_value(json_object_get(c, "name")), key) == 0)
         found = (int)index;
     }
+    if (found < 0 && *param && strcmp(key, "net") == 0) { // the net section: net.domain, net.peers, ...
+      json_t* net = json_object_get(root, "net");
+      if (!net) json_object_set_new(root, "net", net = json_object());
+      if (!json_is_object(net)) return json_decref(value), fail("%s: net: expected an object", file);
+      json_object_set_new(net, param, value);
+      continue;
+    }
     if (found < 0 || !*param) {
       json_decref(value);
       if (!*param) return fail("--set %s: expected CONTROLLER.PARAM=VALUE", text);
@@ -231,14 +238,17 @@ static int apply_devices(const char* file, json_t* root, const tx_load_options* 
   return 0;
 }
 
-static int add_controllers(const char* file, tx_system* sys, json_t* list, const set_origin* origins, int norigins) {
+// map[i]: the index in the file of list[i] (a role runs a part of the list), NULL when the same
+static int add_controllers(const char* file, tx_system* sys, json_t* list, const set_origin* origins, int norigins,
+                           const int* map) {
   if (!json_is_array(list) || json_array_size(list) == 0)
     return fail("%s: controllers: expected a non-empty array", file);
   static const char* const keys[] = {"name", "type", "rate_hz", "params", "thread", NULL};
-  size_t i;
+  size_t index;
   json_t* c;
-  json_array_foreach(list, i, c) {
+  json_array_foreach(list, index, c) {
     char where[48];
+    size_t i = map ? (size_t)map[index] : index;
     if (check_entry(file, "controllers", i, c, keys, where, sizeof where)) return -1;
     json_t *name = json_object_get(c, "name"), *type = json_object_get(c, "type"), *rate = json_object_get(c, "rate_hz");
     if (!json_is_string(name)) return fail("%s: %s.name: expected a string", file, where);
@@ -303,10 +313,252 @@ static int add_view(const char* file, tx_system* sys, json_t* view, const tx_loa
   return fail("%s: view%s%s: %s", file, *k ? "." : "", k, tx_error());
 }
 
+
+// ---- roles and the net section: one scenario split over processes (docs/distributed.md)
+
+#define ROLES_MAX 16
+#define NET_INSTANCE "net" // the bridge's name in the report
+#define NET_DOMAIN_MAX 232 // DDS domain ids with the standard port mapping
+#define NET_PEERS_MAX 32
+
+static bool plain_name(const char* n, size_t max, bool dot) {
+  size_t len = strlen(n);
+  if (len == 0 || len >= max) return false;
+  for (const char* c = n; *c; c++)
+    if (!((*c >= 'a' && *c <= 'z') || (*c >= '0' && *c <= '9') || *c == '_' || (dot ? *c == '.' : *c == '-'))) return false;
+  return true;
+}
+
+// "roles": {ROLE: [CONTROLLER, ...]}: every controller in exactly one role.
+// role_of[i] receives the role index of controllers[i]; *nroles the count
+static int check_roles(const char* file, json_t* roles, json_t* controllers, int* role_of, int* nroles) {
+  *nroles = 0;
+  if (!roles) return 0;
+  if (!json_is_object(roles) || json_object_size(roles) == 0)
+    return fail("%s: roles: expected an object of ROLE: [CONTROLLER, ...]", file);
+  if (json_object_size(roles) > ROLES_MAX) return fail("%s: roles: at most %d", file, ROLES_MAX);
+  size_t n = json_is_array(controllers) ? json_array_size(controllers) : 0;
+  for (size_t i = 0; i < n; i++) role_of[i] = -1;
+  const char* role;
+  json_t* list;
+  int r = 0;
+  json_object_foreach(roles, role, list) {
+    if (!plain_name(role, 32, false)) return fail("%s: roles.%s: a role name is 1-31 characters of a-z 0-9 _ -", file, role);
+    if (!json_is_array(list) || json_array_size(list) == 0)
+      return fail("%s: roles.%s: expected a non-empty array of controller names", file, role);
+    size_t k;
+    json_t* name;
+    json_array_foreach(list, k, name) {
+      size_t found = n;
+      for (size_t i = 0; i < n && found == n; i++) {
+        json_t* cn = json_object_get(json_array_get(controllers, i), "name");
+        if (json_is_string(name) && json_is_string(cn) && strcmp(json_string_value(cn), json_string_value(name)) == 0) found = i;
+      }
+      if (found == n) return fail("%s: roles.%s[%zu]: no controller named %s%s%s", file, role, k, json_is_string(name) ? "'" : "",
+                                  json_is_string(name) ? json_string_value(name) : tx_json_kind(name), json_is_string(name) ? "'" : "");
+      if (role_of[found] >= 0) return fail("%s: roles.%s[%zu]: '%s' already has a role", file, role, k, json_string_value(name));
+      role_of[found] = r;
+    }
+    r++;
+  }
+  for (size_t i = 0; i < n; i++)
+    if (role_of[i] < 0) {
+      json_t* cn = json_object_get(json_array_get(controllers, i), "name");
+      return fail("%s: controllers[%zu]: '%s' has no role (every controller of a scenario with roles has one)", file, i,
+                  json_is_string(cn) ? json_string_value(cn) : "?");
+    }
+  *nroles = r;
+  return 0;
+}
+
+// "net": {domain, peers, rate_hz, fast, state, streams}, checked on every load
+static int check_net(const char* file, json_t* net) {
+  if (!net) return 0;
+  if (!json_is_object(net)) return fail("%s: net: expected an object", file);
+  static const char* const keys[] = {"domain", "peers", "rate_hz", "poll_us", "fast", "state", "streams", NULL};
+  if (check_keys(file, "net", net, keys)) return -1;
+  json_t* domain = json_object_get(net, "domain");
+  if (domain && (!json_is_integer(domain) || json_integer_value(domain) < 0 || json_integer_value(domain) > NET_DOMAIN_MAX))
+    return fail("%s: net.domain: expected an integer in [0, %d] (a DDS domain id)", file, NET_DOMAIN_MAX);
+  json_t* poll = json_object_get(net, "poll_us");
+  if (poll && (!json_is_integer(poll) || json_integer_value(poll) < 0 || json_integer_value(poll) > 100000))
+    return fail("%s: net.poll_us: expected an integer in [0, 100000] (us; 0: send from the bridge's step)", file);
+  json_t* rate = json_object_get(net, "rate_hz");
+  if (rate && (!json_is_number(rate) || !(json_number_value(rate) >= 1 && json_number_value(rate) <= TX_RATE_MAX_HZ)))
+    return fail("%s: net.rate_hz: expected a number in [1, %g]", file, TX_RATE_MAX_HZ);
+  json_t* peers = json_object_get(net, "peers");
+  if (peers && (!json_is_array(peers) || json_array_size(peers) > NET_PEERS_MAX))
+    return fail("%s: net.peers: expected an array of at most %d addresses", file, NET_PEERS_MAX);
+  size_t i;
+  json_t* v;
+  json_array_foreach(peers, i, v) {
+    const char* p = json_string_value(v);
+    bool ok = p && *p && strlen(p) <= 253 && p[0] != '-' && p[0] != '.' && !strstr(p, "..");
+    bool digits = true;
+    for (const char* c = p; ok && *c; c++) {
+      ok = (*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') || *c == '-' || *c == '.';
+      if (!(*c >= '0' && *c <= '9') && *c != '.') digits = false;
+    }
+    if (ok && digits) { // all digits and dots: it must be a dotted quad of bytes
+      unsigned a, b, c, d;
+      char end;
+      ok = sscanf(p, "%u.%u.%u.%u%c", &a, &b, &c, &d, &end) == 4 && a < 256 && b < 256 && c < 256 && d < 256;
+    }
+    if (!ok) return fail("%s: net.peers[%zu]: expected an IPv4 address or a host name", file, i);
+  }
+  static const char* const lists[] = {"fast", "state", "streams"};
+  for (int l = 0; l < 3; l++) {
+    json_t* a = json_object_get(net, lists[l]);
+    if (a && !json_is_array(a)) return fail("%s: net.%s: expected an array of names", file, lists[l]);
+    json_array_foreach(a, i, v)
+      if (!json_is_string(v) || !plain_name(json_string_value(v), TX_NAME_MAX, true))
+        return fail("%s: net.%s[%zu]: expected a component name (a-z 0-9 _ .)", file, lists[l], i);
+  }
+  return 0;
+}
+
+// the writer of a component (or stream) in a finalized system: its instance, or -1
+static int writer_of(tx_system* sys, const char* name, bool stream, const tx_component_def** def) {
+  for (int i = 0; i < tx_system_count(sys); i++)
+    for (int p = 0; p < tx_system_ports(sys, i); p++) {
+      tx_port_info pi = tx_system_port(sys, i, p);
+      if (strcmp(pi.component, name) != 0) continue;
+      if (stream ? pi.stream == 1 : (pi.stream == 0 && pi.write)) {
+        if (def) *def = pi.def;
+        return i;
+      }
+    }
+  return -1;
+}
+
+// every name in net.fast, net.state and net.streams is in the model
+static int check_net_names(const char* file, json_t* net, tx_system* sys) {
+  static const char* const lists[] = {"fast", "state", "streams"};
+  for (int l = 0; net && l < 3; l++) {
+    size_t i;
+    json_t* v;
+    json_array_foreach(json_object_get(net, lists[l]), i, v)
+      if (writer_of(sys, json_string_value(v), l == 2, NULL) < 0)
+        return fail("%s: net.%s[%zu]: '%s' is not %s", file, lists[l], i, json_string_value(v),
+                    l == 2 ? "an event stream any controller emits" : "in the model (no controller writes it)");
+  }
+  return 0;
+}
+
+static bool in_list(json_t* a, const char* name) {
+  size_t i;
+  json_t* v;
+  json_array_foreach(a, i, v)
+    if (strcmp(json_string_value(v), name) == 0) return true;
+  return false;
+}
+
+// the bridge's parameters for one role: what its controllers write and others
+// read goes out, what they read and others write comes in with the writer's
+// schema; a read across roles that the net section does not name is an error
+static json_t* bridge_params(const char* file, const char* scenario, json_t* net, tx_system* full, const int* role_of,
+                             int role, bool* any) {
+  json_t *fast = json_object_get(net, "fast"), *state = json_object_get(net, "state"), *streams = json_object_get(net, "streams");
+  json_t *send = json_array(), *receive = json_array(), *send_streams = json_array(), *receive_streams = json_array(),
+         *best = json_array();
+  json_t* params = json_object();
+  *any = false;
+  for (int i = 0; i < tx_system_count(full); i++) {
+    if (role_of[i] != role) continue;
+    for (int p = 0; p < tx_system_ports(full, i); p++) {
+      tx_port_info pi = tx_system_port(full, i, p);
+      bool stream = pi.stream != 0;
+      const tx_component_def* def = NULL;
+      if (pi.write || pi.stream == 1) { // written here: sent when it crosses
+        bool crosses = stream ? in_list(streams, pi.component) : in_list(fast, pi.component) || in_list(state, pi.component);
+        if (crosses && !in_list(stream ? send_streams : send, pi.component))
+          json_array_append_new(stream ? send_streams : send, json_string(pi.component));
+        if (crosses && !stream && in_list(fast, pi.component) && !in_list(best, pi.component))
+          json_array_append_new(best, json_string(pi.component));
+        continue;
+      }
+      int w = writer_of(full, pi.component, stream, &def);
+      if (w < 0 || role_of[w] == role) continue;
+      bool crosses = stream ? in_list(streams, pi.component) : in_list(fast, pi.component) || in_list(state, pi.component);
+      if (!crosses) {
+        json_decref(params), json_decref(send), json_decref(receive), json_decref(send_streams);
+        json_decref(receive_streams), json_decref(best);
+        return fail("%s: controllers[%d]: %s '%s', which controller '%s' of another role writes: name it in net.%s", file, i,
+                    stream ? "listens to" : "reads", pi.component, tx_system_name(full, w), stream ? "streams" : "fast or net.state"),
+               NULL;
+      }
+      bool seen = false;
+      size_t k;
+      json_t* e;
+      json_array_foreach(stream ? receive_streams : receive, k, e) seen |= strcmp(json_string_value(json_object_get(e, "name")), pi.component) == 0;
+      if (seen) continue;
+      if (stream) {
+        uint32_t capacity = 0;
+        for (int s = 0; s < tx_system_streams(full); s++)
+          if (strcmp(tx_system_stream(full, s).name, pi.component) == 0) capacity = tx_system_stream(full, s).capacity;
+        json_array_append_new(receive_streams, json_pack("{s:s, s:I}", "name", pi.component, "capacity", (json_int_t)capacity));
+      } else {
+        json_array_append_new(receive, json_pack("{s:s, s:s, s:I, s:I, s:s}", "name", pi.component, "type", tx_type_name(def->type),
+                                                 "rows", (json_int_t)def->rows, "cols", (json_int_t)def->cols, "units", def->units));
+        if (in_list(fast, pi.component) && !in_list(best, pi.component)) json_array_append_new(best, json_string(pi.component));
+      }
+    }
+  }
+  *any = json_array_size(send) + json_array_size(receive) + json_array_size(send_streams) + json_array_size(receive_streams) > 0;
+  json_t* domain = json_object_get(net, "domain");
+  json_object_set_new(params, "domain", json_integer(domain ? json_integer_value(domain) : 0));
+  json_t* peers = json_object_get(net, "peers");
+  json_object_set_new(params, "peers", peers ? json_deep_copy(peers) : json_array());
+  json_object_set_new(params, "session", json_string(scenario));
+  json_t* poll = json_object_get(net, "poll_us");
+  json_object_set_new(params, "poll_us", json_integer(poll ? json_integer_value(poll) : 0));
+  json_object_set_new(params, "send", send);
+  json_object_set_new(params, "receive", receive);
+  json_object_set_new(params, "send_streams", send_streams);
+  json_object_set_new(params, "receive_streams", receive_streams);
+  json_object_set_new(params, "best_effort", best);
+  return params;
+}
+
+
+// finalize, naming the controller at fault by its place in the file
+static int finalize(const char* file, tx_system* sys, json_t* root, const tx_load_options* o) {
+  if (tx_system_finalize(sys) == 0) return 0;
+  const char* key = tx_error_key(); // the instance at fault, if any
+  int index = -1;
+  size_t i;
+  json_t* c;
+  json_array_foreach(json_object_get(root, "controllers"), i, c) {
+    json_t* n = json_object_get(c, "name");
+    if (json_is_string(n) && strcmp(json_string_value(n), key) == 0) index = (int)i;
+  }
+  bool is_view = index < 0 && o && o->view && strcmp(o->view, "none") != 0 && strcmp(key, VIEW_INSTANCE) == 0;
+  if (is_view) return fail("%s: view.draw: %s", file, tx_error());
+  if (index < 0 && strcmp(key, NET_INSTANCE) == 0) return fail("%s: net: %s", file, tx_error());
+  if (index >= 0) return fail("%s: controllers[%d]: %s", file, index, tx_error());
+  return fail("%s: %s", file, tx_error());
+}
+
+// a role declares only the model components its own controllers write; the
+// bridge makes those it mirrors in, with the writer's schema
+static int declare_role_model(const char* file, tx_system* sys, json_t* model, tx_system* full, const int* role_of, int role) {
+  if (!model) return 0;
+  json_t* mine = json_array();
+  size_t i;
+  json_t* c;
+  json_array_foreach(model, i, c) {
+    int w = writer_of(full, json_string_value(json_object_get(c, "name")), false, NULL);
+    if (w >= 0 && role_of[w] == role) json_array_append(mine, c);
+  }
+  int rc = declare_model(file, sys, mine);
+  json_decref(mine);
+  return rc;
+}
+
 static tx_scenario* load_root(const char* file, const char* dir, json_t* root, const tx_load_options* o) {
   tx_register_builtin();
   if (!json_is_object(root)) return fail("%s: expected a JSON object at the top", file), NULL;
-  static const char* const keys[] = {"name", "description", "duration_s", "model", "plugins", "controllers", "view", NULL};
+  static const char* const keys[] = {"name", "description", "duration_s", "model", "plugins", "controllers", "view", "roles", "net", NULL};
   if (check_keys(file, "", root, keys)) return NULL;
   set_origin origins[SETS_MAX + 2];
   int norigins = 0;
@@ -340,25 +592,63 @@ static tx_scenario* load_root(const char* file, const char* dir, json_t* root, c
   snprintf(s->name, sizeof s->name, "%s", json_string_value(name));
   snprintf(s->description, sizeof s->description, "%s", desc ? json_string_value(desc) : "");
   s->duration_s = seconds;
-  if (declare_model(file, s->system, json_object_get(root, "model")) ||
-      add_controllers(file, s->system, json_object_get(root, "controllers"), origins, norigins) ||
-      add_view(file, s->system, json_object_get(root, "view"), o)) {
-    tx_scenario_free(s);
-    return NULL;
+  json_t *controllers = json_object_get(root, "controllers"), *roles = json_object_get(root, "roles"),
+         *net = json_object_get(root, "net");
+  int role_of[1024], nroles = 0, role = -1;
+  if (json_is_array(controllers) && json_array_size(controllers) > 1024)
+    return tx_scenario_free(s), fail("%s: controllers: at most 1024", file), NULL;
+  if (check_roles(file, roles, controllers, role_of, &nroles) || check_net(file, net)) return tx_scenario_free(s), NULL;
+  if (o && o->role) {
+    char have[256] = "";
+    const char* rn;
+    json_t* rv;
+    int r = 0;
+    json_object_foreach(roles, rn, rv) {
+      if (strcmp(rn, o->role) == 0) role = r;
+      size_t len = strlen(have);
+      snprintf(have + len, sizeof have - len, "%s%s", r++ ? ", " : "", rn);
+    }
+    if (!roles) return tx_scenario_free(s), fail("--role %s: %s has no roles", o->role, file), NULL;
+    if (role < 0) return tx_scenario_free(s), fail("--role %s: unknown role (%s has: %s)", o->role, file, have), NULL;
   }
-  if (tx_system_finalize(s->system)) {
-    const char* key = tx_error_key(); // the instance at fault, if any
-    int index = -1;
-    for (int i = 0; i < tx_system_count(s->system); i++)
-      if (strcmp(tx_system_name(s->system, i), key) == 0) index = i;
-    bool is_view = index >= 0 && o && o->view && strcmp(o->view, "none") != 0 && index == tx_system_count(s->system) - 1 &&
-                   strcmp(key, VIEW_INSTANCE) == 0;
-    if (is_view) fail("%s: view.draw: %s", file, tx_error());
-    else if (index >= 0) fail("%s: controllers[%d]: %s", file, index, tx_error());
-    else fail("%s: %s", file, tx_error());
-    tx_scenario_free(s);
-    return NULL;
+  // a role: the whole scenario is built first, for the schema of every
+  // component that crosses; then only the role's controllers, and the bridge
+  tx_system* full = s->system;
+  json_t* part = NULL;
+  int map[1024];
+  if (role >= 0) {
+    if (declare_model(file, full, json_object_get(root, "model")) || add_controllers(file, full, controllers, origins, norigins, NULL) ||
+        finalize(file, full, root, o) || check_net_names(file, net, full))
+      return tx_scenario_free(s), NULL;
+    part = json_array();
+    for (size_t i = 0; i < json_array_size(controllers); i++)
+      if (role_of[i] == role) map[json_array_size(part)] = (int)i, json_array_append(part, json_array_get(controllers, i));
+    if (!(s->system = tx_system_create())) {
+      tx_system_destroy(full), json_decref(part), free(s);
+      return fail("%s: out of memory", file), NULL;
+    }
   }
+  bool bridge = false;
+  json_t* bp = role >= 0 ? bridge_params(file, s->name, net, full, role_of, role, &bridge) : NULL;
+  int rc = role >= 0 && !bp ? -1 : 0;
+  if (!rc && role < 0) rc = declare_model(file, s->system, json_object_get(root, "model"));
+  else if (!rc) rc = declare_role_model(file, s->system, json_object_get(root, "model"), full, role_of, role);
+  if (!rc) rc = add_controllers(file, s->system, part ? part : controllers, origins, norigins, part ? map : NULL);
+  if (!rc && bridge && !tx_find_controller("net.dds"))
+    rc = fail("--role %s: %s crosses processes, and this build has no DDS bridge (configure with -DTX_WITH_DDS=ON)", o->role, file);
+  if (!rc && bridge) {
+    json_t* rate = json_object_get(net, "rate_hz");
+    rc = tx_system_add(s->system, NET_INSTANCE, "net.dds", rate ? json_number_value(rate) : 1000, bp);
+    if (rc) fail("%s: net: %s%s%s", file, tx_error_key(), *tx_error_key() ? ": " : "", tx_error());
+    else if ((rc = tx_system_set_thread(s->system, tx_system_count(s->system) - 1, NET_INSTANCE))) fail("%s: net: %s", file, tx_error());
+  }
+  if (!rc) rc = add_view(file, s->system, json_object_get(root, "view"), o);
+  if (!rc) rc = finalize(file, s->system, root, o);
+  if (!rc && role < 0) rc = check_net_names(file, net, s->system);
+  json_decref(bp);
+  json_decref(part);
+  if (full != s->system) tx_system_destroy(full);
+  if (rc) return tx_scenario_free(s), NULL;
   return s;
 }
 

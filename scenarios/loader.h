@@ -26,6 +26,7 @@ typedef struct tx_load_options {
   const char* view;         // "png" or "window" adds the graphics view; NULL or "none" only checks "view"
   const char* stereo;       // the view's stereo mode (mono, sbs, tb, anaglyph, lr), NULL for mono
   bool view_wait;           // lockstep: the view renders every tick instead of dropping frames
+  const char* role;         // run only this role's controllers, and the bridge (docs/distributed.md); NULL: all
 } tx_load_options;
 
 // register the built-in controller classes (idempotent)

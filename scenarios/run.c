@@ -28,6 +28,8 @@ static const char run_usage[] =
     "  --force             write into a --out that holds files (same names are replaced)\n"
     "  --no-record         no device recordings (OUT/deviceN.bin and .csv are written by default)\n"
     "  --quiet             no summary table\n"
+    "  --role NAME         only the controllers of this role, and the bridge to the other roles' processes\n"
+    "                      (a session: one process per role, docs/distributed.md)\n"
     "\n"
     "Writes OUT/report.json: per controller achieved rate, missed deadlines, period jitter and step time,\n"
     "and OUT/device0.png (force and position traces) when a haptics device was recorded.\n"
@@ -148,7 +150,7 @@ int tx_cmd_run(int argc, char** argv) {
       {"duration", required_argument, 0, 'd'}, {"lockstep", no_argument, 0, 'l'}, {"set", required_argument, 0, 's'},
       {"device", required_argument, 0, 'D'},   {"view", required_argument, 0, 'v'}, {"stereo", required_argument, 0, 'S'},
       {"out", required_argument, 0, 'o'},      {"quiet", no_argument, 0, 'q'},   {"help", no_argument, 0, 'h'},
-      {"no-record", no_argument, 0, 'R'},      {"force", no_argument, 0, 'F'},
+      {"no-record", no_argument, 0, 'R'},      {"role", required_argument, 0, 'r'},      {"force", no_argument, 0, 'F'},
       {0, 0, 0, 0}};
   static const char* const views[] = {"none", "png", "window", NULL};
   static const char* const stereo[] = {"mono", "sbs", "tb", "anaglyph", "lr", NULL};
@@ -159,6 +161,7 @@ int tx_cmd_run(int argc, char** argv) {
   const char* view = "none";
   const char* stereo_mode = "mono";
   bool force = false;
+  const char* role = NULL;
   optind = 1;
   opterr = 0;
   // GNU getopt moves operands behind the options, so SCENARIO may stand anywhere
@@ -189,6 +192,7 @@ int tx_cmd_run(int argc, char** argv) {
     case 'q': cfg.quiet = true; break;
     case 'R': cfg.no_record = true; break;
     case 'F': force = true; break;
+    case 'r': role = optarg; break;
     case 'h': return fputs(run_usage, stdout), 0;
     default:
       // inside a group of short options argv[optind - 1] is not the option; optopt is
@@ -213,9 +217,19 @@ int tx_cmd_run(int argc, char** argv) {
     if ((strcmp(devices[i], "mouse") == 0 || strncmp(devices[i], "mouse:", 6) == 0) && strcmp(view, "window") != 0)
       return tx_bad_input("--device %s: the mouse drives the tool through a window: add --view window", devices[i]);
 
+  // the processes of a session meet in real time: a virtual clock cannot be shared
+  if (role && cfg.lockstep) return tx_bad_input("--role %s: a session runs in real time; leave out --lockstep", role);
   if (tx_out_check(cfg.out, force)) return TX_EXIT_BAD_INPUT;
 
-  tx_scenario* sc = tx_load_for_command_view(cfg.scenario, sets, nsets, devices, ndevices, view, stereo_mode, cfg.lockstep);
+  tx_scenario* sc = NULL;
+  if (role) { // the common loader, with the role
+    char path[PATH_MAX];
+    if (tx_scenario_locate(cfg.scenario, path, sizeof path)) return tx_bad_input("%s", tx_error());
+    tx_load_options o = {sets, nsets, true, devices, ndevices, view, stereo_mode, cfg.lockstep, role};
+    if (!(sc = tx_scenario_load(path, &o))) return tx_bad_input("%s", tx_error());
+  } else {
+    sc = tx_load_for_command_view(cfg.scenario, sets, nsets, devices, ndevices, view, stereo_mode, cfg.lockstep);
+  }
   if (!sc) return TX_EXIT_BAD_INPUT;
   tx_replay_warn(sc->system);
   int rc = tx_run_scenario(sc, &cfg, NULL);

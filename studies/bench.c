@@ -1,6 +1,7 @@
 // tactus bench: benchmark tables for the spine. Timings are medians and
 // percentiles of one run on this machine; they are printed, never asserted.
 #include "bench_cloth.h"
+#include "bench_dds.h"
 #include "bench_hip.h"
 #include "bench_instruments.h"
 #include "bench_organ_collision.h"
@@ -360,6 +361,9 @@ static int bench_instruments(const bench_args* a) { return tx_bench_instruments(
 static int bench_thread(const bench_args* a) { return tx_bench_thread(a->duration_s); }
 static int bench_organ_collision(const bench_args* a) { return tx_bench_organ_collision(a->duration_s); }
 
+// the bridges' sender threads poll every 50 us (net.poll_us); the echoing sim runs at the HIP's 4 kHz
+static int bench_dds(const bench_args* a) { return tx_bench_dds(a->duration_s, 1000, 4000, 50); }
+
 static int bench_hip(const bench_args* a) {
   (void)a;
   return tx_bench_hip();
@@ -382,6 +386,7 @@ static const struct {
     {"instruments", bench_instruments, "one 1 kHz ODE step of two articulated instruments and the needle"},
     {"organs", bench_organs, "physics.organs step, liver and stomach (5793 tetrahedra), fem and links, against 30 Hz"},
     {"thread", bench_thread, "suture thread step, ftl and rod, 100 and 1000 nodes with self collision"},
+    {"dds", bench_dds, "two processes over loopback (net.dds): pose -> sim -> force round trip, a 10404x3 mesh at 60 Hz"},
 };
 
 int tx_cmd_bench(int argc, char** argv) {

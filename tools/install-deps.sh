@@ -10,7 +10,8 @@ optional=(libbullet-dev libode-dev libassimp-dev liburdfdom-dev libtinyxml-dev
           libosmesa6-dev libglfw3-dev libpng-dev
           libplplot-dev plplot-driver-cairo
           xvfb xauth                   # xvfb-run: the window-mode screenshot test
-          cyclonedds-dev tetgen
+          cyclonedds-dev cyclonedds-tools  # sessions over several processes (docs/distributed.md); idlc
+          tetgen
           libgts-dev libnifti2-dev)      # the LAGB asset pipeline: marching cubes, a user's NIfTI volume
 
 want=("${core[@]}")

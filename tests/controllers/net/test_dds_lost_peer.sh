@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# A lost peer, and one that comes back (docs/distributed.md, "A lost peer"):
+# suturing-skin's device process renders the sim process's force; the sim
+# process is killed (SIGKILL, nothing said goodbye) while the hand presses the
+# skin, and a new one starts 0.3 s later. With haptics.model_timeout_s = 5 ms
+# the force must be zero within 10 ms of the last force model that arrived,
+# stay zero while no sim runs, and the force models of the new sim process
+# must be taken up again.
+set -euo pipefail
+tactus=$1
+work=$(mktemp -d)
+sim1=; sim2=
+trap 'kill $sim1 $sim2 2>/dev/null || true; rm -rf "$work"' EXIT
+domain=$(( 1 + ($$ + 100) % 200 ))
+cd "$work"
+sim() { exec "$tactus" run suturing-skin --role sim --duration "$1" --set net.domain=$domain --out "$2" --quiet >"$2.log" 2>&1; }
+
+sim 6 sim1 & sim1=$!
+sleep 0.5
+"$tactus" run suturing-skin --role device --duration 4 --set net.domain=$domain --set haptics.model_timeout_s=0.005 \
+  --out device --quiet >device.log 2>&1 & device=$!
+sleep 3.1
+kill -9 $sim1
+sleep 0.3
+sim 2 sim2 & sim2=$!
+wait $device || { cat device.log; exit 1; }
+
+python3 - <<'PY'
+import csv
+rows = list(csv.DictReader(open("device/device0.csv")))
+key = ("f0x_n", "f0y_n", "f0z_n", "x0x_m", "x0y_m", "x0z_m", "kyy")
+model = [tuple(r[k] for k in key) for r in rows]
+# ticks at which a new force model had arrived (the HIP's x0 follows the hand every tick)
+new = [i for i in range(1, len(rows)) if model[i] != model[i - 1]]
+gaps = [(a, b) for a, b in zip(new, new[1:]) if b - a > 100 and a > 1000]
+assert len(gaps) == 1, f"expected one silence of the sim, got {gaps}"
+last, back = gaps[0]
+force = [abs(float(r["fy_n"])) for r in rows]
+print(f"last model at tick {last} (|F| {force[last]:.3f} N), next at tick {back}")
+assert force[last] > 0.05, "the hand was not pressing the skin when the sim was lost"
+zero = next(i for i in range(last, back) if force[i] == 0)
+print(f"force zero {zero - last} ms after the last model")
+assert zero - last <= 10, zero - last
+assert max(force[zero:back]) == 0, "the force came back without a sim"
+taken = sum(1 for i in new if i > back)
+print(f"{taken} new force models from the new sim process")
+assert taken > 200, taken
+PY
