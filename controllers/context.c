@@ -178,3 +178,5 @@ int tx_instance_init(tx_system* s, instance* in) {
   publish_written(s, in, 0); // what init wrote is the first publish, at time 0
   return 0;
 }
+
+void tx_instance_publish(tx_system* s, instance* in, int64_t sim_ns) { publish_written(s, in, sim_ns); }
