@@ -159,6 +159,7 @@ int64_t tx_instance_step(tx_system* s, instance* in, int64_t sim_ns) {
   in->cls->step(&in->ctx, in->self);
   publish_written(s, in, sim_ns);
   in->steps++;
+  atomic_store_explicit(&in->live_steps, in->steps, memory_order_relaxed);
   return tx_mono_ns() - t0;
 }
 

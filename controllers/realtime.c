@@ -106,8 +106,11 @@ static void* worker_main(void* arg) {
     for (int m = 0; m < g->count; m++) {
       instance* in = s->inst[g->members[m]];
       if (in->dead) continue;
-      int64_t at = sim; // live: every tick, at the clock's time
-      if (!in->live) {
+      int64_t at = sim; // live: every tick, at the clock's time, a nanosecond on where the clock stands
+      if (in->live) {       // (paused), so its recording's time still increases
+        if (at <= in->live_ns) at = in->live_ns + 1;
+        in->live_ns = at;
+      } else {
         tx_control_apply_reset(s, in, sim);
         if (in->dead) continue;
         if (tx_tick_ns(g->rate_hz, in->sim_tick) > sim) continue; // the clock has not reached its next tick
@@ -143,7 +146,12 @@ static void* worker_main(void* arg) {
     uint64_t next = k + 1;
     uint64_t missed = done - t0 > tx_tick_ns(g->rate_hz, next);
     while (tx_tick_ns(g->rate_hz, next + 1) <= done - t0) next++, missed++;
-    for (int m = 0; m < g->count && missed && !catch_up; m++) s->inst[g->members[m]]->missed += missed;
+    for (int m = 0; m < g->count; m++) {
+      instance* in = s->inst[g->members[m]];
+      if (missed && !catch_up) in->missed += missed;
+      atomic_store_explicit(&in->live_missed, in->missed, memory_order_relaxed);
+      atomic_store_explicit(&in->live_jitter_ns, k ? (jitter < 0 ? -jitter : jitter) : 0, memory_order_relaxed);
+    }
     k = next;
   }
   for (int m = 0; m < g->count && w->init_rc == 0; m++) tx_instance_finish(s->inst[g->members[m]]);

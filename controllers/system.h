@@ -139,6 +139,14 @@ uint64_t tx_system_resets_done(const tx_system* s); // carried out by every simu
 int tx_system_set_time_scale(tx_system* s, double scale);
 double tx_system_time_scale(const tx_system* s);
 double tx_system_sim_time(const tx_system* s); // the simulation clock now, s
+// the system tx_system_run is running now (the last one started), or NULL: for a window's controls
+tx_system* tx_system_running(void);
+// live, while it runs, from any thread: steps, deadlines missed and the latest jitter of instance i
+typedef struct tx_live_stats {
+  uint64_t steps, missed;
+  int64_t jitter_ns; // |actual - nominal period| of its thread's latest tick
+} tx_live_stats;
+tx_live_stats tx_system_live(const tx_system* s, int i);
 
 // introspection, valid after finalize
 int tx_system_count(const tx_system* s);

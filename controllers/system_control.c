@@ -197,6 +197,16 @@ double tx_system_sim_time(const tx_system* s) {
   return (double)tx_clock_sim(&st, run_now(c)) * 1e-9;
 }
 
+static _Atomic(tx_system*) running_system;
+tx_system* tx_system_running(void) { return atomic_load(&running_system); }
+
+tx_live_stats tx_system_live(const tx_system* s, int i) {
+  instance* in = s->inst[i];
+  return (tx_live_stats){atomic_load_explicit(&in->live_steps, memory_order_relaxed),
+                         atomic_load_explicit(&in->live_missed, memory_order_relaxed),
+                         atomic_load_explicit(&in->live_jitter_ns, memory_order_relaxed)};
+}
+
 void tx_control_start(tx_system* s, bool lockstep) {
   tx_clock* c = &s->clock;
   for (int i = 0; i < s->count; i++) {
@@ -204,8 +214,12 @@ void tx_control_start(tx_system* s, bool lockstep) {
     in->live = tx_class_own_thread(in->cls) || in->cls->view;
     in->dead = false;
     in->sim_tick = 0;
+    in->live_ns = -1;
     in->reset_seen = atomic_load(&c->resets); // a reset asked for before the run is the start itself
     atomic_store(&in->reset_done, in->reset_seen);
+    atomic_store(&in->live_steps, 0);
+    atomic_store(&in->live_missed, 0);
+    atomic_store(&in->live_jitter_ns, 0);
   }
   s->clock_resets_seen = atomic_load(&c->resets);
   write_begin(c);
@@ -216,9 +230,12 @@ void tx_control_start(tx_system* s, bool lockstep) {
   atomic_store(&c->lockstep, lockstep);
   write_end(c);
   atomic_store(&c->running, true);
+  atomic_store(&running_system, s);
 }
 
 void tx_control_end(tx_system* s) {
+  tx_system* expected = s;
+  atomic_compare_exchange_strong(&running_system, &expected, NULL);
   atomic_store(&s->clock.running, false);
   atomic_store(&s->clock.t0, 0);
   for (int i = 0; i < s->count; i++) {

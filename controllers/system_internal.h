@@ -91,10 +91,13 @@ struct instance {
   bool live;          // haptics (own thread) and views: step through a pause, never rebuilt by a reset
   bool dead;          // a reset could not rebuild it: it steps no more
   uint64_t sim_tick;  // simulated instances: the next tick of the simulation clock to run
+  int64_t live_ns;    // live instances: the time of their latest step
   uint64_t reset_seen; // the system's reset count this instance has taken up
   _Atomic uint64_t reset_done; // and carried out (rebuilt, restored, init run again)
   void* initial;      // the contents of what it writes, as after init (a reset restores them)
   uint32_t* initial_rows;
+  _Atomic uint64_t live_steps, live_missed; // copies for other threads (tx_system_live)
+  _Atomic int64_t live_jitter_ns;
 };
 
 // The simulation clock behind pause, step and the time scale. `run_ns` is the

@@ -10,6 +10,7 @@ optional=(libbullet-dev libode-dev libassimp-dev liburdfdom-dev libtinyxml-dev
           libosmesa6-dev libglfw3-dev libpng-dev
           libplplot-dev plplot-driver-cairo
           xvfb xauth                   # xvfb-run: the window-mode screenshot test
+          libimgui-dev xdotool         # the window's panels (Dear ImGui); synthetic input in its test
           cyclonedds-dev tetgen
           libgts-dev libnifti2-dev)      # the LAGB asset pipeline: marching cubes, a user's NIfTI volume
 

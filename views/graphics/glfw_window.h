@@ -6,6 +6,9 @@
 //   arrow keys, W A S D         x and z in steps
 //   space                       button 0 (held)
 //   Esc or closing the window   ends the run (as Ctrl-C does)
+//   P, N, R                     pause or resume, single step, reset (controllers/system.h)
+//   [ and ]                     halve, double the time scale (x0.25 to x1)
+//   H                           hides or shows the panels (where built with Dear ImGui, gui.h)
 // GLFW is used from the view's rendering thread, after the probe at load.
 #ifndef TX_VIEWS_GRAPHICS_GLFW_WINDOW_H
 #define TX_VIEWS_GRAPHICS_GLFW_WINDOW_H
@@ -30,6 +33,8 @@ tx_gl_proc tx_window_proc(const char* name);
 void tx_window_framebuffer(const tx_window* w, int* width, int* height);
 void tx_window_set_title(tx_window* w, const char* title);
 void tx_window_resize(tx_window* w, int width, int height);
+// the panels over the frame drawn, in each of tiles_x x tiles_y eyes (nothing without Dear ImGui)
+void tx_window_draw_gui(tx_window* w, int tiles_x, int tiles_y);
 // show the frame and handle input; false once the window asked to close
 bool tx_window_present(tx_window* w);
 

@@ -311,6 +311,8 @@ static void draw_overlay(view* v, render_state* rs, int w, int h) {
   if (v->stereo == TX_STEREO_SBS) tx_overlay_draw(rs->overlay, w, 0, w, h);
   if (v->stereo == TX_STEREO_TB) tx_overlay_draw(rs->overlay, 0, 0, w, h);
   tx_overlay_clear(rs->overlay);
+  // the trainer's panels over it, at zero disparity (glfw_window.h)
+  tx_window_draw_gui(rs->win, v->stereo == TX_STEREO_SBS ? 2 : 1, v->stereo == TX_STEREO_TB ? 2 : 1);
 }
 #endif
 
