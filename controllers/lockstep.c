@@ -80,6 +80,7 @@ int tx_run_lockstep(tx_system* s, const tx_run_options* o, tx_run_result* r) {
     for (int m = 0; m < s->groups[g].count; m++) {
       instance* in = s->inst[s->groups[g].members[m]];
       if (in->dead) continue;
+      tx_control_apply_tunes(s, in, t);
       if (in->steps == 0) in->first_start_ns = t;
       in->last_start_ns = t;
       tx_hist_add(&in->step_time, tx_instance_step(s, in, t));

@@ -110,8 +110,10 @@ static void* worker_main(void* arg) {
       if (in->live) {       // (paused), so its recording's time still increases
         if (at <= in->live_ns) at = in->live_ns + 1;
         in->live_ns = at;
+        tx_control_apply_tunes(s, in, at);
       } else {
         tx_control_apply_reset(s, in, sim);
+        tx_control_apply_tunes(s, in, sim);
         if (in->dead) continue;
         if (tx_tick_ns(g->rate_hz, in->sim_tick) > sim) continue; // the clock has not reached its next tick
         if (cs.paused) {

@@ -139,6 +139,25 @@ uint64_t tx_system_resets_done(const tx_system* s); // carried out by every simu
 int tx_system_set_time_scale(tx_system* s, double scale);
 double tx_system_time_scale(const tx_system* s);
 double tx_system_sim_time(const tx_system* s); // the simulation clock now, s
+// Tune: a new value for a live parameter (tx_controller_class.live) of instance i,
+// applied by the class's tune on the instance's thread before its next step
+// and logged with the time then (tx_system_tune_at, report.json's "tuned").
+// -1 with tx_error() for a key the table lacks, one not live, a value outside
+// its range (or not whole for an integer, not 0 or 1 for a boolean), or more
+// than TX_TUNES_PENDING waiting. A reset restores the scenario's value.
+#define TX_TUNES_PENDING 32
+#define TX_TUNES_MAX 256 // logged per run; later ones are applied, not logged
+int tx_system_tune(tx_system* s, int i, const char* key, double value);
+bool tx_param_live(const tx_controller_class* cls, const char* key); // in cls->live
+typedef struct tx_tune_info {
+  double t_s;             // simulation time it took effect
+  const char* controller; // instance
+  const char* key;
+  double value;
+} tx_tune_info;
+int tx_system_tunes(tx_system* s); // logged in the current or last run
+tx_tune_info tx_system_tune_at(tx_system* s, int k);
+
 // the system tx_system_run is running now (the last one started), or NULL: for a window's controls
 tx_system* tx_system_running(void);
 // live, while it runs, from any thread: steps, deadlines missed and the latest jitter of instance i

@@ -197,6 +197,12 @@ double tx_system_sim_time(const tx_system* s) {
   return (double)tx_clock_sim(&st, run_now(c)) * 1e-9;
 }
 
+bool tx_param_live(const tx_controller_class* cls, const char* key) {
+  for (int i = 0; cls->live && cls->live[i]; i++)
+    if (strcmp(cls->live[i], key) == 0) return true;
+  return false;
+}
+
 static _Atomic(tx_system*) running_system;
 tx_system* tx_system_running(void) { return atomic_load(&running_system); }
 
@@ -214,6 +220,7 @@ void tx_control_start(tx_system* s, bool lockstep) {
     in->live = tx_class_own_thread(in->cls) || in->cls->view;
     in->dead = false;
     in->sim_tick = 0;
+    in->index = i;
     in->live_ns = -1;
     in->reset_seen = atomic_load(&c->resets); // a reset asked for before the run is the start itself
     atomic_store(&in->reset_done, in->reset_seen);
@@ -222,6 +229,9 @@ void tx_control_start(tx_system* s, bool lockstep) {
     atomic_store(&in->live_jitter_ns, 0);
   }
   s->clock_resets_seen = atomic_load(&c->resets);
+  pthread_mutex_lock(&c->mutex);
+  s->ntunes = 0; // tunes asked for before the run wait for it
+  pthread_mutex_unlock(&c->mutex);
   write_begin(c);
   atomic_store_explicit(&c->anchor_wall, 0, memory_order_relaxed);
   atomic_store_explicit(&c->anchor_sim, 0, memory_order_relaxed);
@@ -326,4 +336,68 @@ void tx_control_apply_reset(tx_system* s, instance* in, int64_t sim_ns) {
   }
   tx_instance_publish(s, in, sim_ns);
   atomic_store(&in->reset_done, want);
+}
+
+int tx_system_tune(tx_system* s, int i, const char* key, double value) {
+  if (i < 0 || i >= s->count) return tx_set_error("no controller %d", i), -1;
+  instance* in = s->inst[i];
+  const tx_controller_class* cls = in->cls;
+  int p = 0;
+  while (p < cls->nparams && strcmp(cls->params[p].key, key ? key : "") != 0) p++;
+  if (!cls->params || p == cls->nparams) return tx_set_error("%s (%s) has no parameter '%s'", in->name, cls->type, key ? key : ""), -1;
+  const tx_param_def* d = &cls->params[p];
+  if (!tx_param_live(cls, key)) return tx_set_error("%s.%s cannot change during a run", in->name, key), -1;
+  bool ok = d->kind == TX_PARAM_BOOL ? (value == 0 || value == 1)
+                                     : value >= d->min && value <= d->max && (d->kind != TX_PARAM_INT || value == floor(value));
+  if (!ok) {
+    if (d->kind == TX_PARAM_BOOL) return tx_set_error("%s.%s: %g is not 0 or 1", in->name, key, value), -1;
+    return tx_set_error("%s.%s: %g is out of range [%g, %g]%s", in->name, key, value, d->min, d->max,
+                        d->kind == TX_PARAM_INT ? " or not whole" : ""), -1;
+  }
+  pthread_mutex_lock(&s->clock.mutex);
+  int n = s->ntunes_pending;
+  if (n < TX_TUNES_PENDING) {
+    s->tunes_pending[s->ntunes_pending++] = (tune_entry){i, p, value, 0};
+    atomic_fetch_add(&in->tune_pending, 1);
+  }
+  pthread_mutex_unlock(&s->clock.mutex);
+  if (n == TX_TUNES_PENDING) return tx_set_error("%d changes are already waiting", TX_TUNES_PENDING), -1;
+  char what[2 * TX_NAME_MAX + 16];
+  snprintf(what, sizeof what, "tune %s.%s", in->name, key);
+  return log_control(s, what, value);
+}
+
+void tx_control_apply_tunes(tx_system* s, instance* in, int64_t sim_ns) {
+  if (!atomic_load_explicit(&in->tune_pending, memory_order_acquire) || in->dead) return;
+  if (pthread_mutex_trylock(&s->clock.mutex) != 0) return; // the haptics thread never waits: next tick
+  int kept = 0;
+  for (int k = 0; k < s->ntunes_pending; k++) {
+    tune_entry e = s->tunes_pending[k];
+    if (e.inst != in->index) {
+      s->tunes_pending[kept++] = e;
+      continue;
+    }
+    in->ctx.sim_ns = sim_ns;
+    in->cls->tune(&in->ctx, in->self, in->cls->params[e.param].key, e.value);
+    e.t_s = (double)sim_ns * 1e-9;
+    if (s->ntunes < TX_TUNES_MAX) s->tunes[s->ntunes++] = e;
+    atomic_fetch_sub(&in->tune_pending, 1);
+  }
+  s->ntunes_pending = kept;
+  pthread_mutex_unlock(&s->clock.mutex);
+}
+
+int tx_system_tunes(tx_system* s) {
+  pthread_mutex_lock(&s->clock.mutex);
+  int n = s->ntunes;
+  pthread_mutex_unlock(&s->clock.mutex);
+  return n;
+}
+
+tx_tune_info tx_system_tune_at(tx_system* s, int k) {
+  pthread_mutex_lock(&s->clock.mutex);
+  tune_entry e = s->tunes[k];
+  pthread_mutex_unlock(&s->clock.mutex);
+  const instance* in = s->inst[e.inst];
+  return (tx_tune_info){e.t_s, in->name, in->cls->params[e.param].key, e.value};
 }

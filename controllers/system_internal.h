@@ -98,7 +98,14 @@ struct instance {
   uint32_t* initial_rows;
   _Atomic uint64_t live_steps, live_missed; // copies for other threads (tx_system_live)
   _Atomic int64_t live_jitter_ns;
+  int index;                // in tx_system.inst
+  _Atomic int tune_pending; // tunes waiting for it
 };
+
+typedef struct tune_entry {
+  int inst, param;
+  double value, t_s;
+} tune_entry;
 
 // The simulation clock behind pause, step and the time scale. `run_ns` is the
 // executor's clock (wall time since the run's t0, or lockstep's virtual time);
@@ -167,6 +174,10 @@ struct tx_system {
   int64_t halt_sim_ns;     // simulation time of that request
   tx_clock clock;          // pause, step, reset, time scale (system_control.c)
   uint64_t clock_resets_seen; // lockstep: the resets carried out
+  tune_entry tunes_pending[TX_TUNES_PENDING]; // under clock.mutex
+  int ntunes_pending;
+  tune_entry tunes[TX_TUNES_MAX]; // applied, under clock.mutex
+  int ntunes;
 };
 
 // true once a controller asked to stop the run (tx_stop_run)
@@ -197,6 +208,9 @@ bool tx_control_keep_initial(tx_system* s, instance* in);
 // on the instance's thread, between its steps: carry out a reset asked for (rebuild the instance,
 // restore what it writes, run init again); simulation time sim_ns
 void tx_control_apply_reset(tx_system* s, instance* in, int64_t sim_ns);
+// on the instance's thread, before a step: apply the tunes waiting for it (never blocks: a
+// busy lock leaves them for the next tick)
+void tx_control_apply_tunes(tx_system* s, instance* in, int64_t sim_ns);
 // publish what an instance wrote (context.c)
 void tx_instance_publish(tx_system* s, instance* in, int64_t sim_ns);
 

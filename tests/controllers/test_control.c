@@ -23,18 +23,29 @@ static _Atomic long mirror[4];
 typedef struct accum {
   tx_port out;
   long count;
+  long gain; // added per step
   int slot;
 } accum;
 
 static const tx_param_def accum_params[] = {
     {"write", TX_PARAM_STR, NULL, 0, 0, 0, NULL, "the component written (f64 1 x 1)"},
     {"slot", TX_PARAM_INT, "1", 0, 3, 0, NULL, "its mirror"},
+    {"gain", TX_PARAM_INT, "1", 1, 100, 1, NULL, "added per step"},
+    {"name", TX_PARAM_STR, NULL, 0, 0, 0, NULL, "a text"},
 };
+static const char* const accum_live[] = {"gain", NULL};
+
+static void accum_tune(tx_ctx* c, void* self, const char* key, double value) {
+  (void)c;
+  assert_string_equal(key, "gain");
+  ((accum*)self)->gain = (long)value;
+}
 
 static int accum_configure(tx_setup* s, void** self) {
   accum* a = calloc(1, sizeof *a);
   *self = a;
   a->slot = (int)tx_table_int(s, "slot");
+  a->gain = tx_table_int(s, "gain");
   a->out = tx_setup_write(s, &(tx_component_def){tx_table_str(s, "write"), TX_F64, 1, 1, "1"});
   return 0;
 }
@@ -51,7 +62,7 @@ static int accum_init(tx_ctx* c, void* self) {
 
 static void accum_step(tx_ctx* c, void* self) {
   accum* a = self;
-  a->count++;
+  a->count += a->gain;
   publish(c, a);
 }
 
@@ -60,12 +71,12 @@ static void accum_fini(void* self) { free(self); }
 static const tx_controller_class accum_cls = {.type = "test.accum", .summary = "counts its steps",
                                               .configure = accum_configure, .init = accum_init, .step = accum_step,
                                               .fini = accum_fini, .params = accum_params,
-                                              .nparams = TX_PARAMS_COUNT(accum_params)};
+                                              .nparams = TX_PARAMS_COUNT(accum_params), .live = accum_live, .tune = accum_tune};
 // the same on a haptics thread: live, it steps through a pause and a reset leaves it be
 static const tx_controller_class live_cls = {.type = "haptics.accum", .summary = "counts its steps",
                                              .configure = accum_configure, .init = accum_init, .step = accum_step,
                                              .fini = accum_fini, .params = accum_params,
-                                             .nparams = TX_PARAMS_COUNT(accum_params)};
+                                             .nparams = TX_PARAMS_COUNT(accum_params), .live = accum_live, .tune = accum_tune};
 
 static void add(tx_system* s, const char* name, const char* type, double rate, const char* write, int slot) {
   char text[128];
@@ -190,7 +201,7 @@ static int fragile_configure(tx_setup* s, void** self) {
 static const tx_controller_class fragile_cls = {.type = "test.fragile", .summary = "fails its second configure",
                                                 .configure = fragile_configure, .init = accum_init,
                                                 .step = accum_step, .fini = accum_fini, .params = accum_params,
-                                                .nparams = TX_PARAMS_COUNT(accum_params)};
+                                                .nparams = TX_PARAMS_COUNT(accum_params), .live = accum_live, .tune = accum_tune};
 
 static bool reset_at_once(double t, void* user) {
   (void)t;
@@ -211,6 +222,62 @@ static void failed_rebuild_stops_the_run(void** state) {
   assert_non_null(strstr(r.halt_reason, "physics: reset: configure failed: the file is gone"));
   assert_true(r.halt_t_s < 0.2);
   tx_system_destroy(s);
+}
+
+// a live parameter changes from the next step on, and the change is logged with its time
+static bool tune_at_half(double t, void* user) {
+  tx_system* s = user;
+  if (t >= 0.5 && tx_system_tunes(s) == 0 && value(s, "phys.x") == 51) {
+    assert_int_equal(tx_system_tune(s, 0, "gain", 10), 0);
+  }
+  return true;
+}
+
+static void tune_live_parameter(void** state) {
+  (void)state;
+  tx_system* s = tx_system_create();
+  add(s, "physics", "test.accum", 100, "phys.x", 0);
+  assert_int_equal(tx_system_finalize(s), 0);
+  // refused: a key the table lacks, one that is not live, out of range, not whole
+  assert_int_equal(tx_system_tune(s, 0, "speed", 1), -1);
+  assert_non_null(strstr(tx_error(), "physics (test.accum) has no parameter 'speed'"));
+  assert_int_equal(tx_system_tune(s, 0, "slot", 1), -1);
+  assert_non_null(strstr(tx_error(), "physics.slot cannot change during a run"));
+  assert_int_equal(tx_system_tune(s, 0, "gain", 101), -1);
+  assert_non_null(strstr(tx_error(), "physics.gain: 101 is out of range [1, 100]"));
+  assert_int_equal(tx_system_tune(s, 0, "gain", 2.5), -1);
+  assert_int_equal(tx_system_tune(s, 7, "gain", 2), -1);
+  tx_run_options o = {.duration_s = 1, .lockstep = true, .progress = tune_at_half, .progress_user = s};
+  tx_run_result r;
+  assert_int_equal(tx_system_run(s, &o, &r), 0);
+  assert_int_equal(tx_system_tunes(s), 1);
+  tx_tune_info t = tx_system_tune_at(s, 0);
+  assert_string_equal(t.controller, "physics");
+  assert_string_equal(t.key, "gain");
+  assert_true(t.value == 10);
+  assert_true(fabs(t.t_s - 0.51) < 1e-9); // the tick after the call
+  // ticks 0.00-0.50 add 1 (51), 0.51-0.99 add 10 (49 ticks)
+  assert_true(value(s, "phys.x") == 51 + 490);
+  tx_system_destroy(s);
+}
+
+// a class with a live parameter and no tune is refused at registration
+static void live_needs_tune(void** state) {
+  (void)state;
+  static const char* const text_live[] = {"name", NULL}, *const unknown_live[] = {"speed", NULL};
+  tx_controller_class bad = accum_cls;
+  bad.type = "test.bad_live";
+  bad.live = text_live;
+  assert_int_equal(tx_register_controller(&bad), -1);
+  assert_non_null(strstr(tx_error(), "name: only a number, an integer or a boolean can be live"));
+  bad.live = unknown_live;
+  assert_int_equal(tx_register_controller(&bad), -1);
+  assert_non_null(strstr(tx_error(), "'speed' is not in the parameter table"));
+  tx_controller_class untuned = accum_cls;
+  untuned.type = "test.untuned";
+  untuned.tune = NULL;
+  assert_int_equal(tx_register_controller(&untuned), -1);
+  assert_non_null(strstr(tx_error(), "gain: live, but the class has no tune"));
 }
 
 // real time: the driver is another thread, as a window's would be
@@ -317,6 +384,8 @@ int main(void) {
       cmocka_unit_test(reset_before_run_is_the_start),
       cmocka_unit_test(time_scale_range),
       cmocka_unit_test(failed_rebuild_stops_the_run),
+      cmocka_unit_test(tune_live_parameter),
+      cmocka_unit_test(live_needs_tune),
       cmocka_unit_test(realtime_haptics_runs_through_a_pause),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

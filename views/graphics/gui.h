@@ -49,8 +49,6 @@ void tx_gui_table_end(void);
 
 // the panels (gui_panel.c): the run's controls, inspect and tune
 void tx_gui_panels(float eye_w, float eye_h);
-// the keys of the controls, also without the panels shown: true when one was taken
-bool tx_gui_control_key(int key);
 
 #ifdef __cplusplus
 }

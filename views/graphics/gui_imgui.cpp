@@ -31,6 +31,12 @@ struct tx_gui {
   bool shown;
   void (*draw_buffer)(unsigned);
   void (*get_integerv)(unsigned, int*);
+  // ImGui 1.86 reads keys as held or not at each frame: a tap shorter than a
+  // frame would be lost, so a release of a key pressed since the last frame
+  // waits for the next one
+  int pressed[16], npressed;
+  struct { int key, scancode, mods; } deferred[16];
+  int ndeferred;
 };
 
 extern "C" {
@@ -86,6 +92,13 @@ bool tx_gui_scroll(tx_gui* g, double dx, double dy) {
 
 bool tx_gui_key(tx_gui* g, int key, int scancode, int action, int mods) {
   if (!g->shown) return false;
+  bool tapped = false;
+  for (int i = 0; i < g->npressed && !tapped; i++) tapped = g->pressed[i] == key;
+  if (action == GLFW_RELEASE && tapped && g->ndeferred < 16) {
+    g->deferred[g->ndeferred++] = {key, scancode, mods};
+    return ImGui::GetIO().WantCaptureKeyboard;
+  }
+  if (action == GLFW_PRESS && g->npressed < 16) g->pressed[g->npressed++] = key;
   ImGui_ImplGlfw_KeyCallback(g->window, key, scancode, action, mods);
   return ImGui::GetIO().WantCaptureKeyboard;
 }
@@ -110,6 +123,11 @@ void tx_gui_frame(tx_gui* g, int fb_w, int fb_h, int tiles_x, int tiles_y, bool 
   if (io.MousePos.x >= 0 && io.MousePos.y >= 0)
     io.MousePos = ImVec2(std::fmod(io.MousePos.x, eye_w), std::fmod(io.MousePos.y, eye_h));
   ImGui::NewFrame();
+  // this frame has seen the taps: their releases now
+  g->npressed = 0;
+  for (int i = 0; i < g->ndeferred; i++)
+    ImGui_ImplGlfw_KeyCallback(g->window, g->deferred[i].key, g->deferred[i].scancode, GLFW_RELEASE, g->deferred[i].mods);
+  g->ndeferred = 0;
   tx_gui_panels(eye_w, eye_h);
   ImGui::Render();
   ImDrawData* d = ImGui::GetDrawData();
@@ -155,6 +173,7 @@ bool tx_gui_slider(const char* label, double* v, double min, double max, const c
 }
 
 bool tx_gui_input(const char* label, double* v, const char* format) {
+  ImGui::SetNextItemWidth(110); // room for "instance.key (units)" beside it
   ImGui::InputDouble(label, v, 0, 0, format);
   return ImGui::IsItemDeactivatedAfterEdit();
 }

@@ -7,7 +7,7 @@
 
 #include <tactus/model.h>
 
-#include <GLFW/glfw3.h>
+#include <jansson.h>
 #include <math.h>
 #include <stdio.h>
 
@@ -38,25 +38,53 @@ static void count_rates(tx_system* s, int n) {
   live.since_ns = now;
 }
 
-bool tx_gui_control_key(int key) {
-  tx_system* s = tx_system_running();
-  if (!s) return false;
-  switch (key) {
-  case GLFW_KEY_P: // a line that cannot be logged is no reason to refuse the control
-    (void)(tx_system_paused(s) ? tx_system_resume(s) : tx_system_pause(s));
-    return true;
-  case GLFW_KEY_N: (void)tx_system_step(s); return true;
-  case GLFW_KEY_R: (void)tx_system_reset(s); return true;
-  case GLFW_KEY_LEFT_BRACKET: (void)tx_system_set_time_scale(s, fmax(TX_TIME_SCALE_MIN, tx_system_time_scale(s) / 2)); return true;
-  case GLFW_KEY_RIGHT_BRACKET: (void)tx_system_set_time_scale(s, fmin(1, tx_system_time_scale(s) * 2)); return true;
-  default: return false;
+// the live parameters of each controller (tx_controller_class.live), as the scenario
+// gave them or as last set here; every other parameter is fixed for the run
+#define TUNE_MAX 64
+static struct {
+  tx_system* sys;
+  int inst[TUNE_MAX], param[TUNE_MAX];
+  double value[TUNE_MAX];
+  int n;
+  char error[256]; // the last refusal, shown under them
+} tune;
+
+static void tune_collect(tx_system* s, int n) {
+  tune.sys = s;
+  tune.n = 0;
+  tune.error[0] = 0;
+  for (int i = 0; i < n; i++) {
+    const tx_controller_class* cls = tx_system_class(s, i);
+    for (int p = 0; p < cls->nparams && tune.n < TUNE_MAX; p++) {
+      const tx_param_def* d = &cls->params[p];
+      if (!tx_param_live(cls, d->key)) continue;
+      json_t* given = json_object_get(tx_system_params(s, i), d->key); // read only: configure is long over
+      tune.inst[tune.n] = i;
+      tune.param[tune.n] = p;
+      tune.value[tune.n++] = json_is_number(given) ? json_number_value(given) : json_is_boolean(given) ? json_is_true(given) : d->def_num;
+    }
   }
+}
+
+static void tune_panel(tx_system* s, int n) {
+  if (tune.sys != s) tune_collect(s, n);
+  if (tune.n == 0) tx_gui_text("no live parameters");
+  for (int k = 0; k < tune.n; k++) {
+    const tx_param_def* d = &tx_system_class(s, tune.inst[k])->params[tune.param[k]];
+    char label[160];
+    snprintf(label, sizeof label, "%s.%s (%s)", tx_system_name(s, tune.inst[k]), d->key, d->units ? d->units : "0/1");
+    double v = tune.value[k];
+    if (tx_gui_input(label, &v, "%g")) {
+      if (tx_system_tune(s, tune.inst[k], d->key, v) == 0) tune.value[k] = v, tune.error[0] = 0;
+      else snprintf(tune.error, sizeof tune.error, "%s", tx_error());
+    }
+  }
+  if (tune.error[0]) tx_gui_text("%s", tune.error);
 }
 
 void tx_gui_panels(float eye_w, float eye_h) {
   tx_system* s = tx_system_running();
-  (void)eye_h;
-  if (!tx_gui_begin("tactus", eye_w - 312, 8, 304, 300)) {
+  if (!tx_gui_begin("tactus", eye_w - 312, 8, 304, eye_h - 16 < 300 ? 300 : eye_h - 16)) {
     tx_gui_end();
     return;
   }
@@ -94,5 +122,6 @@ void tx_gui_panels(float eye_w, float eye_h) {
     }
     tx_gui_table_end();
   }
+  if (tx_gui_header("Tune", true)) tune_panel(s, n);
   tx_gui_end();
 }

@@ -68,6 +68,10 @@ cat >"$WORK/controls.txt" <<'EOF'
 1.0 key n
 0.4 mousemove --sync 515 62 click 1
 0.4 mousemove --sync 340 85 click 1
+0.4 mousemove --sync 390 282 click 1
+0.2 key ctrl+a
+0.1 type 0.02
+0.1 key Return
 0.4 key p
 0.5 key bracketright bracketright
 EOF
@@ -79,9 +83,10 @@ else
     fail "no controls.csv: $(ls "$WORK/mono")"
   else
     # in this order: pause, step, reset (the click), the time scale (the click at the slider's left end: x0.25),
-    # resume, the scale raised twice
+    # the wall's height typed in, resume, the scale raised twice
     actions=$(tail -n +2 "$csv" | cut -d, -f2 | tr '\n' ' ')
-    [ "$actions" = "pause step reset time_scale resume time_scale time_scale " ] || fail "controls logged: '$actions'"
+    [ "$actions" = "pause step reset time_scale tune wall.height_m resume time_scale time_scale " ] ||
+      fail "controls logged: '$actions'"
     low=$(awk -F, '$2 == "time_scale" {print $3; exit}' "$csv")
     awk -v v="${low:-9}" 'BEGIN {exit !(v >= 0.25 && v < 0.3)}' || fail "the slider's left end set x${low:-?}, not about x0.25"
     last=$(awk -F, '$2 == "time_scale" {v = $3} END {print v}' "$csv")
@@ -101,6 +106,19 @@ PY
   )
   [ "${wall:-0}" -ge 88 ] && [ "${wall:-0}" -le 92 ] || fail "the wall stepped ${wall:-?} times in 1.5 s of simulation, not 90"
   [ "${hap:-0}" -ge 2800 ] || fail "haptics stepped ${hap:-?} times: it did not keep its rate through the pause"
+  # the change of a parameter, in report.json with its time; and in the model: the wall's force
+  # model (as haptics recorded it) has no contact before it and the new plane's spring after it
+  read -r tuned tune_t < <(python3 - "$WORK/mono/report.json" <<'PY'
+import json, sys
+t = json.load(open(sys.argv[1])).get("tuned", [])
+print(" ".join(f'{e["controller"]}.{e["key"]}={e["value"]:g}' for e in t) or "none", t[0]["t_s"] if t else -1)
+PY
+  )
+  [ "$tuned" = "wall.height_m=0.02" ] || fail "report.json's tuned: $tuned"
+  awk -F, -v t="${tune_t:--1}" 'NR > 1 && $1 < t && $27 != 0 {before++}
+      NR > 1 && $1 > t + 0.1 && $1 < 1.4 {after++; if ($27 != -300 || $6 <= 0) wrong++}
+      END {exit !(t > 0 && !before && after > 100 && !wrong)}' "$WORK/mono/device0.csv" ||
+    fail "the wall's force model does not follow the tuned height (tuned at t = $tune_t s)"
   grep -q '"halt' "$WORK/mono/report.json" && fail "the run was halted: $(grep -o '"halt[^,]*' "$WORK/mono/report.json")"
   png="$WORK/mono/frames/window.png"
   n=$(panel_in "$png" 328 8 304 20)
