@@ -289,7 +289,7 @@ static bool same_ports(const port* a, const port* b, int n) {
 }
 
 // the rebuild failed: the instance steps no more and the run stops with the reason
-static void rebuild_failed(tx_system* s, instance* in, int64_t sim_ns, const char* why) {
+static void rebuild_failed(instance* in, int64_t sim_ns, const char* why) {
   in->dead = true;
   in->ctx.sim_ns = sim_ns;
   tx_stop_run(&in->ctx, "reset: %s", why);
@@ -301,7 +301,10 @@ void tx_control_apply_reset(tx_system* s, instance* in, int64_t sim_ns) {
   in->reset_seen = want;
   const int n = in->nports;
   port* saved = malloc((n ? n : 1) * sizeof *saved);
-  if (!saved) return rebuild_failed(s, in, sim_ns, "out of memory");
+  if (!saved) {
+    rebuild_failed(in, sim_ns, "out of memory");
+    return;
+  }
   memcpy(saved, in->ports, n * sizeof *saved);
   // a new instance from the same parameters: whatever the old one held is gone
   if (in->cls->fini) in->cls->fini(in->self);
@@ -316,7 +319,10 @@ void tx_control_apply_reset(tx_system* s, instance* in, int64_t sim_ns) {
   memcpy(in->ports, saved, n * sizeof *saved); // the model's ids and readers stay as finalize made them
   in->nports = n;
   free(saved);
-  if (!same) return rebuild_failed(s, in, sim_ns, why);
+  if (!same) {
+    rebuild_failed(in, sim_ns, why);
+    return;
+  }
   // what it writes, as after its first init; then init again, which publishes over it
   const char* at = in->initial;
   for (int p = 0; p < n && at; p++) {
@@ -332,7 +338,8 @@ void tx_control_apply_reset(tx_system* s, instance* in, int64_t sim_ns) {
   in->ctx.step = in->steps;
   if (in->cls->init && in->cls->init(&in->ctx, in->self) != 0) {
     tx_instance_publish(s, in, sim_ns);
-    return rebuild_failed(s, in, sim_ns, "init failed");
+    rebuild_failed(in, sim_ns, "init failed");
+    return;
   }
   tx_instance_publish(s, in, sim_ns);
   atomic_store(&in->reset_done, want);

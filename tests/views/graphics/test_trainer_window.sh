@@ -46,10 +46,10 @@ for _ in $(seq 100); do
   sleep 0.1
 done
 [ -n "$wid" ] || { echo "no window" >>"$out.log"; wait $pid; exit 1; }
-xdotool windowfocus --sync "$wid" 2>/dev/null || true
 while read -r wait_s args; do
   [ -n "$wait_s" ] || continue
   sleep "$wait_s"
+  xdotool windowfocus --sync "$wid" 2>/dev/null || true # XTEST input goes to the focused window
   # shellcheck disable=SC2086
   xdotool $args
 done <"$script"
@@ -142,7 +142,7 @@ else
 fi
 
 # 3. H hides the panels
-echo "0.8 key h" >"$WORK/hide.txt"
+echo "1.0 key h" >"$WORK/hide.txt"
 if ! window_run "$WORK/hidden" "$WORK/hide.txt" --duration 1.5; then
   fail "the window run with H failed: $(tail -n 3 "$WORK/hidden.log")"
 else
