@@ -214,6 +214,14 @@ void tx_window_draw_gui(tx_window* t, int tiles_x, int tiles_y) {
 #endif
 }
 
+void tx_window_sample(tx_window* t, const char* device, double t_s, const double pos[3], const double* force) {
+#ifdef TX_HAVE_GUI
+  if (t->gui) tx_gui_sample(device, t_s, pos, force);
+#else
+  (void)t, (void)device, (void)t_s, (void)pos, (void)force;
+#endif
+}
+
 bool tx_window_present(tx_window* t) {
   glfwSwapBuffers(t->w);
   glfwPollEvents();

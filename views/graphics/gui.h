@@ -49,6 +49,8 @@ void tx_gui_table_end(void);
 
 // the panels (gui_panel.c): the run's controls, inspect and tune
 void tx_gui_panels(float eye_w, float eye_h);
+// a device's position (m) and force (N, or NULL) as the frame drew them, for its plots
+void tx_gui_sample(const char* device, double t_s, const double pos[3], const double* force);
 
 #ifdef __cplusplus
 }

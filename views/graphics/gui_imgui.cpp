@@ -32,11 +32,12 @@ struct tx_gui {
   void (*draw_buffer)(unsigned);
   void (*get_integerv)(unsigned, int*);
   // ImGui 1.86 reads keys as held or not at each frame: a tap shorter than a
-  // frame would be lost, so a release of a key pressed since the last frame
-  // waits for the next one
+  // frame would be lost, so the release of a key pressed since the last frame
+  // waits until a frame has seen it held (forwarded before the next frame
+  // starts, so the modifiers never change within a frame)
   int pressed[16], npressed;
-  struct { int key, scancode, mods; } deferred[16];
-  int ndeferred;
+  struct tap { int key, scancode, mods; } deferred[16], ready[16];
+  int ndeferred, nready;
 };
 
 extern "C" {
@@ -95,7 +96,7 @@ bool tx_gui_key(tx_gui* g, int key, int scancode, int action, int mods) {
   bool tapped = false;
   for (int i = 0; i < g->npressed && !tapped; i++) tapped = g->pressed[i] == key;
   if (action == GLFW_RELEASE && tapped && g->ndeferred < 16) {
-    g->deferred[g->ndeferred++] = {key, scancode, mods};
+    g->deferred[g->ndeferred++] = tx_gui::tap{key, scancode, mods};
     return ImGui::GetIO().WantCaptureKeyboard;
   }
   if (action == GLFW_PRESS && g->npressed < 16) g->pressed[g->npressed++] = key;
@@ -113,6 +114,13 @@ bool tx_gui_shown(const tx_gui* g) { return g->shown; }
 
 void tx_gui_frame(tx_gui* g, int fb_w, int fb_h, int tiles_x, int tiles_y, bool quad) {
   if (!g->shown || fb_w <= 0 || fb_h <= 0) return;
+  // the taps the last frame saw held are released now; those since wait for this one
+  for (int i = 0; i < g->nready; i++)
+    ImGui_ImplGlfw_KeyCallback(g->window, g->ready[i].key, g->ready[i].scancode, GLFW_RELEASE, g->ready[i].mods);
+  for (int i = 0; i < g->ndeferred; i++) g->ready[i] = g->deferred[i];
+  g->nready = g->ndeferred;
+  g->ndeferred = 0;
+  g->npressed = 0;
   const float eye_w = (float)fb_w / (float)tiles_x, eye_h = (float)fb_h / (float)tiles_y;
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
@@ -123,11 +131,6 @@ void tx_gui_frame(tx_gui* g, int fb_w, int fb_h, int tiles_x, int tiles_y, bool 
   if (io.MousePos.x >= 0 && io.MousePos.y >= 0)
     io.MousePos = ImVec2(std::fmod(io.MousePos.x, eye_w), std::fmod(io.MousePos.y, eye_h));
   ImGui::NewFrame();
-  // this frame has seen the taps: their releases now
-  g->npressed = 0;
-  for (int i = 0; i < g->ndeferred; i++)
-    ImGui_ImplGlfw_KeyCallback(g->window, g->deferred[i].key, g->deferred[i].scancode, GLFW_RELEASE, g->deferred[i].mods);
-  g->ndeferred = 0;
   tx_gui_panels(eye_w, eye_h);
   ImGui::Render();
   ImDrawData* d = ImGui::GetDrawData();

@@ -1,7 +1,9 @@
 // The trainer's panels: the run's controls (pause, resume, single step,
-// reset, time scale) and what each controller does live (rate, jitter,
-// deadlines missed), for the system tx_system_run is running.
+// reset, time scale), what each controller does live (rate, jitter,
+// deadlines missed), its live parameters, and each device's force and
+// position as scrolling plots, for the system tx_system_run is running.
 #include "gui.h"
+#include "gui_series.h"
 
 #include "../../controllers/system.h"
 
@@ -36,6 +38,29 @@ static void count_rates(tx_system* s, int n) {
     live.steps_then[i] = steps;
   }
   live.since_ns = now;
+}
+
+static tx_series_set series; // the devices' force and position, one sample per frame
+
+void tx_gui_sample(const char* device, double t_s, const double pos[3], const double* force) {
+  (void)tx_series_push(&series, device, t_s, pos, force); // a fifth device is not plotted
+}
+
+static void device_plots(void) {
+  if (series.count == 0) tx_gui_text("no device drawn");
+  for (int d = 0; d < series.count; d++) {
+    const tx_series* e = &series.dev[d];
+    int last = (e->next + TX_SERIES_LEN - 1) % TX_SERIES_LEN, off = tx_series_offset(e);
+    char label[64];
+    if (e->has_force) {
+      tx_gui_text("%s F (%.2f, %.2f, %.2f) N", e->name, e->fxyz[0], e->fxyz[1], e->fxyz[2]);
+      snprintf(label, sizeof label, "|F| N##%s", e->name);
+      tx_gui_plot(label, e->force, e->count, off, 40);
+    }
+    tx_gui_text("%s at (%.1f, %.1f, %.1f) mm", e->name, e->pos[0][last], e->pos[1][last], e->pos[2][last]);
+    snprintf(label, sizeof label, "y mm##%s", e->name);
+    tx_gui_plot(label, e->pos[1], e->count, off, 40);
+  }
 }
 
 // the live parameters of each controller (tx_controller_class.live), as the scenario
@@ -123,5 +148,6 @@ void tx_gui_panels(float eye_w, float eye_h) {
     tx_gui_table_end();
   }
   if (tx_gui_header("Tune", true)) tune_panel(s, n);
+  if (tx_gui_header("Devices", true)) device_plots();
   tx_gui_end();
 }

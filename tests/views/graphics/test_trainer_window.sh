@@ -4,8 +4,10 @@
 # its button, the time scale set by clicking its slider and raised with ],
 # resume (P). Checks the controls the run logged (controls.csv), the model's
 # clock in report.json (the simulated controller stood still through the
-# pause while haptics kept its rate), and the screenshots: the panel where it
-# belongs, in both eyes of sbs at the same place, and gone after H.
+# pause while haptics kept its rate), the change of a parameter (report.json
+# and the recorded force model), and the screenshots: the panel where it
+# belongs with a trace in the device plot, in both eyes of sbs at the same
+# place, and gone after H.
 # Exit 77 (skipped) only when xvfb-run or xdotool is not installed.
 #
 #   test_trainer_window.sh TACTUS PNG_PROBE [SHOTS_DIR]
@@ -125,6 +127,11 @@ PY
   [ "$n" -gt 2000 ] || fail "no panel title bar at the top right of the mono screenshot ($n px)"
   n=$(panel_in "$png" 0 40 320 440)
   [ "$n" -eq 0 ] || fail "the title bar's colour outside the panel ($n px): the probe cannot tell"
+  # the device plots under Devices: |F| (y 338..376) holds a trace in the plots' line colour
+  read -r _ _ _ n < <("$PROBE" "$png" 336 336 196 42 147 148 150)
+  [ "${n:-0}" -gt 60 ] || fail "no trace in the |F| plot (${n:-0} px of its line colour)"
+  read -r _ _ _ n < <("$PROBE" "$png" 0 40 320 440 147 148 150)
+  [ "${n:-1}" -eq 0 ] || fail "the plots' line colour outside the panel ($n px): the probe cannot tell"
   [ -n "$SHOTS" ] && cp "$png" "$SHOTS/trainer_mono.png"
 fi
 
