@@ -34,6 +34,9 @@ struct tx_window {
 };
 
 static char glfw_error[256];
+static bool panels_at_open = true; // tx_window_show_panels
+
+void tx_window_show_panels(bool shown) { panels_at_open = shown; }
 static void on_error(int code, const char* text) {
   (void)code;
   snprintf(glfw_error, sizeof glfw_error, "%s", text);
@@ -181,6 +184,7 @@ tx_window* tx_window_open(int width, int height, bool want_quad) {
     free(t);
     return NULL; // tx_error() says why
   }
+  tx_gui_set_shown(t->gui, panels_at_open);
 #endif
   t->tool[1] = 0.02;
   publish(t);

@@ -25,6 +25,9 @@ typedef enum tx_window_lack { TX_WINDOW_OK, TX_WINDOW_NO_DISPLAY, TX_WINDOW_NO_Q
 // with need_quad, offers a quad-buffered GL context; the reason in tx_error() when not.
 // GLFW stays initialised, as after tx_window_open.
 tx_window_lack tx_window_probe(bool need_quad);
+// whether windows opened from now on show the trainer's panels (default true;
+// `tactus bench render` measures their cost against a window without them)
+void tx_window_show_panels(bool shown);
 // NULL with a one-line message in tx_error() when no window can be made
 tx_window* tx_window_open(int width, int height, bool want_quad);
 void tx_window_close(tx_window* w);
