@@ -159,6 +159,7 @@ int64_t tx_instance_step(tx_system* s, instance* in, int64_t sim_ns) {
   in->cls->step(&in->ctx, in->self);
   publish_written(s, in, sim_ns);
   in->steps++;
+  atomic_store_explicit(&in->live_steps, in->steps, memory_order_relaxed);
   return tx_mono_ns() - t0;
 }
 
@@ -178,3 +179,5 @@ int tx_instance_init(tx_system* s, instance* in) {
   publish_written(s, in, 0); // what init wrote is the first publish, at time 0
   return 0;
 }
+
+void tx_instance_publish(tx_system* s, instance* in, int64_t sim_ns) { publish_written(s, in, sim_ns); }

@@ -6,9 +6,29 @@
 // controllers see depends on wall time, so two runs give bit-identical traces;
 // wall time only paces the progress calls, so that a stop request is never kept
 // waiting by a slow step or a clock that hardly moves.
+//
+// Run control (system_control.c): a pause stops every instance, haptics
+// included (nothing here is real time), until a resume or a single step; a
+// reset rebuilds the simulated instances before the next tick, in scenario
+// order. The time scale does not apply: nothing here follows the wall clock.
 #include "system_internal.h"
 
 #include <stdlib.h>
+#include <time.h>
+
+// paused: wait for a control call, or 100 ms of wall time for the progress call
+static void wait_paused(tx_system* s) {
+  tx_clock* c = &s->clock;
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  ts.tv_nsec += 100000000;
+  if (ts.tv_nsec >= 1000000000) ts.tv_sec++, ts.tv_nsec -= 1000000000;
+  pthread_mutex_lock(&c->mutex);
+  uint64_t resets = atomic_load(&c->resets), version = atomic_load(&c->version);
+  while (atomic_load(&c->version) == version && atomic_load(&c->resets) == resets &&
+         pthread_cond_timedwait(&c->cond, &c->mutex, &ts) == 0) {}
+  pthread_mutex_unlock(&c->mutex);
+}
 
 int tx_run_lockstep(tx_system* s, const tx_run_options* o, tx_run_result* r) {
   s->tracing = true;
@@ -16,7 +36,10 @@ int tx_run_lockstep(tx_system* s, const tx_run_options* o, tx_run_result* r) {
   s->trace_name = o->trace_name;
   s->trace_hash = TX_HASH_SEED;
   int rc = 0;
-  for (int i = 0; i < s->count && rc == 0; i++) rc = tx_instance_init(s, s->inst[i]);
+  for (int i = 0; i < s->count && rc == 0; i++) {
+    rc = tx_instance_init(s, s->inst[i]);
+    if (rc == 0 && !tx_control_keep_initial(s, s->inst[i])) rc = -1, tx_set_error("out of memory for %s's initial state", s->inst[i]->name);
+  }
 
   uint64_t* next = calloc(s->ngroups, sizeof *next);
   if (!next && rc == 0) rc = -1, tx_set_error("out of memory");
@@ -33,8 +56,31 @@ int tx_run_lockstep(tx_system* s, const tx_run_options* o, tx_run_result* r) {
       if (t < end_ns) reached = t;
       break;
     }
+    // a reset first, at the time of the tick that comes next
+    if (atomic_load(&s->clock.resets) != s->clock_resets_seen) {
+      s->clock_resets_seen = atomic_load(&s->clock.resets);
+      for (int i = 0; i < s->count; i++) tx_control_apply_reset(s, s->inst[i], t);
+      continue;
+    }
+    tx_clock_state cs = tx_clock_read(&s->clock);
+    if (cs.paused && t > cs.anchor_sim) { // the clock stands before this tick: wait, and still ask progress
+      wait_paused(s);
+      int64_t now = tx_mono_ns();
+      if (o->progress && now - last_wall >= 100000000) {
+        last_wall = now;
+        if (!o->progress((double)cs.anchor_sim * 1e-9, o->progress_user)) {
+          r->stopped_early = true;
+          reached = cs.anchor_sim;
+          break;
+        }
+      }
+      continue;
+    }
+    atomic_store(&s->clock.now, t);
     for (int m = 0; m < s->groups[g].count; m++) {
       instance* in = s->inst[s->groups[g].members[m]];
+      if (in->dead) continue;
+      tx_control_apply_tunes(s, in, t);
       if (in->steps == 0) in->first_start_ns = t;
       in->last_start_ns = t;
       tx_hist_add(&in->step_time, tx_instance_step(s, in, t));

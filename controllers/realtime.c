@@ -12,6 +12,7 @@
 #include "system_internal.h"
 
 #include <errno.h>
+#include <math.h>
 #include <pthread.h>
 #include <sched.h>
 #include <stdio.h>
@@ -28,7 +29,7 @@ typedef struct gate {
   bool open;   // t0 and end are set
   bool failed; // an init failed: no step and no finish, as in lockstep
   int64_t t0;  // release of tick 0, monotonic ns
-  int64_t end; // no release at or after this
+  int64_t end_sim; // no tick at or after this simulation time
 } gate;
 
 typedef struct worker {
@@ -71,13 +72,17 @@ static void* worker_main(void* arg) {
   else snprintf(tname, sizeof tname, "tx-%s%.0fHz", g->own ? "hap-" : "", g->rate_hz);
   pthread_setname_np(pthread_self(), tname);
   apply_scheduling(w);
-  for (int m = 0; m < g->count && w->init_rc == 0; m++)
-    if ((w->init_rc = tx_instance_init(s, s->inst[g->members[m]]))) snprintf(w->init_err, sizeof w->init_err, "%s", tx_error());
+  for (int m = 0; m < g->count && w->init_rc == 0; m++) {
+    instance* in = s->inst[g->members[m]];
+    if ((w->init_rc = tx_instance_init(s, in))) snprintf(w->init_err, sizeof w->init_err, "%s", tx_error());
+    else if (!tx_control_keep_initial(s, in))
+      w->init_rc = -1, snprintf(w->init_err, sizeof w->init_err, "out of memory for %s's initial state", in->name);
+  }
   pthread_mutex_lock(&w->gate->mutex);
   w->gate->ready++;
   pthread_cond_broadcast(&w->gate->cond);
   while (!w->gate->open) pthread_cond_wait(&w->gate->cond, &w->gate->mutex);
-  const int64_t t0 = w->gate->t0, end = w->gate->end;
+  const int64_t t0 = w->gate->t0, end_sim = w->gate->end_sim;
   const bool failed = w->gate->failed;
   pthread_mutex_unlock(&w->gate->mutex);
   if (failed) return NULL;
@@ -86,29 +91,69 @@ static void* worker_main(void* arg) {
   uint64_t prev_k = 0;
   for (uint64_t k = 0; !atomic_load_explicit(w->stop, memory_order_relaxed) && !tx_system_halted(s);) {
     int64_t tick = tx_tick_ns(g->rate_hz, k);
-    if (tick >= end - t0) break; // compared before adding: a saturated tick must not wrap
+    tx_clock_state cs = tx_clock_read(&s->clock);
+    // the end is in simulation time: a pause or a slower scale lengthens the run
+    int64_t sim = tx_clock_sim(&cs, tick);
+    if (sim >= end_sim || tick == INT64_MAX) break; // compared before adding: a saturated tick must not wrap
     int64_t release = t0 + tick;
     sleep_until(release);
     int64_t start = tx_mono_ns();
     int64_t expected = tx_tick_ns(g->rate_hz, k) - tx_tick_ns(g->rate_hz, prev_k);
     int64_t jitter = start - prev_start - expected;
+    cs = tx_clock_read(&s->clock); // a control call may have come while asleep
+    sim = tx_clock_sim(&cs, tick);
+    bool catch_up = false;
     for (int m = 0; m < g->count; m++) {
       instance* in = s->inst[g->members[m]];
+      if (in->dead) continue;
+      int64_t at = sim; // live: every tick, at the clock's time, a nanosecond on where the clock stands
+      if (in->live) {       // (paused), so its recording's time still increases
+        if (at <= in->live_ns) at = in->live_ns + 1;
+        in->live_ns = at;
+        tx_control_apply_tunes(s, in, at);
+      } else {
+        tx_control_apply_reset(s, in, sim);
+        tx_control_apply_tunes(s, in, sim);
+        if (in->dead) continue;
+        if (tx_tick_ns(g->rate_hz, in->sim_tick) > sim) continue; // the clock has not reached its next tick
+        if (cs.paused) {
+          // a single step: every tick up to the clock, at once
+          while (!in->dead && tx_tick_ns(g->rate_hz, in->sim_tick) <= sim && !tx_system_halted(s)) {
+            int64_t t = tx_tick_ns(g->rate_hz, in->sim_tick++);
+            if (in->steps == 0) in->first_start_ns = start;
+            in->last_start_ns = start;
+            tx_hist_add(&in->step_time, tx_instance_step(s, in, t));
+            catch_up = true;
+          }
+          continue;
+        }
+        // running: one step a tick, at the latest tick due (those before are skipped, as below)
+        uint64_t last = (uint64_t)floor((double)sim * g->rate_hz * 1e-9);
+        while (last > in->sim_tick && tx_tick_ns(g->rate_hz, last) > sim) last--;
+        while (tx_tick_ns(g->rate_hz, last + 1) <= sim) last++;
+        if (last > in->sim_tick) in->sim_tick = last;
+        at = tx_tick_ns(g->rate_hz, in->sim_tick++);
+      }
       if (in->steps == 0) in->first_start_ns = start;
       else tx_hist_add(&in->jitter, jitter < 0 ? -jitter : jitter);
       in->last_start_ns = start;
-      tx_hist_add(&in->step_time, tx_instance_step(s, in, release - t0));
+      tx_hist_add(&in->step_time, tx_instance_step(s, in, at));
     }
     prev_start = start;
     prev_k = k;
     // a step's deadline is the next tick's release. A late tick still runs,
     // at once, while part of its period is left; one whose whole period is
-    // over is skipped, and counts as missed too
+    // over is skipped, and counts as missed too (not after a single step's catch-up)
     int64_t done = tx_mono_ns();
     uint64_t next = k + 1;
     uint64_t missed = done - t0 > tx_tick_ns(g->rate_hz, next);
     while (tx_tick_ns(g->rate_hz, next + 1) <= done - t0) next++, missed++;
-    for (int m = 0; m < g->count && missed; m++) s->inst[g->members[m]]->missed += missed;
+    for (int m = 0; m < g->count; m++) {
+      instance* in = s->inst[g->members[m]];
+      if (missed && !catch_up) in->missed += missed;
+      atomic_store_explicit(&in->live_missed, in->missed, memory_order_relaxed);
+      atomic_store_explicit(&in->live_jitter_ns, k ? (jitter < 0 ? -jitter : jitter) : 0, memory_order_relaxed);
+    }
     k = next;
   }
   for (int m = 0; m < g->count && w->init_rc == 0; m++) tx_instance_finish(s->inst[g->members[m]]);
@@ -235,16 +280,27 @@ int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r) {
   // running on the host before the first tick
   gt.t0 = tx_mono_ns() + (nspin ? 100000000 : 2000000);
   double steal_start = steal_seconds();
-  gt.end = gt.t0 + (int64_t)(o->duration_s * 1e9);
+  const int64_t end_sim = (int64_t)(o->duration_s * 1e9);
+  gt.end_sim = end_sim;
+  atomic_store(&s->clock.t0, gt.t0);
   gt.open = true;
   pthread_cond_broadcast(&gt.cond);
   pthread_mutex_unlock(&gt.mutex);
 
   while (rc == 0 && !atomic_load(&stop) && !tx_system_halted(s)) {
     int64_t now = tx_mono_ns();
-    if (now >= gt.end) break;
-    sleep_until(now + 100000000 < gt.end ? now + 100000000 : gt.end);
-    if (o->progress && !o->progress((double)(tx_mono_ns() - gt.t0) * 1e-9, o->progress_user)) {
+    tx_clock_state cs = tx_clock_read(&s->clock);
+    int64_t sim = tx_clock_sim(&cs, now - gt.t0);
+    if (sim >= end_sim) break;
+    // the wall time at which the clock reaches the end, if it keeps its pace
+    int64_t wake = now + 100000000;
+    if (!cs.paused) {
+      double left = (double)(end_sim - sim) / cs.scale;
+      if (left < 100000000) wake = now + (int64_t)ceil(left);
+    }
+    sleep_until(wake);
+    cs = tx_clock_read(&s->clock);
+    if (o->progress && !o->progress((double)tx_clock_sim(&cs, tx_mono_ns() - gt.t0) * 1e-9, o->progress_user)) {
       r->stopped_early = true;
       atomic_store(&stop, true);
     }
@@ -257,7 +313,9 @@ int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r) {
   r->awake_cpus = nspin;
   double steal_end = steal_seconds();
   r->steal_s = steal_start >= 0 && steal_end >= 0 ? steal_end - steal_start : -1;
-  r->duration_s = (double)((finish < gt.end ? finish : gt.end) - gt.t0) * 1e-9;
+  tx_clock_state cs = tx_clock_read(&s->clock);
+  int64_t reached = tx_clock_sim(&cs, finish - gt.t0);
+  r->duration_s = (double)(reached < end_sim ? reached : end_sim) * 1e-9; // simulation time reached
   describe_scheduling(w, started, r);
   free(w);
   free(th);

@@ -66,10 +66,23 @@ static int table_check(const tx_controller_class* cls) {
   return 0;
 }
 
+// each live key is a number, an integer or a boolean of the table, and the class can tune it
+static int live_check(const tx_controller_class* cls) {
+  for (int i = 0; cls->live && cls->live[i]; i++) {
+    const tx_param_def* d = tx_param_find(cls, cls->live[i]);
+    if (!d) return tx_set_error("'%s' is not in the parameter table", cls->live[i]), -1;
+    if (!(d->kind == TX_PARAM_NUM || d->kind == TX_PARAM_INT || d->kind == TX_PARAM_BOOL))
+      return tx_set_error("%s: only a number, an integer or a boolean can be live", d->key), -1;
+    if (!cls->tune) return tx_set_error("%s: live, but the class has no tune", d->key), -1;
+  }
+  return 0;
+}
+
 int tx_register_controller(const tx_controller_class* cls) {
   if (!cls || !cls->type || !*cls->type || !cls->configure || !cls->step)
     return tx_set_error("a controller class needs a type, configure and step"), -1;
   if (table_check(cls)) return tx_error_prefix("%s: parameter table", cls->type), -1;
+  if (live_check(cls)) return tx_error_prefix("%s: live parameters", cls->type), -1;
   if (tx_find_controller(cls->type)) return tx_set_error("controller type '%s' is already registered", cls->type), -1;
   if (class_count == CLASSES_MAX) return tx_set_error("more than %d controller types", CLASSES_MAX), -1;
   classes[class_count++] = cls;

@@ -13,7 +13,11 @@
 // an instance's first tx_setup_fail, as the error of the call that configured it
 #define setup_fault(in) (tx_set_error_at((in)->fault.key, "%s", (in)->fault.message), -1)
 
-tx_system* tx_system_create(void) { return calloc(1, sizeof(tx_system)); }
+tx_system* tx_system_create(void) {
+  tx_system* s = calloc(1, sizeof(tx_system));
+  if (s) tx_clock_init(&s->clock);
+  return s;
+}
 
 void tx_system_destroy(tx_system* s) {
   if (!s) return;
@@ -36,6 +40,7 @@ void tx_system_destroy(tx_system* s) {
   free(s->declared_names);
   free(s->declared_units);
   tx_model_destroy(s->model);
+  tx_clock_destroy(&s->clock);
   free(s);
 }
 
@@ -445,7 +450,9 @@ int tx_system_run(tx_system* s, const tx_run_options* o, tx_run_result* r) {
   atomic_store(&s->halt, false);
   atomic_store(&s->halt_claim, 0);
   s->halt_reason[0] = 0;
+  tx_control_start(s, o->lockstep);
   int rc = o->lockstep ? tx_run_lockstep(s, o, r) : tx_run_realtime(s, o, r);
+  tx_control_end(s);
   if (tx_system_halted(s)) {
     r->halted = true;
     snprintf(r->halt_reason, sizeof r->halt_reason, "%s", s->halt_reason);

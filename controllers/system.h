@@ -114,6 +114,59 @@ const tx_controller_class* tx_controller_class_at(int i);
 json_t* tx_param_json(tx_setup* s, const char* key);
 // tx_output_dir (tactus/controller.h) is the run's tx_run_options.out_dir
 
+// Run control (system_control.c, docs/trainer.md), from any thread, before or
+// during a run. Simulated instances (all but haptics and views) step on a
+// simulation clock: pause stops it, resume restarts it, the time scale (real
+// time only) slows it; haptics and views keep stepping at their full rate,
+// haptics rendering the model as the pause left it. Each call that changes
+// something is logged in RECORD_DIR/controls.csv during a recorded run; they
+// return 0, or -1 with tx_error() when that line could not be written.
+#define TX_TIME_SCALE_MIN 0.25
+int tx_system_pause(tx_system* s);
+int tx_system_resume(tx_system* s);
+bool tx_system_paused(const tx_system* s);
+// pause, and advance the clock to the next tick of the slowest simulated
+// instance: every simulated instance runs each of its ticks up to that one
+double tx_system_step_period(const tx_system* s); // s, 0 if nothing is simulated
+int tx_system_step(tx_system* s);
+// rebuild every simulated instance (fini, configure with its parameters,
+// init) on its own thread before its next tick, what it writes restored as
+// after its first init. The simulation clock goes on; paused stays paused.
+int tx_system_reset(tx_system* s);
+uint64_t tx_system_resets(const tx_system* s);      // asked for
+uint64_t tx_system_resets_done(const tx_system* s); // carried out by every simulated instance
+// x TX_TIME_SCALE_MIN to x1; -1 with tx_error() outside
+int tx_system_set_time_scale(tx_system* s, double scale);
+double tx_system_time_scale(const tx_system* s);
+double tx_system_sim_time(const tx_system* s); // the simulation clock now, s
+// Tune: a new value for a live parameter (tx_controller_class.live) of instance i,
+// applied by the class's tune on the instance's thread before its next step
+// and logged with the time then (tx_system_tune_at, report.json's "tuned").
+// -1 with tx_error() for a key the table lacks, one not live, a value outside
+// its range (or not whole for an integer, not 0 or 1 for a boolean), or more
+// than TX_TUNES_PENDING waiting. A reset restores the scenario's value.
+#define TX_TUNES_PENDING 32
+#define TX_TUNES_MAX 256 // logged per run; later ones are applied, not logged
+int tx_system_tune(tx_system* s, int i, const char* key, double value);
+bool tx_param_live(const tx_controller_class* cls, const char* key); // in cls->live
+typedef struct tx_tune_info {
+  double t_s;             // simulation time it took effect
+  const char* controller; // instance
+  const char* key;
+  double value;
+} tx_tune_info;
+int tx_system_tunes(tx_system* s); // logged in the current or last run
+tx_tune_info tx_system_tune_at(tx_system* s, int k);
+
+// the system tx_system_run is running now (the last one started), or NULL: for a window's controls
+tx_system* tx_system_running(void);
+// live, while it runs, from any thread: steps, deadlines missed and the latest jitter of instance i
+typedef struct tx_live_stats {
+  uint64_t steps, missed;
+  int64_t jitter_ns; // |actual - nominal period| of its thread's latest tick
+} tx_live_stats;
+tx_live_stats tx_system_live(const tx_system* s, int i);
+
 // introspection, valid after finalize
 int tx_system_count(const tx_system* s);
 const char* tx_system_name(const tx_system* s, int i);

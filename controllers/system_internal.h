@@ -8,6 +8,7 @@
 
 #include <tactus/events.h>
 
+#include <pthread.h>
 #include <stdatomic.h>
 
 _Static_assert(TX_STREAM_INFO_READERS == TX_STREAM_READERS_MAX, "tx_stream_info holds every reader");
@@ -86,7 +87,51 @@ struct instance {
   tx_hist jitter, step_time; // whole-run statistics in fixed memory
   uint64_t steps, missed;
   int64_t first_start_ns, last_start_ns;
+  // run control (system_control.c)
+  bool live;          // haptics (own thread) and views: step through a pause, never rebuilt by a reset
+  bool dead;          // a reset could not rebuild it: it steps no more
+  uint64_t sim_tick;  // simulated instances: the next tick of the simulation clock to run
+  int64_t live_ns;    // live instances: the time of their latest step
+  uint64_t reset_seen; // the system's reset count this instance has taken up
+  _Atomic uint64_t reset_done; // and carried out (rebuilt, restored, init run again)
+  void* initial;      // the contents of what it writes, as after init (a reset restores them)
+  uint32_t* initial_rows;
+  _Atomic uint64_t live_steps, live_missed; // copies for other threads (tx_system_live)
+  _Atomic int64_t live_jitter_ns;
+  int index;                // in tx_system.inst
+  _Atomic int tune_pending; // tunes waiting for it
 };
+
+typedef struct tune_entry {
+  int inst, param;
+  double value, t_s;
+} tune_entry;
+
+// The simulation clock behind pause, step and the time scale. `run_ns` is the
+// executor's clock (wall time since the run's t0, or lockstep's virtual time);
+// the simulation time at run_ns is anchor_sim, plus (run_ns - anchor_wall) x
+// scale unless paused. Written under `mutex` by the control calls, read by
+// the workers without a lock (a sequence lock: `version` is odd while written).
+typedef struct tx_clock {
+  pthread_mutex_t mutex;
+  pthread_cond_t cond; // lockstep waits here while paused
+  _Atomic uint64_t version;
+  _Atomic int64_t anchor_wall, anchor_sim;
+  _Atomic double scale;
+  _Atomic bool paused;
+  _Atomic int64_t t0;     // realtime: the run's t0 (monotonic ns); 0 outside a run
+  _Atomic int64_t now;    // lockstep: the virtual time of the latest tick
+  _Atomic bool lockstep;
+  _Atomic bool running;   // between tx_control_start and tx_control_end
+  _Atomic uint64_t resets; // resets asked for
+  _Atomic uint64_t steps;  // single steps asked for
+} tx_clock;
+
+typedef struct tx_clock_state {
+  int64_t anchor_wall, anchor_sim;
+  double scale;
+  bool paused;
+} tx_clock_state;
 
 typedef struct group {
   double rate_hz;
@@ -127,6 +172,12 @@ struct tx_system {
   _Atomic bool halt;       // set once halt_reason is written
   char halt_reason[512];   // the first tx_stop_run reason
   int64_t halt_sim_ns;     // simulation time of that request
+  tx_clock clock;          // pause, step, reset, time scale (system_control.c)
+  uint64_t clock_resets_seen; // lockstep: the resets carried out
+  tune_entry tunes_pending[TX_TUNES_PENDING]; // under clock.mutex
+  int ntunes_pending;
+  tune_entry tunes[TX_TUNES_MAX]; // applied, under clock.mutex
+  int ntunes;
 };
 
 // true once a controller asked to stop the run (tx_stop_run)
@@ -142,6 +193,26 @@ int64_t tx_instance_step(tx_system* s, instance* in, int64_t sim_ns);
 int tx_instance_init(tx_system* s, instance* in); // -1 with tx_error()
 // after the last step of a run
 void tx_instance_finish(instance* in);
+
+// run control (system_control.c)
+void tx_clock_init(tx_clock* c);
+void tx_clock_destroy(tx_clock* c);
+tx_clock_state tx_clock_read(tx_clock* c);
+// the simulation time at the executor's time run_ns
+int64_t tx_clock_sim(const tx_clock_state* st, int64_t run_ns);
+// before a run's first tick: mark live instances, set every clock anchor to 0
+void tx_control_start(tx_system* s, bool lockstep);
+void tx_control_end(tx_system* s);
+// after init, on the instance's thread: keep what it wrote, for a reset; false: out of memory
+bool tx_control_keep_initial(tx_system* s, instance* in);
+// on the instance's thread, between its steps: carry out a reset asked for (rebuild the instance,
+// restore what it writes, run init again); simulation time sim_ns
+void tx_control_apply_reset(tx_system* s, instance* in, int64_t sim_ns);
+// on the instance's thread, before a step: apply the tunes waiting for it (never blocks: a
+// busy lock leaves them for the next tick)
+void tx_control_apply_tunes(tx_system* s, instance* in, int64_t sim_ns);
+// publish what an instance wrote (context.c)
+void tx_instance_publish(tx_system* s, instance* in, int64_t sim_ns);
 
 int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r);
 int tx_run_lockstep(tx_system* s, const tx_run_options* o, tx_run_result* r);

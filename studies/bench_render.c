@@ -8,6 +8,10 @@
 #include <tactus/components.h>
 #include <tactus/config.h>
 
+#if TX_WITH_GLFW
+#include "../views/graphics/glfw_window.h"
+#endif
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -96,6 +100,8 @@ static const tx_controller_class skin_class = {.type = "bench.skin",
 
 typedef struct render_case {
   const char* name;
+  const char* target; // png (OSMesa, the default) or window (GLFW)
+  bool panels;        // window: the trainer's panels shown
   const char* stereo;
   int eyes;
   int side;       // skin particles along an edge
@@ -127,7 +133,7 @@ static int run_case(render_case* rc, const char* dir, double seconds) {
            "\"camera\":{\"eye\":[0,0.09,0.15],\"target\":[0,-0.012,0]},"
            "\"draw\":[{\"mesh\":\"skin\"},{\"spheres\":\"ball\"},{\"tool\":\"device0\",\"show_force\":true}]}}",
            rc->side, rc->spacing, rc->voxels);
-  tx_load_options lo = {.view = "png", .stereo = rc->stereo};
+  tx_load_options lo = {.view = rc->target ? rc->target : "png", .stereo = rc->stereo};
   tx_scenario* sc = tx_scenario_load_text("bench-render", text, strlen(text), &lo);
   if (!sc) return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   char sub[4300];
@@ -140,7 +146,13 @@ static int run_case(render_case* rc, const char* dir, double seconds) {
   tx_run_options o = {.duration_s = seconds, .realtime_priority = true, .pin_threads = true, .keep_cpus_awake = true,
                       .out_dir = made};
   tx_run_result r;
+#if TX_WITH_GLFW
+  tx_window_show_panels(!rc->target || rc->panels); // the window opens as the run starts
+#endif
   int failed = tx_system_run(sc->system, &o, &r);
+#if TX_WITH_GLFW
+  tx_window_show_panels(true);
+#endif
   if (failed) fprintf(stderr, "tactus: %s\n", tx_error());
   for (int i = 0; !failed && i < tx_system_count(sc->system); i++) {
     if (strcmp(tx_system_name(sc->system, i), "haptics") == 0) rc->haptics = tx_system_stats(sc->system, i);
@@ -157,6 +169,38 @@ static int run_case(render_case* rc, const char* dir, double seconds) {
   rc->steal_s = r.steal_s;
   tx_scenario_free(sc);
   return failed ? 1 : 0;
+}
+
+// The trainer's panels (docs/trainer.md): the same scene in a 640 x 480 window with and without
+// them; their cost is the difference in the rendering thread's CPU time per frame. Only where
+// a display opens (DISPLAY; xvfb-run gives one) and the panels are built in.
+static int gui_cost(const char* dir, double seconds) {
+#if TX_WITH_GLFW
+  printf("\ngui: the trainer's panels in a 640 x 480 window, the same scene, %g s per case\n", seconds);
+  if (!getenv("DISPLAY") || tx_window_probe(false) != TX_WINDOW_OK) {
+    printf("  no display (DISPLAY unset or it does not open): not measured; run under xvfb-run\n");
+    return 0;
+  }
+  render_case w[] = {
+      {.name = "window-panels", .target = "window", .panels = true, .stereo = "mono", .eyes = 1, .side = 42,
+       .spacing = 0.0025, .voxels = 1},
+      {.name = "window-bare", .target = "window", .panels = false, .stereo = "mono", .eyes = 1, .side = 42,
+       .spacing = 0.0025, .voxels = 1}};
+  for (size_t i = 0; i < 2; i++)
+    if (run_case(&w[i], dir, seconds)) return 1;
+  printf("  %-24s %8s %9s %9s %9s\n", "case", "frames", "frame p50", "frame p99", "cpu p50");
+  for (size_t i = 0; i < 2; i++)
+    printf("  %-24s %8.0f %7.2fms %7.2fms %7.2fms\n", w[i].panels ? "with the panels" : "without", w[i].frames,
+           w[i].p50, w[i].p99, w[i].cpu50);
+  double cost = w[0].cpu50 - w[1].cpu50;
+  char measured[64];
+  snprintf(measured, sizeof measured, "%.2f ms (cpu p50 %.2f - %.2f)", cost, w[0].cpu50, w[1].cpu50);
+  printf("\ntargets:\n");
+  tx_bench_target("the panels' cost per frame at 640x480", measured, "<= 2 ms", cost <= 2);
+#else
+  (void)dir, (void)seconds;
+#endif
+  return 0;
 }
 
 int tx_bench_render(const char* out, double duration_s) {
@@ -213,7 +257,7 @@ int tx_bench_render(const char* out, double duration_s) {
            (unsigned long long)(st->haptics.steps + st->haptics.missed));
   tx_bench_target("haptics 1 kHz beside stereo rendering, missed", measured, "<= 0.1%", missed <= 0.1);
   printf("frames: %s/{mono,sbs,sbs-10404,voxels-1000,voxels-20000}/frames/\n", dir);
-  return 0;
+  return gui_cost(dir, seconds);
 }
 #else
 int tx_bench_render(const char* out, double duration_s) {

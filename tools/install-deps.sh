@@ -12,6 +12,7 @@ optional=(libbullet-dev libode-dev libassimp-dev liburdfdom-dev libtinyxml-dev
           xvfb xauth                   # xvfb-run: the window-mode screenshot test
           cyclonedds-dev cyclonedds-tools  # sessions over several processes (docs/distributed.md); idlc
           tetgen
+          libimgui-dev xdotool         # the window's panels (Dear ImGui); synthetic input in its test
           libgts-dev libnifti2-dev)      # the LAGB asset pipeline: marching cubes, a user's NIfTI volume
 
 want=("${core[@]}")

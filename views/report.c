@@ -83,6 +83,15 @@ json_t* tx_report_json(const tx_report* r) {
     json_object_set_new(report, "trace_hash", json_string(hash));
   }
   if (r->result->stopped_early) json_object_set_new(report, "stopped_early", json_true());
+  if (tx_system_tunes(s)) { // parameters changed during the run (the trainer's window), in order
+    json_t* tuned = json_array();
+    for (int k = 0; k < tx_system_tunes(s); k++) {
+      tx_tune_info t = tx_system_tune_at(s, k);
+      json_array_append_new(tuned, json_pack("{s:f,s:s,s:s,s:f}", "t_s", t.t_s, "controller", t.controller, "key",
+                                             t.key, "value", t.value));
+    }
+    json_object_set_new(report, "tuned", tuned);
+  }
   return report;
 }
 
@@ -91,7 +100,7 @@ static long report_bytes(tx_system* s) {
   int readers = 0;
   for (int k = 0; k < tx_system_streams(s); k++) readers += tx_system_stream(s, k).nreaders;
   return 8192 + 1024L * tx_system_count(s) + 160L * (tx_system_warnings(s) + tx_system_results(s)) +
-         512L * tx_system_streams(s) + 256L * readers;
+         512L * tx_system_streams(s) + 256L * readers + 160L * TX_TUNES_MAX;
 }
 
 int tx_report_reserve(tx_system* s, const char* dir, const char* name) {

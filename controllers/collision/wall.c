@@ -51,6 +51,14 @@ static void step(tx_ctx* c, void* self) {
   }
 }
 
+// both numbers may change during a run: the next step uses them
+static void tune(tx_ctx* c, void* self, const char* key, double value) {
+  (void)c;
+  wall* w = self;
+  if (strcmp(key, "stiffness") == 0) w->stiffness = value;
+  else w->height = value;
+}
+
 static void fini(void* self) { free(self); }
 
 const tx_controller_class tx_collision_wall = {
@@ -61,4 +69,6 @@ const tx_controller_class tx_collision_wall = {
     .fini = fini,
     .params = params,
     .nparams = TX_PARAMS_COUNT(params),
+    .live = (const char* const[]){"stiffness", "height_m", NULL},
+    .tune = tune,
 };

@@ -116,6 +116,11 @@ typedef struct tx_controller_class {
   // a view only reads the model (plots, graphics, recordings): the loader
   // refuses a view that declares a write with tx_setup_write
   bool view;
+  // the table's keys that may change while the run goes (numbers, integers,
+  // booleans), NULL-terminated, or NULL for none; tune applies a new value
+  // (within the table's range) on the instance's own thread between two steps
+  const char* const* live;
+  void (*tune)(tx_ctx* c, void* self, const char* key, double value);
 } tx_controller_class;
 
 // registry; returns 0, or -1 for a bad class (a bad parameter table

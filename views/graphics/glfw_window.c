@@ -6,6 +6,11 @@
 
 #include "laparoscope.h"
 #include "window_input.h"
+#ifdef TX_HAVE_GUI
+#include "gui.h"
+#endif
+
+#include "../../controllers/system.h"
 
 #include <tactus/components.h>
 
@@ -28,9 +33,13 @@ struct tx_window {
   bool dragging;
   bool turning;      // the right button: the laparoscope
   double scope[3];   // its moves not yet taken: yaw, pitch (rad), insertion (m)
+  struct tx_gui* gui; // the trainer's panels, where Dear ImGui is built in
 };
 
 static char glfw_error[256];
+static bool panels_at_open = true; // tx_window_show_panels
+
+void tx_window_show_panels(bool shown) { panels_at_open = shown; }
 static void on_error(int code, const char* text) {
   (void)code;
   snprintf(glfw_error, sizeof glfw_error, "%s", text);
@@ -39,8 +48,12 @@ static void on_error(int code, const char* text) {
 static void publish(tx_window* t) { tx_window_input_set(t->tool, t->buttons); }
 
 static void on_button(GLFWwindow* w, int button, int action, int mods) {
-  (void)mods;
   tx_window* t = glfwGetWindowUserPointer(w);
+#ifdef TX_HAVE_GUI
+  if (t->gui && tx_gui_mouse_button(t->gui, button, action, mods) && action == GLFW_PRESS) return; // a click on a panel
+#else
+  (void)mods;
+#endif
   if (button == GLFW_MOUSE_BUTTON_LEFT) {
     t->dragging = action == GLFW_PRESS;
     glfwGetCursorPos(w, &t->last_x, &t->last_y);
@@ -69,6 +82,9 @@ static void on_cursor(GLFWwindow* w, double x, double y) {
 static void on_scroll(GLFWwindow* w, double dx, double dy) {
   (void)dx;
   tx_window* t = glfwGetWindowUserPointer(w);
+#ifdef TX_HAVE_GUI
+  if (t->gui && tx_gui_scroll(t->gui, dx, dy)) return;
+#endif
   if (glfwGetKey(w, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS || glfwGetKey(w, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS) {
     t->scope[2] += dy * TX_SCOPE_M_PER_SCROLL;
     return;
@@ -77,10 +93,40 @@ static void on_scroll(GLFWwindow* w, double dx, double dy) {
   publish(t);
 }
 
+// the run's controls (controllers/system.h), with or without the panels: true when the key is one
+static bool control_key(int key) {
+  tx_system* s = tx_system_running();
+  if (!s) return false;
+  switch (key) { // a line that cannot be logged is no reason to refuse the control
+  case GLFW_KEY_P: (void)(tx_system_paused(s) ? tx_system_resume(s) : tx_system_pause(s)); return true;
+  case GLFW_KEY_N: (void)tx_system_step(s); return true;
+  case GLFW_KEY_R: (void)tx_system_reset(s); return true;
+  case GLFW_KEY_LEFT_BRACKET: (void)tx_system_set_time_scale(s, fmax(TX_TIME_SCALE_MIN, tx_system_time_scale(s) / 2)); return true;
+  case GLFW_KEY_RIGHT_BRACKET: (void)tx_system_set_time_scale(s, fmin(1, tx_system_time_scale(s) * 2)); return true;
+  default: return false;
+  }
+}
+
+#ifdef TX_HAVE_GUI
+static void on_char(GLFWwindow* w, unsigned c) {
+  tx_window* t = glfwGetWindowUserPointer(w);
+  if (t->gui) tx_gui_char(t->gui, c);
+}
+#endif
+
 static void on_key(GLFWwindow* w, int key, int scancode, int action, int mods) {
+  tx_window* t = glfwGetWindowUserPointer(w);
+#ifdef TX_HAVE_GUI
+  if (t->gui && tx_gui_key(t->gui, key, scancode, action, mods)) return; // typing into a panel
+  if (t->gui && key == GLFW_KEY_H && action == GLFW_PRESS) {
+    tx_gui_set_shown(t->gui, !tx_gui_shown(t->gui));
+    return;
+  }
+#else
   (void)scancode;
   (void)mods;
-  tx_window* t = glfwGetWindowUserPointer(w);
+#endif
+  if (action == GLFW_PRESS && control_key(key)) return;
   if (key == GLFW_KEY_ESCAPE && action == GLFW_PRESS) glfwSetWindowShouldClose(w, GLFW_TRUE);
   if (key == GLFW_KEY_SPACE) {
     if (action == GLFW_PRESS) t->buttons |= 1u;
@@ -146,6 +192,15 @@ tx_window* tx_window_open(int width, int height, bool want_quad) {
   glfwSetCursorPosCallback(t->w, on_cursor);
   glfwSetScrollCallback(t->w, on_scroll);
   glfwSetKeyCallback(t->w, on_key);
+#ifdef TX_HAVE_GUI
+  glfwSetCharCallback(t->w, on_char);
+  if (!(t->gui = tx_gui_create(t->w))) {
+    glfwDestroyWindow(t->w);
+    free(t);
+    return NULL; // tx_error() says why
+  }
+  tx_gui_set_shown(t->gui, panels_at_open);
+#endif
   t->tool[1] = 0.02;
   publish(t);
   return t;
@@ -155,6 +210,9 @@ tx_window* tx_window_open(int width, int height, bool want_quad) {
 // the GL driver, whose process-wide state then can no longer be told apart
 void tx_window_close(tx_window* t) {
   if (!t) return;
+#ifdef TX_HAVE_GUI
+  tx_gui_destroy(t->gui); // with its GL objects, while the context is current
+#endif
   glfwDestroyWindow(t->w);
   free(t);
 }
@@ -164,6 +222,24 @@ tx_gl_proc tx_window_proc(const char* name) { return (tx_gl_proc)glfwGetProcAddr
 void tx_window_framebuffer(const tx_window* t, int* width, int* height) { glfwGetFramebufferSize(t->w, width, height); }
 void tx_window_set_title(tx_window* t, const char* title) { glfwSetWindowTitle(t->w, title); }
 void tx_window_resize(tx_window* t, int width, int height) { glfwSetWindowSize(t->w, width, height); }
+
+void tx_window_draw_gui(tx_window* t, int tiles_x, int tiles_y) {
+#ifdef TX_HAVE_GUI
+  int fw, fh;
+  glfwGetFramebufferSize(t->w, &fw, &fh);
+  if (t->gui) tx_gui_frame(t->gui, fw, fh, t->quad ? 1 : tiles_x, t->quad ? 1 : tiles_y, t->quad);
+#else
+  (void)t, (void)tiles_x, (void)tiles_y;
+#endif
+}
+
+void tx_window_sample(tx_window* t, const char* device, double t_s, const double pos[3], const double* force) {
+#ifdef TX_HAVE_GUI
+  if (t->gui) tx_gui_sample(device, t_s, pos, force);
+#else
+  (void)t, (void)device, (void)t_s, (void)pos, (void)force;
+#endif
+}
 
 bool tx_window_present(tx_window* t) {
   glfwSwapBuffers(t->w);

@@ -298,6 +298,9 @@ static void draw_overlay(view* v, render_state* rs, int w, int h) {
     if (it->kind == TX_DRAW_PLANE) continue;
     snprintf(line, sizeof line, "%s %.0f HZ", it->name, rs->rates[i][0]);
     double mag = -1;
+    if (it->kind == TX_DRAW_TOOL && v->scene.items[i].rows[0]) // the panels' plots (glfw_window.h)
+      tx_window_sample(rs->win, it->name, (double)v->frame_sim_ns * 1e-9, v->scene.items[i].data[0],
+                       it->show_force && v->scene.items[i].rows[1] ? v->scene.items[i].data[1] : NULL);
     if (it->kind == TX_DRAW_TOOL && it->show_force && v->scene.items[i].rows[1]) {
       const double* f = v->scene.items[i].data[1];
       mag = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
@@ -316,6 +319,8 @@ static void draw_overlay(view* v, render_state* rs, int w, int h) {
   if (v->stereo == TX_STEREO_SBS) tx_overlay_draw(rs->overlay, w, 0, w, h);
   if (v->stereo == TX_STEREO_TB) tx_overlay_draw(rs->overlay, 0, 0, w, h);
   tx_overlay_clear(rs->overlay);
+  // the trainer's panels over it, at zero disparity (glfw_window.h)
+  tx_window_draw_gui(rs->win, v->stereo == TX_STEREO_SBS ? 2 : 1, v->stereo == TX_STEREO_TB ? 2 : 1);
 }
 #endif
 
