@@ -620,6 +620,48 @@ static int use_implicit(void** state) {
 }
 #endif
 
+// the implicit skin's force on the HIP is the patch's balance: pressed 5 mm at
+// 1 cm/s (over a particle and over a cell's middle) it is the fixed border's
+// reaction, summed here apart from the cloth, k (l - l0) over every link to the
+// border, to within 1 % (the inertia of a slow press is a few tenths of a mN)
+static void contact_force_is_the_border_reaction(void** state) {
+  (void)state;
+  for (int placement = 0; placement < 2; placement++) {
+    tx_cloth_def d = tx_cloth_def_default();
+    d.res[0] = d.res[1] = 41;
+    d.size[0] = d.size[1] = 0.1;
+    d.rupture_tension = 0;
+    tx_cloth* c = tx_cloth_create(&d);
+    if (!c) fail_msg("%s", tx_error());
+    const double off = placement ? 0.00125 : 0, y_end = 0.0025 - 0.005;
+    for (double y = 0.003; y > y_end; y -= 0.01 / 60) {
+      double pos[3] = {off, y, off};
+      tx_cloth_set_hip(c, pos, 0.0005);
+      assert_int_equal(tx_cloth_step(c, 1.0 / 60), TX_CLOTH_OK);
+    }
+    double f[3], border = 0;
+    tx_cloth_contact_force(c, f);
+    for (int l = 0; l < tx_cloth_link_total(c); l++) {
+      int32_t e[2];
+      if (!tx_cloth_link_ends(c, l, e)) continue;
+      bool b[2];
+      for (int k = 0; k < 2; k++) b[k] = e[k] % 41 == 0 || e[k] / 41 == 0 || e[k] % 41 == 40 || e[k] / 41 == 40;
+      if (b[0] == b[1]) continue;
+      double p0[3], p1[3];
+      tx_cloth_particle(c, e[0], p0);
+      tx_cloth_particle(c, e[1], p1);
+      double dy = b[0] ? p0[1] - p1[1] : p1[1] - p0[1]; // from the free end to the border's
+      double len = sqrt((p1[0] - p0[0]) * (p1[0] - p0[0]) + (p1[1] - p0[1]) * (p1[1] - p0[1]) + (p1[2] - p0[2]) * (p1[2] - p0[2]));
+      border += tx_cloth_link_tension(c, l) * dy / len; // what the border holds the patch up with
+    }
+    print_message("  over a %s: contact %.2f mN, border %.2f mN\n", placement ? "cell's middle" : "particle", f[1] * 1e3,
+                  border * 1e3);
+    assert_true(border > 0.15 && border < 0.25);
+    assert_true(fabs(f[1] - border) < 0.01 * border);
+    tx_cloth_destroy(c);
+  }
+}
+
 // a pinned particle goes where it is put, in a straight line across the
 // step's substeps, its neighbours follow part way; unpinned it falls back
 // with the rest. Bad pins are refused, and a fault keeps the pin
@@ -676,6 +718,7 @@ int main(void) {
       cmocka_unit_test(untorn_skin_holds_to_3cm),
       cmocka_unit_test(rupture_is_located_between_steps),
       cmocka_unit_test(pinned_particles_follow),
+      cmocka_unit_test(contact_force_is_the_border_reaction),
 #if !SANITIZED // the same code paths as above, but for the links' solve; minutes under the sanitizers
       cmocka_unit_test_setup_teardown(pinned_particles_follow, use_xpbd, use_implicit),
       cmocka_unit_test_setup_teardown(rupture_opens_a_hole, use_xpbd, use_implicit),
