@@ -40,6 +40,12 @@ static tx_cloth* make(int res, double gravity, double rupture) {
   return c;
 }
 
+static tx_cloth* make_def(const tx_cloth_def* d) {
+  tx_cloth* c = tx_cloth_create(d);
+  if (!c) fail_msg("%s", tx_error());
+  return c;
+}
+
 static int centre(const tx_cloth* c) {
   int res = tx_cloth_get_def(c)->res[0];
   return (res / 2) * res + res / 2;
@@ -662,6 +668,101 @@ static void contact_force_is_the_border_reaction(void** state) {
   }
 }
 
+// a HIP that stops 5 mm into the skin (half its depth of tear) holds it there:
+// no tear, and the same steady force a second on, the skin resting on it. The
+// face contact leaves the skin's corners a little beyond the contact distance,
+// so a contact found afresh each step let the solve carry the skin up through
+// the stopped HIP: it tore 8 links in the first stopped step
+static void hip_at_rest_holds_the_skin(void** state) {
+  (void)state;
+  tx_cloth_def d = tx_cloth_def_default();
+  d.res[0] = d.res[1] = 41;
+  d.size[0] = d.size[1] = 0.1;
+  d.rupture_tension = 150;
+  d.rupture_length = 0.01;
+  tx_cloth* c = tx_cloth_create(&d);
+  if (!c) fail_msg("%s", tx_error());
+  double pos[3] = {0, 0.003, 0}, f[3], moving = 0;
+  for (; pos[1] > -0.0025; pos[1] -= 0.01 / 60) {
+    tx_cloth_set_hip(c, pos, 0.0005);
+    assert_int_equal(tx_cloth_step(c, 1.0 / 60), TX_CLOTH_OK);
+    tx_cloth_contact_force(c, f);
+    moving = f[1];
+  }
+  double lo = 1e9, hi = 0;
+  for (int s = 0; s < 60; s++) {
+    assert_int_equal(tx_cloth_step(c, 1.0 / 60), TX_CLOTH_OK);
+    tx_cloth_contact_force(c, f);
+    if (s >= 30) lo = fmin(lo, f[1]), hi = fmax(hi, f[1]);
+  }
+  print_message("  moving %.1f mN, at rest %.1f to %.1f mN, %d links torn\n", moving * 1e3, lo * 1e3, hi * 1e3, tx_cloth_torn(c));
+  assert_int_equal(tx_cloth_torn(c), 0);
+  assert_true(lo > 0.1 && hi - lo < 0.01 * hi);
+  assert_true(fabs(hi - moving) < 0.05 * moving);
+  tx_cloth_destroy(c);
+}
+
+// skin flung up into a HIP at rest above it: the free solve would carry it up
+// through the sphere; the solve is undone and done again with those triangles
+// held, so it stops under the HIP
+static void skin_flung_into_a_still_hip_stops_under_it(void** state) {
+  (void)state;
+  tx_cloth_def d = tx_cloth_def_default();
+  d.rupture_tension = 150;
+  d.rupture_length = 0.01;
+  d.res[0] = d.res[1] = 22;
+  tx_cloth* c = make_def(&d);
+  const int i = centre(c);
+  double x[3], up[3] = {0, 0.3, 0};
+  tx_cloth_particle(c, i, x);
+  const double rc = 0.0005 + 0.5 * d.thickness;
+  double hip[3] = {x[0], x[1] + rc + 0.0005, x[2]};
+  assert_int_equal(tx_cloth_set_hip(c, hip, 0.0005), TX_CLOTH_OK);
+  assert_int_equal(tx_cloth_step(c, 1.0 / 60), TX_CLOTH_OK); // not touching yet
+  for (int k = 0; k < tx_cloth_particle_count(c); k++) {
+    double p[3];
+    tx_cloth_particle(c, k, p);
+    tx_cloth_poke(c, k, p, up); // 5 mm up in one step: past the HIP
+  }
+  int resolved = 0;
+  for (int s = 0; s < 30; s++) {
+    assert_int_equal(tx_cloth_step(c, 1.0 / 60), TX_CLOTH_OK);
+    tx_cloth_solve_info si;
+    tx_cloth_solve_stats(c, &si);
+    resolved += si.resolved;
+    tx_cloth_particle(c, i, x);
+    assert_true(x[1] < hip[1] - 0.9 * rc); // under the HIP, never through it
+  }
+  print_message("  solves done again: %d, %d links torn, largest strain %.3f\n", resolved, tx_cloth_torn(c), tx_cloth_max_strain(c));
+  assert_true(resolved > 0);
+  assert_true(all_finite(c));
+  tx_cloth_destroy(c);
+}
+
+// a HIP pressed on through a hanging skin that tears at 20 N/m punches a piece
+// out: the piece leaves the patch (stopped, its triangles gone) instead of
+// falling 10 m in 5 s and faulting every step from then on
+static void punched_piece_leaves_the_patch(void** state) {
+  (void)state;
+  tx_cloth* c = make(42, 9.81, 20);
+  double h[3] = {0, 0.005, 0};
+  for (int s = 0; s < 600; s++) { // to 5.5 cm below, then 8 s more
+    h[1] = 0.005 - 0.0001 * s;
+    tx_cloth_set_hip(c, h, 0.0005);
+    tx_cloth_step(c, 1.0 / 60);
+  }
+  for (int s = 0; s < 480; s++) tx_cloth_step(c, 1.0 / 60);
+  int32_t* tri = malloc(sizeof(int32_t) * 3 * 3362);
+  int live = tx_cloth_triangles(c, tri);
+  print_message("  %d links torn, %d particles cut off, %d faults, %d triangles left\n", tx_cloth_torn(c), tx_cloth_detached(c),
+                tx_cloth_faults(c), live);
+  assert_true(tx_cloth_detached(c) > 0);
+  assert_int_equal(tx_cloth_faults(c), 0);
+  assert_true(all_finite(c));
+  free(tri);
+  tx_cloth_destroy(c);
+}
+
 // a pinned particle goes where it is put, in a straight line across the
 // step's substeps, its neighbours follow part way; unpinned it falls back
 // with the rest. Bad pins are refused, and a fault keeps the pin
@@ -719,6 +820,9 @@ int main(void) {
       cmocka_unit_test(rupture_is_located_between_steps),
       cmocka_unit_test(pinned_particles_follow),
       cmocka_unit_test(contact_force_is_the_border_reaction),
+      cmocka_unit_test(hip_at_rest_holds_the_skin),
+      cmocka_unit_test(skin_flung_into_a_still_hip_stops_under_it),
+      cmocka_unit_test(punched_piece_leaves_the_patch),
 #if !SANITIZED // the same code paths as above, but for the links' solve; minutes under the sanitizers
       cmocka_unit_test_setup_teardown(pinned_particles_follow, use_xpbd, use_implicit),
       cmocka_unit_test_setup_teardown(rupture_opens_a_hole, use_xpbd, use_implicit),
