@@ -15,10 +15,8 @@
 //              transverse term clamped at zero under compression). The
 //              particles the HIP contact moved are held along the contact's
 //              normal in the solve (a Baraff-Witkin filter), and let go where
-//              holding them would pull; those held at the end of a substep
-//              start the next one held, and a solve that carries skin into the
-//              HIP is done again with it held. A link's tension is k (l - l0)
-//              at the end of the substep. Or
+//              holding them would pull. A link's tension is k (l - l0) at the
+//              end of the substep. Or
 //              XPBD (Macklin et al. 2016): each link is a distance constraint
 //              of compliance 1/k with a Lagrange multiplier accumulated over
 //              the iterations of a substep, so the cloth tends to implicit
@@ -207,9 +205,6 @@ double tx_cloth_peak_tension(const tx_cloth* c);
 bool tx_cloth_broke_at(const tx_cloth* c, double at[3]);
 // faults found and recovered so far
 int tx_cloth_faults(const tx_cloth* c);
-// particles of pieces the tears cut off (no stretch or shear link to a fixed or
-// pinned particle): stopped, their triangles gone from tx_cloth_triangles
-int tx_cloth_detached(const tx_cloth* c);
 // implicit solver, the last step: CG iterations summed over its Newton steps and
 // substeps, and the largest relative residual a Newton step ended with (0: XPBD)
 typedef struct tx_cloth_solve_info {
@@ -217,7 +212,6 @@ typedef struct tx_cloth_solve_info {
   double residual;
   int released; // held particles let go because holding them would pull
   int newton;   // Newton steps taken
-  int resolved; // solves done again because they carried skin into the HIP
 } tx_cloth_solve_info;
 void tx_cloth_solve_stats(const tx_cloth* c, tx_cloth_solve_info* out);
 // the substep (s) at which k w h^2 = kwh2 for links of stiffness k (N/m) between

@@ -76,7 +76,6 @@ struct tx_cloth {
   std::vector<uint8_t> state;      // (n) in the solve: 0 fixed, 1 free, 2 held (hold and the mass, packed)
   std::vector<double> mh2;         // (n) N/m, m / h^2 of each particle, 0 when fixed
   std::vector<double> hold_n;      // (n x 3) 1, the contact's push on a held particle, summed
-  std::vector<float> x_pre;        // (n x 3) m, the particles before the substep's solve
   tx_cloth_solve_info stats;       // the last step's
 
   std::vector<int32_t> tri;        // (ntri x 3) vertex indices
@@ -102,9 +101,6 @@ struct tx_cloth {
   std::vector<double> pin_from;   // (n x 3) m, where a pinned particle began the step
   std::vector<double> pin_to;     // (n x 3) m, where it ends the step
   int npinned;
-  std::vector<int32_t> queue;     // (n) scratch: the search for pieces torn off
-  std::vector<uint8_t> reached;   // (n) scratch: held through links to a fixed or pinned particle
-  int detached;                   // particles of pieces torn off
 
   // the HIP, a kinematic sphere
   double hip[3];      // m, centre at the end of the next step
@@ -281,8 +277,6 @@ static bool build(tx_cloth* c) {
   c->pinned.assign((size_t)c->n, 0);
   c->pin_from.assign((size_t)c->n * 3, 0.0);
   c->pin_to.assign((size_t)c->n * 3, 0.0);
-  c->queue.assign((size_t)c->n, 0);
-  c->reached.assign((size_t)c->n, 0);
   c->body->m_cfg.collisions = 0; // the HIP contact is ours (see cloth.h)
   c->body->m_cfg.piterations = d.iterations;
   c->body->m_cfg.kDP = 0;
@@ -419,7 +413,6 @@ static bool build(tx_cloth* c) {
     const size_t n3 = (size_t)c->n * 3;
     for (std::vector<double>* v : {&c->y, &c->dx, &c->rr, &c->zz, &c->pp, &c->qq, &c->warm, &c->grad, &c->hold_n})
       v->assign(n3, 0.0);
-    c->x_pre.assign(n3, 0.0f);
     c->hess.assign((size_t)c->nlink * 6, 0.0);
     c->pinv.assign((size_t)c->n * 6, 0.0);
     c->lend.assign((size_t)c->nlink * 2, 0);
@@ -494,7 +487,6 @@ extern "C" int tx_cloth_triangle_count(const tx_cloth* c) { return c->ntri; }
 extern "C" int tx_cloth_link_count(const tx_cloth* c) { return c->body->m_links.size(); }
 extern "C" int tx_cloth_torn(const tx_cloth* c) { return c->torn; }
 extern "C" int tx_cloth_faults(const tx_cloth* c) { return c->faults; }
-extern "C" int tx_cloth_detached(const tx_cloth* c) { return c->detached; }
 
 extern "C" void tx_cloth_contact_force(const tx_cloth* c, double out[3]) {
   for (int a = 0; a < 3; a++) out[a] = c->contact_force[a];
@@ -1024,53 +1016,6 @@ static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& fr
     }
 }
 
-// After the implicit solve: the live triangles the solve carried into the HIP,
-// their closest point inside the contact distance (by more than 1 %: sliding
-// across the sphere ends a little off it, second order) on the side the HIP came
-// from, or across it. Their corners are flagged in c->in_contact (scratch until
-// the contact after the links fills it); how many triangles
-static int flag_entered(tx_cloth* c, const btVector3& h, const btVector3& from) {
-  const double rc = c->hip_radius + 0.5 * c->def.thickness;
-  if (c->hip_radius <= 0 || rc <= 0) return 0;
-  btAlignedObjectArray<btSoftBody::Node>& nodes = c->body->m_nodes;
-  const btScalar reach = (btScalar)(rc + c->reach_factor * c->max_edge), reach2 = reach * reach;
-  const btScalar rcs = (btScalar)rc, inside = rcs * (btScalar)0.99;
-  std::fill(c->in_contact.begin(), c->in_contact.end(), 0);
-  if (++c->stamp == INT32_MAX) {
-    std::fill(c->tri_stamp.begin(), c->tri_stamp.end(), 0);
-    c->stamp = 1;
-  }
-  int entered = 0;
-  for (int i = 0; i < c->n; i++) {
-    if ((nodes[i].m_x - h).length2() > reach2) continue;
-    const int32_t* ts = &c->node_tris[(size_t)i * 8];
-    for (int k = 0; k < 8 && ts[k] >= 0; k++) {
-      const int32_t t = ts[k];
-      if (!c->tri_alive[(size_t)t] || c->tri_stamp[(size_t)t] == c->stamp) continue;
-      c->tri_stamp[(size_t)t] = c->stamp;
-      const int32_t* v = &c->tri[(size_t)t * 3];
-      btSoftBody::Node* p[3] = {&nodes[v[0]], &nodes[v[1]], &nodes[v[2]]};
-      btScalar w[3];
-      closest_on_triangle(h, p[0]->m_x, p[1]->m_x, p[2]->m_x, w);
-      const btVector3 q = p[0]->m_x * w[0] + p[1]->m_x * w[1] + p[2]->m_x * w[2];
-      const btVector3 nt = (p[1]->m_x - p[0]->m_x).cross(p[2]->m_x - p[0]->m_x);
-      const btVector3 q0 = p[0]->m_q * w[0] + p[1]->m_q * w[1] + p[2]->m_q * w[2];
-      const btVector3 n0 = (p[1]->m_q - p[0]->m_q).cross(p[2]->m_q - p[0]->m_q);
-      const btScalar side_from = (from - q0).dot(n0.length2() > 0 ? n0 : nt), side_now = (h - q).dot(nt);
-      bool in = (q - h).length2() < inside * inside;
-      if (!in && side_from * side_now < 0 && nt.length2() > 0) { // went across the HIP's centre: over it?
-        const btVector3 dq = q - h, across = dq - nt * (dq.dot(nt) / nt.length2());
-        in = across.length2() < rcs * rcs;
-      }
-      if (!in) continue;
-      entered++;
-      for (int j = 0; j < 3; j++)
-        if (w[j] > 0 && p[j]->m_im > 0) c->in_contact[(size_t)v[j]] = 1;
-    }
-  }
-  return entered;
-}
-
 // the HIP over one substep from h0 to h1, in moves of at most half the contact distance
 static void rupture(tx_cloth* c, const btVector3* near);
 
@@ -1355,55 +1300,32 @@ extern "C" void tx_cloth_restore(tx_cloth* c) {
 // is no measure of it here: a position solver's correction at 60 Hz is m/dt^2
 // times what the links' last iterations left over, which the iteration count sets,
 // not the material.
-//
-// The implicit solver takes the whole patch's momentum balance instead: the HIP's
-// push is the one force on the skin not otherwise known, so the skin's reaction on
-// the HIP is what holds the patch up at its kinematic particles (the border, the
-// clamp, the jaws' grasps: the links' pull on them) less the backward Euler
-// inertia M (x - y) / h^2 of the free particles over the last substep (y the
-// prediction with gravity and the loads, so the weight is in it). The held
-// particles' own imbalance, which the local sum reads, carries the part of the
-// solve that has not converged yet (the CG stops at 1e-2, Newton at a tenth),
-// and it sits where the contact is: at 1.25 mm the local sum read 234 mN where
-// the patch's balance reads 198 mN, and with a HIP at rest it flipped between
-// 11 and 136 mN as the contact's active set changed from step to step.
-static int link_reaction(const tx_cloth* c, double dt, double h, double out[3]) {
+static int link_reaction(const tx_cloth* c, double dt, double out[3]) {
   out[0] = out[1] = out[2] = 0;
   int held = 0;
-  const bool balance = c->def.solver == TX_CLOTH_IMPLICIT;
-  const double ih2 = 1 / (h * h);
   for (int i = 0; i < c->n; i++) {
     const btSoftBody::Node& nd = c->body->m_nodes[i];
-    if (!(nd.m_im > 0)) continue;
-    const bool in = c->in_contact[(size_t)i] != 0;
-    held += in;
+    if (!c->in_contact[(size_t)i] || !(nd.m_im > 0)) continue;
+    held++;
     double m = 1.0 / nd.m_im;
-    if (balance)
-      for (int e = 0; e < 3; e++) out[e] -= m * ((double)nd.m_x[e] - c->y[(size_t)i * 3 + e]) * ih2;
-    else if (in)
-      for (int e = 0; e < 3; e++)
-        out[e] += m * (c->world.m_gravity[e] - (nd.m_v[e] - c->good_v[(size_t)i * 3 + e]) / dt);
+    for (int e = 0; e < 3; e++)
+      out[e] += m * (c->world.m_gravity[e] - (nd.m_v[e] - c->good_v[(size_t)i * 3 + e]) / dt);
   }
-  if (held == 0) {
-    out[0] = out[1] = out[2] = 0;
-    return 0;
-  }
+  if (held == 0) return 0;
   const btAlignedObjectArray<btSoftBody::Link>& links = c->body->m_links;
   const btSoftBody::Node* base = &c->body->m_nodes[0];
   for (int i = 0, ni = links.size(); i < ni; i++) {
     const btSoftBody::Link& l = links[i];
     int a = (int)(l.m_n[0] - base), b = (int)(l.m_n[1] - base);
-    bool ia, ib; // balance: the kinematic end, which the link pulls towards the other; else the held end
-    if (balance) ia = !(l.m_n[0]->m_im > 0), ib = !(l.m_n[1]->m_im > 0);
-    else ia = c->in_contact[(size_t)a] != 0, ib = c->in_contact[(size_t)b] != 0;
+    bool ia = c->in_contact[(size_t)a] != 0, ib = c->in_contact[(size_t)b] != 0;
     if (ia == ib) continue; // none held, or both: a link inside the contact pulls both ways
     btVector3 d = l.m_n[1]->m_x - l.m_n[0]->m_x;
     double len = d.length();
     if (!(len > 0)) continue;
     bool bend = c->info[(size_t)(intptr_t)l.m_tag].kind == BEND;
     double k = bend ? c->def.bend_stiffness : c->def.stretch_stiffness;
-    double s = k * (len - (double)l.m_rl) / len * (ia ? 1 : -1); // on the held (kinematic) end, toward the other
-    for (int e = 0; e < 3; e++) out[e] += balance ? -s * d[e] : s * d[e]; // what holds the patch, or pulls the held
+    double s = k * (len - (double)l.m_rl) / len * (ia ? 1 : -1); // on the held end, toward the other
+    for (int e = 0; e < 3; e++) out[e] += s * d[e];
   }
   // a smooth sphere takes only the push along its contact normal: the rest is the held
   // particles' own imbalance, which the solver has not yet spread (no pull either).
@@ -1417,85 +1339,6 @@ static int link_reaction(const tx_cloth* c, double dt, double h, double out[3]) 
   double along = nl > 0 ? (out[0] * n[0] + out[1] * n[1] + out[2] * n[2]) / nl : 0;
   for (int e = 0; e < 3; e++) out[e] = along > 0 ? along * n[e] / nl : 0;
   return held;
-}
-
-// The implicit substep and its contact's active set. The holds come from the
-// contact before the solve; skin that was not touching then (resting a little
-// off a HIP that stopped: the face contact leaves the corners beyond its 1 %) is
-// free in the solve, and one backward Euler step of a tensed membrane carries it
-// into the sphere, past its centre (the HIP stopped 5 mm into the skin: the
-// skin went 2.3 mm up through it, the contact after the links threw it 2 rc back
-// down, and the links it stretched tore at 5 times the rupture tension). So a
-// solve that carries skin into the HIP is undone and solved again with those
-// triangles' corners held where they were (once: what a second solve carries in,
-// the contact after the links puts back)
-static void implicit_with_contact(tx_cloth* c, double h, const btVector3& hip, const btVector3& from) {
-  btAlignedObjectArray<btSoftBody::Node>& nodes = c->body->m_nodes;
-  const bool contact = c->hip_radius > 0;
-  if (contact) {
-    // the last substep's active set is this one's start: skin resting on a HIP at rest
-    // stays held instead of being solved free, carried in and solved again every step
-    // (the face contact leaves corners up to an edge beyond the contact distance);
-    // what would now have to pull is let go after the solve
-    const double reach = c->hip_radius + 0.5 * c->def.thickness + c->max_edge;
-    for (int i = 0; i < c->n; i++) {
-      for (int a = 0; a < 3; a++) c->x_pre[(size_t)i * 3 + a] = nodes[i].m_x[a];
-      if (!c->held_solve[(size_t)i] || c->hold[(size_t)i] || !(nodes[i].m_im > 0)) continue;
-      const btVector3 r = nodes[i].m_x - hip;
-      if (!(r.length2() < reach * reach)) continue;
-      c->hold[(size_t)i] = 1;
-      for (int a = 0; a < 3; a++) c->hold_n[(size_t)i * 3 + a] = r[a];
-    }
-  }
-  solve_implicit(c, h);
-  if (!contact || flag_entered(c, hip, from) == 0) return;
-  c->stats.resolved++;
-  for (int i = 0; i < c->n; i++) {
-    const float* x = &c->x_pre[(size_t)i * 3];
-    nodes[i].m_x = btVector3(x[0], x[1], x[2]);
-    const bool add = c->in_contact[(size_t)i] && !c->held_solve[(size_t)i];
-    c->hold[(size_t)i] = c->held_solve[(size_t)i] || add;
-    if (add)
-      for (int a = 0; a < 3; a++) c->hold_n[(size_t)i * 3 + a] = (double)nodes[i].m_x[a] - hip[a];
-  }
-  solve_implicit(c, h);
-}
-
-// A piece the tears cut off (no stretch or shear link leads from it to a fixed or
-// pinned particle) leaves the patch: its particles stop and its triangles go, so
-// it is no longer drawn, touched or stepped. Left to fall under gravity it would
-// pass the fault check's 10 m in some 5 s (its terminal speed is g / damping, 2
-// m/s) and fault every step from then on. After a good step that tore, so that
-// the saved state has it gone; how many particles left
-static int detach_pieces(tx_cloth* c) {
-  std::fill(c->reached.begin(), c->reached.end(), 0);
-  int head = 0, tail = 0;
-  for (int i = 0; i < c->n; i++)
-    if (!(c->im0[(size_t)i] > 0) || c->pinned[(size_t)i]) c->reached[(size_t)i] = 1, c->queue[(size_t)tail++] = i;
-  while (head < tail) {
-    const int i = c->queue[(size_t)head++];
-    const int32_t* ls = &c->node_links[(size_t)i * 12];
-    for (int k = 0; k < 12 && ls[k] >= 0; k++) {
-      const link_info& li = c->info[(size_t)ls[k]];
-      if (li.slot < 0 || li.kind == BEND) continue;
-      const int j = li.end[0] == i ? li.end[1] : li.end[0];
-      if (!c->reached[(size_t)j]) c->reached[(size_t)j] = 1, c->queue[(size_t)tail++] = j;
-    }
-  }
-  int gone = 0;
-  btAlignedObjectArray<btSoftBody::Node>& nodes = c->body->m_nodes;
-  for (int i = 0; i < c->n; i++) {
-    if (c->reached[(size_t)i] || !(nodes[i].m_im > 0)) continue;
-    nodes[i].m_im = 0;
-    nodes[i].m_v = btVector3(0, 0, 0);
-    c->im0[(size_t)i] = 0; // gone for good: it cannot be pinned either
-    const int32_t* ts = &c->node_tris[(size_t)i * 8];
-    for (int k = 0; k < 8 && ts[k] >= 0; k++)
-      if (c->tri_alive[(size_t)ts[k]]) c->tri_alive[(size_t)ts[k]] = 0, c->live_dirty = c->topology_dirty = true;
-    gone++;
-  }
-  c->detached += gone;
-  return gone;
 }
 
 // the pinned particles where the jaws have them at fraction u of the step: after
@@ -1562,7 +1405,6 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
   c->stats.residual = 0;
   c->stats.released = 0;
   c->stats.newton = 0;
-  c->stats.resolved = 0;
   const btScalar ih = (btScalar)(1 / h);
   c->contact_depth = 0;
   c->contact_moves = 0;
@@ -1570,7 +1412,6 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
   const btVector3 start((btScalar)c->hip_prev[0], (btScalar)c->hip_prev[1], (btScalar)c->hip_prev[2]);
   const btVector3 end((btScalar)c->hip[0], (btScalar)c->hip[1], (btScalar)c->hip[2]);
   c->broke = false;
-  const int torn_at_start = c->torn;
   if (c->npinned > 0)
     for (int i = 0; i < c->n; i++)
       if (c->pinned[(size_t)i])
@@ -1583,7 +1424,7 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
     predict(c, h);
     if (c->npinned > 0) place_pinned(c, (double)(s + 1) / substeps);
     sweep_contact(c, h0, h1, h, true);
-    if (c->def.solver == TX_CLOTH_IMPLICIT) implicit_with_contact(c, h, h1, h0);
+    if (c->def.solver == TX_CLOTH_IMPLICIT) solve_implicit(c, h);
     else solve_links(c, h);
     btAlignedObjectArray<btSoftBody::Node>& nodes = b->m_nodes;
     const btScalar vc = (btScalar)(ih * std::exp(-c->def.damping * h));
@@ -1630,8 +1471,7 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
     }
     c->prev_peak = c->sub_peak;
   }
-  if (c->torn > torn_at_start) detach_pieces(c);
-  c->contact_held = link_reaction(c, dt, h, c->contact_force);
+  c->contact_held = link_reaction(c, dt, c->contact_force);
   for (int a = 0; a < 3; a++) {
     c->contact_at[a] = c->hip[a];
     c->hip_prev[a] = c->hip[a];
