@@ -676,8 +676,8 @@ int main(void) {
       cmocka_unit_test(untorn_skin_holds_to_3cm),
       cmocka_unit_test(rupture_is_located_between_steps),
       cmocka_unit_test(pinned_particles_follow),
-      cmocka_unit_test_setup_teardown(pinned_particles_follow, use_xpbd, use_implicit),
 #if !SANITIZED // the same code paths as above, but for the links' solve; minutes under the sanitizers
+      cmocka_unit_test_setup_teardown(pinned_particles_follow, use_xpbd, use_implicit),
       cmocka_unit_test_setup_teardown(rupture_opens_a_hole, use_xpbd, use_implicit),
       cmocka_unit_test_setup_teardown(faults_are_recovered, use_xpbd, use_implicit),
       cmocka_unit_test_setup_teardown(restore_brings_links_back, use_xpbd, use_implicit),
