@@ -8,10 +8,14 @@
 #include "bullet/cloth.h"
 
 #include <tactus/components.h>
+#include <tactus/events.h>
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#define GRASP_HANDS_MAX 4
 
 typedef struct skin {
   tx_cloth* cloth;     // the patch; made in configure, stepped only by this instance
@@ -23,6 +27,18 @@ typedef struct skin {
   double k;              // N/m, the last tangent stiffness
   tx_warning fault, bad_pose;
   tx_result torn_result, fault_result;
+  // grasps: the particles between a hand's jaws follow its instrument<h>.pose
+  tx_port grasp_in;                     // listened: the grasp stream (0: none)
+  tx_port jaws[GRASP_HANDS_MAX];        // read: instrument<h>.pose
+  int hands;                            // hands whose grasps count
+  double grasp_radius;                  // m
+  int n;                                // particles
+  int8_t* holder;                       // (n) the hand holding each particle, -1 none
+  double* offset;                       // (n x 3) m, a held particle in its jaws' frame
+  int32_t* held;                        // (n) the held particles, in the order taken
+  int nheld;
+  int grasps;                           // grasps that took particles
+  tx_result grasp_result;
 } skin;
 
 // defaults are tx_cloth_def_default()'s (tests/controllers/test_param_tables.c checks)
@@ -52,6 +68,12 @@ static const tx_param_def params[] = {
     {"max_speed", TX_PARAM_NUM, "m/s", 1e-3, 1e4, 100, NULL, "a faster particle is a blow-up"},
     {"hip_radius_m", TX_PARAM_NUM, "m", 0, 0.01, 0.0005, NULL, "the HIP sphere (0.05 cm); 0: no HIP"},
     {"pose", TX_PARAM_STR, NULL, 0, 0, 0, "device0.pose", "the pose the HIP follows (f64 1 x 7)"},
+    {"grasp_events", TX_PARAM_STR, NULL, 0, 0, 0, "",
+     "stream of the jaws' grasps and releases (source = hand h; its jaws' frame is instrument<h>.pose); \"\": none"},
+    {"grasp_radius_m", TX_PARAM_NUM, "m", 1e-4, 0.05, 0.002, NULL,
+     "a grasp takes the free particles this close to its point; none in reach: not the skin's"},
+    {"grasp_hands", TX_PARAM_INT, "1", 1, GRASP_HANDS_MAX, 2, NULL,
+     "with grasp_events: hands 0 to this less one, each with its instrument<h>.pose"},
 };
 
 static int configure(tx_setup* s, void** self) {
@@ -118,7 +140,117 @@ static int configure(tx_setup* s, void** self) {
   k->bad_pose = tx_setup_warning(s, "bad_pose");
   k->torn_result = tx_setup_result(s, "torn_links");
   k->fault_result = tx_setup_result(s, "faults");
+
+  const char* grasps = tx_table_str(s, "grasp_events");
+  if (!grasps) return -1;
+  k->grasp_radius = tx_table_num(s, "grasp_radius_m");
+  k->hands = (int)tx_table_int(s, "grasp_hands");
+  k->n = (int)n;
+  if (*grasps) {
+    k->grasp_in = tx_setup_listen(s, grasps);
+    for (int h = 0; h < k->hands; h++) {
+      char name[TX_NAME_MAX];
+      snprintf(name, sizeof name, "instrument%d.pose", h);
+      k->jaws[h] = TX_READ_OF(s, name, tx_instrument_pose);
+    }
+    k->holder = malloc((size_t)n * sizeof *k->holder);
+    k->offset = calloc((size_t)n * 3, sizeof *k->offset);
+    k->held = malloc((size_t)n * sizeof *k->held);
+    if (!k->holder || !k->offset || !k->held) return tx_setup_fail(s, NULL, "out of memory");
+    memset(k->holder, -1, (size_t)n * sizeof *k->holder);
+  }
+  k->grasp_result = tx_setup_result(s, "grasps");
   return 0;
+}
+
+// v rotated by the unit quaternion q = (w, x, y, z), or by its inverse
+static void rotate(const double q[4], bool inverse, const double v[3], double out[3]) {
+  const double w = q[0], x = inverse ? -q[1] : q[1], y = inverse ? -q[2] : q[2], z = inverse ? -q[3] : q[3];
+  // t = 2 (q.xyz x v); out = v + w t + q.xyz x t
+  const double t0 = 2 * (y * v[2] - z * v[1]), t1 = 2 * (z * v[0] - x * v[2]), t2 = 2 * (x * v[1] - y * v[0]);
+  out[0] = v[0] + w * t0 + (y * t2 - z * t1);
+  out[1] = v[1] + w * t1 + (z * t0 - x * t2);
+  out[2] = v[2] + w * t2 + (x * t1 - y * t0);
+}
+
+// the jaws of hand h now; false when nothing is published yet or not finite
+static bool jaws_of(tx_ctx* c, const skin* k, int h, tx_instrument_pose* out) {
+  tx_snapshot p = tx_read(c, k->jaws[h]);
+  if (p.seq == 0) return false;
+  *out = *(const tx_instrument_pose*)p.data;
+  double qq = 0;
+  for (int a = 0; a < 4; a++) qq += out->quat[a] * out->quat[a];
+  for (int a = 0; a < 3; a++)
+    if (!isfinite(out->pos[a])) return false;
+  if (!(qq > 0.5 && qq < 2)) return false; // no rotation
+  for (int a = 0; a < 4; a++) out->quat[a] /= sqrt(qq);
+  return true;
+}
+
+static void release(skin* k, int h) {
+  int kept = 0;
+  for (int j = 0; j < k->nheld; j++) {
+    int i = k->held[j];
+    if (k->holder[i] != h) {
+      k->held[kept++] = i;
+      continue;
+    }
+    k->holder[i] = -1;
+    tx_cloth_unpin(k->cloth, i);
+  }
+  k->nheld = kept;
+}
+
+// a grasp by hand h at point: the free particles within grasp_radius become its
+// jaws', each kept at its offset in their frame; none in reach: not the skin's
+// (the needle's and the thread's grasps come on the same stream)
+static void grasp(tx_ctx* c, skin* k, int h, const double point[3]) {
+  tx_instrument_pose jp;
+  if (!jaws_of(c, k, h, &jp)) return;
+  const double r2 = k->grasp_radius * k->grasp_radius;
+  int took = 0;
+  for (int i = 0; i < k->n; i++) {
+    if (k->holder[i] >= 0) continue; // the other hand's already
+    double x[3], d2 = 0;
+    tx_cloth_particle(k->cloth, i, x);
+    for (int a = 0; a < 3; a++) d2 += (x[a] - point[a]) * (x[a] - point[a]);
+    if (!(d2 <= r2)) continue;
+    if (tx_cloth_pin(k->cloth, i, x) != TX_CLOTH_OK) continue; // the fixed border stays where it is
+    double rel[3] = {x[0] - jp.pos[0], x[1] - jp.pos[1], x[2] - jp.pos[2]};
+    rotate(jp.quat, true, rel, &k->offset[(size_t)i * 3]);
+    k->holder[i] = (int8_t)h;
+    k->held[k->nheld++] = i;
+    took++;
+  }
+  if (took > 0) k->grasps++;
+}
+
+// the grasps and releases sent since the last step, then every held particle
+// where its jaws now put it
+static void follow_jaws(tx_ctx* c, skin* k) {
+  for (tx_event e; tx_next_event(c, k->grasp_in, &e);) {
+    if (e.source >= (uint32_t)k->hands) continue; // a hand this skin does not watch
+    const int h = (int)e.source;
+    if (e.kind == TX_EVENT_RELEASE) release(k, h);
+    else if (e.kind == TX_EVENT_GRASP) {
+      bool finite = isfinite(e.grasp.point[0]) && isfinite(e.grasp.point[1]) && isfinite(e.grasp.point[2]);
+      if (finite) grasp(c, k, h, e.grasp.point);
+    }
+  }
+  for (int h = 0; h < k->hands; h++) {
+    tx_instrument_pose jp;
+    bool any = false;
+    for (int j = 0; j < k->nheld && !any; j++) any = k->holder[k->held[j]] == h;
+    if (!any || !jaws_of(c, k, h, &jp)) continue; // a pose gone bad: they stay where they are
+    for (int j = 0; j < k->nheld; j++) {
+      const int i = k->held[j];
+      if (k->holder[i] != h) continue;
+      double x[3];
+      rotate(jp.quat, false, &k->offset[(size_t)i * 3], x);
+      for (int a = 0; a < 3; a++) x[a] += jp.pos[a];
+      tx_cloth_pin(k->cloth, i, x);
+    }
+  }
 }
 
 // The skin's reaction on the HIP and its tangent stiffness k = d|f|/dw. A
@@ -173,6 +305,9 @@ static void publish(tx_ctx* c, skin* k) {
 }
 
 static int init(tx_ctx* c, void* self) {
+  skin* k = self;
+  for (int h = 0; h < k->hands && k->grasp_in.id; h++) release(k, h); // a run starts with open jaws
+  k->grasps = 0;
   publish(c, self); // the patch at rest, at time 0
   return 0;
 }
@@ -186,6 +321,7 @@ static void step(tx_ctx* c, void* self) {
       if (tx_cloth_set_hip(k->cloth, pose->pos, k->hip_radius) != TX_CLOTH_OK) tx_warn(c, k->bad_pose);
     }
   }
+  if (k->grasp_in.id) follow_jaws(c, k);
   if (tx_cloth_step(k->cloth, k->dt) == TX_CLOTH_FAULT) tx_warn(c, k->fault);
   publish(c, k);
 }
@@ -194,12 +330,16 @@ static void finish(tx_ctx* c, void* self) {
   skin* k = self;
   tx_set_result(c, k->torn_result, tx_cloth_torn(k->cloth));
   tx_set_result(c, k->fault_result, tx_cloth_faults(k->cloth));
+  tx_set_result(c, k->grasp_result, k->grasps);
 }
 
 static void fini(void* self) {
   skin* k = self;
   if (!k) return;
   tx_cloth_destroy(k->cloth);
+  free(k->holder);
+  free(k->offset);
+  free(k->held);
   free(k);
 }
 

@@ -10,14 +10,18 @@
 //   rupture_tension_n_per_m (N/m, 0: never), rupture_length_m (m),
 //   iterations, max_substep_s, max_speed (m/s), hip_radius_m 0.0005
 //   (0.05 cm; 0: no HIP), pose (the component the HIP follows, default
-//   device0.pose, f64 1 x 7).
+//   device0.pose, f64 1 x 7); grasp_events (a stream of TX_EVENT_GRASP and
+//   TX_EVENT_RELEASE, source = hand h; "": none), grasp_radius_m 0.002 and
+//   grasp_hands 2: a grasp holds the free particles within the radius at
+//   their offset in instrument<h>.pose's frame until h releases.
 // Rate 20 to 120 Hz (60 by default in the scenarios).
 //
 // Writes, every step: skin.x (f32 N x 3, m), skin.tri (i32 M x 3, the live
 // triangles; rows in use = M), skin.thickness (f64 1 x 1, m), skin.torn
 // (i32 1 x 1, links broken so far). Warnings: numerical_fault (a step found
 // a NaN, an Inf or a blow-up and went back to the last good state),
-// bad_pose (a non-finite HIP pose, ignored). Results: torn_links, faults.
+// bad_pose (a non-finite HIP pose, ignored). Results: torn_links, faults,
+// grasps.
 #ifndef TX_CONTROLLERS_PHYSICS_SKIN_CONTROLLER_H
 #define TX_CONTROLLERS_PHYSICS_SKIN_CONTROLLER_H
 

@@ -30,6 +30,8 @@
 //   clamp      the border ring (fixed_border) and, with clamp_radius > 0,
 //              every particle at or beyond that distance from the centre
 //   load       an external force per particle (tx_cloth_set_load)
+//   pin        grasped particles (tx_cloth_pin): kinematic, moved where the
+//              jaws put them across a step, until unpinned
 //   rupture    the membrane tension, the largest principal value of the
 //              link stresses averaged over a disc of radius rupture_length
 //              (a smooth kernel), breaks the most tensed stretch or shear
@@ -171,6 +173,16 @@ double tx_cloth_max_strain(const tx_cloth* c);
 // an external force (N) on particle i from the next step on, until set
 // again (zero removes it); TX_CLOTH_BAD for a bad index or a non-finite force
 tx_cloth_status tx_cloth_set_load(tx_cloth* c, int i, const double f[3]);
+// grasped particles (the forceps' jaws hold them): a pinned particle is
+// kinematic, moved in a straight line from where it is to x (m) across the
+// next step's substeps and held there until pinned again elsewhere or
+// unpinned; the links, the HIP and gravity do not move it. TX_CLOTH_BAD
+// (tx_error() set) for a bad index, a non-finite or far x, or a particle the
+// patch holds fixed (border, clamp). Unpin gives it back its mass; false when
+// it was not pinned
+tx_cloth_status tx_cloth_pin(tx_cloth* c, int i, const double x[3]);
+bool tx_cloth_unpin(tx_cloth* c, int i);
+int tx_cloth_pinned(const tx_cloth* c); // particles pinned now
 // link ids run from 0 to the count at creation (tx_cloth_link_total); a
 // broken link keeps its id. Its two particles; false for a bad id
 int tx_cloth_link_total(const tx_cloth* c);

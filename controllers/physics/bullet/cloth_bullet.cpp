@@ -95,6 +95,13 @@ struct tx_cloth {
   int torn;
   int faults;
 
+  // grasped particles (tx_cloth_pin): kinematic, moved to pin_to across a step
+  std::vector<btScalar> im0;      // (n) each particle's inverse mass as built: 0 fixed
+  std::vector<uint8_t> pinned;    // (n)
+  std::vector<double> pin_from;   // (n x 3) m, where a pinned particle began the step
+  std::vector<double> pin_to;     // (n x 3) m, where it ends the step
+  int npinned;
+
   // the HIP, a kinematic sphere
   double hip[3];      // m, centre at the end of the next step
   double hip_prev[3]; // m, centre at the end of the last step
@@ -265,6 +272,11 @@ static bool build(tx_cloth* c) {
       m[(size_t)i] = ((d.fixed_border && border) || clamped) ? 0 : (btScalar)c->node_mass;
     }
   c->body = new btSoftBody(&c->world, c->n, x.data(), m.data());
+  c->im0.resize((size_t)c->n);
+  for (int i = 0; i < c->n; i++) c->im0[(size_t)i] = c->body->m_nodes[i].m_im;
+  c->pinned.assign((size_t)c->n, 0);
+  c->pin_from.assign((size_t)c->n * 3, 0.0);
+  c->pin_to.assign((size_t)c->n * 3, 0.0);
   c->body->m_cfg.collisions = 0; // the HIP contact is ours (see cloth.h)
   c->body->m_cfg.piterations = d.iterations;
   c->body->m_cfg.kDP = 0;
@@ -1329,6 +1341,56 @@ static int link_reaction(const tx_cloth* c, double dt, double out[3]) {
   return held;
 }
 
+// the pinned particles where the jaws have them at fraction u of the step: after
+// predict, before the contact and the solve, which move only what has mass
+static void place_pinned(tx_cloth* c, double u) {
+  btAlignedObjectArray<btSoftBody::Node>& nodes = c->body->m_nodes;
+  for (int i = 0; i < c->n; i++) {
+    if (!c->pinned[(size_t)i]) continue;
+    const double* f = &c->pin_from[(size_t)i * 3];
+    const double* t = &c->pin_to[(size_t)i * 3];
+    if (u >= 1) nodes[i].m_x = btVector3((btScalar)t[0], (btScalar)t[1], (btScalar)t[2]); // exactly where asked
+    else
+      nodes[i].m_x = btVector3((btScalar)(f[0] + u * (t[0] - f[0])), (btScalar)(f[1] + u * (t[1] - f[1])),
+                               (btScalar)(f[2] + u * (t[2] - f[2])));
+  }
+}
+
+extern "C" tx_cloth_status tx_cloth_pin(tx_cloth* c, int i, const double x[3]) {
+  if (i < 0 || i >= c->n) {
+    tx_set_error("skin: pin on particle %d, there are %d", i, c->n);
+    return TX_CLOTH_BAD;
+  }
+  if (!(std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]) && std::fabs(x[0]) <= 1e3 &&
+        std::fabs(x[1]) <= 1e3 && std::fabs(x[2]) <= 1e3)) {
+    tx_set_error("skin: pin of particle %d at (%g, %g, %g) m, must be finite and within 1 km", i, x[0], x[1], x[2]);
+    return TX_CLOTH_BAD;
+  }
+  if (!(c->im0[(size_t)i] > 0)) {
+    tx_set_error("skin: particle %d is fixed (border or clamp), it cannot be pinned", i);
+    return TX_CLOTH_BAD;
+  }
+  btSoftBody::Node& nd = c->body->m_nodes[i];
+  if (!c->pinned[(size_t)i]) {
+    c->pinned[(size_t)i] = 1;
+    c->npinned++;
+    nd.m_im = 0; // kinematic: the links and the contact move only what has mass
+    nd.m_v = btVector3(0, 0, 0);
+  }
+  for (int a = 0; a < 3; a++) c->pin_to[(size_t)i * 3 + a] = x[a];
+  return TX_CLOTH_OK;
+}
+
+extern "C" bool tx_cloth_unpin(tx_cloth* c, int i) {
+  if (i < 0 || i >= c->n || !c->pinned[(size_t)i]) return false;
+  c->pinned[(size_t)i] = 0;
+  c->npinned--;
+  c->body->m_nodes[i].m_im = c->im0[(size_t)i]; // it keeps the jaws' last velocity
+  return true;
+}
+
+extern "C" int tx_cloth_pinned(const tx_cloth* c) { return c->npinned; }
+
 extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
   if (!(dt > 0 && dt <= 1)) {
     tx_set_error("skin: step dt = %g s, must be finite and in (0, 1]", dt);
@@ -1350,12 +1412,17 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
   const btVector3 start((btScalar)c->hip_prev[0], (btScalar)c->hip_prev[1], (btScalar)c->hip_prev[2]);
   const btVector3 end((btScalar)c->hip[0], (btScalar)c->hip[1], (btScalar)c->hip[2]);
   c->broke = false;
+  if (c->npinned > 0)
+    for (int i = 0; i < c->n; i++)
+      if (c->pinned[(size_t)i])
+        for (int a = 0; a < 3; a++) c->pin_from[(size_t)i * 3 + a] = c->body->m_nodes[i].m_x[a];
   for (int s = 0; s < substeps; s++) {
     btVector3 h0 = start.lerp(end, (btScalar)s / (btScalar)substeps);
     btVector3 h1 = start.lerp(end, (btScalar)(s + 1) / (btScalar)substeps);
     const int torn0 = c->torn;
     c->sub_peak = 0;
     predict(c, h);
+    if (c->npinned > 0) place_pinned(c, (double)(s + 1) / substeps);
     sweep_contact(c, h0, h1, h, true);
     if (c->def.solver == TX_CLOTH_IMPLICIT) solve_implicit(c, h);
     else solve_links(c, h);

@@ -11,6 +11,7 @@
 #include "tests/scenario_support.h"
 
 #include <tactus/components.h>
+#include <tactus/events.h>
 
 #include <math.h>
 #include <stdio.h>
@@ -145,12 +146,162 @@ static void bad_parameters_are_named(void** state) {
   }
 }
 
+// a test class standing for physics.instruments: hand 0's jaws (instrument0.pose)
+// and their grasps on instruments.events. At grasp_at it grasps at point; from
+// 0.2 s to 0.7 s the jaws rise by lift along y and turn by turn rad about y;
+// at release_at they open
+static struct {
+  double point[3], lift, turn, grasp_at, release_at;
+} jaws_plan;
+static tx_port jaws_pose, jaws_events;
+static int jaws_configure(tx_setup* s, void** self) {
+  *self = NULL;
+  jaws_pose = tx_setup_write(s, &TX_COMPONENT_OF("instrument0.pose", tx_instrument_pose, 1));
+  jaws_events = tx_setup_emit(s, "instruments.events", 64);
+  return 0;
+}
+// the jaws at time t: they hold the grasp point, raised and turned
+static void jaws_at(double t, tx_instrument_pose* p) {
+  double u = (t - 0.2) / 0.5;
+  u = u < 0 ? 0 : u > 1 ? 1 : u;
+  memset(p, 0, sizeof *p);
+  for (int a = 0; a < 3; a++) p->pos[a] = jaws_plan.point[a];
+  p->pos[1] += u * jaws_plan.lift;
+  p->quat[0] = cos(0.5 * u * jaws_plan.turn);
+  p->quat[2] = sin(0.5 * u * jaws_plan.turn);
+}
+static void jaws_step(tx_ctx* c, void* self) {
+  (void)self;
+  double t = (double)tx_sim_ns(c) * 1e-9;
+  jaws_at(t, tx_write(c, jaws_pose));
+  uint64_t i = tx_step_index(c);
+  if (i == (uint64_t)llround(jaws_plan.grasp_at * 1000)) {
+    tx_event e = {.kind = TX_EVENT_GRASP, .source = 0};
+    memcpy(e.grasp.point, jaws_plan.point, sizeof e.grasp.point);
+    tx_emit(c, jaws_events, &e);
+    tx_emit(c, jaws_events, &(tx_event){.kind = TX_EVENT_GRASP, .source = 3}); // a hand the skin does not watch
+  }
+  if (i == (uint64_t)llround(jaws_plan.release_at * 1000)) tx_emit(c, jaws_events, &(tx_event){.kind = TX_EVENT_RELEASE, .source = 0});
+}
+static const tx_controller_class jaws_class = {.type = "test.jaws", .summary = "forceps jaws", .configure = jaws_configure, .step = jaws_step};
+
+static tx_scenario* load_with_jaws(const char* skin_params) {
+  if (!tx_find_controller(jaws_class.type)) assert_int_equal(tx_register_controller(&jaws_class), 0);
+  char text[2048];
+  snprintf(text, sizeof text,
+           "{\"name\":\"t\",\"controllers\":["
+           "{\"name\":\"jaws\",\"type\":\"test.jaws\",\"rate_hz\":1000},"
+           "{\"name\":\"skin\",\"type\":\"physics.skin\",\"rate_hz\":60,"
+           "\"params\":{\"hip_radius_m\":0,\"grasp_events\":\"instruments.events\",\"grasp_hands\":1%s}}]}",
+           skin_params);
+  return tx_scenario_load_text("test", text, strlen(text), NULL);
+}
+
+// the flat patch's particles (no gravity, nothing touches it before the grasp)
+static void rest_positions(float* out) {
+  jaws_plan.grasp_at = jaws_plan.release_at = 100;
+  tx_scenario* s = load_with_jaws("");
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 0.05);
+  memcpy(out, latest_snapshot(s, "skin.x").data, 1764 * 3 * sizeof(float));
+  tx_scenario_free(s);
+}
+
+// forceps grasp the skin at a cell's middle: the four particles within 2 mm
+// follow the jaws (raised 5 mm and turned 0.2 rad about y) to 1e-9 m, the ring
+// beside them rises part way (a tent), the far patch stays; opened, the skin
+// falls back flat. A grasp from a hand the skin does not watch is ignored
+static void grasped_skin_follows_the_jaws(void** state) {
+  (void)state;
+  static float rest[1764 * 3];
+  rest_positions(rest);
+  jaws_plan = (__typeof__(jaws_plan)){{0, 0, 0}, 0.005, 0.2, 0.1, 1.5};
+  tx_scenario* s = load_with_jaws("");
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 1.2);
+  const float* x = latest_snapshot(s, "skin.x").data;
+  tx_instrument_pose jp;
+  jaws_at(1.2, &jp);
+  int held = 0, tent = 0;
+  double worst = 0, tent_low = 1, far_high = 0;
+  for (int i = 0; i < 1764; i++) {
+    const float* r = &rest[i * 3];
+    double d = hypot(r[0], r[2]);
+    if (d <= 0.002) { // held: the rest offset turned by 0.2 rad about y and raised
+      double c = cos(jaws_plan.turn), sn = sin(jaws_plan.turn);
+      double want[3] = {c * r[0] + sn * r[2] + jp.pos[0], r[1] + jp.pos[1], -sn * r[0] + c * r[2] + jp.pos[2]};
+      for (int a = 0; a < 3; a++) worst = fmax(worst, fabs(x[i * 3 + a] - want[a]));
+      held++;
+    } else if (d < 0.004) { // the ring beside: raised, below the jaws
+      assert_true(x[i * 3 + 1] > 0 && x[i * 3 + 1] < 0.005);
+      tent_low = fmin(tent_low, x[i * 3 + 1]);
+      tent++;
+    } else if (d > 0.03)
+      far_high = fmax(far_high, x[i * 3 + 1]);
+  }
+  print_message("  %d held, furthest from the jaws' frame %.2e m; %d in the tent's first ring, from %.2f mm up; "
+                "beyond 3 cm at most %.2f mm\n", held, worst, tent, tent_low * 1e3, far_high * 1e3);
+  assert_true(far_high < tent_low);
+  assert_int_equal(held, 4);
+  assert_true(worst < 1e-9);
+  assert_true(tent > 0);
+  assert_true(result(s, "skin.grasps") == 1);
+  assert_int_equal(warnings(s, "skin.numerical_fault"), 0);
+  tx_scenario_free(s);
+
+  s = load_with_jaws(""); // on past the release at 1.5 s: it falls back
+  run(s, 4.0);
+  x = latest_snapshot(s, "skin.x").data;
+  double high = 0;
+  for (int i = 0; i < 1764; i++) high = fmax(high, fabs(x[i * 3 + 1]));
+  print_message("  3.5 s after the release: highest particle %.3f mm\n", high * 1e3);
+  assert_true(high < 0.0005);
+  assert_true(result(s, "skin.grasps") == 1);
+  tx_scenario_free(s);
+}
+
+// a grasp 3 cm above the skin (the needle's or the thread's) takes nothing:
+// the jaws rise and the skin stays flat
+static void grasp_out_of_reach_does_nothing(void** state) {
+  (void)state;
+  jaws_plan = (__typeof__(jaws_plan)){{0, 0.03, 0}, 0.005, 0, 0.1, 1.5};
+  tx_scenario* s = load_with_jaws("");
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 1.0);
+  const float* x = latest_snapshot(s, "skin.x").data;
+  for (int i = 0; i < 1764; i++) assert_true(x[i * 3 + 1] == 0);
+  assert_true(result(s, "skin.grasps") == 0);
+  tx_scenario_free(s);
+}
+
+// jaws that lift the skin 2 cm tear it at 20 N/m beside the particles they
+// hold: no fault, nothing non-finite, the held particles still on the jaws
+static void tear_beside_the_jaws(void** state) {
+  (void)state;
+  jaws_plan = (__typeof__(jaws_plan)){{0, 0, 0}, 0.02, 0, 0.1, 100};
+  tx_scenario* s = load_with_jaws(",\"rupture_tension_n_per_m\":20");
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 1.2);
+  const float* x = latest_snapshot(s, "skin.x").data;
+  int torn = ((const int*)latest_snapshot(s, "skin.torn").data)[0], on = 0;
+  for (int i = 0; i < 1764 * 3; i++) assert_true(isfinite(x[i]));
+  for (int i = 0; i < 1764; i++) on += fabs(x[i * 3 + 1] - 0.02) < 1e-6;
+  print_message("  %d links torn, %d particles on the jaws\n", torn, on);
+  assert_true(torn > 0);
+  assert_int_equal(on, 4);
+  assert_int_equal(warnings(s, "skin.numerical_fault"), 0);
+  tx_scenario_free(s);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(publishes_the_skin),
       cmocka_unit_test(hip_follows_the_device_and_pierces),
       cmocka_unit_test(publishes_the_contact),
       cmocka_unit_test(bad_parameters_are_named),
+      cmocka_unit_test(grasped_skin_follows_the_jaws),
+      cmocka_unit_test(grasp_out_of_reach_does_nothing),
+      cmocka_unit_test(tear_beside_the_jaws),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

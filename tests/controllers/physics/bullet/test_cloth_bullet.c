@@ -620,6 +620,44 @@ static int use_implicit(void** state) {
 }
 #endif
 
+// a pinned particle goes where it is put, in a straight line across the
+// step's substeps, its neighbours follow part way; unpinned it falls back
+// with the rest. Bad pins are refused, and a fault keeps the pin
+static void pinned_particles_follow(void** state) {
+  (void)state;
+  tx_cloth* c = make(22, 0, 0);
+  const int i = centre(c);
+  double x0[3], x[3], nb[3], bad[3] = {0, NAN, 0};
+  tx_cloth_particle(c, i, x0);
+  assert_int_equal(tx_cloth_pin(c, -1, x0), TX_CLOTH_BAD);
+  assert_int_equal(tx_cloth_pin(c, i, bad), TX_CLOTH_BAD);
+  assert_int_equal(tx_cloth_pin(c, 0, x0), TX_CLOTH_BAD); // a border corner: fixed
+  assert_non_null(strstr(tx_error(), "fixed"));
+  assert_false(tx_cloth_unpin(c, i)); // not pinned
+  double up[3] = {x0[0], x0[1] + 0.004, x0[2]};
+  assert_int_equal(tx_cloth_pin(c, i, up), TX_CLOTH_OK);
+  assert_int_equal(tx_cloth_pinned(c), 1);
+  for (int s = 0; s < 30; s++) assert_int_equal(tx_cloth_step(c, 1.0 / 60), TX_CLOTH_OK);
+  tx_cloth_particle(c, i, x);
+  tx_cloth_particle(c, i + 1, nb);
+  for (int a = 0; a < 3; a++) assert_float_equal(x[a], up[a], 1e-9);
+  assert_true(nb[1] > 0.0005 && nb[1] < 0.004); // the tent
+  // a fault restores the last good state; the pin holds on
+  double far[3] = {nb[0], nb[1] + 50, nb[2]}, still[3] = {0, 0, 0};
+  assert_true(tx_cloth_poke(c, i + 1, far, still));
+  assert_int_equal(tx_cloth_step(c, 1.0 / 60), TX_CLOTH_FAULT);
+  assert_int_equal(tx_cloth_step(c, 1.0 / 60), TX_CLOTH_OK);
+  tx_cloth_particle(c, i, x);
+  for (int a = 0; a < 3; a++) assert_float_equal(x[a], up[a], 1e-9);
+  assert_true(tx_cloth_unpin(c, i));
+  assert_int_equal(tx_cloth_pinned(c), 0);
+  for (int s = 0; s < 180; s++) tx_cloth_step(c, 1.0 / 60);
+  tx_cloth_particle(c, i, x);
+  assert_true(fabs(x[1] - x0[1]) < 0.0005);
+  assert_true(all_finite(c));
+  tx_cloth_destroy(c);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(counts_match_the_papers),
@@ -637,7 +675,9 @@ int main(void) {
       cmocka_unit_test(implicit_is_stable_when_stiff),
       cmocka_unit_test(untorn_skin_holds_to_3cm),
       cmocka_unit_test(rupture_is_located_between_steps),
+      cmocka_unit_test(pinned_particles_follow),
 #if !SANITIZED // the same code paths as above, but for the links' solve; minutes under the sanitizers
+      cmocka_unit_test_setup_teardown(pinned_particles_follow, use_xpbd, use_implicit),
       cmocka_unit_test_setup_teardown(rupture_opens_a_hole, use_xpbd, use_implicit),
       cmocka_unit_test_setup_teardown(faults_are_recovered, use_xpbd, use_implicit),
       cmocka_unit_test_setup_teardown(restore_brings_links_back, use_xpbd, use_implicit),
