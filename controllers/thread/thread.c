@@ -738,6 +738,15 @@ static void solve_self(tx_thread* t) {
     if (t->pairs[k].d0 < far) solve_self_pair(t, t->pairs[k].i, t->pairs[k].j);
 }
 
+// A contact at fraction t of a link moves its two nodes by g / den of the
+// depth, g = w (1 - t) and w t: the point at t then moves the depth whole.
+// With one node pinned (the head at the swage, a node in the jaws) the other
+// needs a lever of 1 / t, unbounded as the contact nears the pin (a node
+// thrown metres in a step). No node moves more than the depth: near a pin
+// the link only turns part of the way out each pass (the iterations and the
+// next substeps finish it), and a contact right at a pin cannot throw it.
+static double bounded_lever(double g, double den) { return fmin(g / den, 1); }
+
 // every cylinder against every capsule: the thread moves out to r + R
 static void solve_capsules(tx_thread* t) {
   double* x = t->x;
@@ -763,10 +772,10 @@ static void solve_capsules(tx_thread* t) {
       double wi = t->w[i] * (1 - c.t), wi1 = t->w[i + 1] * c.t;
       double den = wi * (1 - c.t) + wi1 * c.t;
       if (den <= 0) continue;
-      double dl = (reach - c.dist) / den;
+      double depth = reach - c.dist, ka = bounded_lever(wi, den), kb = bounded_lever(wi1, den);
       for (int a = 0; a < 3; a++) {
-        x[3 * i + a] += wi * dl * n[a];
-        x[3 * i + 3 + a] += wi1 * dl * n[a];
+        x[3 * i + a] += ka * depth * n[a];
+        x[3 * i + 3 + a] += kb * depth * n[a];
       }
       t->last.shape_hits++;
     }
@@ -859,6 +868,14 @@ static void solve_mesh_node(tx_thread* t, int i) {
   for_triangles_near(t, lo, hi, i, node_triangle);
 }
 
+// the distance from p to the segment ab
+static double point_edge_dist(const double p[3], const double a[3], const double b[3]) {
+  double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, ee = dot3(e, e), u = 0, q[3];
+  if (ee > 0) u = fmin(1, fmax(0, (dot3(p, e) - dot3(a, e)) / ee));
+  for (int k = 0; k < 3; k++) q[k] = a[k] + u * e[k];
+  return dist3(p, q);
+}
+
 // cylinder i against the three edges of a triangle: a cylinder cannot pass
 // across an edge (the skin's border, a fold), so its nodes cannot end up on
 // two sides of the skin without going round it. The side is the one the
@@ -882,13 +899,20 @@ static void edge_contacts(tx_thread* t, int i, const double v[3][3]) {
     } else {
       continue;
     }
+    // a pin inside the edge's reach (the head in the needle's hole, a node
+    // in jaws at the skin): no turn about it clears the link, and the pin
+    // wins; pushing the free end would throw it on every pass
+    if ((t->w[i] == 0) != (t->w[i + 1] == 0) && point_edge_dist(x + 3 * (t->w[i] == 0 ? i : i + 1), va, vb) < reach)
+      continue;
     double ga = wi * (1 - c.t), gb = wj * c.t, den = ga * (1 - c.t) + gb * c.t;
     if (den <= 0) continue;
-    // move A so that it sits reach from the edge along n
+    // move A so that it sits reach from the edge along n, no node by more
+    // than that (bounded_lever)
+    double ka = bounded_lever(ga, den), kb = bounded_lever(gb, den);
     for (int a = 0; a < 3; a++) {
       double delta = n[a] * reach - sep[a];
-      x[3 * i + a] += ga / den * delta;
-      x[3 * i + 3 + a] += gb / den * delta;
+      x[3 * i + a] += ka * delta;
+      x[3 * i + 3 + a] += kb * delta;
     }
     t->last.mesh_hits++;
   }
@@ -1010,6 +1034,11 @@ static void punctures_begin_substep(tx_thread* t) {
     for (int i = c - m; i <= c + 1 + m; i++)
       if (i >= 0 && i < t->n) t->near_punct[i] = 1;
   }
+  // the head rides on the needle's swage, which goes through the hole the
+  // needle made: while a puncture is still to pass, the links at the head go
+  // through the skin with it (held back by it, the head's link was torn apart)
+  if (t->passed < t->npunct)
+    for (int i = 0; i <= m && i < t->n; i++) t->near_punct[i] = 1;
 }
 
 // each passed puncture holds the thread's point at arc[k] on it. In the

@@ -349,6 +349,64 @@ static void test_sweep_around_a_skin_patch(void** state) {
   }
 }
 
+// a link whose head is pinned just past the patch's border, running back
+// under it: the border edge touches the link at t = 0.05 of it. Pushed by the
+// lever 1 / t that makes the contact point move the whole depth, node 1 was
+// thrown metres in the instruments scenario (here 85 mm in a step in the rod,
+// strain 40). Now no contact pass moves a node more than the depth.
+static void test_pinned_link_on_a_skin_edge_is_bounded(void** state) {
+  (void)state;
+  float px[21 * 21 * 3];
+  int32_t tri[2 * 20 * 20 * 3];
+  uint32_t ntri = tx_skin_grid(21, 21, 0.001, 0.001, (double[3]){0, 0, 0}, px, tri);
+  for (int model = 0; model < 2; model++) {
+    tx_thread_def d = tx_thread_def_default();
+    d.model = (tx_thread_model)model;
+    d.nodes = 3;
+    d.length = 0.004; // l0 = 2 mm
+    d.gravity = 0;
+    d.max_triangles = (int)ntri;
+    tx_thread* t = tx_thread_create(&d);
+    assert_non_null(t);
+    double thick = 0.001, reach = d.radius + thick / 2;
+    assert_int_equal(tx_thread_set_mesh(t, px, 21 * 21, tri, ntri, thick), TX_THREAD_OK);
+    double head[3] = {0.0101, -0.0001, 0.0003}, dir[3] = {-0.97, -0.243, 0}, x[9], y[9];
+    double dl = sqrt(dir[0] * dir[0] + dir[1] * dir[1]);
+    for (int i = 0; i < 3; i++)
+      for (int a = 0; a < 3; a++) x[3 * i + a] = head[a] + dir[a] / dl * 0.002 * i;
+    assert_int_equal(tx_thread_set_positions(t, x), TX_THREAD_OK);
+    assert_int_equal(tx_thread_set_head(t, head), TX_THREAD_OK);
+    double worst = 0, strain = 0;
+    for (int k = 0; k < 20; k++) {
+      tx_thread_positions(t, x);
+      assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
+      tx_thread_positions(t, y);
+      for (int i = 0; i < 3; i++) {
+        double m = 0;
+        for (int a = 0; a < 3; a++) m += pow(y[3 * i + a] - x[3 * i + a], 2);
+        m = sqrt(m);
+        if (m > worst) worst = m;
+      }
+      if (tx_thread_max_strain(t) > strain) strain = tx_thread_max_strain(t);
+    }
+    tx_thread_contacts c;
+    tx_thread_last_contacts(t, &c);
+    print_message("%s: pinned link on the border edge: largest node move %.3g mm in a step (reach %.3g mm), "
+                  "max strain %.3g\n", model ? "rod" : "ftl", worst * 1e3, reach * 1e3, strain);
+    // unbounded (before): ftl 7.65 mm, rod 85.1 mm and strain 40.5. The head
+    // lies within the reach of the edge, so no turn clears the link: each
+    // contact pass (a few a substep) moves node 1 at most the depth
+    if (model == TX_THREAD_ROD) {
+      assert_true(worst < 0.01);
+      assert_true(strain < 0.01);
+    } else {
+      assert_true(worst < 1.2 * reach);
+      assert_true(strain < 1e-12);
+    }
+    tx_thread_destroy(t);
+  }
+}
+
 static void test_bad_shapes_and_mesh_refused(void** state) {
   (void)state;
   tx_thread_def d = tx_thread_def_default();
@@ -381,6 +439,7 @@ int main(void) {
       cmocka_unit_test(test_sweep_around_a_capsule_thread),
       cmocka_unit_test(test_sweep_around_its_own_strand),
       cmocka_unit_test(test_sweep_around_a_skin_patch),
+      cmocka_unit_test(test_pinned_link_on_a_skin_edge_is_bounded),
       cmocka_unit_test(test_bad_shapes_and_mesh_refused),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
