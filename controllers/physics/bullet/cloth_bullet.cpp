@@ -831,6 +831,8 @@ static int release_pulling(tx_cloth* c, double h) {
   return freed;
 }
 
+#define KEEP_TOUCH 1.03 // a triangle the HIP touched stays held before the solve out to this over the contact distance
+#define KEEP_STILL 0.01 // ... while the HIP moves less than this over the contact distance in the substep
 #define NEWTON_STOP 0.1 // Newton stops at this gradient over the first step's
 
 // the substep's positions: newton_steps Newton steps from where the contact
@@ -961,8 +963,16 @@ static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& fr
         btVector3 across = nl2 > 0 ? dq - nn * (dq.dot(nn) / nl2) : dq;
         recheck = across.length2() < rcs * rcs;
       }
-      if (near) *held = c->substep_id;
-      if (!near && !recheck) continue;
+      // before the implicit solve, a triangle the HIP touched at the last substep stays held
+      // out to KEEP_TOUCH: skin resting on a HIP that stopped sits just beyond the 1 %, and
+      // solved free its tension carried it up through the sphere, the contact after the
+      // links threw it 2 r + t back and tore what it stretched
+      const btScalar keep_r = rcs * (btScalar)KEEP_TOUCH;
+      const bool still = (h - from).length2() < (btScalar)(KEEP_STILL * KEEP_STILL) * rcs * rcs;
+      const bool keep = !fix_velocity && !near && c->def.solver == TX_CLOTH_IMPLICIT && still &&
+                        *held >= c->substep_id - 1 && dist2 < keep_r * keep_r;
+      if (near || keep) *held = c->substep_id;
+      if (!near && !recheck && !keep) continue;
       btVector3 nt = (p[1]->m_x - p[0]->m_x).cross(p[2]->m_x - p[0]->m_x);
       btScalar ntl = nt.length();
       if (!(ntl > 0)) continue;
@@ -974,6 +984,16 @@ static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& fr
       btVector3 n0 = (p[1]->m_q - p[0]->m_q).cross(p[2]->m_q - p[0]->m_q);
       btScalar side_from = (from - q0).dot(n0.length2() > 0 ? n0 : nt), side_now = (h - q).dot(nt);
       btScalar side = side_from != 0 ? (side_from > 0 ? 1 : -1) : (side_now >= 0 ? 1 : -1);
+      if (keep) { // only held in the solve, and only on its side: nothing to push
+        for (int j = 0; j < 3 && side_now * side > 0; j++) {
+          if (p[j]->m_im <= 0 || !(w[j] > 0)) continue;
+          const size_t pi = (size_t)(p[j] - &nodes[0]);
+          const btVector3 radial = p[j]->m_x - h;
+          c->hold[pi] = 1;
+          for (int a = 0; a < 3; a++) c->hold_n[pi * 3 + a] = radial[a];
+        }
+        continue;
+      }
       if (!near && side_now * side > 0) continue; // held, but on its side and out of reach: let go
       btVector3 dir;
       if (side_now * side > 0 && dist2 > 1e-20f) dir = dq / btSqrt(dist2); // still on its side: away from the centre
