@@ -28,6 +28,13 @@ int tx_setup_fail(tx_setup* s, const char* key, const char* fmt, ...) {
   return -1;
 }
 
+double tx_setup_rate_in(tx_setup* s, double lo, double hi) {
+  double rate = s->in->rate_hz;
+  if (rate >= lo && rate <= hi) return rate;
+  tx_setup_fail(s, NULL, "%s runs at %g to %g Hz, not %g", s->in->cls->type, lo, hi, rate);
+  return 0;
+}
+
 // the value of params.KEY, marked as used; NULL when absent or after an error
 static json_t* param(tx_setup* s, const char* key) {
   if (s->in->failed || !key) return NULL;

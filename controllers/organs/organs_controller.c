@@ -274,10 +274,8 @@ static int configure(tx_setup* s, void** self) {
   organs* g = calloc(1, sizeof *g);
   if (!g) return -1;
   *self = g;
-  double rate = tx_setup_rate(s);
-  if (!(rate >= TX_ORGANS_RATE_MIN_HZ && rate <= TX_ORGANS_RATE_MAX_HZ))
-    return tx_setup_fail(s, NULL, "physics.organs runs at %g to %g Hz, not %g", TX_ORGANS_RATE_MIN_HZ, TX_ORGANS_RATE_MAX_HZ,
-                         rate);
+  double rate = tx_setup_rate_in(s, TX_ORGANS_RATE_MIN_HZ, TX_ORGANS_RATE_MAX_HZ);
+  if (!rate) return -1;
   const char *mode = tx_table_str(s, "mode"), *model = tx_table_str(s, "model"), *assets = tx_table_str(s, "assets"),
              *pose = tx_table_str(s, "pose");
   if (!mode || !model || !assets || !pose) return -1;

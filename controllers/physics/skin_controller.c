@@ -80,10 +80,8 @@ static int configure(tx_setup* s, void** self) {
   skin* k = calloc(1, sizeof *k);
   if (!k) return -1;
   *self = k;
-  double rate = tx_setup_rate(s);
-  if (!(rate >= TX_SKIN_RATE_MIN_HZ && rate <= TX_SKIN_RATE_MAX_HZ))
-    return tx_setup_fail(s, NULL, "physics.skin runs at %g to %g Hz, not %g", TX_SKIN_RATE_MIN_HZ, TX_SKIN_RATE_MAX_HZ,
-                         rate);
+  double rate = tx_setup_rate_in(s, TX_SKIN_RATE_MIN_HZ, TX_SKIN_RATE_MAX_HZ);
+  if (!rate) return -1;
   k->dt = 1.0 / rate;
 
   // the patch, in metres (the papers' centimetres / 100)

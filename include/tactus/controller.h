@@ -131,6 +131,8 @@ const tx_controller_class* tx_find_controller(const char* type);
 // configure: identity
 const char* tx_setup_name(const tx_setup* s); // instance name from the scenario
 double tx_setup_rate(const tx_setup* s);      // Hz
+// the rate when it is in lo..hi Hz; otherwise fails configure ("TYPE runs at LO to HI Hz, not R") and returns 0
+double tx_setup_rate_in(tx_setup* s, double lo, double hi);
 
 // configure: model access. A written component is created with def's schema
 // (def->name may be freed after the call). A read resolves once every
