@@ -35,6 +35,7 @@ typedef struct stab_case {
   double end_strain;  // at the end
   int faults, retries;
   bool finite, stable;
+  double pulled_s;    // the knot: when the force on the head reached 20 N (-1: never)
 } stab_case;
 
 typedef enum kind { HEAD_10MS, TELEPORT, COINCIDENT, ZERO_LENGTH, STIFF, TIME_STEP, KNOT_20N } kind;
@@ -131,6 +132,7 @@ static int run_case(kind k, int model, double dt, stab_case* c) {
   c->finite = true;
   c->retries = 0;
   bool holding = false;
+  c->pulled_s = -1;
   for (int s = 0; s < steps; s++) {
     if (k == HEAD_10MS) head[0] -= 10 * dt;                 // 10 m/s away along -x
     if (k == TELEPORT && s == steps / 2) head[1] += 0.1;    // 10 cm in one step
@@ -142,7 +144,8 @@ static int run_case(kind k, int model, double dt, stab_case* c) {
     double f[3], K[9], raw[3];
     tx_thread_tension(t, TENSION_K, CLAMP_N, f, K);
     tx_thread_head_force(t, raw);
-    if (k == KNOT_20N && model == 1 && sqrt(raw[0] * raw[0] + raw[1] * raw[1] + raw[2] * raw[2]) >= 20) holding = true;
+    if (k == KNOT_20N && model == 1 && !holding && sqrt(raw[0] * raw[0] + raw[1] * raw[1] + raw[2] * raw[2]) >= 20)
+      holding = true, c->pulled_s = (s + 1) * dt;
     c->max_force = fmax(c->max_force, sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]));
     c->max_strain = fmax(c->max_strain, tx_thread_max_strain(t));
     c->finite &= all_finite(t);
@@ -180,6 +183,7 @@ int tx_study_thread_stability(const tx_study_args* a) {
         if (run_case((kind)k, model, k == TIME_STEP ? dts[j] : 1e-3, c)) return 1;
         printf("  %-30s %-5s %8.0e %12.4g %12.4g %12.4g %7d %8d %s\n", c->name, model ? "rod" : "ftl", c->dt, c->max_force,
                c->max_strain, c->end_strain, c->faults, c->retries, c->stable ? "stable" : "UNSTABLE");
+        if (k == KNOT_20N) printf("  %-30s the rod's force on the head reached 20 N at %.3f s (-1: never)\n", "", c->pulled_s);
         all &= c->stable;
         n++;
       }
@@ -201,11 +205,12 @@ int tx_study_thread_stability(const tx_study_args* a) {
     return remove(tmp), fprintf(stderr, "tactus: %s: cannot be written\n", path), 1;
   json_t* list = json_array();
   for (int i = 0; i < n && list; i++)
-    json_array_append_new(list, json_pack("{s:s,s:s,s:f,s:f,s:f,s:f,s:i,s:i,s:b,s:b}", "case", cases[i].name, "model",
+    json_array_append_new(list, json_pack("{s:s,s:s,s:f,s:f,s:f,s:f,s:i,s:i,s:b,s:b,s:f}", "case", cases[i].name, "model",
                                           cases[i].model ? "rod" : "ftl", "time_step_s", cases[i].dt, "max_force_n",
                                           cases[i].max_force, "max_strain", cases[i].max_strain, "end_strain",
                                           cases[i].end_strain, "faults", cases[i].faults, "retries", cases[i].retries,
-                                          "finite", cases[i].finite, "stable", cases[i].stable));
+                                          "finite", cases[i].finite, "stable", cases[i].stable, "pulled_20n_s",
+                                          cases[i].pulled_s));
   json_t* doc = json_pack("{s:s,s:f,s:b,s:o}", "study", "thread-stability", "clamp_n", CLAMP_N, "all_stable", all,
                           "cases", list);
   if (!doc || tx_report_save(doc, a->out_dir, "thread-stability.json")) {

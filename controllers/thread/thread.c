@@ -67,6 +67,15 @@ struct tx_thread {
   double* xb;                // (n x 3) the positions the pairs were listed at
   int axis;                  // the sweep axis; -1: order not sorted yet
   pair* pairs;               // candidate pairs of the substep
+  // the rod's continuous check of a substep (self contacts): the cylinders'
+  // boxes swept from x0 to x, sorted and swept as above, in their own order
+  double* sbox;              // (nseg x 6)
+  double* sb01;              // (nseg x 12) each cylinder's box at x0, then at x
+  double* smove;             // (nseg) the larger of its two nodes' moves, m
+  int32_t* sorder;           // (nseg)
+  double* skey;              // (nseg)
+  int saxis;
+  int sub_hint;              // rod: substeps the last steps needed (the next step starts from it)
   int npairs, pair_cap;
   uint8_t* colliding;        // (nseg)
   tx_thread_capsule* caps;
@@ -227,11 +236,18 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   t->key = malloc(sizeof(double) * nseg);
   t->xb = malloc(sizeof(double) * 3 * n);
   t->axis = -1;
+  t->sbox = malloc(sizeof(double) * 6 * nseg);
+  t->sb01 = malloc(sizeof(double) * 12 * nseg);
+  t->smove = malloc(sizeof(double) * nseg);
+  t->sorder = malloc(sizeof(int32_t) * nseg);
+  t->skey = malloc(sizeof(double) * nseg);
+  t->saxis = -1;
+  t->sub_hint = 1;
   t->pairs = malloc(sizeof(pair) * t->pair_cap);
   t->colliding = calloc((size_t)nseg, 1);
   t->caps = malloc(sizeof(tx_thread_capsule) * (def->max_shapes + 1));
   if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->v0 || !t->w || !t->wf || !t->lam || !t->band || !t->bend || !t->rhs || !t->dir || !t->pinned || !t->severed || !t->punct || !t->arc || !t->near_punct || !t->arc_step || !t->arc_sub || !t->plam || !t->pin || !t->held || !t->hold_from || !t->hold_to || !t->box ||
-      !t->order || !t->order_tmp || !t->key || !t->xb || !t->pairs || !t->colliding || !t->caps)
+      !t->order || !t->order_tmp || !t->key || !t->xb || !t->sbox || !t->sb01 || !t->smove || !t->sorder || !t->skey || !t->pairs || !t->colliding || !t->caps)
     goto oom;
   if (def->max_triangles > 0) {
     if (tx_tri_bvh_init(&t->bvh, (uint32_t)def->max_triangles)) goto oom;
@@ -244,7 +260,7 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   for (int i = 0; i < n; i++)
     for (int a = 0; a < 3; a++) t->x[3 * i + a] = def->head[a] + def->direction[a] / dl * t->l0 * i;
   for (int a = 0; a < 3; a++) t->head_from[a] = t->head_to[a] = def->head[a];
-  for (int i = 0; i < nseg; i++) t->order[i] = i;
+  for (int i = 0; i < nseg; i++) t->order[i] = t->sorder[i] = i;
   t->pinned[0] = 1;
   memcpy(t->pin, t->x, sizeof(double) * 3);
   if (def->pin_tail) {
@@ -291,6 +307,11 @@ void tx_thread_destroy(tx_thread* t) {
   free(t->order_tmp);
   free(t->key);
   free(t->xb);
+  free(t->sbox);
+  free(t->sb01);
+  free(t->smove);
+  free(t->sorder);
+  free(t->skey);
   free(t->pairs);
   free(t->colliding);
   free(t->caps);
@@ -634,12 +655,10 @@ static void solve_self_pair(tx_thread* t, int i, int j) {
 // sorts order by the boxes' low ends on the axis: insertion sort, near
 // linear on the last substep's order; a merge sort (no allocation: its
 // buffer is the thread's) when the axis changed or the order is far off
-static void sort_boxes(tx_thread* t, int axis) {
+static void sort_boxes_in(tx_thread* t, const double* box, int32_t* o, double* key, int* cur, int axis) {
   int n = t->nseg;
-  int32_t* o = t->order;
-  const double* box = t->box;
-  long budget = t->axis == axis ? 8L * n + 64 : 0;
-  t->axis = axis;
+  long budget = *cur == axis ? 8L * n + 64 : 0;
+  *cur = axis;
   for (int p = 1; p < n && budget > 0; p++) {
     int32_t it = o[p];
     double k = box[6 * it + axis];
@@ -665,8 +684,10 @@ static void sort_boxes(tx_thread* t, int axis) {
     }
     if (src != o) memcpy(o, src, sizeof(int32_t) * n);
   }
-  for (int p = 0; p < n; p++) t->key[p] = box[6 * o[p] + axis];
+  for (int p = 0; p < n; p++) key[p] = box[6 * o[p] + axis];
 }
+
+static void sort_boxes(tx_thread* t, int axis) { sort_boxes_in(t, t->box, t->order, t->key, &t->axis, axis); }
 
 // the candidate pairs of the substep: cylinders whose boxes, grown by the
 // contact distance and a margin, overlap (sort and sweep along the axis of
@@ -736,6 +757,91 @@ static void solve_self(tx_thread* t) {
   double far = 2 * t->def.radius + 2 * sqrt(m2);
   for (int k = 0; k < t->npairs; k++)
     if (t->pairs[k].d0 < far) solve_self_pair(t, t->pairs[k].i, t->pairs[k].j);
+}
+
+// min and max written out: fmin and fmax are library calls here (NaN rules)
+static double mn(double a, double b) { return a < b ? a : b; }
+static double mx(double a, double b) { return a < b ? b : a; }
+
+// the distance of two axis-aligned boxes (lo then hi), a lower bound of the
+// distance of anything in one to anything in the other
+static double box_gap(const double* a, const double* b) {
+  double s = 0;
+  for (int k = 0; k < 3; k++) {
+    double g = mx(a[k] - b[k + 3], b[k] - a[k + 3]);
+    if (g > 0) s += g * g;
+  }
+  return sqrt(s);
+}
+
+static void seg_box(const double* p, const double* q, double* b) {
+  for (int a = 0; a < 3; a++) b[a] = mn(p[a], q[a]), b[a + 3] = mx(p[a], q[a]);
+}
+
+// continuous collision (rod): whether the substep, its nodes moving in a
+// straight line from x0 to x, kept every two cylinders' centrelines apart.
+// Along that motion a point of cylinder i less a point of cylinder j moves
+// by an affine function of the two parameters, at most M, the largest of
+// the four node pairs' relative moves; so their distance D(s) >= D0 - s M
+// and >= D1 - (1 - s) M, and min D >= (D0 + D1 - M) / 2. A substep is
+// kept when, for every pair whose swept boxes come within reach, that
+// bound and the end distance D1 are at least half of min(r, D0): two
+// cylinders apart stay r / 2 apart, two already pressed together (a pulled
+// knot) get no more than twice as deep. This bounds the cylinders' motion
+// relative to each other, not every node's own move: a loop swinging fast
+// as a whole takes one substep. Box gaps bound D0 and D1 from below, so most
+// pairs are settled without their closest points.
+static bool self_substep_ok(tx_thread* t) {
+  const double *x = t->x, *y = t->x0;
+  int nseg = t->nseg;
+  double r = t->def.radius, half = 0.5 * r, g = 0.25 * r;
+  double mprev = dist3(x, y);
+  for (int i = 0; i < nseg; i++) {
+    double *b = t->sbox + 6 * i, *b01 = t->sb01 + 12 * i;
+    seg_box(y + 3 * i, y + 3 * i + 3, b01);
+    seg_box(x + 3 * i, x + 3 * i + 3, b01 + 6);
+    for (int a = 0; a < 3; a++) b[a] = mn(b01[a], b01[6 + a]) - g, b[a + 3] = mx(b01[3 + a], b01[9 + a]) + g;
+    double m = dist3(x + 3 * i + 3, y + 3 * i + 3);
+    t->smove[i] = mx(mprev, m);
+    mprev = m;
+  }
+  int axis = t->axis < 0 ? 0 : t->axis;
+  sort_boxes_in(t, t->sbox, t->sorder, t->skey, &t->saxis, axis);
+  int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+  for (int p = 0; p < nseg; p++) {
+    int i = t->sorder[p];
+    if (t->severed[i]) continue;
+    const double* bi = t->sbox + 6 * i;
+    double end = bi[axis + 3];
+    for (int q = p + 1; q < nseg && t->skey[q] <= end; q++) {
+      int j = t->sorder[q];
+      const double* bj = t->sbox + 6 * j;
+      if (bj[a1] > bi[a1 + 3] || bi[a1] > bj[a1 + 3] || bj[a2] > bi[a2 + 3] || bi[a2] > bj[a2 + 3]) continue;
+      int lo = i < j ? i : j, hi = i < j ? j : i;
+      if (hi <= lo + t->skip || t->severed[j]) continue;
+      const double *l01 = t->sb01 + 12 * lo, *h01 = t->sb01 + 12 * hi;
+      double d0 = box_gap(l01, h01), d1 = box_gap(l01 + 6, h01 + 6); // <= D0, D1
+      if (d1 >= half && d0 + d1 - (t->smove[lo] + t->smove[hi]) >= 2 * half) continue; // the thresholds are <= r / 2
+      double m2 = 0; // M: the largest relative move of a node of lo and one of hi
+      for (int u = lo; u <= lo + 1; u++)
+        for (int v = hi; v <= hi + 1; v++) {
+          double e[3];
+          for (int a = 0; a < 3; a++) e[a] = (x[3 * u + a] - y[3 * u + a]) - (x[3 * v + a] - y[3 * v + a]);
+          double s = dot3(e, e);
+          if (s > m2) m2 = s;
+        }
+      double M = sqrt(m2);
+      if (d1 >= half && d0 + d1 - M >= 2 * half) continue;
+      tx_seg_closest c;
+      tx_seg_closest_points(y + 3 * lo, y + 3 * lo + 3, y + 3 * hi, y + 3 * hi + 3, &c);
+      d0 = c.dist;
+      tx_seg_closest_points(x + 3 * lo, x + 3 * lo + 3, x + 3 * hi, x + 3 * hi + 3, &c);
+      d1 = c.dist;
+      double need = 0.5 * fmin(r, d0);
+      if (d1 < need || d0 + d1 - M < 2 * need) return false;
+    }
+  }
+  return true;
 }
 
 // A contact at fraction t of a link moves its two nodes by g / den of the
@@ -1463,7 +1569,12 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
   for (int i = 1; i < n && t->nheld; i++)
     if (t->held[i]) held_move = fmax(held_move, dist3(t->hold_from + 3 * i, t->hold_to + 3 * i));
   if (held_move > move) move = held_move;
-  if (d->model == TX_THREAD_ROD) {
+  // the rod with no shapes and no mesh (self contacts alone) checks each
+  // substep continuously (self_substep_ok) instead of bounding every node's
+  // move: it starts from the substeps the last step needed
+  bool ccd = d->model == TX_THREAD_ROD && t->ncaps == 0 && t->mntri == 0;
+  bool self = d->self_collision && t->nseg > t->skip + 1;
+  if (d->model == TX_THREAD_ROD && !ccd) {
     double vmax2 = 0;
     for (int i = 0; i < n; i++) {
       double s = dot3(t->v + 3 * i, t->v + 3 * i);
@@ -1475,9 +1586,10 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
   double sub = ceil(dt / d->max_substep - 1e-9);
   double need = ceil(move / (0.75 * d->radius));
   if (need > sub) sub = need;
+  if (ccd && t->sub_hint > sub) sub = t->sub_hint;
   if (sub < 1) sub = 1;
   if (sub > d->max_substeps) sub = d->max_substeps;
-  double h = dt / sub, hmin = dt / d->max_substeps, tau = 0;
+  double h = dt / sub, hmin = dt / d->max_substeps, tau = 0, hkept = h;
   int ns = 0;
   // a substep in which a free node moved more than 0.9 r (a kink springing
   // back, a whip) is taken again at half the length, down to dt /
@@ -1503,13 +1615,21 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
     else
       rod_substep(t, h, margin);
     ns++;
-    double far2 = 0;
-    for (int i = 1; i < n; i++) {
-      double e[3] = {t->x[3 * i] - t->x0[3 * i], t->x[3 * i + 1] - t->x0[3 * i + 1], t->x[3 * i + 2] - t->x0[3 * i + 2]};
-      double s = dot3(e, e);
-      if (s > far2 && !t->pinned[i]) far2 = s;
+    bool again = false;
+    if (h > hmin * (1 + 1e-9) && ns < 4 * d->max_substeps) {
+      if (ccd) {
+        again = self && !self_substep_ok(t);
+      } else {
+        double far2 = 0;
+        for (int i = 1; i < n; i++) {
+          double e[3] = {t->x[3 * i] - t->x0[3 * i], t->x[3 * i + 1] - t->x0[3 * i + 1], t->x[3 * i + 2] - t->x0[3 * i + 2]};
+          double s = dot3(e, e);
+          if (s > far2 && !t->pinned[i]) far2 = s;
+        }
+        again = far2 > 0.81 * d->radius * d->radius;
+      }
     }
-    if (far2 > 0.81 * d->radius * d->radius && h > hmin * (1 + 1e-9) && ns < 4 * d->max_substeps) {
+    if (again) {
       memcpy(t->x, t->x0, sizeof(double) * 3 * n);
       memcpy(t->v, t->v0, sizeof(double) * 3 * n);
       t->passed = passed_sub;
@@ -1518,7 +1638,15 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
       t->last.retries++;
       continue;
     }
+    if (h < hkept) hkept = h;
     tau += h;
+  }
+  // the next step starts from the shortest substep this one kept, or one
+  // substep fewer when none was taken again (the motion calming down)
+  if (ccd) {
+    int want = (int)ceil(dt / hkept - 1e-9);
+    t->sub_hint = t->last.retries ? want : (t->sub_hint > 1 ? t->sub_hint - 1 : 1);
+    if (t->sub_hint > d->max_substeps) t->sub_hint = d->max_substeps;
   }
   memcpy(t->head_from, t->head_to, sizeof(double) * 3);
   for (int i = 1; i < n && t->nheld; i++)

@@ -30,12 +30,19 @@
 // contact between cylinders (|AB| < 2 r, segment.h) found through a
 // sort and sweep of their boxes, kinematic capsules and spheres, and a triangle mesh (the skin's
 // SKIN.x / SKIN.tri arrays). A step is split into substeps short enough
-// that the head and, by its last velocity, every node move no more than
-// 3 r / 4 in one; a substep in which a free node still moved more than
-// 0.9 r is taken again at half the length (down to dt / max_substeps). So neither a
-// fast head nor a fast node jumps across a 2 r contact. Against triangles
-// each node's move in a substep is also tested as a segment (continuous),
-// so a node never crosses a triangle whatever its speed.
+// that the head (and a held node) moves no more than 3 r / 4 in one. With
+// capsules or a mesh, and in ftl, every node's move by its last velocity is
+// bounded the same way, and a substep in which a free node still moved more
+// than 0.9 r is taken again at half the length (down to dt / max_substeps).
+// The rod with self contacts alone checks each substep continuously
+// instead: its nodes moving in a straight line over it, no two cylinders'
+// centrelines may come within half of min(r, their starting distance) (a
+// bound from the pairs' relative moves); a substep that fails is taken
+// again at half the length, and the next step starts from the substeps
+// this one needed. So neither a fast head nor a fast node jumps across a
+// contact, while a loop swinging fast as a whole takes one substep. Against
+// triangles each node's move in a substep is also tested as a segment
+// (continuous), so a node never crosses a triangle whatever its speed.
 //
 //     tx_thread_def d = tx_thread_def_default();
 //     d.model = TX_THREAD_ROD;
