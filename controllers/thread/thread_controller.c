@@ -73,6 +73,8 @@ typedef struct thread_ctl {
   tx_thread_capsule* shapes; // (max_shapes) the capsules' rows gathered each step
   uint8_t* marks;
   double* start;      // (N x 3) the first shape
+  tx_port start_shape; // start_shape (id 0: none): the first shape, tx_thread_node rows
+  tx_warning bad_start;
   double tail[3];     // m, tail_m
   bool started;
   tx_warning fault, bad_head, bad_skin, bad_capsule, too_many;
@@ -105,6 +107,7 @@ static const tx_param_def params[] = {
     {"self_friction", TX_PARAM_NUM, "1", 0, 10, 0, NULL, "rod: Coulomb friction coefficient of the thread's contacts with itself"},
     {"slack", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "ftl: a node follows only when pulled (no segment longer than its rest length, some shorter)"},
     {"pin_tail", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "the tail stays where it starts"},
+    {"start_shape", TX_PARAM_STR, NULL, 0, 0, 0, "", "a component of N tx_thread_node rows (e.g. a knot tied beforehand) the thread starts on, at rest; empty: straight from the head towards tail_m"},
     {"tail_m", TX_PARAM_JSON, NULL, 0, 0, 0, NULL, "[x, y, z], m: where the thread starts straight towards from the head; [0.2, 0, 0] by default"},
     {"head", TX_PARAM_STR, NULL, 0, 0, 0, "device0.pose", "the pose the head follows (f64 1 x 7)"},
     {"prefix", TX_PARAM_STR, NULL, 0, 0, 0, "thread", "writes PREFIX.nodes, PREFIX.force_model, PREFIX.events"},
@@ -184,6 +187,8 @@ static int configure(tx_setup* s, void** self) {
   double tail[3];
   if (read_tail(s, tail)) return -1;
   const char* head = tx_table_str(s, "head");
+  const char* start_shape = tx_table_str(s, "start_shape");
+  if (!start_shape) return -1;
   const char* prefix = tx_table_str(s, "prefix");
   const char* skin = tx_table_str(s, "skin");
   if (!head || !prefix || !skin) return -1;
@@ -211,6 +216,8 @@ static int configure(tx_setup* s, void** self) {
   if (k->classify_every > 0 && !(k->work = tx_knot_work_create(d.nodes))) return tx_setup_fail(s, NULL, "out of memory");
   char name[256];
   k->head = TX_READ_OF(s, head, tx_pose);
+  if (*start_shape) k->start_shape = TX_READ_OF(s, start_shape, tx_thread_node);
+  k->bad_start = tx_setup_warning(s, "bad_start_shape");
   snprintf(name, sizeof name, "%s.nodes", prefix);
   k->nodes = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_thread_node, (uint32_t)d.nodes));
   snprintf(name, sizeof name, "%s.force_model", prefix);
@@ -518,6 +525,42 @@ static void take_punctures(tx_ctx* c, thread_ctl* k, tx_snapshot sx) {
   if (tx_thread_set_punctures(k->t, k->punct, n) != TX_THREAD_OK) tx_warn(c, k->bad_puncture);
 }
 
+// the first shape: start_shape's rows when set (waiting for its first
+// publish; a count other than N or a row not finite is counted and the
+// thread starts straight), else straight from the head's first pose towards tail_m
+static void start(tx_ctx* c, thread_ctl* k, const tx_pose* pose) {
+  const tx_thread_def* d = tx_thread_get_def(k->t);
+  int n = d->nodes;
+  if (k->start_shape.id) {
+    tx_snapshot sh = tx_read(c, k->start_shape);
+    if (sh.seq == 0) return;
+    const tx_thread_node* rows = sh.data;
+    bool ok = sh.rows == (uint32_t)n;
+    for (int i = 0; i < n && ok; i++)
+      for (int a = 0; a < 3; a++) {
+        ok &= isfinite(rows[i].x[a]) && fabs(rows[i].x[a]) <= 10;
+        k->start[3 * i + a] = ok ? rows[i].x[a] : 0;
+      }
+    if (ok) {
+      tx_thread_set_positions(k->t, k->start);
+      k->started = true;
+      return;
+    }
+    tx_warn(c, k->bad_start);
+  }
+  double dir[3], l = 0;
+  for (int a = 0; a < 3; a++) {
+    dir[a] = k->tail[a] - pose->pos[a];
+    l += dir[a] * dir[a];
+  }
+  l = sqrt(l);
+  for (int i = 0; i < n; i++)
+    for (int a = 0; a < 3; a++)
+      k->start[3 * i + a] = pose->pos[a] + (l > 0 ? dir[a] / l : a == 0) * d->length * i / (n - 1);
+  tx_thread_set_positions(k->t, k->start);
+  k->started = true;
+}
+
 static void step(tx_ctx* c, void* self) {
   thread_ctl* k = self;
   if (k->cut_in.id) take_cuts(c, k);
@@ -528,21 +571,7 @@ static void step(tx_ctx* c, void* self) {
   if (p.seq > 0) { // nothing published yet: the head waits
     const tx_pose* pose = p.data;
     if (tx_thread_set_head(k->t, pose->pos) != TX_THREAD_OK) tx_warn(c, k->bad_head);
-    if (!k->started) { // the thread starts at the head's first pose, straight towards tail_m
-      const tx_thread_def* d = tx_thread_get_def(k->t);
-      int n = d->nodes;
-      double dir[3], l = 0;
-      for (int a = 0; a < 3; a++) {
-        dir[a] = k->tail[a] - pose->pos[a];
-        l += dir[a] * dir[a];
-      }
-      l = sqrt(l);
-      for (int i = 0; i < n; i++)
-        for (int a = 0; a < 3; a++)
-          k->start[3 * i + a] = pose->pos[a] + (l > 0 ? dir[a] / l : a == 0) * d->length * i / (n - 1);
-      tx_thread_set_positions(k->t, k->start);
-      k->started = true;
-    }
+    if (!k->started) start(c, k, pose);
   }
   if (k->skin_x.id) {
     tx_snapshot sx = tx_read(c, k->skin_x), st = tx_read(c, k->skin_tri), sh = tx_read(c, k->skin_h);

@@ -9,6 +9,7 @@
 #include <cmocka.h>
 
 #include "scenarios/loader.h"
+#include "tests/controllers/thread/knot_shapes.h"
 #include "tests/scenario_support.h"
 
 #include <tactus/components.h>
@@ -554,6 +555,129 @@ static void ftl_held_by_grasping_jaws(void** state) {
   tx_scenario_free(s);
 }
 
+// a test class standing for a thread tied beforehand over a skin patch: it
+// publishes the tight overhand of the reference set as knot.shape
+// (tx_thread_node rows, the thread's start_shape), a still hand on its first
+// node (knot.hand), and a patch (skin.x, skin.tri: two triangles 4 cm wide,
+// skin.thickness 1 mm) lying flat knot_gap below the knot's lowest node. It
+// hears the thread's knot events and reads the nodes when the thread turns
+// into a rod and at the end.
+static shape knot_shape;
+static double knot_gap, knot_ymin;
+static tx_port ks_x, ks_tri, ks_h, ks_hand, ks_shape, ks_events, ks_nodes;
+static int ks_heard[2];                      // knot events heard: found (value[2] 0), fixed (value[2] 1)
+static double ks_fixed_first, ks_fixed_last; // the fixed knot's cylinders
+static double *ks_at_rod, *ks_at_end;        // (n x 3) the nodes when the thread turns into a rod, and at the end
+static int64_t ks_rod_step, ks_end_step;
+static int ks_configure(tx_setup* s, void** self) {
+  *self = NULL;
+  ks_x = tx_setup_write(s, &TX_COMPONENT_OF("skin.x", tx_vertex, 4));
+  ks_tri = tx_setup_write(s, &TX_COMPONENT_OF("skin.tri", tx_triangle, 2));
+  ks_h = tx_setup_write(s, &TX_COMPONENT_OF("skin.thickness", tx_thickness, 1));
+  ks_hand = tx_setup_write(s, &TX_COMPONENT_OF("knot.hand", tx_pose, 1));
+  ks_shape = tx_setup_write(s, &TX_COMPONENT_OF("knot.shape", tx_thread_node, (uint32_t)knot_shape.n));
+  ks_events = tx_setup_listen(s, "thread.events");
+  ks_nodes = TX_READ_OF(s, "thread.nodes", tx_thread_node);
+  return 0;
+}
+static void ks_step(tx_ctx* c, void* self) {
+  (void)self;
+  int64_t k = (int64_t)tx_step_index(c);
+  int n = knot_shape.n;
+  tx_vertex* x = tx_write(c, ks_x);
+  float y = (float)(knot_ymin - knot_gap);
+  x[0] = (tx_vertex){{-0.02f, y, -0.02f}}, x[1] = (tx_vertex){{0.02f, y, -0.02f}};
+  x[2] = (tx_vertex){{0.02f, y, 0.02f}}, x[3] = (tx_vertex){{-0.02f, y, 0.02f}};
+  tx_triangle* tri = tx_write(c, ks_tri);
+  tri[0] = (tx_triangle){{0, 1, 2}}, tri[1] = (tx_triangle){{0, 2, 3}};
+  ((tx_thickness*)tx_write(c, ks_h))->m = 0.001;
+  tx_thread_node* sh = tx_write(c, ks_shape);
+  for (int i = 0; i < n; i++) {
+    memcpy(sh[i].x, knot_shape.x + 3 * i, sizeof sh[i].x);
+    sh[i].radius = SHAPE_RADIUS;
+  }
+  tx_pose* h = tx_write(c, ks_hand);
+  *h = (tx_pose){{knot_shape.x[0], knot_shape.x[1], knot_shape.x[2]}, {1, 0, 0, 0}};
+  for (tx_event e; tx_next_event(c, ks_events, &e);)
+    if (e.kind == TX_EVENT_KNOT) {
+      ks_heard[e.value[2] > 0.5]++;
+      if (e.value[2] > 0.5) ks_fixed_first = e.value[0], ks_fixed_last = e.value[1];
+    }
+  tx_snapshot ns = tx_read(c, ks_nodes);
+  if (ns.rows != (uint32_t)n) return;
+  const tx_thread_node* nd = ns.data;
+  double* dst = k == ks_rod_step ? ks_at_rod : k == ks_end_step ? ks_at_end : NULL;
+  for (int j = 0; dst && j < n; j++) memcpy(dst + 3 * j, nd[j].x, sizeof nd[j].x);
+}
+static const tx_controller_class knot_skin_class = {
+    .type = "test.knot_skin", .summary = "a knot over a skin patch", .configure = ks_configure, .step = ks_step};
+
+// the tight overhand, 1 mm over the skin (ftl, no self contacts: the thread
+// keeps the shape): the papers' rule finds it at its first check and, the
+// knot within fix_distance_m (2 mm) of the skin, fixes it: a knot event
+// with value[2] 1 naming its cylinders. From 20 ms the thread is a rod
+// under gravity: in the next 0.1 s the knot's nodes do not move at all while
+// the rest falls. 1 cm over the skin the knot is found, not fixed, and falls.
+static void knot_near_the_skin_is_fixed(void** state) {
+  (void)state;
+  if (!tx_find_controller(knot_skin_class.type)) assert_int_equal(tx_register_controller(&knot_skin_class), 0);
+  shape set[16];
+  int nset = knot_shapes(set);
+  knot_shape = set[0]; // overhand, tight
+  int n = knot_shape.n;
+  knot_ymin = 1;
+  for (int i = 0; i < n; i++) knot_ymin = fmin(knot_ymin, knot_shape.x[3 * i + 1]);
+  ks_rod_step = 20, ks_end_step = 120;
+  ks_at_rod = calloc(3 * (size_t)n, sizeof(double));
+  ks_at_end = calloc(3 * (size_t)n, sizeof(double));
+  assert_non_null(ks_at_rod);
+  assert_non_null(ks_at_end);
+  for (int near = 1; near >= 0; near--) {
+    knot_gap = near ? 0.001 : 0.01;
+    ks_heard[0] = ks_heard[1] = 0;
+    ks_fixed_first = ks_fixed_last = -1;
+    char text[2048];
+    snprintf(text, sizeof text,
+             "{\"name\":\"t\",\"controllers\":["
+             "{\"name\":\"fixture\",\"type\":\"test.knot_skin\",\"rate_hz\":1000},"
+             "{\"name\":\"thread\",\"type\":\"physics.thread\",\"rate_hz\":1000,\"params\":{\"head\":\"knot.hand\","
+             "\"start_shape\":\"knot.shape\",\"nodes\":%d,\"length_m\":%.17g,\"radius_m\":%.17g,\"skin\":\"skin\","
+             "\"self_collision\":false,\"slack\":true,\"knot_every\":5,\"rod_after_s\":0.02,\"damping\":0}}]}",
+             n, SHAPE_SPACING * (n - 1), SHAPE_RADIUS);
+    tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+    if (!s) fail_msg("%s", tx_error());
+    run(s, (ks_end_step + 2) * 1e-3);
+    int first = (int)ks_fixed_first, lastc = (int)ks_fixed_last;
+    double still = 0, rest = 0;
+    for (int i = 0; i < n; i++) {
+      double d = 0;
+      for (int a = 0; a < 3; a++) d += pow(ks_at_end[3 * i + a] - ks_at_rod[3 * i + a], 2);
+      d = sqrt(d);
+      if (near && i >= first && i <= lastc + 1) still = fmax(still, d);
+      else if (i > 0) rest = fmax(rest, d);
+    }
+    print_message("knot %s the skin: %d found, %d fixed (cylinders %d..%d of %d); in 0.1 s as a rod its nodes moved "
+                  "%.3g mm, the rest up to %.3g mm\n", near ? "1 mm over" : "1 cm over", ks_heard[0], ks_heard[1], first,
+                  lastc, n - 1, still * 1e3, rest * 1e3);
+    assert_int_equal(ks_heard[0], 1);
+    assert_true(result(s, "thread.knots") == 1);
+    if (near) {
+      assert_int_equal(ks_heard[1], 1);
+      assert_true(first >= 0 && lastc >= first + 9); // at least 10 colliding cylinders
+      assert_true(still == 0);                       // immobilised
+    } else {
+      assert_int_equal(ks_heard[1], 0);
+    }
+    assert_true(rest > 1e-3); // the rest falls
+    assert_int_equal(warnings(s, "thread.bad_start_shape"), 0);
+    assert_int_equal(warnings(s, "thread.numerical_fault"), 0);
+    tx_scenario_free(s);
+  }
+  free(ks_at_rod);
+  free(ks_at_end);
+  free_shapes(set, nset);
+}
+
 static void bad_input_is_named(void** state) {
   (void)state;
   struct {
@@ -596,6 +720,7 @@ int main(void) {
       cmocka_unit_test(passes_through_skin_punctures),
       cmocka_unit_test(puncture_survives_renumbering),
       cmocka_unit_test(ftl_held_by_grasping_jaws),
+      cmocka_unit_test(knot_near_the_skin_is_fixed),
       cmocka_unit_test(bad_input_is_named),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
