@@ -19,6 +19,15 @@ typedef struct pair {
   double d0;    // m, their distance when listed
 } pair;
 
+typedef struct thread_mesh {
+  const float* x;            // the caller's arrays
+  const int32_t* tri;
+  uint32_t nx, ntri, max;
+  double thickness;          // m
+  tx_tri_bvh bvh;
+  bool have_bvh;
+} thread_mesh;
+
 struct tx_thread {
   tx_thread_def def;
   int n, nseg, skip;
@@ -80,12 +89,13 @@ struct tx_thread {
   uint8_t* colliding;        // (nseg)
   tx_thread_capsule* caps;
   int ncaps;
-  const float* mx;           // the mesh, the caller's arrays
-  const int32_t* mtri;
-  uint32_t mnx, mntri;
-  double thickness;
-  tx_tri_bvh bvh;
-  bool have_bvh;
+  // triangle meshes: slot 0 the skin (tx_thread_set_mesh), slots 1.. the
+  // rigid meshes (tx_thread_set_rigid_mesh); cur: the one being solved
+  thread_mesh* meshes;       // (1 + max_meshes)
+  int nslots;
+  thread_mesh* cur;
+  uint32_t mntri;            // the skin's triangles (0: no skin)
+  bool any_mesh;             // some slot has triangles
   bool move_first;           // edge contacts may move a cylinder's first node
   double probe;              // m, the nearest triangle found by a query
   tx_thread_contacts last;
@@ -131,6 +141,8 @@ tx_thread_def tx_thread_def_default(void) {
   d.max_stretch = 0.05;
   d.max_shapes = 16;
   d.max_triangles = 0;
+  d.max_meshes = 0;
+  d.max_mesh_triangles = 0;
   d.max_punctures = 16;
   d.puncture_friction = 0;
   d.puncture_capture = 0.001;
@@ -166,6 +178,8 @@ int tx_thread_def_check(const tx_thread_def* d) {
   if (range("max_stretch", d->max_stretch, 0, false, 1, false, "")) return -1;
   if (tx_check_count("thread", "max_shapes", d->max_shapes, 0, 4096)) return -1;
   if (tx_check_count("thread", "max_triangles", d->max_triangles, 0, 10000000)) return -1;
+  if (tx_check_count("thread", "max_meshes", d->max_meshes, 0, TX_THREAD_MAX_MESHES)) return -1;
+  if (tx_check_count("thread", "max_mesh_triangles", d->max_mesh_triangles, 0, 10000000)) return -1;
   if (tx_check_count("thread", "max_punctures", d->max_punctures, 0, 1024)) return -1;
   if (range("puncture_friction", d->puncture_friction, 0, false, 100, false, "N")) return -1;
   if (range("puncture_capture", d->puncture_capture, 0, true, 0.1, false, "m")) return -1;
@@ -249,10 +263,18 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->v0 || !t->w || !t->wf || !t->lam || !t->band || !t->bend || !t->rhs || !t->dir || !t->pinned || !t->severed || !t->punct || !t->arc || !t->near_punct || !t->arc_step || !t->arc_sub || !t->plam || !t->pin || !t->held || !t->hold_from || !t->hold_to || !t->box ||
       !t->order || !t->order_tmp || !t->key || !t->xb || !t->sbox || !t->sb01 || !t->smove || !t->sorder || !t->skey || !t->pairs || !t->colliding || !t->caps)
     goto oom;
-  if (def->max_triangles > 0) {
-    if (tx_tri_bvh_init(&t->bvh, (uint32_t)def->max_triangles)) goto oom;
-    t->have_bvh = true;
+  t->nslots = 1 + def->max_meshes;
+  t->meshes = calloc((size_t)t->nslots, sizeof(thread_mesh));
+  if (!t->meshes) goto oom;
+  for (int k = 0; k < t->nslots; k++) {
+    thread_mesh* m = &t->meshes[k];
+    m->max = (uint32_t)(k == 0 ? def->max_triangles : def->max_mesh_triangles);
+    if (m->max > 0) {
+      if (tx_tri_bvh_init(&m->bvh, m->max)) goto oom;
+      m->have_bvh = true;
+    }
   }
+  t->cur = &t->meshes[0];
   // masses: each segment's mass rho A l0 shared by its two nodes
   double m = def->density * area * t->l0;
   for (int i = 0; i < n; i++) t->wf[i] = (i == 0 || i == n - 1) ? 2 / m : 1 / m;
@@ -315,7 +337,9 @@ void tx_thread_destroy(tx_thread* t) {
   free(t->pairs);
   free(t->colliding);
   free(t->caps);
-  if (t->have_bvh) tx_tri_bvh_free(&t->bvh);
+  for (int k = 0; t->meshes && k < t->nslots; k++)
+    if (t->meshes[k].have_bvh) tx_tri_bvh_free(&t->meshes[k].bvh);
+  free(t->meshes);
   free(t);
 }
 
@@ -563,31 +587,54 @@ int tx_thread_punctures_passed(const tx_thread* t) { return t->passed; }
 int tx_thread_punctures_slid(const tx_thread* t) { return t->slid; }
 double tx_thread_puncture_arc(const tx_thread* t, int k) { return k >= 0 && k < t->passed ? t->arc[k] : -1; }
 
-tx_thread_status tx_thread_set_mesh(tx_thread* t, const float* x, uint32_t nx, const int32_t* tri, uint32_t ntri,
-                                    double thickness) {
+static void note_meshes(tx_thread* t) {
+  t->mntri = t->meshes[0].ntri;
+  t->any_mesh = false;
+  for (int k = 0; k < t->nslots; k++) t->any_mesh |= t->meshes[k].ntri > 0;
+}
+
+static tx_thread_status set_slot(tx_thread* t, thread_mesh* m, const char* room, const float* x, uint32_t nx,
+                                 const int32_t* tri, uint32_t ntri, double thickness) {
   if (ntri == 0) {
-    t->mntri = 0;
+    m->ntri = 0;
+    note_meshes(t);
     return TX_THREAD_OK;
   }
-  if (!t->have_bvh || ntri > (uint32_t)t->def.max_triangles) {
-    tx_set_error("thread: %u mesh triangles, more than max_triangles = %d", ntri, t->def.max_triangles);
+  if (!m->have_bvh || ntri > m->max) {
+    tx_set_error("thread: %u mesh triangles, more than %s = %u", ntri, room, m->max);
     return TX_THREAD_BAD;
   }
   if (range("thickness", thickness, 0, false, 0.02, false, "m")) return TX_THREAD_BAD;
-  bool same = t->mntri == ntri && t->mnx == nx && tx_tri_bvh_same(&t->bvh, tri, ntri);
+  bool same = m->ntri == ntri && m->nx == nx && tx_tri_bvh_same(&m->bvh, tri, ntri);
   if (same) {
-    tx_tri_bvh_refit(&t->bvh, x);
-  } else if (tx_tri_bvh_build(&t->bvh, x, nx, tri, ntri)) {
+    tx_tri_bvh_refit(&m->bvh, x);
+  } else if (tx_tri_bvh_build(&m->bvh, x, nx, tri, ntri)) {
     tx_set_error("thread: mesh triangle index outside [0, %u)", nx);
-    t->mntri = 0;
+    m->ntri = 0;
+    note_meshes(t);
     return TX_THREAD_BAD;
   }
-  t->mx = x;
-  t->mtri = tri;
-  t->mnx = nx;
-  t->mntri = ntri;
-  t->thickness = thickness;
+  m->x = x;
+  m->tri = tri;
+  m->nx = nx;
+  m->ntri = ntri;
+  m->thickness = thickness;
+  note_meshes(t);
   return TX_THREAD_OK;
+}
+
+tx_thread_status tx_thread_set_mesh(tx_thread* t, const float* x, uint32_t nx, const int32_t* tri, uint32_t ntri,
+                                    double thickness) {
+  return set_slot(t, &t->meshes[0], "max_triangles", x, nx, tri, ntri, thickness);
+}
+
+tx_thread_status tx_thread_set_rigid_mesh(tx_thread* t, int k, const float* x, uint32_t nx, const int32_t* tri,
+                                          uint32_t ntri) {
+  if (k < 0 || k >= t->def.max_meshes) {
+    tx_set_error("thread: rigid mesh %d, must be in [0, max_meshes = %d)", k, t->def.max_meshes);
+    return TX_THREAD_BAD;
+  }
+  return set_slot(t, &t->meshes[1 + k], "max_mesh_triangles", x, nx, tri, ntri, 0);
 }
 
 // ---------------------------------------------------------------------------
@@ -892,7 +939,7 @@ static void solve_capsules(tx_thread* t) {
 typedef void (*tri_fn)(tx_thread* t, int i, const double v[3][3]);
 
 static void for_triangles_near(tx_thread* t, const float lo[3], const float hi[3], int i, tri_fn fn) {
-  const tx_tri_bvh* b = &t->bvh;
+  const tx_tri_bvh* b = &t->cur->bvh;
   if (b->nnodes == 0) return;
   uint32_t stack[BVH_STACK];
   int top = 0;
@@ -914,7 +961,7 @@ static void for_triangles_near(tx_thread* t, const float lo[3], const float hi[3
       const int32_t* tv = b->tri + 3 * sl;
       double v[3][3];
       for (int c = 0; c < 3; c++)
-        for (int a = 0; a < 3; a++) v[c][a] = t->mx[3 * tv[c] + a];
+        for (int a = 0; a < 3; a++) v[c][a] = t->cur->x[3 * tv[c] + a];
       fn(t, i, v);
     }
   }
@@ -926,7 +973,7 @@ static void for_triangles_near(tx_thread* t, const float lo[3], const float hi[3
 static void node_triangle(tx_thread* t, int i, const double v[3][3]) {
   double* p = t->x + 3 * i;
   const double* p0 = t->x0 + 3 * i;
-  double reach = t->def.radius + 0.5 * t->thickness;
+  double reach = t->def.radius + 0.5 * t->cur->thickness;
   double e1[3], e2[3], nrm[3];
   for (int a = 0; a < 3; a++) {
     e1[a] = v[1][a] - v[0][a];
@@ -965,7 +1012,7 @@ static void node_triangle(tx_thread* t, int i, const double v[3][3]) {
 static void solve_mesh_node(tx_thread* t, int i) {
   const double* p = t->x + 3 * i;
   const double* p0 = t->x0 + 3 * i;
-  double reach = t->def.radius + 0.5 * t->thickness;
+  double reach = t->def.radius + 0.5 * t->cur->thickness;
   float lo[3], hi[3];
   for (int a = 0; a < 3; a++) {
     lo[a] = (float)(fmin(p[a], p0[a]) - reach) - 1e-6f;
@@ -987,7 +1034,7 @@ static double point_edge_dist(const double p[3], const double a[3], const double
 // two sides of the skin without going round it. The side is the one the
 // cylinder was on at the start of the substep.
 static void edge_contacts(tx_thread* t, int i, const double v[3][3]) {
-  double reach = t->def.radius + 0.5 * t->thickness;
+  double reach = t->def.radius + 0.5 * t->cur->thickness;
   double* x = t->x;
   double wi = t->move_first ? t->w[i] : 0, wj = t->w[i + 1];
   for (int e = 0; e < 3; e++) {
@@ -1025,7 +1072,7 @@ static void edge_contacts(tx_thread* t, int i, const double v[3][3]) {
 }
 
 static void solve_mesh_edges(tx_thread* t, int i) {
-  double reach = t->def.radius + 0.5 * t->thickness;
+  double reach = t->def.radius + 0.5 * t->cur->thickness;
   float lo[3], hi[3];
   const double *p = t->x + 3 * i, *p0 = t->x0 + 3 * i;
   for (int a = 0; a < 3; a++) {
@@ -1050,6 +1097,7 @@ int tx_thread_fix_near_mesh(tx_thread* t, int first, int last, double limit) {
   }
   if (range("fix limit", limit, 0, false, 1, false, "m")) return -1;
   if (t->mntri == 0) return 0;
+  t->cur = &t->meshes[0]; // the skin
   t->probe = INFINITY;
   for (int i = first; i <= last + 1; i++) {
     float lo[3], hi[3];
@@ -1073,14 +1121,19 @@ int tx_thread_fix_near_mesh(tx_thread* t, int first, int last, double limit) {
 }
 
 // the thread passes through the skin at a puncture: the nodes near one
-// (near_punct) have no skin contact
+// (near_punct) have no skin contact; the rigid meshes have no puncture
 static void solve_mesh(tx_thread* t) {
-  if (t->mntri == 0) return;
-  t->move_first = true;
-  for (int i = 0; i < t->nseg; i++)
-    if (!t->severed[i] && !t->near_punct[i] && !t->near_punct[i + 1]) solve_mesh_edges(t, i);
-  for (int i = 0; i < t->n; i++)
-    if (!t->pinned[i] && !t->near_punct[i]) solve_mesh_node(t, i);
+  if (!t->any_mesh) return;
+  for (int k = 0; k < t->nslots; k++) {
+    t->cur = &t->meshes[k];
+    if (t->cur->ntri == 0) continue;
+    const uint8_t* skip = k == 0 ? t->near_punct : NULL;
+    t->move_first = true;
+    for (int i = 0; i < t->nseg; i++)
+      if (!t->severed[i] && !(skip && (skip[i] || skip[i + 1]))) solve_mesh_edges(t, i);
+    for (int i = 0; i < t->n; i++)
+      if (!t->pinned[i] && !(skip && skip[i])) solve_mesh_node(t, i);
+  }
 }
 
 // ---------------------------------------------------------------------------
@@ -1134,7 +1187,7 @@ static void punctures_begin_substep(tx_thread* t) {
   }
   if (t->mntri == 0) return;
   memset(t->near_punct, 0, (size_t)t->n);
-  int m = (int)ceil((t->thickness + 2 * t->def.radius) / t->l0) + 1;
+  int m = (int)ceil((t->meshes[0].thickness + 2 * t->def.radius) / t->l0) + 1;
   for (int k = 0; k < t->passed; k++) {
     int c = (int)floor(t->arc[k] / t->l0);
     for (int i = c - m; i <= c + 1 + m; i++)
@@ -1274,7 +1327,9 @@ static void ftl_forward(tx_thread* t) {
     } else {
       follow(t, i, i - 1);
     }
-    if (t->mntri && !t->near_punct[i] && !t->near_punct[i - 1]) {
+    for (int m = 0; m < t->nslots && t->any_mesh; m++) {
+      t->cur = &t->meshes[m];
+      if (t->cur->ntri == 0 || (m == 0 && (t->near_punct[i] || t->near_punct[i - 1]))) continue;
       t->move_first = false; // the leader is placed: only this node moves
       solve_mesh_edges(t, i - 1);
       solve_mesh_node(t, i);
@@ -1307,7 +1362,7 @@ static void ftl_substep(tx_thread* t, double h, double margin) {
     }
   }
   // the kinematic thread follows around shapes: push out, follow again
-  for (int it = 0; it < 2 && (t->ncaps || t->mntri); it++) {
+  for (int it = 0; it < 2 && (t->ncaps || t->any_mesh); it++) {
     solve_capsules(t);
     solve_mesh(t);
     ftl_solve(t);
@@ -1572,7 +1627,7 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
   // the rod with no shapes and no mesh (self contacts alone) checks each
   // substep continuously (self_substep_ok) instead of bounding every node's
   // move: it starts from the substeps the last step needed
-  bool ccd = d->model == TX_THREAD_ROD && t->ncaps == 0 && t->mntri == 0;
+  bool ccd = d->model == TX_THREAD_ROD && t->ncaps == 0 && !t->any_mesh;
   bool self = d->self_collision && t->nseg > t->skip + 1;
   if (d->model == TX_THREAD_ROD && !ccd) {
     double vmax2 = 0;

@@ -60,6 +60,8 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#define TX_THREAD_MAX_MESHES 8 // rigid meshes at most
+
 typedef enum tx_thread_model {
   TX_THREAD_FTL = 0, // follow-the-leader, kinematic
   TX_THREAD_ROD = 1, // XPBD rod
@@ -88,6 +90,8 @@ typedef struct tx_thread_def {
   double max_stretch;    // the stretch cap: (l - l0) / l0 of a segment, in [0, 1]; 0.05
   int max_shapes;        // room for capsules and spheres, in [0, 4096]; 16
   int max_triangles;     // room for mesh triangles, in [0, 10000000]; 0: no mesh
+  int max_meshes;        // rigid meshes (tx_thread_set_rigid_mesh), in [0, TX_THREAD_MAX_MESHES]; 0
+  int max_mesh_triangles; // room for each rigid mesh's triangles, in [0, 10000000]; 0
   int max_punctures;     // room for puncture points, in [0, 1024]; 16
   double puncture_friction; // N, in [0, 100]: the force along the thread a puncture holds it with
                             // before it slides (and drags with while sliding); 0
@@ -160,6 +164,15 @@ tx_thread_status tx_thread_set_capsules(tx_thread* t, const tx_thread_capsule* c
 // (m, in [0, 0.02]): the surface's collision thickness. ntri = 0 removes it.
 tx_thread_status tx_thread_set_mesh(tx_thread* t, const float* x, uint32_t nx, const int32_t* tri, uint32_t ntri,
                                     double thickness);
+
+// rigid mesh k (k in [0, max_meshes)) for the next steps: x (nx x 3) and
+// tri (ntri x 3) as tx_vertex and tx_triangle rows (an instrument's or an
+// organ's surface, kinematic: it moves between steps), read during
+// tx_thread_step as the skin's. The thread keeps r off its triangles, with
+// the skin's contacts (continuous for the nodes, the edges kept on their
+// side) and no thickness; no puncture and no knot fixing. ntri = 0 removes it.
+tx_thread_status tx_thread_set_rigid_mesh(tx_thread* t, int k, const float* x, uint32_t nx, const int32_t* tri,
+                                          uint32_t ntri);
 
 // cutting: severs link seg (node seg to seg + 1, in [0, N - 2]). The piece
 // that holds the head stays on it; the piece behind the cut has a free end

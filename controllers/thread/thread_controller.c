@@ -5,8 +5,9 @@
 // and on PREFIX.events a TX_EVENT_KNOT when the papers' rule finds a knot
 // (value[0..1]: its first and last cylinder, value[2]: 0) and when a knot
 // within fix_distance_m of the skin is fixed (value[2]: 1). With skin set,
-// the thread collides with SKIN.x / SKIN.tri, and with the rigid capsules
-// (tx_capsule rows) of the components listed in capsules. With cut_events
+// the thread collides with SKIN.x / SKIN.tri, with the rigid meshes
+// (MESH.x / MESH.tri) of the prefixes listed in meshes, and with the rigid
+// capsules (tx_capsule rows) of the components listed in capsules. With cut_events
 // it takes the TX_EVENT_CUT events of that stream: the link they name (or the
 // one nearest their point) is severed, PREFIX.cut_links marks it and the pieces,
 // and the cut is sent again on PREFIX.events. With punctures (tx_puncture
@@ -50,6 +51,9 @@ typedef struct thread_ctl {
   bool draw;
   tx_port segments, spheres; // with draw: the thread as a tube for the graphics view
   tx_port caps[8];
+  int nmeshes;
+  tx_port mesh_x[TX_THREAD_MAX_MESHES], mesh_tri[TX_THREAD_MAX_MESHES]; // the rigid meshes' MESH.x, MESH.tri
+  tx_warning bad_mesh;
   tx_port cut_in, links;     // the cut events listened to (cut_in.id 0: none); PREFIX.cut_links
   tx_port grasp_in;          // the grasp events (grasp_in.id 0: none)
   bool grasp_shared;         // grasp_in is cut_in: one stream for both
@@ -113,6 +117,8 @@ static const tx_param_def params[] = {
     {"prefix", TX_PARAM_STR, NULL, 0, 0, 0, "thread", "writes PREFIX.nodes, PREFIX.force_model, PREFIX.events"},
     {"skin", TX_PARAM_STR, NULL, 0, 0, 0, "", "a skin's prefix (skin): collide with SKIN.x and SKIN.tri; empty: none"},
     {"capsules", TX_PARAM_STRS, NULL, 0, 8, 0, NULL, "components of rigid capsules (tx_capsule rows: instrument jaws, the needle) the thread keeps out of"},
+    {"meshes", TX_PARAM_STRS, NULL, 0, TX_THREAD_MAX_MESHES, 0, NULL, "prefixes of rigid triangle meshes (MESH.x tx_vertex, MESH.tri tx_triangle rows: an organ, an instrument's surface) the thread keeps r off"},
+    {"max_mesh_triangles", TX_PARAM_INT, "1", 1, 10000000, 20000, NULL, "room for each rigid mesh's triangles"},
     {"max_shapes", TX_PARAM_INT, "1", 0, 4096, 16, NULL, "room for the capsules' rows, all together"},
     {"max_triangles", TX_PARAM_INT, "1", 1, 10000000, 200000, NULL, "room for the skin's triangles"},
     {"tension_n_per_m", TX_PARAM_NUM, "N/m", 0, 1e6, 200, NULL, "ftl: force (length - rest length) x this, along the segments' sum"},
@@ -195,6 +201,10 @@ static int configure(tx_setup* s, void** self) {
   if (!*prefix) return tx_setup_fail(s, "prefix", "must not be empty");
   bool with_skin = *skin != 0;
   d.max_triangles = with_skin ? (int)tx_table_int(s, "max_triangles") : 0;
+  const char* meshes[TX_THREAD_MAX_MESHES];
+  k->nmeshes = tx_table_strs(s, "meshes", meshes, TX_THREAD_MAX_MESHES);
+  d.max_meshes = k->nmeshes;
+  d.max_mesh_triangles = k->nmeshes ? (int)tx_table_int(s, "max_mesh_triangles") : 0;
   // until the head's first pose the thread lies from the origin towards
   // tail_m; then it starts again straight from the head towards tail_m
   for (int a = 0; a < 3; a++) d.direction[a] = tail[a];
@@ -276,6 +286,14 @@ static int configure(tx_setup* s, void** self) {
     snprintf(name, sizeof name, "%s.thickness", skin);
     k->skin_h = TX_READ_OF(s, name, tx_thickness);
   }
+  for (int i = 0; i < k->nmeshes; i++) {
+    if (!*meshes[i]) return tx_setup_fail(s, "meshes", "entry %d is empty: expected a mesh's prefix", i);
+    snprintf(name, sizeof name, "%s.x", meshes[i]);
+    k->mesh_x[i] = TX_READ_OF(s, name, tx_vertex);
+    snprintf(name, sizeof name, "%s.tri", meshes[i]);
+    k->mesh_tri[i] = TX_READ_OF(s, name, tx_triangle);
+  }
+  k->bad_mesh = tx_setup_warning(s, "bad_mesh");
   const char* caps[8];
   k->ncaps = tx_table_strs(s, "capsules", caps, 8);
   for (int i = 0; i < k->ncaps; i++) k->caps[i] = TX_READ_OF(s, caps[i], tx_capsule);
@@ -579,6 +597,11 @@ static void step(tx_ctx* c, void* self) {
         tx_thread_set_mesh(k->t, sx.data, sx.rows, st.data, st.rows, ((const tx_thickness*)sh.data)->m) != TX_THREAD_OK)
       tx_warn(c, k->bad_skin);
     if (k->punct_in.id && sx.seq > 0 && st.seq > 0) take_punctures(c, k, sx);
+  }
+  for (int i = 0; i < k->nmeshes; i++) { // kinematic: as published this step (refitted when only moved)
+    tx_snapshot mx = tx_read(c, k->mesh_x[i]), mt = tx_read(c, k->mesh_tri[i]);
+    if (mx.seq > 0 && mt.seq > 0 && tx_thread_set_rigid_mesh(k->t, i, mx.data, mx.rows, mt.data, mt.rows) != TX_THREAD_OK)
+      tx_warn(c, k->bad_mesh);
   }
   if (k->ncaps) { // every capsule row, as far as there is room
     int m = 0, max = tx_thread_get_def(k->t)->max_shapes;

@@ -457,6 +457,91 @@ static void test_rod_falling_onto_its_own_strand(void** state) {
   tx_thread_destroy(t);
 }
 
+// a box's surface, 8 corners and 12 triangles (outward by the right-hand rule)
+static void box_mesh(const double lo[3], const double hi[3], float x[24], int32_t tri[36]) {
+  for (int c = 0; c < 8; c++)
+    for (int a = 0; a < 3; a++) x[3 * c + a] = (float)((c >> a & 1) ? hi[a] : lo[a]);
+  static const int32_t f[36] = {0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4,
+                                2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5};
+  memcpy(tri, f, sizeof f);
+}
+
+// node p's distance from the box, negative inside it (its depth)
+static double box_clearance(const double* p, const double lo[3], const double hi[3]) {
+  double out = 0, depth = INFINITY;
+  for (int a = 0; a < 3; a++) {
+    double g = fmax(lo[a] - p[a], p[a] - hi[a]);
+    if (g > 0) out += g * g;
+    depth = fmin(depth, -g);
+  }
+  return out > 0 ? sqrt(out) : -depth;
+}
+
+// the rod falls across a rigid box (a closed triangle mesh given as a rigid
+// mesh, not the skin): it drapes over it, every node at least r off the box,
+// the part beyond hangs down its side;
+// without the mesh it falls through
+static void test_rod_drapes_over_a_rigid_mesh(void** state) {
+  (void)state;
+  const double lo[3] = {-0.004, -0.004, -0.01}, hi[3] = {0.004, 0, 0.01};
+  float bx[24];
+  int32_t bt[36];
+  box_mesh(lo, hi, bx, bt);
+  for (int listed = 1; listed >= 0; listed--) {
+    tx_thread_def d = tx_thread_def_default();
+    d.model = TX_THREAD_ROD;
+    d.nodes = 41;
+    d.length = 0.04;
+    d.head[0] = -0.02, d.head[1] = 0.002;
+    d.youngs_modulus = 2e5;
+    d.damping = 5;
+    d.max_meshes = 2;
+    d.max_mesh_triangles = 12;
+    tx_thread* t = tx_thread_create(&d);
+    assert_non_null(t);
+    if (listed) assert_int_equal(tx_thread_set_rigid_mesh(t, 1, bx, 8, bt, 12), TX_THREAD_OK);
+    double nearest = INFINITY;
+    int hits = 0;
+    for (int k = 0; k < 500; k++) {
+      assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
+      tx_thread_contacts c;
+      tx_thread_last_contacts(t, &c);
+      hits += c.mesh_hits;
+      for (int i = 0; i < 41; i++) nearest = fmin(nearest, box_clearance(tx_thread_position(t, i), lo, hi));
+    }
+    print_message("rigid box %s: %d contacts, nearest node %.3g mm from it (r = 0.25 mm); node 20 at y %.2f mm, "
+                  "node 40 at y %.2f mm\n", listed ? "listed" : "not listed", hits, nearest * 1e3,
+                  tx_thread_position(t, 20)[1] * 1e3, tx_thread_position(t, 40)[1] * 1e3);
+    if (listed) {
+      assert_true(hits > 0);
+      assert_true(nearest >= 0.99 * d.radius);
+      assert_true(tx_thread_position(t, 20)[1] > 0);      // on the top face
+      assert_true(tx_thread_position(t, 40)[1] < -0.002); // down its far side
+    } else {
+      assert_int_equal(hits, 0);
+      assert_true(nearest < -0.001); // through it
+    }
+    tx_thread_destroy(t);
+  }
+  // slots and room
+  tx_thread_def d = tx_thread_def_default();
+  d.max_meshes = 1;
+  d.max_mesh_triangles = 11;
+  tx_thread* t = tx_thread_create(&d);
+  assert_non_null(t);
+  assert_int_equal(tx_thread_set_rigid_mesh(t, 1, bx, 8, bt, 12), TX_THREAD_BAD);
+  assert_non_null(strstr(tx_error(), "max_meshes"));
+  assert_int_equal(tx_thread_set_rigid_mesh(t, 0, bx, 8, bt, 12), TX_THREAD_BAD);
+  assert_non_null(strstr(tx_error(), "max_mesh_triangles"));
+  assert_int_equal(tx_thread_set_rigid_mesh(t, 0, bx, 7, bt, 11), TX_THREAD_BAD); // corner 7 is no vertex
+  assert_int_equal(tx_thread_set_rigid_mesh(t, 0, bx, 8, bt, 11), TX_THREAD_OK);
+  assert_int_equal(tx_thread_set_rigid_mesh(t, 0, bx, 8, bt, 0), TX_THREAD_OK);
+  tx_thread_destroy(t);
+  d.max_meshes = TX_THREAD_MAX_MESHES + 1;
+  assert_null(tx_thread_create(&d));
+  assert_non_null(strstr(tx_error(), "max_meshes"));
+}
+
 static void test_bad_shapes_and_mesh_refused(void** state) {
   (void)state;
   tx_thread_def d = tx_thread_def_default();
@@ -491,6 +576,7 @@ int main(void) {
       cmocka_unit_test(test_sweep_around_a_skin_patch),
       cmocka_unit_test(test_pinned_link_on_a_skin_edge_is_bounded),
       cmocka_unit_test(test_rod_falling_onto_its_own_strand),
+      cmocka_unit_test(test_rod_drapes_over_a_rigid_mesh),
       cmocka_unit_test(test_bad_shapes_and_mesh_refused),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -195,6 +195,76 @@ static void rod_keeps_out_of_a_capsule(void** state) {
   }
 }
 
+// a test class that writes a rigid box's surface as block.x (8 tx_vertex
+// rows) and block.tri (12 tx_triangle rows): x in [-4, -2] cm, y in
+// [-1, 0] cm, z in [-1, 1] cm, under the still device (at (-3, 1, 0) cm, a
+// limp thread lying from it along +x)
+static const double block_lo[3] = {-0.04, -0.01, -0.01}, block_hi[3] = {-0.02, 0, 0.01};
+static tx_port block_x, block_tri;
+static int block_configure(tx_setup* s, void** self) {
+  *self = NULL;
+  block_x = tx_setup_write(s, &TX_COMPONENT_OF("block.x", tx_vertex, 8));
+  block_tri = tx_setup_write(s, &TX_COMPONENT_OF("block.tri", tx_triangle, 12));
+  return 0;
+}
+static void block_step(tx_ctx* c, void* self) {
+  (void)self;
+  tx_vertex* x = tx_write(c, block_x);
+  for (int k = 0; k < 8; k++)
+    for (int a = 0; a < 3; a++) x[k].x[a] = (float)((k >> a & 1) ? block_hi[a] : block_lo[a]);
+  static const int32_t f[36] = {0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4,
+                                2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5};
+  tx_triangle* t = tx_write(c, block_tri);
+  for (int k = 0; k < 12; k++)
+    for (int v = 0; v < 3; v++) t[k].v[v] = f[3 * k + v];
+}
+static const tx_controller_class block_class = {
+    .type = "test.block", .summary = "a rigid box mesh", .configure = block_configure, .step = block_step};
+
+// the limp rod falls from the device onto the box: with the box listed in
+// meshes it lies on its top face and hangs down its side, no node nearer
+// the box than r; without, it falls through
+static void rod_keeps_off_a_rigid_mesh(void** state) {
+  (void)state;
+  if (!tx_find_controller(block_class.type)) assert_int_equal(tx_register_controller(&block_class), 0);
+  for (int listed = 1; listed >= 0; listed--) {
+    char text[1024];
+    snprintf(text, sizeof text,
+             "{\"name\":\"t\",\"controllers\":["
+             "{\"name\":\"block\",\"type\":\"test.block\",\"rate_hz\":1000},"
+             "{\"name\":\"thread\",\"type\":\"physics.thread\",\"rate_hz\":1000,\"params\":{\"model\":\"rod\","
+             "\"nodes\":21,\"length_m\":0.02,\"tail_m\":[0.1,0.01,0],\"bend_factor\":0,\"damping\":10%s}},"
+             "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:slide-x-over\"}}]}",
+             listed ? ",\"meshes\":[\"block\"]" : "");
+    tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+    if (!s) fail_msg("%s", tx_error());
+    run(s, 0.45);
+    const tx_thread_node* n = latest_snapshot(s, "thread.nodes").data;
+    double nearest = INFINITY;
+    int resting = 0; // nodes lying on the top face
+    for (int i = 0; i < 21; i++) {
+      double out = 0, depth = INFINITY;
+      for (int a = 0; a < 3; a++) {
+        double g = fmax(block_lo[a] - n[i].x[a], n[i].x[a] - block_hi[a]);
+        if (g > 0) out += g * g;
+        depth = fmin(depth, -g);
+      }
+      nearest = fmin(nearest, out > 0 ? sqrt(out) : -depth);
+      resting += i > 0 && n[i].x[0] > block_lo[0] && n[i].x[0] < block_hi[0] && n[i].x[1] > block_hi[1] && n[i].x[1] < block_hi[1] + 0.00075;
+    }
+    print_message("rigid mesh %s: the nearest node %.3f mm from the box (r = 0.25 mm), %d nodes on its top face\n",
+                  listed ? "listed" : "not listed", nearest * 1e3, resting);
+    if (listed) {
+      assert_true(nearest >= 0.99 * 0.00025);
+      assert_true(resting > 0);
+      assert_int_equal(warnings(s, "thread.bad_mesh"), 0);
+    } else {
+      assert_true(nearest < 0); // through it
+    }
+    tx_scenario_free(s);
+  }
+}
+
 // a test class that sends TX_EVENT_CUT events on tool.events at set steps,
 // and one that listens to thread.events and keeps the cuts it sees
 typedef struct cut_plan {
@@ -694,6 +764,8 @@ static void bad_input_is_named(void** state) {
       {"\"prefix\":\"\"", "params.prefix"},
       {"\"head\":\"nobody.pose\"", "nobody.pose"},
       {"\"capsules\":[\"nobody.capsules\"]", "nobody.capsules"},
+      {"\"meshes\":[\"nobody\"]", "nobody.x"},
+      {"\"meshes\":[\"\"]", "params.meshes"},
       {"\"cut_events\":\"nobody.events\"", "nobody.events"},
       {"\"cut_events\":5", "cut_events"},
       {"\"grasp_events\":\"nobody.events\"", "instrument0.pose"}, // no jaws' frame
@@ -715,6 +787,7 @@ int main(void) {
       cmocka_unit_test(tension_of_a_thread_pulled_past_its_pin),
       cmocka_unit_test(rod_force_on_the_head),
       cmocka_unit_test(rod_keeps_out_of_a_capsule),
+      cmocka_unit_test(rod_keeps_off_a_rigid_mesh),
       cmocka_unit_test(ftl_cut_by_events),
       cmocka_unit_test(rod_cut_by_an_event),
       cmocka_unit_test(passes_through_skin_punctures),
