@@ -261,7 +261,8 @@ static int configure(tx_setup* s, void** self) {
   if (!punctures) return -1;
   if (*punctures) {
     if (!with_skin) return tx_setup_fail(s, "punctures", "'%s' needs skin: its rows are points on SKIN.x's triangles", punctures);
-    k->punct_in = TX_READ_OF(s, punctures, tx_puncture);
+    // the layout and its units: a list of poses (f64 x 7 too) is refused at load
+    k->punct_in = TX_READ_EXPECT(s, punctures, tx_puncture);
   }
   k->max_punct = d.max_punctures;
   k->punct = malloc(sizeof(double) * 3 * (size_t)(d.max_punctures + 1));

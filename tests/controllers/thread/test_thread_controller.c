@@ -396,7 +396,7 @@ static void rod_cut_by_an_event(void** state) {
 // SKIN.tri packed without row 1 from that step on, as physics.skin does
 // after a tear: the second puncture's triangle moves from row 2 to row 1.
 typedef struct skin_fixture {
-  tx_port x, tri, thick, punct, hand, nodes;
+  tx_port x, tri, thick, punct, hand, nodes, decoy;
   double worst;  // m
   bool bad_row;  // publish a malformed second puncture (a corner past SKIN.x)
   int drop_at;   // > 0: from this step on, SKIN.tri without row 1 (the rows after it renumbered)
@@ -409,6 +409,7 @@ static int fixture_configure(tx_setup* s, void** self) {
   fixture.thick = tx_setup_write(s, &TX_COMPONENT_OF("skin.thickness", tx_thickness, 1));
   fixture.punct = tx_setup_write(s, &TX_COMPONENT_OF("needle.punctures", tx_puncture, 4));
   fixture.hand = tx_setup_write(s, &TX_COMPONENT_OF("hand.pose", tx_pose, 1));
+  fixture.decoy = tx_setup_write(s, &TX_COMPONENT_OF("needle.pose", tx_pose, 1)); // f64 x 7, as a puncture row
   fixture.nodes = TX_READ_OF(s, "thread.nodes", tx_thread_node);
   return 0;
 }
@@ -441,6 +442,7 @@ static void fixture_step(tx_ctx* c, void* self) {
   pu[1] = (tx_puncture){{4, 5, f->bad_row ? 9 : 6}, {0.49, 0.02, 0.49}, -1};
   pu[2] = (tx_puncture){{-1, -1, -1}, {0, 0, 0}, 0};
   pu[3] = (tx_puncture){{-1, -1, -1}, {0, 0, 0}, 0};
+  *(tx_pose*)tx_write(c, f->decoy) = (tx_pose){{0, 0, 0}, {1, 0, 0, 0}};
   tx_pose* h = tx_write(c, f->hand);
   double g = fmin(1, fmax(0, (time - 0.2) / 0.2));
   *h = (tx_pose){{time <= 0.2 ? 0.1 * time : 0.02 + 0.01 * g, 0.01 * g, 0}, {1, 0, 0, 0}};
@@ -505,14 +507,22 @@ static void passes_through_skin_punctures(void** state) {
   assert_true(result(s, "thread.punctures_passed") == 1);
   assert_true(warnings(s, "thread.bad_puncture") > 0);
   tx_scenario_free(s);
-  // the list without the skin it lies on, or of another layout: refused at load, named
+  // the list without the skin it lies on, of another layout (a pose: f64 x 7
+  // like a puncture row, in m), of another shape, or nobody's: refused at load, named
   s = load_with_fixture("\"punctures\":\"needle.punctures\"");
   assert_null(s);
   assert_non_null(strstr(tx_error(), "params.punctures"));
-  s = load_with_fixture("\"skin\":\"skin\",\"punctures\":\"hand.pose\"");
-  assert_null(s);
-  assert_non_null(strstr(tx_error(), "hand.pose"));
-  assert_null(strchr(tx_error(), '\n'));
+  const char* bad[][2] = {{"needle.pose", "units"}, {"skin.x", "skin.x"}, {"nobody.punctures", "nobody.punctures"}};
+  for (int i = 0; i < 3; i++) {
+    char p[256];
+    snprintf(p, sizeof p, "\"skin\":\"skin\",\"punctures\":\"%s\"", bad[i][0]);
+    s = load_with_fixture(p);
+    if (s) fail_msg("punctures %s loaded", bad[i][0]);
+    print_message("punctures %s: %s\n", bad[i][0], tx_error());
+    assert_non_null(strstr(tx_error(), bad[i][0]));
+    assert_non_null(strstr(tx_error(), bad[i][1]));
+    assert_null(strchr(tx_error(), '\n'));
+  }
 }
 
 // a tear between two publishes drops SKIN.tri's row 1, renumbering the
@@ -741,6 +751,22 @@ static void knot_near_the_skin_is_fixed(void** state) {
     assert_true(rest > 1e-3); // the rest falls
     assert_int_equal(warnings(s, "thread.bad_start_shape"), 0);
     assert_int_equal(warnings(s, "thread.numerical_fault"), 0);
+    tx_scenario_free(s);
+  }
+  // a start_shape of another count of rows: counted, and the thread starts straight (no knot)
+  {
+    char text[2048];
+    snprintf(text, sizeof text,
+             "{\"name\":\"t\",\"controllers\":["
+             "{\"name\":\"fixture\",\"type\":\"test.knot_skin\",\"rate_hz\":1000},"
+             "{\"name\":\"thread\",\"type\":\"physics.thread\",\"rate_hz\":1000,\"params\":{\"head\":\"knot.hand\","
+             "\"start_shape\":\"knot.shape\",\"nodes\":%d,\"length_m\":0.02,\"knot_every\":5}}]}",
+             n + 1);
+    tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+    if (!s) fail_msg("%s", tx_error());
+    run(s, 0.03);
+    assert_true(warnings(s, "thread.bad_start_shape") == 1);
+    assert_true(result(s, "thread.knots") == 0);
     tx_scenario_free(s);
   }
   free(ks_at_rod);
