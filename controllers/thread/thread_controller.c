@@ -14,7 +14,8 @@
 // rows: points on triangles of the skin's particles) the thread passes through them in order.
 // With grasp_events, a TX_EVENT_GRASP from hand h whose point is on the
 // thread holds the nearest node in the jaws' frame (instrument<h>.pose)
-// until a TX_EVENT_RELEASE from h.
+// until a TX_EVENT_RELEASE from h. With start_shape the thread starts on
+// that component's rows (a knot tied beforehand) instead of straight.
 #include "thread_controller.h"
 
 #include "knot.h"
