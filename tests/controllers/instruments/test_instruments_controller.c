@@ -398,6 +398,9 @@ static void test_needle_punctures_the_skin(void** state) {
   unlink(path);
   const tx_puncture* rows = latest_snapshot(s, "needle.punctures").data;
   int ntri = (int)latest_snapshot(s, "skin.tri").rows;
+  const int32_t* tri = latest_snapshot(s, "skin.tri").data;
+  const float* sx = latest_snapshot(s, "skin.x").data;
+  const tx_pose* needle = latest_snapshot(s, "needle.pose").data;
   int np = 0;
   for (int i = 0; i < the_listener.n; i++) {
     const tx_event* e = &the_listener.got[i];
@@ -412,7 +415,25 @@ static void test_needle_punctures_the_skin(void** state) {
       assert_true(r->v[k] != r->v[(k + 1) % 3]);
     }
     assert_true(fabs(r->bary[0] + r->bary[1] + r->bary[2] - 1) < 1e-9);
-    for (int k = 0; k < 3; k++) assert_true(r->bary[k] >= 0);
+    // the hole: the point on the needle's arc, where it crosses the skin, on a live triangle
+    double p[3] = {0}, R = 0.03 / (0.75 * M_PI), d[3], n[3], dn = 0, dd = 0;
+    for (int v = 0; v < 3; v++)
+      for (int k = 0; k < 3; k++) p[k] += r->bary[v] * sx[3 * (int)r->v[v] + k];
+    for (int k = 0; k < 3; k++) d[k] = p[k] - needle->pos[k];
+    const double* q = needle->quat; // the needle frame's z: its circle's axis
+    n[0] = 2 * (q[1] * q[3] + q[0] * q[2]), n[1] = 2 * (q[2] * q[3] - q[0] * q[1]), n[2] = 1 - 2 * (q[1] * q[1] + q[2] * q[2]);
+    for (int k = 0; k < 3; k++) dn += d[k] * n[k];
+    for (int k = 0; k < 3; k++) dd += (d[k] - dn * n[k]) * (d[k] - dn * n[k]);
+    double off = sqrt((sqrt(dd) - R) * (sqrt(dd) - R) + dn * dn);
+    bool live = false;
+    for (int t = 0; t < ntri && !live; t++)
+      for (int k = 0; k < 3; k++)
+        live = live || (tri[3 * t] == r->v[k] && tri[3 * t + 1] == r->v[(k + 1) % 3] && tri[3 * t + 2] == r->v[(k + 2) % 3]);
+    print_message("  its point (%.2f, %.2f, %.2f) mm, %.3f mm off the needle's circle, on a live triangle: %d\n", 1e3 * p[0],
+                  1e3 * p[1], 1e3 * p[2], 1e3 * off, live);
+    assert_true(off < 2.5e-3); // the needle moved on after it was last seen crossing there
+    assert_true(live);
+    assert_true(fabs(p[1]) < 0.006); // at the skin, not a flap carried under it
     assert_true(e->puncture.force > 0.01); // the tip felt the skin before it tore
     np++;
   }
