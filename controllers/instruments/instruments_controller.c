@@ -56,6 +56,8 @@ typedef struct instruments {
   double pin_bary[TX_NEEDLE_PINS_MAX][3];   // and their weights
   bool at_hole[TX_NEEDLE_PINS_MAX]; // the row is at the hole: where the arc crossed the patch's sheet
   int32_t* hole_scratch; // 2 x HOLE_PARTICLES_MAX: the skin's components (tx_puncture_hole)
+  tx_result clearance;
+  double clearance_min; // m: the lowest any held instrument's collision shapes came above the skin's sheet
   double pin_offset[TX_NEEDLE_PINS_MAX][3]; // from the skin's point to the pin: the tip where it tore through
   double pin_origin[TX_NEEDLE_PINS_MAX][3]; // where each puncture was made
   int npins;
@@ -319,6 +321,7 @@ static int configure(tx_setup* s, void** self) {
     m->npunct = tx_setup_result(s, "needle_punctures");
     m->pulled_through = tx_setup_result(s, "needle_pulled_through");
     if (*skin) m->reanchors = tx_setup_result(s, "needle_reanchors");
+    if (*skin) m->clearance = tx_setup_result(s, "skin_clearance_m");
     m->grasps = tx_setup_result(s, "needle_grasps");
     m->releases = tx_setup_result(s, "needle_releases");
   }
@@ -353,6 +356,7 @@ static int init(tx_ctx* c, void* self) {
       if (!isfinite(start[i][k])) start[i][k] = 0;
   }
   m->npins = m->nreanchors = 0;
+  m->clearance_min = INFINITY;
   m->ncuts = m->nthread_grasps = m->nskin_grasps = 0;
   for (int i = 0; i < m->n; i++) m->blades[i].armed = 0, m->holds_thread[i] = m->holds_skin[i] = false;
   m->contact_seq = 0;
@@ -462,6 +466,61 @@ static void hole_row(instruments* m, int i, const float* xs, int nx, const int32
   m->at_hole[i] = true;
 }
 
+static void rotate(const double q[4], const double v[3], double o[3]) {
+  double t[3] = {2 * (q[2] * v[2] - q[3] * v[1]), 2 * (q[3] * v[0] - q[1] * v[2]), 2 * (q[1] * v[1] - q[2] * v[0])};
+  o[0] = v[0] + q[0] * t[0] + q[2] * t[2] - q[3] * t[1];
+  o[1] = v[1] + q[0] * t[1] + q[3] * t[0] - q[1] * t[2];
+  o[2] = v[2] + q[0] * t[2] + q[1] * t[1] - q[2] * t[0];
+}
+
+// The lowest the held instruments come above the skin: every corner of
+// their collision boxes, the lowest point of each cylinder's rim and of each
+// sphere, against the sheet under it (tx_height_above_sheet), at each publish
+// of the skin. The skin does not collide with the instruments (only with the
+// needle's tip), so this is what keeps them out of it.
+static void clearance(instruments* m, const float* xs, int nx) {
+  double top = -INFINITY;
+  for (int i = 0; i < nx; i++) top = fmax(top, xs[3 * i + 1]);
+  for (int h = 0; h < m->nhands; h++) {
+    int i = m->slot[h][m->cur[h]];
+    const tx_urdf* u = m->desc[i]->urdf;
+    for (int l = 0; l < u->nlinks; l++) {
+      double lp[3], lq[4];
+      tx_instrument_world_link(m->world, i, l, lp, lq);
+      for (int k = 0; k < u->links[l].nshapes; k++) {
+        const tx_urdf_shape* sh = &u->links[l].shapes[k];
+        double c[3], q[4], pts[8][3];
+        int n = 0;
+        rotate(lq, sh->pose.p, c);
+        for (int j = 0; j < 3; j++) c[j] += lp[j];
+        q[0] = lq[0] * sh->pose.q[0] - lq[1] * sh->pose.q[1] - lq[2] * sh->pose.q[2] - lq[3] * sh->pose.q[3];
+        q[1] = lq[0] * sh->pose.q[1] + lq[1] * sh->pose.q[0] + lq[2] * sh->pose.q[3] - lq[3] * sh->pose.q[2];
+        q[2] = lq[0] * sh->pose.q[2] - lq[1] * sh->pose.q[3] + lq[2] * sh->pose.q[0] + lq[3] * sh->pose.q[1];
+        q[3] = lq[0] * sh->pose.q[3] + lq[1] * sh->pose.q[2] - lq[2] * sh->pose.q[1] + lq[3] * sh->pose.q[0];
+        if (sh->kind == TX_URDF_BOX) {
+          for (int corner = 0; corner < 8; corner++, n++) {
+            double v[3] = {(corner & 1 ? 0.5 : -0.5) * sh->size[0], (corner & 2 ? 0.5 : -0.5) * sh->size[1],
+                           (corner & 4 ? 0.5 : -0.5) * sh->size[2]};
+            rotate(q, v, pts[n]);
+            for (int j = 0; j < 3; j++) pts[n][j] += c[j];
+          }
+        } else if (sh->kind == TX_URDF_CYLINDER) { // the lower end's rim, at its lowest
+          double z[3] = {0, 0, 1}, a[3];
+          rotate(q, z, a);
+          double e = a[1] > 0 ? -sh->size[1] / 2 : sh->size[1] / 2, up[3] = {-a[1] * a[0], 1 - a[1] * a[1], -a[1] * a[2]};
+          double un = sqrt(up[0] * up[0] + up[1] * up[1] + up[2] * up[2]);
+          for (int j = 0; j < 3; j++) pts[n][j] = c[j] + e * a[j] - (un > 1e-12 ? sh->size[0] * up[j] / un : 0);
+          n++;
+        } else {
+          memcpy(pts[n], c, sizeof c), pts[n][1] -= sh->size[0], n++;
+        }
+        for (int j = 0; j < n; j++)
+          if (pts[j][1] < top + 0.01) m->clearance_min = fmin(m->clearance_min, tx_height_above_sheet(xs, nx, pts[j]));
+      }
+    }
+  }
+}
+
 // the skin against the tip: its contact pushes the tip; each puncture it
 // tears pins the needle's arc there, is an event and a row of needle.punctures
 static void pierce(tx_ctx* c, instruments* m) {
@@ -482,6 +541,7 @@ static void pierce(tx_ctx* c, instruments* m) {
   }
   if (ct.seq == m->contact_seq) return; // one look at each of the skin's publishes
   m->contact_seq = ct.seq;
+  clearance(m, xs, (int)x.rows);
   if (tri.seq)
     for (int i = 0; i < m->npins; i++) {
       reanchor(m, i, xs, (int)x.rows, tri.data, (int)tri.rows);
@@ -607,6 +667,7 @@ static void finish(tx_ctx* c, void* self) {
     for (int i = 0; i < m->npins; i++) through += tx_instrument_world_needle_pin_through(m->world, i);
     tx_set_result(c, m->pulled_through, through);
     if (m->skin) tx_set_result(c, m->reanchors, m->nreanchors), tx_set_result(c, m->skin_grasps, m->nskin_grasps);
+    if (m->skin && isfinite(m->clearance_min)) tx_set_result(c, m->clearance, m->clearance_min);
   }
   // the world goes on the thread that made and stepped it, with ODE's data for that thread
   tx_instrument_world_destroy(m->world);

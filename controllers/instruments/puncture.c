@@ -232,3 +232,16 @@ bool tx_puncture_update(tx_puncture_tracker* t, const tx_skin_contact* c, const 
   t->peak_f = t->peak_depth = 0;
   return true;
 }
+
+double tx_height_above_sheet(const float* x, int nx, const double p[3]) {
+  double best = INFINITY, y = 0, lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+  for (int i = 0; i < nx; i++) {
+    const float* q = x + 3 * i;
+    if (!isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2])) continue;
+    double dx = p[0] - q[0], dz = p[2] - q[2], d2 = dx * dx + dz * dz;
+    lo[0] = fmin(lo[0], q[0]), hi[0] = fmax(hi[0], q[0]), lo[1] = fmin(lo[1], q[2]), hi[1] = fmax(hi[1], q[2]);
+    if (d2 < best) best = d2, y = q[1];
+  }
+  if (!(p[0] >= lo[0] && p[0] <= hi[0] && p[2] >= lo[1] && p[2] <= hi[1])) return INFINITY;
+  return p[1] - y;
+}

@@ -75,4 +75,9 @@ int tx_puncture_hole(const float* x, int nx, const int32_t* tri, int ntri, const
 // the patch (as in tx_puncture_hole; scratch NULL: any live one is)
 bool tx_puncture_attached(int nx, const int32_t* tri, int ntri, int32_t* scratch, int nscratch, const int32_t v[3]);
 
+// how high p is above the skin's sheet (m; negative: under it): p's height
+// less that of the particle nearest it across (in x and z); INFINITY when
+// p is not over the patch (outside its particles' x-z bounds)
+double tx_height_above_sheet(const float* x, int nx, const double p[3]);
+
 #endif

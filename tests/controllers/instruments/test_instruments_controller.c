@@ -339,6 +339,10 @@ static void test_forceps_grasp_the_skin(void** state) {
   assert_int_equal(the_listener.got[1].kind, TX_EVENT_RELEASE);
   assert_int_equal(the_listener.got[1].source, 0);
   assert_true(result(s, "instruments.skin_grasps") == 1);
+  // the lowest the forceps came above the skin: their jaw boxes, 5.75 mm
+  // across in y, about the pivot's line 1 mm above the sheet: -1.875 mm
+  print_message("  lowest above the skin: %.4f mm\n", 1e3 * result(s, "instruments.skin_clearance_m"));
+  assert_true(fabs(result(s, "instruments.skin_clearance_m") + 0.001875) < 1e-4);
   tx_scenario_free(s);
 }
 

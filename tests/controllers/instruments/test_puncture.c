@@ -260,11 +260,28 @@ static void test_hole_at_the_crossing_on_the_patch(void** state) {
   assert_false(tx_puncture_attached(nx, t, n, scratch, 2 * nx, out));
 }
 
+
+// the height above the sheet: of the particle nearest across; over the
+// patch only; a particle that is not finite is skipped
+static void test_height_above_sheet(void** state) {
+  (void)state;
+  float x[N * N * 3];
+  memcpy(x, xs, sizeof xs);
+  x[3 * 12 + 1] = 0.004f; // the middle particle (0, 0) raised 4 mm
+  assert_true(fabs(tx_height_above_sheet(x, N * N, (double[3]){0.001, 0.01, -0.002}) - 0.006) < 1e-7);
+  assert_true(fabs(tx_height_above_sheet(x, N * N, (double[3]){0.013, -0.003, 0.008}) + 0.003) < 1e-7);
+  assert_true(isinf(tx_height_above_sheet(x, N * N, (double[3]){0.025, 0, 0}))); // beyond the patch's edge
+  assert_true(isinf(tx_height_above_sheet(x, 0, (double[3]){0, 0, 0})));
+  x[3 * 12] = NAN;
+  assert_true(fabs(tx_height_above_sheet(x, N * N, (double[3]){0.001, 0.01, -0.002}) - 0.01) < 1e-7);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test_setup(test_nearest_triangle, patch),
       cmocka_unit_test_setup(test_entry_then_exit, patch),
       cmocka_unit_test_setup(test_hole_at_the_crossing_on_the_patch, patch),
+      cmocka_unit_test_setup(test_height_above_sheet, patch),
       cmocka_unit_test(test_scissors_cut_between_the_blades),
       cmocka_unit_test(test_jaws_pinch_the_skin),
       cmocka_unit_test(test_blades_close_once),
