@@ -14,9 +14,6 @@
 #define TX_JAW_STOP_GUARD 0.02 // rad
 #define TX_NEEDLE_RELEASE_RAD 0.01 // a jaw this much wider than when it took the needle has let it go
 #define STEEL_DENSITY 7900.0 // kg/m^3
-// m/(N s): with erp 0.2 at 1 kHz a 2e5 N/m contact spring, 16 um deep at the
-// device's 3.3 N on a 0.6 mm wire (1e-4 still let the LCP blow up)
-#define TX_NEEDLE_CONTACT_CFM 1e-3
 
 typedef struct instrument {
   const tx_urdf* urdf;
@@ -58,6 +55,7 @@ struct tx_instrument_world {
   int npins;
   double needle_mass;
   double depth; // deepest contact of the last step, m
+  double dt; // the step being taken (s), for the contacts' softness
 };
 
 static char needle_tag; // the needle's geoms carry its address
@@ -96,6 +94,7 @@ tx_instrument_sim_params tx_instrument_sim_defaults(void) {
                                     .friction = 0.5,
                                     .erp = 0.2,
                                     .cfm = 1e-7,
+                                    .contact_relax = TX_CONTACT_RELAX,
                                     .pin_stiffness = 200,
                                     .pin_damping = 0.1,
                                     .pin_friction = 0.02,
@@ -128,6 +127,43 @@ static void compose(const double pa[3], const double qa[4], const double pb[3], 
 
 // ---- contacts
 
+// The normal row's diagonal of ODE's LCP matrix, J M^-1 J^T: 1/m + (r x n)^T
+// I^-1 (r x n) summed over the contact's bodies (r from each centre of mass
+// to the point, I in the world): the inverse of the effective mass the
+// contact pushes on (kg^-1)
+static double inverse_mass_along(dBodyID b, const dReal pos[3], const dReal n[3]) {
+  if (!b) return 0;
+  dMass m;
+  dBodyGetMass(b, &m);
+  const dReal* c = dBodyGetPosition(b);
+  const dReal* R = dBodyGetRotation(b); // rows of 4: world = R body
+  double r[3] = {pos[0] - c[0], pos[1] - c[1], pos[2] - c[2]};
+  double rn[3] = {r[1] * n[2] - r[2] * n[1], r[2] * n[0] - r[0] * n[2], r[0] * n[1] - r[1] * n[0]}, v[3];
+  for (int i = 0; i < 3; i++) v[i] = R[i] * rn[0] + R[4 + i] * rn[1] + R[8 + i] * rn[2]; // R^T (r x n): in the body
+  // solve I x = v (I symmetric positive definite, body frame) by its adjugate
+  const dReal* I = m.I;
+  double a = I[0], b2 = I[1], c2 = I[2], d = I[5], e = I[6], f = I[10];
+  double A = d * f - e * e, B = c2 * e - b2 * f, C = b2 * e - c2 * d, det = a * A + b2 * B + c2 * C;
+  double x[3] = {(A * v[0] + B * v[1] + C * v[2]) / det, (B * v[0] + (a * f - c2 * c2) * v[1] + (b2 * c2 - a * e) * v[2]) / det,
+                 (C * v[0] + (b2 * c2 - a * e) * v[1] + (a * d - b2 * b2) * v[2]) / det};
+  return 1 / m.mass + v[0] * x[0] + v[1] * x[1] + v[2] * x[2];
+}
+
+// A contact's CFM: contact_relax x dt x its row's diagonal (above), or the
+// world's CFM if that is softer. CFM / dt is what ODE adds to that diagonal,
+// so every contact row is regularised by the same fraction of itself, which
+// bounds the LCP's conditioning whatever the masses: a 42 mg needle welded
+// to one instrument and pinched by another's jaws is otherwise an all but
+// singular LCP (ODE's Dantzig solver aborts the process in dxLDLTRemove, or
+// returns infinite velocities). The contact is then a spring k = erp m_eff /
+// (relax dt^2) with damping (1 - erp) m_eff / (relax dt): the same natural
+// frequency for every contact, sqrt(erp / relax) / dt, far above the step's
+// (docs/instruments.md, "Contacts").
+double tx_instrument_contact_cfm(const tx_instrument_sim_params* p, double inverse_mass, double dt) {
+  double cfm = p->contact_relax * dt * inverse_mass;
+  return isfinite(cfm) && cfm > p->cfm ? cfm : p->cfm;
+}
+
 static void near(void* data, dGeomID a, dGeomID b) {
   tx_instrument_world* w = data;
   dBodyID ba = dGeomGetBody(a), bb = dGeomGetBody(b);
@@ -150,11 +186,8 @@ static void near(void* data, dGeomID a, dGeomID b) {
     c.surface.mode = dContactApprox1 | dContactSoftERP | dContactSoftCFM;
     c.surface.mu = w->p.friction;
     c.surface.soft_erp = w->p.erp;
-    // a contact on the 42 mg needle gets at least TX_NEEDLE_CONTACT_CFM: with
-    // the world's 1e-7 the needle welded to one instrument and pinched by
-    // another's jaws is an all but singular LCP, and ODE's Dantzig solver
-    // aborts the process (dxLDLTRemove) or returns infinite velocities
-    c.surface.soft_cfm = other ? fmax(w->p.cfm, TX_NEEDLE_CONTACT_CFM) : w->p.cfm;
+    double d = inverse_mass_along(ba, cg[i].pos, cg[i].normal) + inverse_mass_along(bb, cg[i].pos, cg[i].normal);
+    c.surface.soft_cfm = tx_instrument_contact_cfm(&w->p, d, w->dt);
     dJointID j = dJointCreateContact(w->world, w->contacts, &c);
     dJointAttach(j, ba, bb);
     w->ncontacts++;
@@ -662,6 +695,7 @@ void tx_instrument_world_step(tx_instrument_world* w, const tx_instrument_input*
     tip_push(w, dt);
     for (int i = 0; i < w->npins; i++) pin_hold(w, i, dt);
   }
+  w->dt = dt;
   dSpaceCollide(w->space, w, near);
   dWorldStep(w->world, dt);
   dJointGroupEmpty(w->contacts);

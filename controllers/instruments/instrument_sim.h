@@ -55,7 +55,10 @@ typedef struct tx_instrument_sim_params {
   double gravity[3]; // m/s^2
   double table_height; // m: the table is the half-space y < table_height
   double friction; // Coulomb coefficient of every contact
-  double erp, cfm; // ODE's error reduction and constraint force mixing
+  double erp, cfm; // ODE's error reduction and constraint force mixing (cfm: of joints, and the least of contacts)
+  // a contact's CFM / dt as a fraction of its normal row's 1/m_eff
+  // (tx_instrument_contact_cfm); 0: the world's cfm for every contact
+  double contact_relax;
   tx_needle_params needle;
   // where the needle has pierced the skin (pins): a spring-damper holds its
   // arc on each puncture point across the arc, and a friction force of at
@@ -68,6 +71,16 @@ typedef struct tx_instrument_sim_params {
 } tx_instrument_sim_params;
 
 tx_instrument_sim_params tx_instrument_sim_defaults(void);
+
+// the default contact_relax: every contact row regularised by this fraction
+// of its own diagonal (the scenario's needle, welded and pinched, needs about
+// 1e-5; 2e-6 still let ODE's LCP blow up)
+#define TX_CONTACT_RELAX 2e-5
+
+// the CFM of a contact whose normal row's diagonal of ODE's LCP matrix (the
+// inverse of the effective mass it pushes on, kg^-1) is inverse_mass, at a
+// step of dt: contact_relax x dt x inverse_mass, at least p->cfm
+double tx_instrument_contact_cfm(const tx_instrument_sim_params* p, double inverse_mass, double dt);
 
 // one instrument's device this step
 typedef struct tx_instrument_input {

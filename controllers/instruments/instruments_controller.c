@@ -21,6 +21,8 @@
 #define HANDS 2
 #define PER_HAND (TX_INSTRUMENTS_MAX / HANDS) // one held, the others parked
 #define NEEDLE_CHORDS 16 // needle.segments: the arc drawn as this many chords
+#define HOLE_PARTICLES_MAX 16384 // skins up to this many particles (102 x 102 at 1 mm) tell a torn-off flap from the patch
+#define HOLE_SAMPLES 64 // the arc, tip to swage, searched for where it crosses the skin
 
 typedef struct instruments {
   tx_instrument_sim_params p;
@@ -50,7 +52,12 @@ typedef struct instruments {
   uint64_t contact_seq;
   tx_puncture_tracker tracker;
   tx_puncture rows[TX_NEEDLE_PINS_MAX];
-  int32_t pin_verts[TX_NEEDLE_PINS_MAX][3]; // the particles that carry each puncture point
+  int32_t pin_verts[TX_NEEDLE_PINS_MAX][3]; // the particles that carry each pin
+  double pin_bary[TX_NEEDLE_PINS_MAX][3];   // and their weights
+  bool at_hole[TX_NEEDLE_PINS_MAX]; // the row is at the hole: where the arc crossed the patch's sheet
+  int32_t* hole_scratch; // 2 x HOLE_PARTICLES_MAX: the skin's components (tx_puncture_hole)
+  tx_result clearance;
+  double clearance_min; // m: the lowest any held instrument's collision shapes came above the skin's sheet
   double pin_offset[TX_NEEDLE_PINS_MAX][3]; // from the skin's point to the pin: the tip where it tore through
   double pin_origin[TX_NEEDLE_PINS_MAX][3]; // where each puncture was made
   int npins;
@@ -239,6 +246,8 @@ static int configure(tx_setup* s, void** self) {
     m->skin_tri = TX_READ_OF(s, name, tx_triangle);
     snprintf(name, sizeof name, "%s.contact", skin);
     m->skin_contact = TX_READ_OF(s, name, tx_skin_contact);
+    m->hole_scratch = calloc(2 * HOLE_PARTICLES_MAX, sizeof *m->hole_scratch);
+    if (!m->hole_scratch) return -1;
     tx_puncture_tracker_init(&m->tracker, tx_table_num(s, "puncture_separation_m"), tx_table_num(s, "puncture_min_force_n"), 0);
   }
   for (int h = 0; h < HANDS; h++) {
@@ -312,6 +321,7 @@ static int configure(tx_setup* s, void** self) {
     m->npunct = tx_setup_result(s, "needle_punctures");
     m->pulled_through = tx_setup_result(s, "needle_pulled_through");
     if (*skin) m->reanchors = tx_setup_result(s, "needle_reanchors");
+    if (*skin) m->clearance = tx_setup_result(s, "skin_clearance_m");
     m->grasps = tx_setup_result(s, "needle_grasps");
     m->releases = tx_setup_result(s, "needle_releases");
   }
@@ -346,6 +356,7 @@ static int init(tx_ctx* c, void* self) {
       if (!isfinite(start[i][k])) start[i][k] = 0;
   }
   m->npins = m->nreanchors = 0;
+  m->clearance_min = INFINITY;
   m->ncuts = m->nthread_grasps = m->nskin_grasps = 0;
   for (int i = 0; i < m->n; i++) m->blades[i].armed = 0, m->holds_thread[i] = m->holds_skin[i] = false;
   m->contact_seq = 0;
@@ -421,12 +432,93 @@ static void reanchor(instruments* m, int i, const float* xs, int nx, const int32
   if (best_t < 0) return;
   for (int v = 0; v < 3; v++) {
     m->pin_verts[i][v] = tri[3 * best_t + v];
-    m->rows[i].v[v] = tri[3 * best_t + v];
-    m->rows[i].bary[v] = best_bary[v];
+    m->pin_bary[i][v] = best_bary[v];
   }
   for (int k = 0; k < 3; k++) m->pin_offset[i][k] = best_c[k] - best_point[k];
   tx_instrument_world_needle_pin_move(m->world, i, best_c);
   m->nreanchors++;
+}
+
+// The row of needle.punctures (for the thread) is the hole in the patch: the
+// tear's place, the triangles nearest the HIP, is torn on as the tip goes
+// through, and a particle of it can come loose and be carried off under the
+// skin. At the tear the arc has not crossed the sheet yet (the HIP tears at
+// its contact distance), so at each publish until it has, and again if the
+// row's triangle is later torn or cut off from the patch, the row moves to
+// the patch's triangle nearest where the arc crosses the sheet (its rim).
+// The pin (the needle's own hold) keeps its particles.
+static void hole_row(instruments* m, int i, const float* xs, int nx, const int32_t* tri, int ntri) {
+  if (tx_instrument_world_needle_pin_through(m->world, i)) return; // the thread holds it where it is now
+  double arc[HOLE_SAMPLES + 1][3], on_arc[3], bary[3], point[3], at[3] = {0};
+  for (int k = 0; k <= HOLE_SAMPLES; k++) arc_point(m, m->p.needle.arc * (1 - (double)k / HOLE_SAMPLES), arc[k]);
+  int32_t rv[3];
+  for (int v = 0; v < 3; v++) {
+    rv[v] = (int32_t)m->rows[i].v[v];
+    for (int k = 0; k < 3 && rv[v] >= 0 && rv[v] < nx; k++) at[k] += m->rows[i].bary[v] * xs[3 * rv[v] + k];
+  }
+  int hole = tx_puncture_hole(xs, nx, tri, ntri, (const double(*)[3])arc, HOLE_SAMPLES + 1, m->at_hole[i] ? at : NULL,
+                              m->pin_capture, m->hole_scratch, 2 * HOLE_PARTICLES_MAX, bary, point, on_arc);
+  if (hole < 0) { // lost: its triangle torn or cut off from the patch, the next publish looks from the tip again
+    if (m->at_hole[i] && !tx_puncture_attached(nx, tri, ntri, m->hole_scratch, 2 * HOLE_PARTICLES_MAX, rv)) m->at_hole[i] = false;
+    return;
+  }
+  for (int k = 0; k < 3; k++) m->rows[i].v[k] = tri[3 * hole + k], m->rows[i].bary[k] = bary[k];
+  m->at_hole[i] = true;
+}
+
+static void rotate(const double q[4], const double v[3], double o[3]) {
+  double t[3] = {2 * (q[2] * v[2] - q[3] * v[1]), 2 * (q[3] * v[0] - q[1] * v[2]), 2 * (q[1] * v[1] - q[2] * v[0])};
+  o[0] = v[0] + q[0] * t[0] + q[2] * t[2] - q[3] * t[1];
+  o[1] = v[1] + q[0] * t[1] + q[3] * t[0] - q[1] * t[2];
+  o[2] = v[2] + q[0] * t[2] + q[1] * t[1] - q[2] * t[0];
+}
+
+// The lowest the held instruments come above the skin: every corner of
+// their collision boxes, the lowest point of each cylinder's rim and of each
+// sphere, against the sheet under it (tx_height_above_sheet), at each publish
+// of the skin. The skin does not collide with the instruments (only with the
+// needle's tip), so this is what keeps them out of it.
+static void clearance(instruments* m, const float* xs, int nx) {
+  double top = -INFINITY;
+  for (int i = 0; i < nx; i++) top = fmax(top, xs[3 * i + 1]);
+  for (int h = 0; h < m->nhands; h++) {
+    int i = m->slot[h][m->cur[h]];
+    const tx_urdf* u = m->desc[i]->urdf;
+    for (int l = 0; l < u->nlinks; l++) {
+      double lp[3], lq[4];
+      tx_instrument_world_link(m->world, i, l, lp, lq);
+      for (int k = 0; k < u->links[l].nshapes; k++) {
+        const tx_urdf_shape* sh = &u->links[l].shapes[k];
+        double c[3], q[4], pts[8][3];
+        int n = 0;
+        rotate(lq, sh->pose.p, c);
+        for (int j = 0; j < 3; j++) c[j] += lp[j];
+        q[0] = lq[0] * sh->pose.q[0] - lq[1] * sh->pose.q[1] - lq[2] * sh->pose.q[2] - lq[3] * sh->pose.q[3];
+        q[1] = lq[0] * sh->pose.q[1] + lq[1] * sh->pose.q[0] + lq[2] * sh->pose.q[3] - lq[3] * sh->pose.q[2];
+        q[2] = lq[0] * sh->pose.q[2] - lq[1] * sh->pose.q[3] + lq[2] * sh->pose.q[0] + lq[3] * sh->pose.q[1];
+        q[3] = lq[0] * sh->pose.q[3] + lq[1] * sh->pose.q[2] - lq[2] * sh->pose.q[1] + lq[3] * sh->pose.q[0];
+        if (sh->kind == TX_URDF_BOX) {
+          for (int corner = 0; corner < 8; corner++, n++) {
+            double v[3] = {(corner & 1 ? 0.5 : -0.5) * sh->size[0], (corner & 2 ? 0.5 : -0.5) * sh->size[1],
+                           (corner & 4 ? 0.5 : -0.5) * sh->size[2]};
+            rotate(q, v, pts[n]);
+            for (int j = 0; j < 3; j++) pts[n][j] += c[j];
+          }
+        } else if (sh->kind == TX_URDF_CYLINDER) { // the lower end's rim, at its lowest
+          double z[3] = {0, 0, 1}, a[3];
+          rotate(q, z, a);
+          double e = a[1] > 0 ? -sh->size[1] / 2 : sh->size[1] / 2, up[3] = {-a[1] * a[0], 1 - a[1] * a[1], -a[1] * a[2]};
+          double un = sqrt(up[0] * up[0] + up[1] * up[1] + up[2] * up[2]);
+          for (int j = 0; j < 3; j++) pts[n][j] = c[j] + e * a[j] - (un > 1e-12 ? sh->size[0] * up[j] / un : 0);
+          n++;
+        } else {
+          memcpy(pts[n], c, sizeof c), pts[n][1] -= sh->size[0], n++;
+        }
+        for (int j = 0; j < n; j++)
+          if (pts[j][1] < top + 0.01) m->clearance_min = fmin(m->clearance_min, tx_height_above_sheet(xs, nx, pts[j]));
+      }
+    }
+  }
 }
 
 // the skin against the tip: its contact pushes the tip; each puncture it
@@ -443,14 +535,18 @@ static void pierce(tx_ctx* c, instruments* m) {
     double p[3] = {0};
     for (int v = 0; v < 3; v++)
       for (int k = 0; k < 3; k++)
-        if (m->pin_verts[i][v] < (int32_t)x.rows) p[k] += m->rows[i].bary[v] * xs[3 * m->pin_verts[i][v] + k];
+        if (m->pin_verts[i][v] < (int32_t)x.rows) p[k] += m->pin_bary[i][v] * xs[3 * m->pin_verts[i][v] + k];
     for (int k = 0; k < 3; k++) p[k] += m->pin_offset[i][k];
     tx_instrument_world_needle_pin_move(m->world, i, p);
   }
   if (ct.seq == m->contact_seq) return; // one look at each of the skin's publishes
   m->contact_seq = ct.seq;
+  clearance(m, xs, (int)x.rows);
   if (tri.seq)
-    for (int i = 0; i < m->npins; i++) reanchor(m, i, xs, (int)x.rows, tri.data, (int)tri.rows);
+    for (int i = 0; i < m->npins; i++) {
+      reanchor(m, i, xs, (int)x.rows, tri.data, (int)tri.rows);
+      hole_row(m, i, xs, (int)x.rows, tri.data, (int)tri.rows);
+    }
   tx_puncture_found f;
   if (!tri.seq || !tx_puncture_update(&m->tracker, sc, xs, (int)x.rows, tri.data, (int)tri.rows, &f)) return;
   // the pin starts at the tip, which is on the arc (the hole's rim, where the
@@ -462,7 +558,10 @@ static void pierce(tx_ctx* c, instruments* m) {
   memcpy(m->pin_origin[m->npins], f.point, sizeof f.point);
   m->rows[m->npins] = f.row;
   memcpy(m->pin_verts[m->npins], f.verts, sizeof f.verts);
+  memcpy(m->pin_bary[m->npins], f.row.bary, sizeof f.row.bary);
+  m->at_hole[m->npins] = false;
   m->npins++;
+  hole_row(m, m->npins - 1, xs, (int)x.rows, tri.data, (int)tri.rows);
   // source: the skin.tri row at this publish (the next tear renumbers it; the row of needle.punctures keeps the particles)
   tx_event e = {.kind = TX_EVENT_PUNCTURE, .source = (uint32_t)f.triangle};
   memcpy(e.puncture.point, f.point, sizeof f.point);
@@ -568,6 +667,7 @@ static void finish(tx_ctx* c, void* self) {
     for (int i = 0; i < m->npins; i++) through += tx_instrument_world_needle_pin_through(m->world, i);
     tx_set_result(c, m->pulled_through, through);
     if (m->skin) tx_set_result(c, m->reanchors, m->nreanchors), tx_set_result(c, m->skin_grasps, m->nskin_grasps);
+    if (m->skin && isfinite(m->clearance_min)) tx_set_result(c, m->clearance, m->clearance_min);
   }
   // the world goes on the thread that made and stepped it, with ODE's data for that thread
   tx_instrument_world_destroy(m->world);
@@ -586,6 +686,7 @@ static void fini(void* self) {
   if (!m) return;
   tx_instrument_world_destroy(m->world);
   for (int i = 0; i < TX_INSTRUMENTS_MAX; i++) tx_instrument_desc_free(m->desc[i]);
+  free(m->hole_scratch);
   free(m);
 }
 

@@ -43,13 +43,16 @@ static void corner(const float* x, int32_t i, double o[3]) {
   for (int k = 0; k < 3; k++) o[k] = x[3 * i + k];
 }
 
-int tx_nearest_triangle(const float* x, int nx, const int32_t* tri, int ntri, const double p[3], double bary[3],
-                        double point[3]) {
+// the nearest point of the triangles whose first particle is in component
+// `patch` of `root` (all of them when root is NULL)
+static int nearest_of(const float* x, int nx, const int32_t* tri, int ntri, const int32_t* root, int32_t patch,
+                      const double p[3], double bary[3], double point[3]) {
   int best = -1;
   double best_d2 = INFINITY;
   for (int t = 0; t < ntri; t++) {
     const int32_t* v = tri + 3 * t;
     if (v[0] < 0 || v[1] < 0 || v[2] < 0 || v[0] >= nx || v[1] >= nx || v[2] >= nx) continue;
+    if (root && root[v[0]] != patch) continue;
     double a[3], b[3], c[3], w[3], q[3], d2 = 0;
     corner(x, v[0], a), corner(x, v[1], b), corner(x, v[2], c);
     closest_bary(a, b, c, p, w);
@@ -61,6 +64,113 @@ int tx_nearest_triangle(const float* x, int nx, const int32_t* tri, int ntri, co
     }
   }
   return best;
+}
+
+int tx_nearest_triangle(const float* x, int nx, const int32_t* tri, int ntri, const double p[3], double bary[3],
+                        double point[3]) {
+  return nearest_of(x, nx, tri, ntri, NULL, 0, p, bary, point);
+}
+
+static int32_t find(int32_t* up, int32_t i) {
+  while (up[i] != i) up[i] = up[up[i]], i = up[i];
+  return i;
+}
+
+// which side of the patch's sheet p is on: the sign of the nearest
+// triangle's normal (by its corners' order) dotted with p - that point
+static int side_of(const float* x, int nx, const int32_t* tri, int ntri, const int32_t* root, int32_t patch,
+                   const double p[3], double* dist) {
+  double bary[3], q[3], a[3], b[3], c[3], ab[3], ac[3];
+  int t = nearest_of(x, nx, tri, ntri, root, patch, p, bary, q);
+  if (t < 0) return 0;
+  corner(x, tri[3 * t], a), corner(x, tri[3 * t + 1], b), corner(x, tri[3 * t + 2], c);
+  for (int k = 0; k < 3; k++) ab[k] = b[k] - a[k], ac[k] = c[k] - a[k];
+  double n[3] = {ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2], ab[0] * ac[1] - ab[1] * ac[0]};
+  double len = sqrt(dot(n, n)), d = (n[0] * (p[0] - q[0]) + n[1] * (p[1] - q[1]) + n[2] * (p[2] - q[2])) / len;
+  if (!(len > 0) || !isfinite(d)) return 0;
+  *dist = fabs(d);
+  return d >= 0 ? 1 : -1;
+}
+
+// the particles' components joined by the live triangles (up[i]: particle
+// i's), and the patch: the one the most triangles join; false without room
+static bool components(const int32_t* tri, int nx, int ntri, int32_t* scratch, int nscratch, int32_t* patch) {
+  if (!scratch || nscratch < 2 * nx || nx <= 0) return false;
+  int32_t *up = scratch, *count = scratch + nx;
+  for (int32_t i = 0; i < nx; i++) up[i] = i, count[i] = 0;
+  for (int t = 0; t < ntri; t++) {
+    const int32_t* v = tri + 3 * t;
+    if (v[0] < 0 || v[1] < 0 || v[2] < 0 || v[0] >= nx || v[1] >= nx || v[2] >= nx) continue;
+    int32_t r0 = find(up, v[0]), r1 = find(up, v[1]);
+    up[r1] = r0;
+    up[find(up, v[2])] = r0;
+  }
+  for (int32_t i = 0; i < nx; i++) up[i] = find(up, i);
+  for (int t = 0; t < ntri; t++)
+    if (tri[3 * t] >= 0 && tri[3 * t] < nx) count[up[tri[3 * t]]]++;
+  *patch = 0;
+  for (int32_t i = 0; i < nx; i++)
+    if (count[i] > count[*patch]) *patch = i;
+  return true;
+}
+
+bool tx_puncture_attached(int nx, const int32_t* tri, int ntri, int32_t* scratch, int nscratch, const int32_t v[3]) {
+  int32_t patch;
+  bool live = false;
+  for (int t = 0; t < ntri && !live; t++) // the same three particles, in any turn of their order
+    for (int r = 0; r < 3 && !live; r++)
+      live = tri[3 * t] == v[r] && tri[3 * t + 1] == v[(r + 1) % 3] && tri[3 * t + 2] == v[(r + 2) % 3];
+  if (!live || v[0] < 0 || v[0] >= nx) return false;
+  return !components(tri, nx, ntri, scratch, nscratch, &patch) || scratch[v[0]] == patch;
+}
+
+int tx_puncture_hole(const float* x, int nx, const int32_t* tri, int ntri, const double (*arc)[3], int narc,
+                     const double near_to[3], double within, int32_t* scratch, int nscratch, double bary[3],
+                     double point[3], double on_arc[3]) {
+  int32_t patch = 0;
+  const int32_t* root = components(tri, nx, ntri, scratch, nscratch, &patch) ? scratch : NULL;
+  // the crossings of the sheet along the arc (the side flips between two
+  // points, where the signed distance goes through zero): the first from the
+  // tip, or the one nearest near_to within `within` of it
+  double d0 = 0, d1 = 0, best = INFINITY;
+  int s0 = 0, found = 0;
+  for (int k = 0; k < narc; k++) {
+    if (near_to) {
+      double e2 = 0;
+      for (int j = 0; j < 3; j++) e2 += (arc[k][j] - near_to[j]) * (arc[k][j] - near_to[j]);
+      if (e2 > within * within) {
+        s0 = 0;
+        continue;
+      }
+    }
+    int s1 = side_of(x, nx, tri, ntri, root, patch, arc[k], &d1);
+    if (s0 && s1 && s1 != s0) {
+      double u = d0 + d1 > 0 ? d0 / (d0 + d1) : 0.5, c[3], e2 = 0;
+      for (int j = 0; j < 3; j++) c[j] = arc[k - 1][j] + u * (arc[k][j] - arc[k - 1][j]);
+      if (near_to)
+        for (int j = 0; j < 3; j++) e2 += (c[j] - near_to[j]) * (c[j] - near_to[j]);
+      if (e2 < best) best = e2, found = 1, memcpy(on_arc, c, sizeof c);
+      if (!near_to) break;
+    }
+    s0 = s1, d0 = d1;
+  }
+  if (!found) return -1;
+  int t = nearest_of(x, nx, tri, ntri, root, patch, on_arc, bary, point);
+  if (t < 0) return -1;
+  // the crossing itself, in the rim triangle's plane: its coordinates in
+  // that plane (summing to 1, outside [0, 1] off the triangle), so the
+  // point rides on the rim where the hole's centre is
+  double a[3], b[3], c[3], e0[3], e1[3], e2[3];
+  corner(x, tri[3 * t], a), corner(x, tri[3 * t + 1], b), corner(x, tri[3 * t + 2], c);
+  for (int j = 0; j < 3; j++) e0[j] = b[j] - a[j], e1[j] = c[j] - a[j], e2[j] = on_arc[j] - a[j];
+  double d00 = dot(e0, e0), d01 = dot(e0, e1), d11 = dot(e1, e1), d20 = dot(e2, e0), d21 = dot(e2, e1);
+  double den = d00 * d11 - d01 * d01;
+  if (!(den > 0)) return t; // a degenerate rim triangle: its nearest point
+  double v = (d11 * d20 - d01 * d21) / den, w2 = (d00 * d21 - d01 * d20) / den;
+  bary[0] = 1 - v - w2, bary[1] = v, bary[2] = w2;
+  for (int j = 0; j < 3; j++) point[j] = bary[0] * a[j] + bary[1] * b[j] + bary[2] * c[j];
+  return t;
+
 }
 
 void tx_puncture_tracker_init(tx_puncture_tracker* t, double separation, double min_force, double torn) {
@@ -121,4 +231,17 @@ bool tx_puncture_update(tx_puncture_tracker* t, const tx_skin_contact* c, const 
   t->free = false;
   t->peak_f = t->peak_depth = 0;
   return true;
+}
+
+double tx_height_above_sheet(const float* x, int nx, const double p[3]) {
+  double best = INFINITY, y = 0, lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+  for (int i = 0; i < nx; i++) {
+    const float* q = x + 3 * i;
+    if (!isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2])) continue;
+    double dx = p[0] - q[0], dz = p[2] - q[2], d2 = dx * dx + dz * dz;
+    lo[0] = fmin(lo[0], q[0]), hi[0] = fmax(hi[0], q[0]), lo[1] = fmin(lo[1], q[2]), hi[1] = fmax(hi[1], q[2]);
+    if (d2 < best) best = d2, y = q[1];
+  }
+  if (!(p[0] >= lo[0] && p[0] <= hi[0] && p[2] >= lo[1] && p[2] <= hi[1])) return INFINITY;
+  return p[1] - y;
 }

@@ -52,4 +52,32 @@ bool tx_puncture_update(tx_puncture_tracker* t, const tx_skin_contact* c, const 
 int tx_nearest_triangle(const float* x, int nx, const int32_t* tri, int ntri, const double p[3], double bary[3],
                         double point[3]);
 
+// Where the needle crossed the skin: arc holds narc points along the needle
+// from its tip back towards its swage. The patch is the component of the
+// particles that the most live triangles join (a flap torn loose, hanging
+// by nothing or by itself, is not the patch); scratch (nscratch int32 >= 2
+// nx, NULL: every triangle counts as the patch) is its work space. The
+// first point back from the tip on the other side of the patch's sheet than
+// the tip (the side: the nearest triangle's normal) brackets the crossing
+// (with near_to: of the arc's points within `within` of near_to, the
+// crossing nearest it, for a hole the needle slides through);
+// on_arc is the crossing, between the two points where the distance to the
+// sheet goes through zero, and the result is the patch's triangle nearest
+// it (the hole's rim), with the crossing's barycentric coordinates in its
+// plane (summing to 1; outside [0, 1], as the hole's centre is off the
+// rim) and that point (the crossing projected on the plane); -1 when the arc
+// does not cross the sheet.
+int tx_puncture_hole(const float* x, int nx, const int32_t* tri, int ntri, const double (*arc)[3], int narc,
+                     const double near_to[3], double within, int32_t* scratch, int nscratch, double bary[3],
+                     double point[3], double on_arc[3]);
+
+// whether the triangle of particles v is still a live triangle (in tri) of
+// the patch (as in tx_puncture_hole; scratch NULL: any live one is)
+bool tx_puncture_attached(int nx, const int32_t* tri, int ntri, int32_t* scratch, int nscratch, const int32_t v[3]);
+
+// how high p is above the skin's sheet (m; negative: under it): p's height
+// less that of the particle nearest it across (in x and z); INFINITY when
+// p is not over the patch (outside its particles' x-z bounds)
+double tx_height_above_sheet(const float* x, int nx, const double p[3]);
+
 #endif

@@ -1193,11 +1193,6 @@ static void punctures_begin_substep(tx_thread* t) {
     for (int i = c - m; i <= c + 1 + m; i++)
       if (i >= 0 && i < t->n) t->near_punct[i] = 1;
   }
-  // the head rides on the needle's swage, which goes through the hole the
-  // needle made: while a puncture is still to pass, the links at the head go
-  // through the skin with it (held back by it, the head's link was torn apart)
-  if (t->passed < t->npunct)
-    for (int i = 0; i <= m && i < t->n; i++) t->near_punct[i] = 1;
 }
 
 // each passed puncture holds the thread's point at arc[k] on it. In the

@@ -209,10 +209,79 @@ static void test_blades_close_once(void** state) {
   assert_int_equal(tx_blades_close(&b, NAN), 0);
 }
 
+
+// the hole where the needle crossed the skin: the patch with the cell
+// (-1..0, -1..0) cm torn out and a flap of three loose particles hanging
+// 12 mm under it; an arc going up through the hole's centre from its tip
+// 10 mm under: the crossing is the hole's centre on the sheet, held by a
+// triangle of the patch (not the flap nearer the tip), in its plane
+static void test_hole_at_the_crossing_on_the_patch(void** state) {
+  (void)state;
+  float x[(N * N + 3) * 3];
+  int32_t t[(2 * (N - 1) * (N - 1) + 1) * 3], scratch[2 * (N * N + 3)];
+  memcpy(x, xs, sizeof xs);
+  int n = 0;
+  for (int k = 0; k < ntri; k++)
+    if (k / 2 != 1 * (N - 1) + 1) memcpy(t + 3 * n++, tris + 3 * k, sizeof(int32_t) * 3); // the cell i = 1, k = 1 torn out
+  assert_int_equal(n, ntri - 2);
+  float flap[9] = {-0.006f, -0.012f, -0.004f, -0.004f, -0.012f, -0.004f, -0.005f, -0.012f, -0.006f};
+  memcpy(x + 3 * N * N, flap, sizeof flap);
+  t[3 * n] = N * N, t[3 * n + 1] = N * N + 1, t[3 * n + 2] = N * N + 2;
+  n++;
+  int nx = N * N + 3;
+  double arc[21][3];
+  for (int k = 0; k <= 20; k++) arc[k][0] = -0.005, arc[k][1] = -0.01 + 0.001 * k, arc[k][2] = -0.005;
+  double bary[3], point[3], on[3];
+  int h = tx_puncture_hole(x, nx, t, n, (const double(*)[3])arc, 21, NULL, 0, scratch, 2 * nx, bary, point, on);
+  print_message("  hole: triangle %d (%d %d %d), crossing (%.2f, %.2f, %.2f) mm, bary (%.3f, %.3f, %.3f)\n", h, t[3 * h],
+                t[3 * h + 1], t[3 * h + 2], 1e3 * on[0], 1e3 * on[1], 1e3 * on[2], bary[0], bary[1], bary[2]);
+  assert_true(h >= 0 && h < n - 1); // of the patch
+  assert_true(fabs(on[0] + 0.005) < 1e-12 && fabs(on[1]) < 1e-9 && fabs(on[2] + 0.005) < 1e-12);
+  assert_true(fabs(bary[0] + bary[1] + bary[2] - 1) < 1e-12);
+  for (int k = 0; k < 3; k++) {
+    double p = 0;
+    for (int v = 0; v < 3; v++) p += bary[v] * x[3 * t[3 * h + v] + k];
+    assert_true(fabs(p - on[k]) < 1e-9 && fabs(point[k] - on[k]) < 1e-9); // the crossing, riding on the rim triangle
+  }
+  // near a given point: the crossing within reach of it, none beyond
+  double near_to[3] = {-0.005, 0.001, -0.004}, far_to[3] = {0.03, 0, 0};
+  assert_int_equal(tx_puncture_hole(x, nx, t, n, (const double(*)[3])arc, 21, near_to, 0.003, scratch, 2 * nx, bary, point, on), h);
+  assert_int_equal(tx_puncture_hole(x, nx, t, n, (const double(*)[3])arc, 21, far_to, 0.003, scratch, 2 * nx, bary, point, on), -1);
+  // an arc that stays under the sheet crosses nothing
+  assert_int_equal(tx_puncture_hole(x, nx, t, n, (const double(*)[3])arc, 8, NULL, 0, scratch, 2 * nx, bary, point, on), -1);
+  // attached: a live triangle of the patch in any turn of its order; not
+  // the flap, not a torn one, not a particle out of range
+  int32_t live[3] = {t[4], t[5], t[3]}, flap_t[3] = {N * N, N * N + 1, N * N + 2}, torn[3] = {tris[30], tris[31], tris[32]};
+  assert_true(tx_puncture_attached(nx, t, n, scratch, 2 * nx, live));
+  assert_false(tx_puncture_attached(nx, t, n, scratch, 2 * nx, flap_t));
+  assert_true(tx_puncture_attached(nx, t, n, NULL, 0, flap_t)); // with no room for the components any live one is
+  assert_false(tx_puncture_attached(nx, t, n, scratch, 2 * nx, torn));
+  int32_t out[3] = {-1, 0, 1};
+  assert_false(tx_puncture_attached(nx, t, n, scratch, 2 * nx, out));
+}
+
+
+// the height above the sheet: of the particle nearest across; over the
+// patch only; a particle that is not finite is skipped
+static void test_height_above_sheet(void** state) {
+  (void)state;
+  float x[N * N * 3];
+  memcpy(x, xs, sizeof xs);
+  x[3 * 12 + 1] = 0.004f; // the middle particle (0, 0) raised 4 mm
+  assert_true(fabs(tx_height_above_sheet(x, N * N, (double[3]){0.001, 0.01, -0.002}) - 0.006) < 1e-7);
+  assert_true(fabs(tx_height_above_sheet(x, N * N, (double[3]){0.013, -0.003, 0.008}) + 0.003) < 1e-7);
+  assert_true(isinf(tx_height_above_sheet(x, N * N, (double[3]){0.025, 0, 0}))); // beyond the patch's edge
+  assert_true(isinf(tx_height_above_sheet(x, 0, (double[3]){0, 0, 0})));
+  x[3 * 12] = NAN;
+  assert_true(fabs(tx_height_above_sheet(x, N * N, (double[3]){0.001, 0.01, -0.002}) - 0.01) < 1e-7);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test_setup(test_nearest_triangle, patch),
       cmocka_unit_test_setup(test_entry_then_exit, patch),
+      cmocka_unit_test_setup(test_hole_at_the_crossing_on_the_patch, patch),
+      cmocka_unit_test_setup(test_height_above_sheet, patch),
       cmocka_unit_test(test_scissors_cut_between_the_blades),
       cmocka_unit_test(test_jaws_pinch_the_skin),
       cmocka_unit_test(test_blades_close_once),
