@@ -60,6 +60,8 @@ static const tx_param_def params[] = {
     {"rupture_length_m", TX_PARAM_NUM, "m", 1e-4, 0.05, 0.002, NULL, "radius over which the tension is averaged"},
     {"solver", TX_PARAM_STR, NULL, 0, 0, 0, "implicit",
      "\"implicit\": backward Euler, Newton and preconditioned CG (real time); \"xpbd\": XPBD, converged only with k w h^2 <= 1/4"},
+    {"force_reading", TX_PARAM_STR, NULL, 0, 0, 0, "balance",
+     "implicit: \"balance\": the force on the HIP is the patch's momentum balance; \"held\": the held particles' own imbalance (docs/skin.md)"},
     {"iterations", TX_PARAM_INT, "1", 1, 200, 1, NULL, "XPBD iterations per substep"},
     {"newton_steps", TX_PARAM_INT, "1", 1, 20, 2, NULL, "implicit: most Newton steps per substep; they stop once the gradient is a tenth of the first step's"},
     {"cg_iterations", TX_PARAM_INT, "1", 1, 10000, 100, NULL, "implicit: most CG iterations per Newton step"},
@@ -103,6 +105,11 @@ static int configure(tx_setup* s, void** self) {
   if (strcmp(solver, "implicit") == 0) d.solver = TX_CLOTH_IMPLICIT;
   else if (strcmp(solver, "xpbd") == 0) d.solver = TX_CLOTH_XPBD;
   else return tx_setup_fail(s, "solver", "expected \"implicit\" or \"xpbd\", got \"%s\"", solver);
+  const char* reading = tx_table_str(s, "force_reading");
+  if (!reading) return -1;
+  if (strcmp(reading, "balance") == 0) d.reading = TX_CLOTH_BALANCE;
+  else if (strcmp(reading, "held") == 0) d.reading = TX_CLOTH_HELD;
+  else return tx_setup_fail(s, "force_reading", "expected \"balance\" or \"held\", got \"%s\"", reading);
   d.iterations = (int)tx_table_int(s, "iterations");
   d.newton_steps = (int)tx_table_int(s, "newton_steps");
   d.cg_iterations = (int)tx_table_int(s, "cg_iterations");
