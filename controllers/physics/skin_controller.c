@@ -66,6 +66,8 @@ static const tx_param_def params[] = {
     {"newton_steps", TX_PARAM_INT, "1", 1, 20, 2, NULL, "implicit: most Newton steps per substep; they stop once the gradient is a tenth of the first step's"},
     {"cg_iterations", TX_PARAM_INT, "1", 1, 10000, 100, NULL, "implicit: most CG iterations per Newton step"},
     {"cg_tolerance", TX_PARAM_NUM, "1", 1e-12, 1, 1e-2, NULL, "implicit: CG stops at this relative residual"},
+    {"coarse_block", TX_PARAM_INT, "1", 0, 64, 0, NULL,
+     "implicit: 0, CG preconditioned by block Jacobi; else in [2, 64], plus a coarse level of one particle per block of this many a side"},
     {"max_substep_s", TX_PARAM_NUM, "s", 1e-6, 0.1, 1.0 / 60, NULL, "a step is split into substeps of at most this"},
     {"max_speed", TX_PARAM_NUM, "m/s", 1e-3, 1e4, 100, NULL, "a faster particle is a blow-up"},
     {"hip_radius_m", TX_PARAM_NUM, "m", 0, 0.01, 0.0005, NULL, "the HIP sphere (0.05 cm); 0: no HIP"},
@@ -114,6 +116,8 @@ static int configure(tx_setup* s, void** self) {
   d.newton_steps = (int)tx_table_int(s, "newton_steps");
   d.cg_iterations = (int)tx_table_int(s, "cg_iterations");
   d.cg_tolerance = tx_table_num(s, "cg_tolerance");
+  d.coarse_block = (int)tx_table_int(s, "coarse_block");
+  if (d.coarse_block == 1) return tx_setup_fail(s, "coarse_block", "1: a block must hold 2 or more particles a side (0: none)");
   d.max_substep = tx_table_num(s, "max_substep_s");
   d.max_speed = tx_table_num(s, "max_speed");
   k->hip_radius = tx_table_num(s, "hip_radius_m");

@@ -115,6 +115,8 @@ typedef struct tx_cloth_def {
                             // gradient is a tenth of the first's)
   int cg_iterations;        // implicit: most conjugate-gradient iterations per Newton step, in [1, 10000]; 100
   double cg_tolerance;      // implicit: the CG stops at this residual over the right-hand side's, in [1e-12, 1]; 1e-2
+  int coarse_block;         // implicit: 0, the CG preconditioned by block Jacobi; else, plus a coarse level of one
+                            // particle per coarse_block x coarse_block block (two-level), in [2, 64]; 0
   double max_substep;       // s, a step is split into substeps of at most this, in [1e-6, 0.1]; 1/60
   double max_speed;         // m/s, a faster particle is a blow-up, in (0, 1e4]; 100
   double settle_time;       // s, with gravity the patch first hangs this long without rupture, in [0, 10]; 1

@@ -712,6 +712,52 @@ static void balance_reads_the_converged_force(void** state) {
   assert_true(fabs(bal - ref) < 0.02 * ref); // the real-time reading is the converged one
 }
 
+// the two-level preconditioner (coarse_block) solves the same system in fewer
+// CG iterations, before and after the skin tears (its coarse matrix is built
+// from the links there are): 41 x 41, 10 cm, pressed over a particle at 1 cm/s
+// to 5 mm, then on through the tear at some 10 mm
+static void press_through(int coarse, double* f5, int* cg, int* torn) {
+  tx_cloth_def d = tx_cloth_def_default();
+  d.res[0] = d.res[1] = 41;
+  d.size[0] = d.size[1] = 0.1;
+  d.rupture_tension = 150;
+  d.rupture_length = 0.01;
+  d.coarse_block = coarse;
+  tx_cloth* c = tx_cloth_create(&d);
+  if (!c) fail_msg("%s", tx_error());
+  double pos[3] = {0, 0.003, 0}, f[3];
+  *cg = 0;
+  *f5 = NAN;
+  for (int s = 0; pos[1] > 0.0025 - 0.013; s++, pos[1] -= 0.01 / 60) {
+    tx_cloth_set_hip(c, pos, 0.0005);
+    assert_int_equal(tx_cloth_step(c, 1.0 / 60), TX_CLOTH_OK);
+    tx_cloth_solve_info si;
+    tx_cloth_solve_stats(c, &si);
+    *cg += si.cg_iterations;
+    tx_cloth_contact_force(c, f);
+    if (isnan(*f5) && pos[1] <= 0.0025 - 0.005) *f5 = f[1];
+  }
+  *torn = tx_cloth_torn(c);
+  assert_true(all_finite(c));
+  tx_cloth_destroy(c);
+}
+
+static void two_level_preconditioner(void** state) {
+  (void)state;
+  double f0, f4;
+  int cg0, cg4, t0, t4;
+  press_through(0, &f0, &cg0, &t0);
+  press_through(4, &f4, &cg4, &t4);
+  print_message("  block Jacobi: %d CG iterations, %.1f mN at 5 mm, %d torn; two-level (4 x 4 blocks): %d, %.1f mN, %d torn\n",
+                cg0, f0 * 1e3, t0, cg4, f4 * 1e3, t4);
+  assert_true(fabs(f4 - f0) < 0.01 * f0);
+  assert_true(t0 > 0 && t4 > 0);
+  assert_true(cg4 < 0.6 * cg0);
+  tx_cloth_def d = tx_cloth_def_default();
+  d.coarse_block = 1;
+  assert_int_equal(tx_cloth_def_check(&d), -1);
+}
+
 // the faults, restore, rupture and allocation tests again with the XPBD solver
 #if !SANITIZED
 static int use_xpbd(void** state) {
@@ -783,6 +829,7 @@ int main(void) {
       cmocka_unit_test(rupture_is_located_between_steps),
       cmocka_unit_test(pinned_particles_follow),
       cmocka_unit_test(stopped_hip_rests_in_the_skin),
+      cmocka_unit_test(two_level_preconditioner),
 #if !SANITIZED
       cmocka_unit_test(balance_reads_the_converged_force), // some 20 s under the sanitizers: the converged solves // the same code paths as above, but for the links' solve; minutes under the sanitizers
       cmocka_unit_test_setup_teardown(pinned_particles_follow, use_xpbd, use_implicit),
