@@ -176,6 +176,7 @@ typedef struct setting {
   char solver[12]; // "xpbd" or "implicit"
   int newton_steps, cg_iterations; // implicit only
   double cg_tolerance;
+  int coarse_block; // implicit only: the CG's coarse level (0: none)
 } setting;
 
 typedef struct row {
@@ -263,6 +264,7 @@ static int real_time_setting(setting* s) {
   s->newton_steps = (int)num_of(params, "newton_steps");
   s->cg_iterations = (int)num_of(params, "cg_iterations");
   s->cg_tolerance = num_of(params, "cg_tolerance");
+  s->coarse_block = (int)num_of(params, "coarse_block");
   json_t* sv = json_object_get(params, "solver");
   const tx_param_def* sp = skin_param("solver");
   snprintf(s->solver, sizeof s->solver, "%s", json_is_string(sv) ? json_string_value(sv) : sp ? sp->def_str : "?");
@@ -355,6 +357,7 @@ static json_t* skin_params(const setting* s, bool gravity, double hip_radius) {
                         "thickness_m", THICKNESS_M, "hip_radius_m", hip_radius, "iterations", s->iterations,
                         "max_substep_s", s->substep, "gravity", gravity, "solver", s->solver, "newton_steps",
                         s->newton_steps, "cg_iterations", s->cg_iterations, "cg_tolerance", s->cg_tolerance);
+  if (p && s->coarse_block > 0) json_object_set_new(p, "coarse_block", json_integer(s->coarse_block));
   if (p && gravity) no_rupture(p);
   else if (p) {
     json_object_set_new(p, "rupture_tension_n_per_m", json_real(RUPTURE_T));

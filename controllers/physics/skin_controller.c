@@ -60,10 +60,14 @@ static const tx_param_def params[] = {
     {"rupture_length_m", TX_PARAM_NUM, "m", 1e-4, 0.05, 0.002, NULL, "radius over which the tension is averaged"},
     {"solver", TX_PARAM_STR, NULL, 0, 0, 0, "implicit",
      "\"implicit\": backward Euler, Newton and preconditioned CG (real time); \"xpbd\": XPBD, converged only with k w h^2 <= 1/4"},
+    {"force_reading", TX_PARAM_STR, NULL, 0, 0, 0, "balance",
+     "implicit: \"balance\": the force on the HIP is the patch's momentum balance; \"held\": the held particles' own imbalance (docs/skin.md)"},
     {"iterations", TX_PARAM_INT, "1", 1, 200, 1, NULL, "XPBD iterations per substep"},
     {"newton_steps", TX_PARAM_INT, "1", 1, 20, 2, NULL, "implicit: most Newton steps per substep; they stop once the gradient is a tenth of the first step's"},
     {"cg_iterations", TX_PARAM_INT, "1", 1, 10000, 100, NULL, "implicit: most CG iterations per Newton step"},
     {"cg_tolerance", TX_PARAM_NUM, "1", 1e-12, 1, 1e-2, NULL, "implicit: CG stops at this relative residual"},
+    {"coarse_block", TX_PARAM_INT, "1", 0, 64, 0, NULL,
+     "implicit: 0, CG preconditioned by block Jacobi; else in [2, 64], plus a coarse level of one particle per block of this many a side"},
     {"max_substep_s", TX_PARAM_NUM, "s", 1e-6, 0.1, 1.0 / 60, NULL, "a step is split into substeps of at most this"},
     {"max_speed", TX_PARAM_NUM, "m/s", 1e-3, 1e4, 100, NULL, "a faster particle is a blow-up"},
     {"hip_radius_m", TX_PARAM_NUM, "m", 0, 0.01, 0.0005, NULL, "the HIP sphere (0.05 cm); 0: no HIP"},
@@ -103,10 +107,17 @@ static int configure(tx_setup* s, void** self) {
   if (strcmp(solver, "implicit") == 0) d.solver = TX_CLOTH_IMPLICIT;
   else if (strcmp(solver, "xpbd") == 0) d.solver = TX_CLOTH_XPBD;
   else return tx_setup_fail(s, "solver", "expected \"implicit\" or \"xpbd\", got \"%s\"", solver);
+  const char* reading = tx_table_str(s, "force_reading");
+  if (!reading) return -1;
+  if (strcmp(reading, "balance") == 0) d.reading = TX_CLOTH_BALANCE;
+  else if (strcmp(reading, "held") == 0) d.reading = TX_CLOTH_HELD;
+  else return tx_setup_fail(s, "force_reading", "expected \"balance\" or \"held\", got \"%s\"", reading);
   d.iterations = (int)tx_table_int(s, "iterations");
   d.newton_steps = (int)tx_table_int(s, "newton_steps");
   d.cg_iterations = (int)tx_table_int(s, "cg_iterations");
   d.cg_tolerance = tx_table_num(s, "cg_tolerance");
+  d.coarse_block = (int)tx_table_int(s, "coarse_block");
+  if (d.coarse_block == 1) return tx_setup_fail(s, "coarse_block", "1: a block must hold 2 or more particles a side (0: none)");
   d.max_substep = tx_table_num(s, "max_substep_s");
   d.max_speed = tx_table_num(s, "max_speed");
   k->hip_radius = tx_table_num(s, "hip_radius_m");

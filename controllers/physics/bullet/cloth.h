@@ -86,6 +86,11 @@ typedef enum tx_cloth_solver {
   TX_CLOTH_XPBD = 1,     // XPBD: converges only with k w h^2 under about 1 (the refinement path)
 } tx_cloth_solver;
 
+typedef enum tx_cloth_reading {
+  TX_CLOTH_BALANCE = 0, // implicit: the patch's momentum balance (the default)
+  TX_CLOTH_HELD = 1,    // the held particles' own imbalance (XPBD always reads this)
+} tx_cloth_reading;
+
 typedef struct tx_cloth_def {
   double size[2];           // m, edge lengths along x and z; 0.1 (the papers' 10 x 10 cm patch)
   int res[2];               // particles along x and z, in [2, 1024]; 42 (0.25 cm spacing: 1764 particles)
@@ -110,9 +115,12 @@ typedef struct tx_cloth_def {
                             // gradient is a tenth of the first's)
   int cg_iterations;        // implicit: most conjugate-gradient iterations per Newton step, in [1, 10000]; 100
   double cg_tolerance;      // implicit: the CG stops at this residual over the right-hand side's, in [1e-12, 1]; 1e-2
+  int coarse_block;         // implicit: 0, the CG preconditioned by block Jacobi; else, plus a coarse level of one
+                            // particle per coarse_block x coarse_block block (two-level), in [2, 64]; 0
   double max_substep;       // s, a step is split into substeps of at most this, in [1e-6, 0.1]; 1/60
   double max_speed;         // m/s, a faster particle is a blow-up, in (0, 1e4]; 100
   double settle_time;       // s, with gravity the patch first hangs this long without rupture, in [0, 10]; 1
+  int reading;              // tx_cloth_reading, how the implicit solver reads the force on the HIP; TX_CLOTH_BALANCE
 } tx_cloth_def;
 
 typedef struct tx_cloth tx_cloth;
@@ -154,9 +162,12 @@ bool tx_cloth_positions(const tx_cloth* c, float* out);
 int tx_cloth_triangles(tx_cloth* c, int32_t* out);
 // stretch and shear links broken so far
 int tx_cloth_torn(const tx_cloth* c);
-// force of the skin on the HIP at the end of the last step (N): the links'
-// pull (k (l - l0) each), the weight and less the m a of the particles the
-// contact holds, along the contact's normal, never a pull; zero without contact
+// force of the skin on the HIP at the end of the last step (N), along the
+// contact's normal, never a pull; zero without contact. TX_CLOTH_HELD: the
+// links' pull (k (l - l0) each) and the weight, less the m a, of the particles
+// the contact holds. TX_CLOTH_BALANCE (implicit only): the whole patch's
+// momentum balance, the links' pull on its kinematic particles (border, clamp,
+// pins) less the free particles' backward Euler inertia M (x - y) / h^2
 void tx_cloth_contact_force(const tx_cloth* c, double out[3]);
 // the contact over the last step, what the skin's reaction on the HIP is
 typedef struct tx_cloth_contact_info {

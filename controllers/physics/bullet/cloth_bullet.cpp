@@ -76,6 +76,12 @@ struct tx_cloth {
   std::vector<uint8_t> state;      // (n) in the solve: 0 fixed, 1 free, 2 held (hold and the mass, packed)
   std::vector<double> mh2;         // (n) N/m, m / h^2 of each particle, 0 when fixed
   std::vector<double> hold_n;      // (n x 3) 1, the contact's push on a held particle, summed
+  // the two-level preconditioner (coarse_block > 0): blocks of coarse_block x coarse_block particles,
+  // each one coarse particle; the Galerkin product P^T S A S P, banded, factored each Newton step
+  std::vector<int32_t> agg;        // (n) each particle's block
+  int nagg, agg_cols, band;        // blocks; blocks along x; the band's half-width in unknowns
+  std::vector<double> coarse;      // (nagg x 3 x (band + 1)) the lower band, then its Cholesky factor
+  std::vector<double> cvec;        // (nagg x 3) the coarse residual, then the correction
   tx_cloth_solve_info stats;       // the last step's
 
   std::vector<int32_t> tri;        // (ntri x 3) vertex indices
@@ -156,6 +162,8 @@ extern "C" tx_cloth_def tx_cloth_def_default(void) {
   d.max_substep = 1.0 / 60;
   d.max_speed = 100;
   d.settle_time = 1;
+  d.reading = TX_CLOTH_BALANCE;
+  d.coarse_block = 0;
   return d;
 }
 
@@ -190,6 +198,11 @@ extern "C" int tx_cloth_def_check(const tx_cloth_def* d) {
     tx_set_error("skin: solver = %d, must be %d (implicit) or %d (xpbd)", d->solver, TX_CLOTH_IMPLICIT, TX_CLOTH_XPBD);
     return -1;
   }
+  if (d->reading != TX_CLOTH_BALANCE && d->reading != TX_CLOTH_HELD) {
+    tx_set_error("skin: reading = %d, must be %d (balance) or %d (held)", d->reading, TX_CLOTH_BALANCE, TX_CLOTH_HELD);
+    return -1;
+  }
+  if (d->coarse_block != 0 && tx_check_count("skin", "coarse_block", d->coarse_block, 2, 64)) return -1;
   if (tx_check_count("skin", "iterations", d->iterations, 1, 200)) return -1;
   if (tx_check_count("skin", "newton_steps", d->newton_steps, 1, 20)) return -1;
   if (tx_check_count("skin", "cg_iterations", d->cg_iterations, 1, 10000)) return -1;
@@ -420,6 +433,19 @@ static bool build(tx_cloth* c) {
     c->state.assign((size_t)c->n, 0);
     c->held_solve.assign((size_t)c->n, 0);
     c->mh2.assign((size_t)c->n, 0.0);
+    if (d.coarse_block > 0) {
+      const int b = d.coarse_block, cx = (nx + b - 1) / b, cz = (nz + b - 1) / b;
+      c->agg.assign((size_t)c->n, 0);
+      for (int iz = 0; iz < nz; iz++)
+        for (int ix = 0; ix < nx; ix++) c->agg[(size_t)node_index(d, ix, iz)] = (iz / b) * cx + ix / b;
+      c->nagg = cx * cz;
+      c->agg_cols = cx;
+      // a link spans at most two spacings (bending), so it joins blocks at most one apart
+      // along x and z when b >= 2: the band reaches cx + 1 blocks back
+      c->band = 3 * (cx + 1) + 2;
+      c->coarse.assign((size_t)c->nagg * 3 * (size_t)(c->band + 1), 0.0);
+      c->cvec.assign((size_t)c->nagg * 3, 0.0);
+    }
   }
   return true;
 }
@@ -702,6 +728,8 @@ static void apply_system(tx_cloth* c, const double* v, double* out) {
   for (int i = 0; i < n; i++) filter(c, i, &out[i * 3]);
 }
 
+static void coarse_correct(tx_cloth* c, const double* r, double* z);
+
 // z = S P^-1 r
 static void precondition(tx_cloth* c, const double* r, double* z) {
   const double* pi = c->pinv.data();
@@ -713,6 +741,7 @@ static void precondition(tx_cloth* c, const double* r, double* z) {
     z[i * 3 + 2] = m[4] * v[0] + m[5] * v[1] + m[2] * v[2];
     filter(c, i, &z[i * 3]);
   }
+  if (c->def.coarse_block > 0) coarse_correct(c, r, z);
 }
 
 static double dot(const std::vector<double>& a, const std::vector<double>& b) {
@@ -745,6 +774,147 @@ static double energy(const tx_cloth* c, double h) {
   return e;
 }
 
+// The coarse level (Galerkin, unsmoothed aggregation): a coarse particle per
+// block, its displacement given to each of the block's particles through its
+// filter S (fixed: none; held: across the contact's normal). Its matrix
+// P^T S (M / h^2 + H) S P from the same link blocks as the fine product, so
+// torn links are simply absent from it; banded (blocks are numbered row by
+// row and a link joins neighbouring blocks only) and factored by Cholesky.
+// The preconditioner is then additive, block Jacobi plus P A_c^-1 P^T: the
+// Jacobi part damps the short waves and the coarse part the long ones, which
+// Jacobi alone needs some res iterations to spread across the patch.
+static inline double& cband(tx_cloth* c, int r, int col) { // lower band, r >= col
+  return c->coarse[(size_t)r * (size_t)(c->band + 1) + (size_t)(col - r + c->band)];
+}
+
+// S_i as a full 3 x 3 (0 for fixed, I - n n^T for held, I for free)
+static void filter_matrix(const tx_cloth* c, int i, double S[9]) {
+  const uint8_t st = c->state[(size_t)i];
+  for (int e = 0; e < 9; e++) S[e] = 0;
+  if (st == 0) return;
+  S[0] = S[4] = S[8] = 1;
+  if (st == 2) {
+    const double* n = &c->hold_n[(size_t)i * 3];
+    for (int r = 0; r < 3; r++)
+      for (int q = 0; q < 3; q++) S[r * 3 + q] -= n[r] * n[q];
+  }
+}
+
+// adds the 3 x 3 block B (row major) at coarse blocks (I, J), lower band only
+static void coarse_add(tx_cloth* c, int I, int J, const double B[9]) {
+  for (int r = 0; r < 3; r++)
+    for (int q = 0; q < 3; q++) {
+      const int R = I * 3 + r, Q = J * 3 + q;
+      if (Q <= R) cband(c, R, Q) += B[r * 3 + q];
+    }
+}
+
+static void build_coarse(tx_cloth* c) {
+  std::fill(c->coarse.begin(), c->coarse.end(), 0.0);
+  const int n = c->n, nl = c->body->m_links.size();
+  double S[9], Sa[9], Sb[9], T[9], B[9];
+  for (int i = 0; i < n; i++) { // the mass, S (m / h^2) S = (m / h^2) S
+    if (c->state[(size_t)i] == 0) continue;
+    filter_matrix(c, i, S);
+    for (int e = 0; e < 9; e++) B[e] = c->mh2[(size_t)i] * S[e];
+    coarse_add(c, c->agg[(size_t)i], c->agg[(size_t)i], B);
+  }
+  const int32_t* le = c->lend.data();
+  for (int s = 0; s < nl; s++) {
+    const int a = le[s * 2], b = le[s * 2 + 1];
+    const uint8_t sa = c->state[(size_t)a], sb = c->state[(size_t)b];
+    const int A = c->agg[(size_t)a], Bk = c->agg[(size_t)b];
+    if ((sa == 0 && sb == 0) || (A == Bk && sa == 1 && sb == 1)) continue; // nothing, or sums to zero in its block
+    const double* h = &c->hess[(size_t)s * 6];
+    const double H[9] = {h[0], h[3], h[4], h[3], h[1], h[5], h[4], h[5], h[2]};
+    filter_matrix(c, a, Sa);
+    filter_matrix(c, b, Sb);
+    // blocks: (A,A) Sa H Sa, (B,B) Sb H Sb, (A,B) -Sa H Sb, (B,A) -Sb H Sa
+    const double* Sl[2] = {Sa, Sb};
+    const int K[2] = {A, Bk};
+    for (int u = 0; u < 2; u++)
+      for (int v = 0; v < 2; v++) {
+        if (K[v] > K[u]) continue; // the lower band: blocks (I, J) with J <= I
+        for (int r = 0; r < 3; r++)
+          for (int q = 0; q < 3; q++) {
+            double t = 0;
+            for (int m = 0; m < 3; m++) t += Sl[u][r * 3 + m] * H[m * 3 + q];
+            T[r * 3 + q] = t;
+          }
+        const double sign = u == v ? 1 : -1;
+        for (int r = 0; r < 3; r++)
+          for (int q = 0; q < 3; q++) {
+            double t = 0;
+            for (int m = 0; m < 3; m++) t += T[r * 3 + m] * Sl[v][m * 3 + q];
+            B[r * 3 + q] = sign * t;
+          }
+        coarse_add(c, K[u], K[v], B);
+      }
+  }
+  // Cholesky of the band in place; an unknown with nothing in it (a block of fixed
+  // particles, or one held along a single normal) is dropped
+  const int N = c->nagg * 3, w = c->band;
+  for (int j = 0; j < N; j++) {
+    double d = cband(c, j, j);
+    const int k0 = std::max(0, j - w);
+    const double d0 = d;
+    for (int k = k0; k < j; k++) d -= cband(c, j, k) * cband(c, j, k);
+    if (!(d > 1e-10 * std::fabs(d0)) || !(d0 > 0)) { // drop it: zero its column below
+      cband(c, j, j) = 0;
+      for (int i = j + 1; i <= std::min(N - 1, j + w); i++) cband(c, i, j) = 0;
+      continue;
+    }
+    const double l = std::sqrt(d);
+    cband(c, j, j) = l;
+    for (int i = j + 1; i <= std::min(N - 1, j + w); i++) {
+      double v = cband(c, i, j);
+      for (int k = std::max(k0, i - w); k < j; k++) v -= cband(c, i, k) * cband(c, j, k);
+      cband(c, i, j) = v / l;
+    }
+  }
+}
+
+// z += S P A_c^-1 P^T r
+static void coarse_correct(tx_cloth* c, const double* r, double* z) {
+  double* y = c->cvec.data();
+  std::fill(c->cvec.begin(), c->cvec.end(), 0.0);
+  for (int i = 0; i < c->n; i++) {
+    if (c->state[(size_t)i] == 0) continue;
+    double v[3] = {r[i * 3], r[i * 3 + 1], r[i * 3 + 2]};
+    filter(c, i, v);
+    double* t = &y[(size_t)c->agg[(size_t)i] * 3];
+    t[0] += v[0], t[1] += v[1], t[2] += v[2];
+  }
+  const int N = c->nagg * 3, w = c->band;
+  for (int i = 0; i < N; i++) { // L y = b
+    const double l = cband(c, i, i);
+    if (l == 0) {
+      y[i] = 0;
+      continue;
+    }
+    double v = y[i];
+    for (int k = std::max(0, i - w); k < i; k++) v -= cband(c, i, k) * y[k];
+    y[i] = v / l;
+  }
+  for (int i = N - 1; i >= 0; i--) { // L^T x = y
+    const double l = cband(c, i, i);
+    if (l == 0) {
+      y[i] = 0;
+      continue;
+    }
+    double v = y[i];
+    for (int k = i + 1; k <= std::min(N - 1, i + w); k++) v -= cband(c, k, i) * y[k];
+    y[i] = v / l;
+  }
+  for (int i = 0; i < c->n; i++) {
+    if (c->state[(size_t)i] == 0) continue;
+    const double* t = &y[(size_t)c->agg[(size_t)i] * 3];
+    double v[3] = {t[0], t[1], t[2]};
+    filter(c, i, v);
+    z[i * 3] += v[0], z[i * 3 + 1] += v[1], z[i * 3 + 2] += v[2];
+  }
+}
+
 // one Newton step: solves S (M / h^2 + H) S dx = -S grad E by PCG (from the
 // last substep's dx with warm), moves the particles by dx; the relative
 // residual reached. *gg: |S grad E|^2 before the step; none is taken when
@@ -758,6 +928,7 @@ static double newton_step(tx_cloth* c, double h, bool warm, double* gg, double s
   for (int i = 0; i < n3; i++) bb += g[i] * g[i];
   *gg = bb;
   if (!(bb > stop2)) return 0;
+  if (c->def.coarse_block > 0) build_coarse(c);
   double* x = c->dx.data();
   double* r = c->rr.data();
   if (warm) std::memcpy(x, c->warm.data(), (size_t)n3 * sizeof(double));
@@ -1320,32 +1491,55 @@ extern "C" void tx_cloth_restore(tx_cloth* c) {
 // is no measure of it here: a position solver's correction at 60 Hz is m/dt^2
 // times what the links' last iterations left over, which the iteration count sets,
 // not the material.
-static int link_reaction(const tx_cloth* c, double dt, double out[3]) {
+//
+// The implicit solver takes the whole patch's momentum balance instead: the HIP's
+// push is the one force on the skin not otherwise known, so the skin's reaction on
+// the HIP is what holds the patch up at its kinematic particles (the border, the
+// clamp, the jaws' grasps: the links' pull on them) less the backward Euler
+// inertia M (x - y) / h^2 of the free particles over the last substep (y the
+// prediction with gravity and the loads, so the weight is in it). The held
+// particles' own imbalance, which the local sum reads, carries the part of the
+// solve that has not converged yet (the CG stops at 1e-2, Newton at a tenth),
+// and it sits where the contact is: at 1.25 mm the local sum read 234 mN where
+// the patch's balance reads 198 mN, and with a HIP at rest it flipped between
+// 11 and 136 mN as the contact's active set changed from step to step.
+static int link_reaction(const tx_cloth* c, double dt, double h, double out[3]) {
   out[0] = out[1] = out[2] = 0;
   int held = 0;
+  const bool balance = c->def.solver == TX_CLOTH_IMPLICIT && c->def.reading == TX_CLOTH_BALANCE;
+  const double ih2 = 1 / (h * h);
   for (int i = 0; i < c->n; i++) {
     const btSoftBody::Node& nd = c->body->m_nodes[i];
-    if (!c->in_contact[(size_t)i] || !(nd.m_im > 0)) continue;
-    held++;
+    if (!(nd.m_im > 0)) continue;
+    const bool in = c->in_contact[(size_t)i] != 0;
+    held += in;
     double m = 1.0 / nd.m_im;
-    for (int e = 0; e < 3; e++)
-      out[e] += m * (c->world.m_gravity[e] - (nd.m_v[e] - c->good_v[(size_t)i * 3 + e]) / dt);
+    if (balance)
+      for (int e = 0; e < 3; e++) out[e] -= m * ((double)nd.m_x[e] - c->y[(size_t)i * 3 + e]) * ih2;
+    else if (in)
+      for (int e = 0; e < 3; e++)
+        out[e] += m * (c->world.m_gravity[e] - (nd.m_v[e] - c->good_v[(size_t)i * 3 + e]) / dt);
   }
-  if (held == 0) return 0;
+  if (held == 0) {
+    out[0] = out[1] = out[2] = 0;
+    return 0;
+  }
   const btAlignedObjectArray<btSoftBody::Link>& links = c->body->m_links;
   const btSoftBody::Node* base = &c->body->m_nodes[0];
   for (int i = 0, ni = links.size(); i < ni; i++) {
     const btSoftBody::Link& l = links[i];
     int a = (int)(l.m_n[0] - base), b = (int)(l.m_n[1] - base);
-    bool ia = c->in_contact[(size_t)a] != 0, ib = c->in_contact[(size_t)b] != 0;
+    bool ia, ib; // balance: the kinematic end, which the link pulls towards the other; else the held end
+    if (balance) ia = !(l.m_n[0]->m_im > 0), ib = !(l.m_n[1]->m_im > 0);
+    else ia = c->in_contact[(size_t)a] != 0, ib = c->in_contact[(size_t)b] != 0;
     if (ia == ib) continue; // none held, or both: a link inside the contact pulls both ways
     btVector3 d = l.m_n[1]->m_x - l.m_n[0]->m_x;
     double len = d.length();
     if (!(len > 0)) continue;
     bool bend = c->info[(size_t)(intptr_t)l.m_tag].kind == BEND;
     double k = bend ? c->def.bend_stiffness : c->def.stretch_stiffness;
-    double s = k * (len - (double)l.m_rl) / len * (ia ? 1 : -1); // on the held end, toward the other
-    for (int e = 0; e < 3; e++) out[e] += s * d[e];
+    double s = k * (len - (double)l.m_rl) / len * (ia ? 1 : -1); // on the held (kinematic) end, toward the other
+    for (int e = 0; e < 3; e++) out[e] += balance ? -s * d[e] : s * d[e]; // what holds the patch, or pulls the held
   }
   // a smooth sphere takes only the push along its contact normal: the rest is the held
   // particles' own imbalance, which the solver has not yet spread (no pull either).
@@ -1491,7 +1685,7 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
     }
     c->prev_peak = c->sub_peak;
   }
-  c->contact_held = link_reaction(c, dt, c->contact_force);
+  c->contact_held = link_reaction(c, dt, h, c->contact_force);
   for (int a = 0; a < 3; a++) {
     c->contact_at[a] = c->hip[a];
     c->hip_prev[a] = c->hip[a];
