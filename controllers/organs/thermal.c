@@ -25,6 +25,15 @@ struct tx_thermal {
   double* q;          // W (n): the source
   double cap, boiled; // K (0: none), J
   bool* reached;      // (n)
+  double band;        // K: nodes within it of T_a whose neighbours are too are left alone (0: every node steps)
+  int *list, *next;   // (n): the nodes stepped, and the next substep's being built
+  int nlist;
+  unsigned* mark;     // (n): == stamp when in next
+  unsigned stamp;
+  bool rescan;        // the whole field changed: find the band anew
+  int* src;           // (n): the nodes the source heats
+  int nsrc;
+  double time, rest_rate; // s stepped; 1/s, the damage rate at T_a
   bool source_on;
   double power, energy;
   int *row, *col;     // the conductances between neighbours, CSR (n + 1, row[n])
@@ -86,7 +95,7 @@ bool tx_tet_barycentric(const double* x, const int* tet, int e, const double p[3
 void tx_thermal_destroy(tx_thermal* h) {
   if (!h) return;
   free(h->t), free(h->tn), free(h->omega), free(h->vol), free(h->inv_mass), free(h->perf), free(h->q);
-  free(h->reached), free(h->row), free(h->col), free(h->cond), free(h->x);
+  free(h->reached), free(h->list), free(h->next), free(h->mark), free(h->src), free(h->row), free(h->col), free(h->cond), free(h->x);
   free(h);
 }
 
@@ -105,13 +114,15 @@ tx_thermal* tx_thermal_create(const double* x, int n, const int* tet, int ntet, 
   tx_thermal* h = calloc(1, sizeof *h);
   if (!h) return tx_set_error("thermal: out of memory"), NULL;
   h->n = n, h->tissue = *ts, h->dt = dt;
-  if (d) h->arr = *d, h->damage_on = true;
+  if (d) h->arr = *d, h->damage_on = true, h->rest_rate = tx_arrhenius_rate(d, ts->t_arterial);
   size_t sz = sizeof(double) * (size_t)n;
   h->t = malloc(sz), h->tn = malloc(sz), h->omega = calloc((size_t)n, sizeof(double)), h->vol = calloc((size_t)n, sizeof(double));
   h->inv_mass = malloc(sz), h->perf = malloc(sz), h->q = calloc((size_t)n, sizeof(double)), h->x = malloc(3 * sz);
   h->row = calloc((size_t)n + 1, sizeof(int));
   h->reached = calloc((size_t)n, sizeof(bool));
-  if (!h->reached || !h->t || !h->tn || !h->omega || !h->vol || !h->inv_mass || !h->perf || !h->q || !h->x || !h->row)
+  h->list = malloc(sizeof(int) * (size_t)n), h->next = malloc(sizeof(int) * (size_t)n);
+  h->mark = calloc((size_t)n, sizeof(unsigned)), h->src = malloc(sizeof(int) * (size_t)n);
+  if (!h->list || !h->next || !h->mark || !h->src || !h->reached || !h->t || !h->tn || !h->omega || !h->vol || !h->inv_mass || !h->perf || !h->q || !h->x || !h->row)
     return tx_set_error("thermal: out of memory"), fail(h, NULL);
   memcpy(h->x, x, 3 * sz);
 
@@ -204,14 +215,25 @@ double tx_thermal_stable_dt(const tx_thermal* h) { return h->stable_dt; }
 int tx_thermal_substeps(const tx_thermal* h) { return h->substeps; }
 int tx_thermal_nodes(const tx_thermal* h) { return h->n; }
 const double* tx_thermal_temperature(const tx_thermal* h) { return h->t; }
-double* tx_thermal_temperature_mut(tx_thermal* h) { return h->t; }
+double* tx_thermal_temperature_mut(tx_thermal* h) {
+  h->rescan = true;
+  return h->t;
+}
+double tx_thermal_damage_rest(const tx_thermal* h) { return h->rest_rate * h->time; }
+int tx_thermal_stepped(const tx_thermal* h) { return h->nlist; }
+
+void tx_thermal_band(tx_thermal* h, double band_k) {
+  h->band = band_k > 0 ? band_k : 0;
+  h->rescan = true;
+}
 const double* tx_thermal_damage(const tx_thermal* h) { return h->omega; }
 const double* tx_thermal_volume(const tx_thermal* h) { return h->vol; }
 double tx_thermal_energy(const tx_thermal* h) { return h->energy; }
 
 void tx_thermal_reset(tx_thermal* h) {
   for (int i = 0; i < h->n; i++) h->t[i] = h->tn[i] = h->tissue.t_arterial, h->omega[i] = 0, h->q[i] = 0;
-  h->source_on = false, h->power = 0, h->energy = 0, h->boiled = 0;
+  h->source_on = false, h->power = 0, h->energy = 0, h->boiled = 0, h->nsrc = 0, h->time = 0;
+  h->rescan = true;
   memset(h->reached, 0, sizeof(bool) * (size_t)h->n);
 }
 
@@ -222,29 +244,68 @@ const bool* tx_thermal_reached(const tx_thermal* h) { return h->reached; }
 void tx_thermal_source(tx_thermal* h, const double c[3], double radius, double power) {
   h->source_on = power > 0 && radius > 0 && isfinite(power + radius + c[0] + c[1] + c[2]);
   if (!h->source_on) {
-    h->power = 0;
+    for (int k = 0; k < h->nsrc; k++) h->q[h->src[k]] = 0;
+    h->power = 0, h->nsrc = 0;
     return;
   }
+  for (int k = 0; k < h->nsrc; k++) h->q[h->src[k]] = 0;
+  h->nsrc = 0;
   double sum = 0, best = INFINITY, cut = 64 * radius * radius; // beyond 8 radii: below 1e-14
   int nearest = 0;
   for (int i = 0; i < h->n; i++) {
     const double* p = h->x + 3 * i;
     double d2 = (p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]);
     if (d2 < best) best = d2, nearest = i;
-    h->q[i] = d2 < cut ? exp(-d2 / (2 * radius * radius)) * h->vol[i] : 0;
-    sum += h->q[i];
+    if (d2 < cut) {
+      h->q[i] = exp(-d2 / (2 * radius * radius)) * h->vol[i];
+      if (h->q[i] > 0) sum += h->q[i], h->src[h->nsrc++] = i;
+    }
   }
   if (sum > 0)
-    for (int i = 0; i < h->n; i++) h->q[i] *= power / sum;
-  else h->q[nearest] = power; // narrower than the elements and far from every node: all at the nearest
+    for (int k = 0; k < h->nsrc; k++) h->q[h->src[k]] *= power / sum;
+  else h->q[nearest] = power, h->src[h->nsrc++] = nearest; // narrower than the elements, far from every node
   h->power = power;
+}
+
+static void add(tx_thermal* h, int i, int* n) {
+  if (h->mark[i] != h->stamp) h->mark[i] = h->stamp, h->next[(*n)++] = i;
+}
+
+// the nodes to step: those off T_a by more than the band or heated, and
+// their neighbours; the rest (within the band, their neighbours too) stay
+// as they are. Only stepped nodes change, so the hot ones are among the
+// last list's, or the source's.
+static void find_band(tx_thermal* h) {
+  const double ta = h->tissue.t_arterial;
+  if (++h->stamp == 0) { // wrapped: clear the marks
+    memset(h->mark, 0, sizeof(unsigned) * (size_t)h->n);
+    h->stamp = 1;
+  }
+  int n = 0;
+  int count = h->rescan ? h->n : h->nlist;
+  for (int k = 0; k < count + (h->source_on ? h->nsrc : 0); k++) {
+    int i = k < count ? (h->rescan ? k : h->list[k]) : h->src[k - count];
+    bool heated = h->source_on && h->q[i] > 0;
+    if (!heated && !(fabs(h->t[i] - ta) > h->band)) continue;
+    add(h, i, &n);
+    for (int a = h->row[i]; a < h->row[i + 1]; a++) add(h, h->col[a], &n);
+  }
+  int* t = h->list;
+  h->list = h->next, h->next = t, h->nlist = n;
+  h->rescan = false;
 }
 
 void tx_thermal_step(tx_thermal* h) {
   const double ta = h->tissue.t_arterial, dt = h->h;
+  double *t = h->t, *tn = h->tn;
   for (int s = 0; s < h->substeps; s++) {
-    double *t = h->t, *tn = h->tn;
-    for (int i = 0; i < h->n; i++) {
+    if (h->band > 0) find_band(h);
+    else if (h->nlist != h->n) {
+      for (int i = 0; i < h->n; i++) h->list[i] = i;
+      h->nlist = h->n;
+    }
+    for (int k = 0; k < h->nlist; k++) {
+      int i = h->list[k];
       double flow = h->source_on ? h->q[i] : 0;
       flow -= h->perf[i] * (t[i] - ta);
       for (int a = h->row[i]; a < h->row[i + 1]; a++) flow += h->cond[a] * (t[h->col[a]] - t[i]);
@@ -254,14 +315,18 @@ void tx_thermal_step(tx_thermal* h) {
         tn[i] = h->cap, h->reached[i] = true;
       }
     }
-    if (h->damage_on)
-      for (int i = 0; i < h->n; i++) h->omega[i] += dt * tx_arrhenius_rate(&h->arr, t[i]);
-    h->t = tn, h->tn = t;
+    for (int k = 0; k < h->nlist; k++) {
+      int i = h->list[k];
+      if (h->damage_on) h->omega[i] += dt * (tx_arrhenius_rate(&h->arr, t[i]) - h->rest_rate);
+      t[i] = tn[i];
+    }
   }
   if (h->source_on) h->energy += h->power * h->dt;
+  h->time += h->dt;
 }
 
-void tx_thermal_embed(const double* x, const int* tet, int ntet, const float* points, int np, int* out_tet, float* out_w) {
+void tx_thermal_embed(const double* x, const int* tet, int ntet, const float* points, int np, int* out_tet, float* out_w,
+                      int* out_e) {
   for (int v = 0; v < np; v++) {
     const double p[3] = {points[3 * v], points[3 * v + 1], points[3 * v + 2]};
     double best = -INFINITY, bw[4] = {1, 0, 0, 0}, w[4];
@@ -273,7 +338,88 @@ void tx_thermal_embed(const double* x, const int* tet, int ntet, const float* po
       if (lo >= 0) break; // inside
     }
     for (int k = 0; k < 4; k++) out_tet[4 * v + k] = tet[4 * bt + k], out_w[4 * v + k] = (float)bw[k];
+    if (out_e) out_e[v] = bt;
   }
+}
+
+int tx_thermal_embed_child(const double* x, const int* tet, int e, const float* point, int* out_tet, float* out_w) {
+  const double p[3] = {point[0], point[1], point[2]};
+  double best = -INFINITY, bw[4] = {1, 0, 0, 0}, w[4];
+  int bt = 8 * e;
+  for (int c = 8 * e; c < 8 * e + 8; c++) {
+    if (!tx_tet_barycentric(x, tet, c, p, w)) continue;
+    double lo = fmin(fmin(w[0], w[1]), fmin(w[2], w[3]));
+    if (lo > best) best = lo, bt = c, memcpy(bw, w, sizeof bw);
+  }
+  for (int k = 0; k < 4; k++) out_tet[k] = tet[4 * bt + k], out_w[k] = (float)bw[k];
+  return bt;
+}
+
+typedef struct edge {
+  int a, b; // a < b
+} edge;
+
+static int edge_cmp(const void* p, const void* q) {
+  const edge *e = p, *f = q;
+  return e->a != f->a ? (e->a > f->a) - (e->a < f->a) : (e->b > f->b) - (e->b < f->b);
+}
+
+static int midpoint(const edge* edges, int ne, int n, int a, int b) {
+  edge key = {a < b ? a : b, a < b ? b : a};
+  const edge* e = bsearch(&key, edges, (size_t)ne, sizeof key, edge_cmp);
+  return n + (int)(e - edges);
+}
+
+bool tx_tet_refine(const double* x, int n, const int* tet, int ntet, double** x2, int* n2, int** tet2, int* ntet2) {
+  static const int pair[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+  edge* edges = malloc(sizeof(edge) * 6 * (size_t)ntet);
+  *x2 = NULL, *tet2 = NULL;
+  if (!edges) return tx_set_error("thermal: out of memory"), false;
+  for (int e = 0; e < ntet; e++)
+    for (int k = 0; k < 6; k++) {
+      int a = tet[4 * e + pair[k][0]], b = tet[4 * e + pair[k][1]];
+      edges[6 * e + k] = (edge){a < b ? a : b, a < b ? b : a};
+    }
+  qsort(edges, 6 * (size_t)ntet, sizeof(edge), edge_cmp);
+  int ne = 0;
+  for (int i = 0; i < 6 * ntet; i++)
+    if (ne == 0 || edge_cmp(&edges[ne - 1], &edges[i]) != 0) edges[ne++] = edges[i];
+  *n2 = n + ne, *ntet2 = 8 * ntet;
+  *x2 = malloc(sizeof(double) * 3 * (size_t)*n2);
+  *tet2 = malloc(sizeof(int) * 4 * (size_t)*ntet2);
+  if (!*x2 || !*tet2) {
+    free(edges), free(*x2), free(*tet2);
+    *x2 = NULL, *tet2 = NULL;
+    return tx_set_error("thermal: out of memory"), false;
+  }
+  memcpy(*x2, x, sizeof(double) * 3 * (size_t)n);
+  for (int i = 0; i < ne; i++)
+    for (int a = 0; a < 3; a++) (*x2)[3 * (n + i) + a] = 0.5 * (x[3 * edges[i].a + a] + x[3 * edges[i].b + a]);
+  for (int e = 0; e < ntet; e++) {
+    const int* t = tet + 4 * e;
+    int m[6]; // ab ac ad bc bd cd
+    for (int k = 0; k < 6; k++) m[k] = midpoint(edges, ne, n, t[pair[k][0]], t[pair[k][1]]);
+    int* c = *tet2 + 32 * e;
+    const int corner[4][4] = {{t[0], m[0], m[1], m[2]}, {m[0], t[1], m[3], m[4]}, {m[1], m[3], t[2], m[5]}, {m[2], m[4], m[5], t[3]}};
+    memcpy(c, corner, sizeof corner);
+    // the octahedron around its shortest diagonal: ab-cd, ac-bd or ad-bc,
+    // with the other four midpoints in their ring
+    static const int diag[3][2] = {{0, 5}, {1, 4}, {2, 3}};
+    static const int ring[3][4] = {{1, 2, 4, 3}, {0, 2, 5, 3}, {0, 1, 5, 4}};
+    int best = 0;
+    double len[3];
+    for (int d = 0; d < 3; d++) {
+      const double *p = *x2 + 3 * m[diag[d][0]], *q = *x2 + 3 * m[diag[d][1]];
+      len[d] = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]);
+      if (len[d] < len[best]) best = d;
+    }
+    for (int k = 0; k < 4; k++) {
+      int* o = c + 16 + 4 * k;
+      o[0] = m[diag[best][0]], o[1] = m[diag[best][1]], o[2] = m[ring[best][k]], o[3] = m[ring[best][(k + 1) % 4]];
+    }
+  }
+  free(edges);
+  return true;
 }
 
 static bool read_fail(FILE* f, const char* path, const char* what) {
@@ -360,5 +506,26 @@ bool tx_obj_read(const char* path, float** x, int* nv, int** tri, int* nt) {
   if (bad) return free(*x), free(*tri), *x = NULL, *tri = NULL, read_fail(f, path, bad);
   fclose(f);
   *nv = v, *nt = t;
+  return true;
+}
+
+bool tx_thermal_refine_embed(const double* x, int n, const int* tet, int ntet, int levels, const float* points, int np,
+                             double** xf, int* nf, int** tetf, int* ntetf, int* out_tet, float* out_w) {
+  int* e = malloc(sizeof(int) * (size_t)(np > 0 ? np : 1));
+  double* cx = malloc(sizeof(double) * 3 * (size_t)n);
+  int* ct = malloc(sizeof(int) * 4 * (size_t)ntet);
+  if (!e || !cx || !ct) return free(e), free(cx), free(ct), tx_set_error("thermal: out of memory"), false;
+  memcpy(cx, x, sizeof(double) * 3 * (size_t)n), memcpy(ct, tet, sizeof(int) * 4 * (size_t)ntet);
+  tx_thermal_embed(cx, ct, ntet, points, np, out_tet, out_w, e);
+  for (int l = 0; l < levels; l++) {
+    double* rx;
+    int rn, *rt, rnt;
+    if (!tx_tet_refine(cx, n, ct, ntet, &rx, &rn, &rt, &rnt)) return free(e), free(cx), free(ct), false;
+    free(cx), free(ct);
+    cx = rx, ct = rt, n = rn, ntet = rnt;
+    for (int v = 0; v < np; v++) e[v] = tx_thermal_embed_child(cx, ct, e[v], points + 3 * v, out_tet + 4 * v, out_w + 4 * v);
+  }
+  free(e);
+  *xf = cx, *nf = n, *tetf = ct, *ntetf = ntet;
   return true;
 }

@@ -74,6 +74,15 @@ void tx_thermal_cap(tx_thermal* h, double t_cap);
 double tx_thermal_boiled(const tx_thermal* h);
 const bool* tx_thermal_reached(const tx_thermal* h); // one per node: reached the cap since the reset
 
+// a band, K (0, the default: none): each substep steps only the nodes off
+// T_a by more than band_k, those heated, and their neighbours; the rest keep
+// their temperature (each within band_k of T_a, so the field is off by at
+// most about band_k there) and their damage past the resting tissue's. The
+// cost follows the heated region, not the organ. tx_thermal_stepped: the
+// nodes the last substep stepped.
+void tx_thermal_band(tx_thermal* h, double band_k);
+int tx_thermal_stepped(const tx_thermal* h);
+
 // one step dt: temperature, then damage at the substep's start temperature
 void tx_thermal_step(tx_thermal* h);
 
@@ -83,7 +92,11 @@ void tx_thermal_reset(tx_thermal* h);
 int tx_thermal_nodes(const tx_thermal* h);
 const double* tx_thermal_temperature(const tx_thermal* h); // K, one per node
 double* tx_thermal_temperature_mut(tx_thermal* h);         // to set an initial field
-const double* tx_thermal_damage(const tx_thermal* h);      // Omega, one per node
+// Omega, one per node, past the resting tissue's own: add tx_thermal_damage_rest
+const double* tx_thermal_damage(const tx_thermal* h);
+// A exp(-Ea / (R T_a)) times the time stepped: the damage of tissue at rest
+// (2.9e-4 1/s for liver at 37 C: 1 after about an hour)
+double tx_thermal_damage_rest(const tx_thermal* h);
 const double* tx_thermal_volume(const tx_thermal* h);      // m^3, each node's lumped share
 double tx_thermal_energy(const tx_thermal* h);             // J deposited by the source so far
 
@@ -91,11 +104,28 @@ double tx_thermal_energy(const tx_thermal* h);             // J deposited by the
 // weights at p (negative outside); false for a degenerate tetrahedron
 bool tx_tet_barycentric(const double* x, const int* tet, int e, const double p[3], double w[4]);
 
+// one level of regular ("red") refinement: each tetrahedron into 8, new
+// nodes at the edges' midpoints (the octahedron cut along its shortest
+// diagonal); the children of tetrahedron e are 8 e .. 8 e + 7, the old nodes
+// keep their numbers. malloc'd *x2, *tet2; false and tx_error() on memory
+bool tx_tet_refine(const double* x, int n, const int* tet, int ntet, double** x2, int* n2, int** tet2, int* ntet2);
+
 // the tetrahedron of (x, tet) each of np points lies in, or nearest to by
 // its least negative barycentric weight (a surface drawn a fraction of an
 // element off the tetrahedra's hull): out_tet (np x 4) its nodes, out_w
 // (np x 4) the weights, so that a nodal field f reads sum w f[tet] there
-void tx_thermal_embed(const double* x, const int* tet, int ntet, const float* points, int np, int* out_tet, float* out_w);
+// out_e (np, may be NULL): the tetrahedron's number
+void tx_thermal_embed(const double* x, const int* tet, int ntet, const float* points, int np, int* out_tet, float* out_w,
+                      int* out_e);
+// the same, the point's tetrahedron e of a coarser mesh known: among e's
+// children in the once refined (x, tet) (tx_tet_refine); returns the child
+int tx_thermal_embed_child(const double* x, const int* tet, int e, const float* point, int* out_tet, float* out_w);
+
+// a mesh refined `levels` times (tx_tet_refine) and np points embedded in
+// it (as tx_thermal_embed, in O(np (ntet + 8 levels)), not O(np ntet 8^levels)):
+// malloc'd *xf, *tetf; out_tet, out_w (np x 4); false and tx_error() on memory
+bool tx_thermal_refine_embed(const double* x, int n, const int* tet, int ntet, int levels, const float* points, int np,
+                             double** xf, int* nf, int** tetf, int* ntetf, int* out_tet, float* out_w);
 
 // TetGen's BASE.node (3-D, zero-based) and BASE.ele (4 nodes): malloc'd x
 // (n x 3) and tet (ntet x 4); false and tx_error() (naming the file) else
