@@ -4,16 +4,31 @@
 # the device's own force limits; the hook's pedal was down 2.5 s on the liver
 # (30 W: 75 J, all deposited), the liver's drawn surface reached boiling
 # (100 C) where the hook held still, some tissue boiled and more than that
-# has Omega > 1 (about 0.25 cm^3), and the stomach stayed at 37 C.
+# has Omega > 1 (about 0.25 cm^3), and the stomach stayed at 37 C. With
+# OSMesa (PNG=1) the run draws its frames, the organs coloured by
+# temperature: each a PNG (test_renderer checks the colouring itself).
 #
-#   test_lagb_cautery.sh TACTUS REPORT_CHECK
+#   test_lagb_cautery.sh TACTUS REPORT_CHECK [PNG]
 set -eu
 TACTUS=$1
 CHECK=$2
+PNG=${3:-0}
 d=$(mktemp -d)
 trap 'rm -rf "$d"' EXIT
 value() { awk -v k="\"$2\":" '$1 == k { gsub(",", "", $2); print $2 }' "$1"; }
-"$TACTUS" run lagb-cautery --lockstep --quiet --out "$d/o"
+view=""
+if [ "$PNG" = 1 ]; then view="--view png"; fi
+# shellcheck disable=SC2086
+"$TACTUS" run lagb-cautery --lockstep --quiet $view --out "$d/o"
+if [ "$PNG" = 1 ]; then
+  n=0
+  for f in "$d"/o/frames/*.png; do
+    head -c 8 "$f" | od -An -tx1 | tr -d ' \n' | grep -qx 89504e470d0a1a0a
+    n=$((n + 1))
+  done
+  echo "$n frames"
+  test "$n" -ge 5
+fi
 r=$d/o/report.json
 "$CHECK" "$r" keys
 awk '/"warnings": \{/ { w = 1; next } w && /\}/ { w = 0 } w && $1 !~ /haptics.force_(clamped|rate_limited)/ { v = $2; gsub(",", "", v); if (v + 0 != 0) { print "warning: " $0; bad = 1 } }
