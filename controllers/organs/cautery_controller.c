@@ -58,7 +58,7 @@ static const tx_param_def params[] = {
     {"band_k", TX_PARAM_NUM, "K", 0, 1, 1e-3, NULL,
      "only nodes off the blood's temperature by more than this, and their neighbours, are stepped (the cost follows "
      "the heated region); 0: every node"},
-    {"pose", TX_PARAM_STR, NULL, 0, 0, 0, "device0.pose", "the pose the hook follows (tx_pose)"},
+    {"pose", TX_PARAM_STR, NULL, 0, 0, 0, "device0.pose", "the pose the hook follows (tx_pose; its first row: device0.pose, or instrumentN.links' root link)"},
     {"tip_x_m", TX_PARAM_NUM, "m", -0.5, 0.5, 0, NULL, "the hook's tip in the pose's frame, x"},
     {"tip_y_m", TX_PARAM_NUM, "m", -0.5, 0.5, 0, NULL, "the hook's tip in the pose's frame, y"},
     {"tip_z_m", TX_PARAM_NUM, "m", -0.5, 0.5, 0, NULL, "the hook's tip in the pose's frame, z"},
@@ -251,7 +251,7 @@ static void step(tx_ctx* c, void* self) {
   }
   // the organ the tip touches (the deepest in, if both)
   int hot = -1;
-  double best = INFINITY, mat[SOFT][3];
+  double best = INFINITY, mat[SOFT][3] = {{0}};
   for (int i = 0; i < SOFT && active && g->power > 0; i++) {
     organ* o = &g->o[i];
     tx_snapshot xs = tx_read(c, o->x);
@@ -263,7 +263,7 @@ static void step(tx_ctx* c, void* self) {
   }
   for (int i = 0; i < SOFT; i++) {
     organ* o = &g->o[i];
-    tx_thermal_source(o->h, mat[i < SOFT ? i : 0], g->radius, i == hot ? g->power : 0);
+    tx_thermal_source(o->h, mat[i], g->radius, i == hot ? g->power : 0);
     tx_thermal_step(o->h);
     publish(c, o);
   }

@@ -6,7 +6,8 @@
 # (100 C) where the hook held still, some tissue boiled and more than that
 # has Omega > 1 (about 0.25 cm^3), and the stomach stayed at 37 C. With
 # OSMesa (PNG=1) the run draws its frames, the organs coloured by
-# temperature: each a PNG (test_renderer checks the colouring itself).
+# temperature: each a PNG (test_renderer checks the colouring itself). A
+# bad parameter is refused with status 2 and one line naming it.
 #
 #   test_lagb_cautery.sh TACTUS REPORT_CHECK [PNG]
 set -eu
@@ -45,3 +46,8 @@ echo "active $active s, $energy J; liver peak $peak K, $damaged m^3 with Omega >
 awk -v a="$active" -v e="$energy" 'BEGIN { exit !(a > 2.4 && a < 2.6 && e > 29.99 * a && e < 30.01 * a) }'
 awk -v p="$peak" -v dm="$damaged" -v b="$boiled" 'BEGIN { exit !(p > 373.14 && p < 373.16 && b > 0 && dm > b && dm < 2e-6) }'
 awk -v p="$speak" -v dm="$sdamaged" 'BEGIN { exit !(p < 310.151 && dm == 0) }'
+# a bad parameter: status 2, one line naming the key, nothing kept
+rc=0
+"$TACTUS" run lagb-cautery --lockstep --quiet --set cautery.power_w=-1 --out "$d/bad" >"$d/err" 2>&1 || rc=$?
+cat "$d/err"
+test "$rc" -eq 2 && test "$(grep -c '' "$d/err")" -eq 1 && grep -q 'power_w' "$d/err" && test ! -e "$d/bad/report.json"
