@@ -3,7 +3,8 @@
 // the liver with its pedal down burns it there (temperature and Omega on
 // liver.x's rows, the power all deposited, boiling at 100 C, the stomach
 // untouched) and the spot cools once the pedal is up; with the pedal up or
-// the tip off the tissue nothing heats; bad parameters and a missing asset
+// the tip off the tissue nothing heats; physics.instruments' L-hook drives
+// it through its root link (with ODE); bad parameters and a missing asset
 // are refused with one line naming the key or the file.
 #include <stdarg.h>
 #include <stddef.h>
@@ -14,6 +15,7 @@
 #include "tests/scenario_support.h"
 
 #include <tactus/components.h>
+#include <tactus/config.h>
 
 #include <math.h>
 #include <stdio.h>
@@ -160,6 +162,48 @@ static void nothing_heats_unless_active_and_touching(void** state) {
   }
 }
 
+#if TX_WITH_ODE
+// the hook as physics.instruments' L-hook (hook_cautery), held by the
+// scripted hand 1 cm behind the spot: the cautery follows its root link
+// (instrument0.links' first row) and the electrode's end 1 cm along its x
+static void follows_the_hook_instrument(void** state) {
+  (void)state;
+  char path[64];
+  snprintf(path, sizeof path, "/tmp/tx_cautery_hand_XXXXXX.csv");
+  int fd = mkstemps(path, 4);
+  assert_true(fd >= 0);
+  close(fd);
+  FILE* f = fopen(path, "w");
+  assert_non_null(f);
+  double x = spot[0] - 0.01, y = spot[1] - 0.001, z = spot[2];
+  fprintf(f, "t_s,x_m,y_m,z_m,qw,qx,qy,qz,grip_rad,buttons\n0,%g,%g,%g,1,0,0,0,0,0\n0.4,%g,%g,%g,1,0,0,0,0,0\n"
+             "0.5,%g,%g,%g,1,0,0,0,0,1\n1.5,%g,%g,%g,1,0,0,0,0,0\n",
+          x, y + 0.02, z, x, y, z, x, y, z, x, y, z);
+  fclose(f);
+  char text[4096];
+  snprintf(text, sizeof text,
+           "{\"name\":\"t\",\"controllers\":["
+           "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:%s\"}},"
+           "{\"name\":\"instruments\",\"type\":\"physics.instruments\",\"rate_hz\":1000,"
+           "\"params\":{\"instrument0\":\"hook_cautery\",\"table_height_m\":-1,\"gravity_m_s2\":0}},"
+           "{\"name\":\"organs\",\"type\":\"physics.organs\",\"rate_hz\":30,\"params\":{\"assets\":\"" COARSE "\",\"tool_radius_m\":0}},"
+           "{\"name\":\"cautery\",\"type\":\"physics.cautery\",\"rate_hz\":100,"
+           "\"params\":{\"assets\":\"" COARSE "\",\"pose\":\"instrument0.links\",\"tip_x_m\":0.01,\"refine\":3}}]}",
+           path);
+  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 1.5);
+  field a = read_field(s);
+  double active = result(s, "cautery.active_s");
+  print_message("  the L-hook: active %.2f s, the spot %.1f K\n", active, a.at_spot);
+  assert_true(fabs(active - 1.0) < 0.021);
+  assert_true(fabs(result(s, "cautery.energy_j") - 30 * active) < 1e-9);
+  assert_true(a.at_spot > 340);
+  tx_scenario_free(s);
+  unlink(path);
+}
+#endif
+
 static void expect_refused(const char* params, const char* needle) {
   tx_scenario* s = load(params);
   assert_null(s);
@@ -189,6 +233,9 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(burns_the_spot_then_cools),
       cmocka_unit_test(nothing_heats_unless_active_and_touching),
+#if TX_WITH_ODE
+      cmocka_unit_test(follows_the_hook_instrument),
+#endif
       cmocka_unit_test(bad_parameters_and_assets),
   };
   return cmocka_run_group_tests(tests, write_hook, remove_hook);
