@@ -36,5 +36,6 @@ int tx_study_organ_hemisphere(const tx_study_args* a);
 int tx_study_organ_stability(const tx_study_args* a);
 int tx_study_thread_accuracy(const tx_study_args* a);
 int tx_study_thread_stability(const tx_study_args* a);
+int tx_study_cautery_heat(const tx_study_args* a);
 
 #endif

@@ -52,6 +52,8 @@ static const struct {
      "the rod hanging against the catenary: error vs nodes, iterations and step with CPU time; ftl's length error"},
     {"thread-stability", tx_study_thread_stability,
      "the thread at 10 m/s, a 10 cm teleport, coincident nodes, stiffness x1e6, steps 1e-5..1e-2 s, a knot at 20 N"},
+    {"cautery-heat", tx_study_cautery_heat,
+     "the organs' bioheat solver against the erfc and perfused closed forms: error vs CPU time, mesh and step, order"},
 };
 
 // the studies that take a FILE after their name

@@ -336,6 +336,30 @@ TX_LAYOUT_ASSERT(tx_instrument_held, double);
 //   organs.contact (1 row, tx_skin_contact): force, where it holds, its
 //     direction, the tangent stiffness k along it, the indentation
 
+// --- gastric banding: the organs' temperature (physics.cautery) --------------
+
+// physics.cautery writes, for each soft organ ORGAN, one row per row of
+// ORGAN.x (its drawn surface vertices, interpolated from the tetrahedra's
+// nodes):
+//   ORGAN.temperature (tx_temperature): K
+//   ORGAN.damage (tx_organ_damage): the Arrhenius integral Omega (1: the
+//     tissue is coagulated)
+typedef struct tx_temperature {
+  float t; // K
+} tx_temperature;
+#define tx_temperature_TYPE TX_F32
+#define tx_temperature_COLS 1u
+#define tx_temperature_UNITS "K"
+TX_LAYOUT_ASSERT(tx_temperature, float);
+
+typedef struct tx_organ_damage {
+  float omega; // 1
+} tx_organ_damage;
+#define tx_organ_damage_TYPE TX_F32
+#define tx_organ_damage_COLS 1u
+#define tx_organ_damage_UNITS "1"
+TX_LAYOUT_ASSERT(tx_organ_damage, float);
+
 #ifdef __cplusplus
 }
 #endif

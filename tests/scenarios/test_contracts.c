@@ -29,7 +29,8 @@ typedef struct layout {
 // whole names first: they win over a suffix
 static const layout layouts[] = {
     L("needle.force", tx_needle_force), L("instrument0.pose", tx_instrument_pose),
-    L("instrument1.pose", tx_instrument_pose), L(".links", tx_pose), L(".swage", tx_pose), L(".grip", tx_device_grip),
+    L("instrument1.pose", tx_instrument_pose), L("liver.damage", tx_organ_damage), L("stomach.damage", tx_organ_damage),
+    L(".temperature", tx_temperature),  L(".links", tx_pose), L(".swage", tx_pose), L(".grip", tx_device_grip),
     L(".force_model", tx_force_model), L(".pose", tx_pose),
     L(".velocity", tx_velocity),        L(".force", tx_force),             L(".energy", tx_device_energy),
     L(".state", tx_hip_state),          L(".spheres", tx_sphere),          L(".segments", tx_segment),

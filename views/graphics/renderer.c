@@ -26,7 +26,7 @@ typedef struct mesh_slot {
   float uv_basis[6]; // planar projection of the first frame: origin (u, v) and axes
   uint32_t uv_for;  // vertex count the basis was made for
   float colour[3];
-  int textured; // 0: the colour; 1: the skin texture; 2: the colour times the tissue texture
+  int textured; // 0: the colour; 1: the skin texture; 2: the colour times the tissue texture; 3: a scalar's colour map
 } mesh_slot;
 
 struct tx_renderer {
@@ -34,7 +34,7 @@ struct tx_renderer {
   GLuint mesh_prog, sphere_prog, cyl_prog;
   GLuint sphere_vao, sphere_vbo, sphere_inst;
   GLuint cyl_vao, cyl_vbo, cyl_inst;
-  GLuint skin_tex, tissue_tex;
+  GLuint skin_tex, tissue_tex, cmap_tex;
   int cyl_nverts;
   mesh_slot meshes[TX_DRAW_MAX + TX_DRAW_MAX];
   int nmeshes;
@@ -48,6 +48,8 @@ struct tx_renderer {
   tx_instrument_mesh* instruments[TX_DRAW_MAX]; // read at the first frame that draws each
   const tx_draw_item* instrument_of[TX_DRAW_MAX];
 };
+
+static void make_colour_map(tx_renderer* r); // colour_by on meshes, below
 
 // per-pixel Blinn-Phong with the viewer at infinity (as fixed-function GL's
 // default): the half vector is one per eye, and the highlight's power is five
@@ -328,6 +330,7 @@ tx_renderer* tx_renderer_create(tx_gl_loader load) {
     gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
   }
   free(tex);
+  make_colour_map(r);
   if (gl->GetError() != GL_NO_ERROR) {
     tx_renderer_destroy(r);
     return tx_set_error("GL error while setting up the renderer"), NULL;
@@ -352,6 +355,7 @@ void tx_renderer_destroy(tx_renderer* r) {
       if (bufs[i]) gl->DeleteBuffers(1, &bufs[i]);
     if (r->skin_tex) gl->DeleteTextures(1, &r->skin_tex);
     if (r->tissue_tex) gl->DeleteTextures(1, &r->tissue_tex);
+    if (r->cmap_tex) gl->DeleteTextures(1, &r->cmap_tex);
     if (r->mesh_prog) gl->DeleteProgram(r->mesh_prog);
     if (r->sphere_prog) gl->DeleteProgram(r->sphere_prog);
     if (r->cyl_prog) gl->DeleteProgram(r->cyl_prog);
@@ -470,6 +474,47 @@ static void fill_mesh(tx_renderer* r, mesh_slot* m, const float* x, uint32_t nv,
   m->nverts = nv;
 }
 
+// A mesh coloured by a scalar per vertex (colour_by, e.g. ORGAN.temperature,
+// the paper's Figure 12): the scalar goes into the texture coordinate and the
+// colour map is a 1-D texture, so the colours interpolate smoothly across
+// each triangle through the shaders the textures use.
+#define CMAP_TEXELS 256
+
+static void make_colour_map(tx_renderer* r) {
+  tx_gl* gl = &r->gl;
+  uint8_t rgb[CMAP_TEXELS * 3];
+  for (int i = 0; i < CMAP_TEXELS; i++) {
+    float c[3];
+    tx_colour_map((float)i / (CMAP_TEXELS - 1), c);
+    for (int k = 0; k < 3; k++) rgb[3 * i + k] = (uint8_t)lroundf(255 * c[k]);
+  }
+  gl->GenTextures(1, &r->cmap_tex);
+  gl->BindTexture(GL_TEXTURE_2D, r->cmap_tex);
+  gl->PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  gl->TexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, CMAP_TEXELS, 1, 0, GL_RGB, GL_UNSIGNED_BYTE, rgb);
+  gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  gl->TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+}
+
+// the scalar of each vertex into u (texel centres of the map), or the plain
+// colour while the scalar has other rows (not yet published)
+static void colour_mesh_by(tx_renderer* r, mesh_slot* m, const tx_draw_item* it, const float* scalar, uint32_t n) {
+  if (!scalar || n != m->nverts || !n) {
+    if (n) r->skipped++;
+    return;
+  }
+  for (uint32_t i = 0; i < n; i++) {
+    float t = (scalar[i] - it->range[0]) / (it->range[1] - it->range[0]);
+    if (!(t > 0)) t = 0; // NaN too
+    if (t > 1) t = 1;
+    m->verts[8 * i + 6] = (0.5f + t * (CMAP_TEXELS - 1)) / CMAP_TEXELS;
+    m->verts[8 * i + 7] = 0.5f;
+  }
+  m->textured = 3;
+}
+
 static mesh_slot* slot(tx_renderer* r) {
   mesh_slot* m = &r->meshes[r->nmeshes++];
   if (!m->vao) {
@@ -529,6 +574,7 @@ void tx_renderer_upload(tx_renderer* r, const tx_scene* s) {
       fill_mesh(r, m, si->data[0], si->rows[0], si->data[1], si->rows[1]);
       memcpy(m->colour, it->colour, sizeof m->colour);
       m->textured = it->skin_texture ? 1 : it->tissue_texture ? 2 : 0;
+      if (*it->scalar) colour_mesh_by(r, m, it, si->data[2], si->rows[2]);
       upload_mesh(r, m);
       break;
     }
@@ -715,8 +761,8 @@ void tx_renderer_draw(tx_renderer* r, const tx_view_def* d, const tx_camera* c, 
     mesh_slot* m = &r->meshes[i];
     if (!m->nidx) continue;
     gl->Uniform3fv(colour_at, 1, m->colour);
-    gl->Uniform1i(textured_at, m->textured);
-    gl->BindTexture(GL_TEXTURE_2D, m->textured == 2 ? r->tissue_tex : r->skin_tex);
+    gl->Uniform1i(textured_at, m->textured == 3 ? 1 : m->textured); // the map is drawn as a texture
+    gl->BindTexture(GL_TEXTURE_2D, m->textured == 3 ? r->cmap_tex : m->textured == 2 ? r->tissue_tex : r->skin_tex);
     gl->BindVertexArray(m->vao);
     gl->DrawElements(GL_TRIANGLES, (GLsizei)m->nidx, GL_UNSIGNED_INT, 0);
   }

@@ -207,10 +207,10 @@ static int read_item(size_t i, const json_t* e, tx_draw_item* it) {
   }
   snprintf(key, sizeof key, "%s.colour_by", at);
   if ((v = json_object_get(e, "colour_by"))) {
-    if (it->kind != TX_DRAW_SPHERES && it->kind != TX_DRAW_SEGMENTS)
-      return bad(key, "only spheres and segments take a colour map");
+    if (it->kind != TX_DRAW_SPHERES && it->kind != TX_DRAW_SEGMENTS && it->kind != TX_DRAW_MESH)
+      return bad(key, "only meshes, spheres and segments take a colour map");
     if (!json_is_string(v) || !plain_name(json_string_value(v)))
-      return bad(key, "expected a component name such as tissue.damage");
+      return bad(key, "expected a component name such as tissue.damage or liver.temperature");
     snprintf(it->scalar, sizeof it->scalar, "%s", json_string_value(v));
   }
   snprintf(key, sizeof key, "%s.range", at);

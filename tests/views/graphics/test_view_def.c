@@ -61,6 +61,11 @@ static void full_view(void** state) {
   assert_string_equal(comps[1], "device0.force");
   assert_int_equal(tx_draw_item_components(&d.items[4], comps), 0);
   assert_false(d.items[1].has_cut);
+  // a mesh coloured by a scalar per vertex (an organ's temperature): its third component
+  assert_int_equal(parse("{\"draw\": [{\"mesh\": \"liver\", \"colour_by\": \"liver.temperature\", \"range\": [310, 373]}]}", &d), 0);
+  assert_int_equal(tx_draw_item_components(&d.items[0], comps), 3);
+  assert_string_equal(comps[2], "liver.temperature");
+  assert_true(d.items[0].range[0] == 310 && d.items[0].range[1] == 373);
   // a cutaway of spheres: a point and a direction made unit
   assert_int_equal(parse("{\"draw\": [{\"spheres\": \"t\", \"cut\": {\"point\": [0, 0.5, 0], \"normal\": [0, 0, 3]}}]}", &d),
                    0);
@@ -106,7 +111,7 @@ static void errors_name_the_key(void** state) {
   expect_error("{\"draw\": [{\"mesh\": \"Skin!\"}]}", "draw[0].mesh", "component prefix");
   expect_error("{\"draw\": [{\"mesh\": \"skin\", \"colur\": [1, 0, 0]}]}", "draw[0].colur", "unknown key");
   expect_error("{\"draw\": [{\"mesh\": \"skin\"}, {\"spheres\": \"t\", \"colour\": [1, 0]}]}", "draw[1].colour", "3 numbers");
-  expect_error("{\"draw\": [{\"mesh\": \"skin\", \"colour_by\": \"skin.t\"}]}", "draw[0].colour_by", "only spheres");
+  expect_error("{\"draw\": [{\"tool\": \"device0\", \"colour_by\": \"skin.t\"}]}", "draw[0].colour_by", "only meshes, spheres");
   expect_error("{\"draw\": [{\"mesh\": \"skin\", \"cut\": {}}]}", "draw[0].cut", "only spheres");
   expect_error("{\"draw\": [{\"spheres\": \"t\", \"cut\": {\"normal\": [0, 0, 0]}}]}", "draw[0].cut.normal", "non-zero");
   expect_error("{\"draw\": [{\"spheres\": \"t\", \"cut\": {\"side\": 1}}]}", "draw[0].cut.side", "unknown key");
