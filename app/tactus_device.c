@@ -35,8 +35,9 @@ static const char usage[] =
     "  --rate HZ           state packets per second, up to 100000 (default 1000; a replay's recorded rate)\n"
     "  --duration S        stop S seconds after the first hello (default: until Ctrl-C)\n"
     "  --quiet             no summary at the end\n"
-    "  --dds DOMAIN[:NAME] serve over Cyclone DDS instead (DDS builds): domain in [0, 232], the device's name\n"
-    "                      (default device0), loopback only unless CYCLONEDDS_URI says otherwise; for\n"
+    "  --dds DOMAIN[:NAME][,peer=HOST]...\n"
+    "                      serve over Cyclone DDS instead (DDS builds): domain in [0, 232], the device's name\n"
+    "                      (default device0); loopback only unless peers are named (or CYCLONEDDS_URI); for\n"
     "                      `tactus run --device dds:DOMAIN[:NAME]`. No force for 3 ms ramps it to zero over 5 ms\n"
     "\n"
     "ADDR is an IPv4 address or localhost. It listens on loopback unless --listen says otherwise,\n"
@@ -78,9 +79,9 @@ static void print_stats(const tx_device_server_stats* s) {
 static int serve_dds(const char* arg, const tx_device_server_def* udp, bool quiet) {
 #if TX_WITH_DDS
   tx_device_dds_server_def def = tx_device_dds_server_def_default();
-  char name[32];
-  if (!tx_device_dds_parse(arg, &def.domain, name, sizeof name)) return tx_bad_input("--dds %s: %s", arg, tx_error());
-  def.name = name;
+  static tx_device_dds_spec spec; // 8 kB of peer names: not on the stack
+  if (!tx_device_dds_parse(arg, &spec)) return tx_bad_input("--dds %s: %s", arg, tx_error());
+  def.dds = arg;
   def.spec = udp->spec;
   def.rate_hz = udp->rate_hz;
   def.duration_s = udp->duration_s;
@@ -90,7 +91,8 @@ static int serve_dds(const char* arg, const tx_device_server_def* udp, bool quie
   sa.sa_handler = on_stop;
   sigaction(SIGINT, &sa, NULL);
   sigaction(SIGTERM, &sa, NULL);
-  printf("tactus-device: serving %s on DDS domain %d as %s at %g Hz\n", def.spec, def.domain, name, def.rate_hz);
+  printf("tactus-device: serving %s on DDS domain %d as %s at %g Hz, %s\n", def.spec, spec.domain, spec.name, def.rate_hz,
+         spec.npeers ? "discovering only its peers" : "on loopback only");
   int rc = tx_device_dds_server_run(s, &stop_requested);
   tx_device_dds_server_stats st;
   tx_device_dds_server_get_stats(s, &st);

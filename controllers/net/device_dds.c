@@ -21,24 +21,37 @@
 #define STATE_COLS TX_DEVICE_DDS_STATE_COLS
 #define FORCE_COLS TX_DEVICE_DDS_FORCE_COLS
 
-bool tx_device_dds_parse(const char* arg, int* domain, char* name, size_t size) {
-  const char* colon = strchr(arg, ':');
-  size_t dlen = colon ? (size_t)(colon - arg) : strlen(arg);
-  char digits[8];
-  if (dlen == 0 || dlen >= sizeof digits) return tx_set_error("expected DOMAIN[:NAME], DOMAIN in [0, %d]", TX_NET_DOMAIN_MAX), false;
-  memcpy(digits, arg, dlen);
-  digits[dlen] = 0;
+bool tx_device_dds_parse(const char* arg, tx_device_dds_spec* out) {
+  memset(out, 0, sizeof *out);
+  char text[512];
+  if (strlen(arg) >= sizeof text) return tx_set_error("too long"), false;
+  snprintf(text, sizeof text, "%s", arg);
+  char* rest = strchr(text, ',');
+  if (rest) *rest++ = 0;
+  char* colon = strchr(text, ':');
+  if (colon) *colon = 0;
   char* end;
-  long d = strtol(digits, &end, 10);
-  if (*end || d < 0 || d > TX_NET_DOMAIN_MAX)
-    return tx_set_error("domain '%s': expected an integer in [0, %d]", digits, TX_NET_DOMAIN_MAX), false;
+  long d = strtol(text, &end, 10);
+  if (!*text || *end || d < 0 || d > TX_NET_DOMAIN_MAX || strlen(text) > 3)
+    return tx_set_error("domain '%s': expected an integer in [0, %d]", text, TX_NET_DOMAIN_MAX), false;
   const char* n = colon ? colon + 1 : "device0";
   size_t nlen = strlen(n);
-  bool ok = nlen > 0 && nlen < size && nlen < 32;
+  bool ok = nlen > 0 && nlen < sizeof out->name;
   for (size_t i = 0; ok && i < nlen; i++) ok = (n[i] >= 'a' && n[i] <= 'z') || (n[i] >= '0' && n[i] <= '9') || n[i] == '_';
   if (!ok) return tx_set_error("name '%s': expected 1-31 characters of a-z 0-9 _", n), false;
-  *domain = (int)d;
-  snprintf(name, size, "%s", n);
+  out->domain = (int)d;
+  snprintf(out->name, sizeof out->name, "%s", n);
+  for (char* item = rest; item;) {
+    char* next = strchr(item, ',');
+    if (next) *next++ = 0;
+    if (strncmp(item, "peer=", 5) != 0) return tx_set_error("'%s': expected peer=HOST", item), false;
+    if (out->npeers == TX_DEVICE_DDS_PEERS_MAX) return tx_set_error("at most %d peers", TX_DEVICE_DDS_PEERS_MAX), false;
+    if (!tx_net_peer_valid(item + 5)) return tx_error_prefix("peer"), false;
+    snprintf(out->peer_text[out->npeers], sizeof out->peer_text[0], "%s", item + 5);
+    out->peers[out->npeers] = out->peer_text[out->npeers];
+    out->npeers++;
+    item = next;
+  }
   return true;
 }
 
@@ -56,8 +69,9 @@ static uint64_t session_tag(const char* name, int domain) {
 }
 
 // a participant (loopback unless CYCLONEDDS_URI says otherwise), and the two topics
-static int endpoints(int domain, const char* name, bool server, dds_entity_t* pp, dds_entity_t* writer, dds_entity_t* reader) {
-  *pp = tx_net_participant(domain, NULL, 0);
+static int endpoints(const tx_device_dds_spec* spec, bool server, dds_entity_t* pp, dds_entity_t* writer, dds_entity_t* reader) {
+  const char* name = spec->name;
+  *pp = tx_net_participant(spec->domain, spec->peers, spec->npeers);
   if (*pp < 0) return -1;
   char state[96], force[96];
   snprintf(state, sizeof state, "tx/d/%s/state", name);
@@ -204,14 +218,16 @@ static void close_dds(tx_device* d) {
 
 static tx_device* open_dds(const char* arg, double period_s) {
   (void)period_s;
-  int domain;
-  char name[32];
-  if (!tx_device_dds_parse(arg, &domain, name, sizeof name)) return tx_error_prefix("device 'dds:%s'", arg), NULL;
+  tx_device_dds_spec* spec = malloc(sizeof *spec);
+  if (!spec) return tx_set_error("out of memory"), NULL;
+  if (!tx_device_dds_parse(arg, spec)) return free(spec), tx_error_prefix("device 'dds:%s'", arg), NULL;
   tx_device* d = calloc(1, sizeof *d);
-  if (!d) return tx_set_error("out of memory"), NULL;
-  snprintf(d->name, sizeof d->name, "dds:%d:%s", domain, name);
-  d->tag = session_tag(name, domain);
-  if (endpoints(domain, name, false, &d->pp, &d->writer, &d->reader)) {
+  if (!d) return free(spec), tx_set_error("out of memory"), NULL;
+  snprintf(d->name, sizeof d->name, "dds:%d:%s", spec->domain, spec->name);
+  d->tag = session_tag(spec->name, spec->domain);
+  int bad = endpoints(spec, false, &d->pp, &d->writer, &d->reader);
+  free(spec);
+  if (bad) {
     tx_error_prefix("device %s", d->name);
     free(d);
     return NULL;
@@ -290,7 +306,7 @@ const tx_device_backend tx_device_dds = {"dds", open_dds, info_dds, read_dds, wr
 
 struct tx_device_dds_server {
   tx_device_dds_server_def def;
-  char name[32];
+  tx_device_dds_spec spec;
   tx_device_handle dev;
   tx_device_info info;
   dds_entity_t pp, writer, reader;
@@ -301,29 +317,23 @@ struct tx_device_dds_server {
 };
 
 tx_device_dds_server_def tx_device_dds_server_def_default(void) {
-  return (tx_device_dds_server_def){.spec = "sim", .domain = 0, .name = "device0", .rate_hz = 1000, .force_timeout_s = 0.003, .ramp_s = 0.005};
+  return (tx_device_dds_server_def){.spec = "sim", .dds = "0", .rate_hz = 1000, .force_timeout_s = 0.003, .ramp_s = 0.005};
 }
 
 tx_device_dds_server* tx_device_dds_server_open(const tx_device_dds_server_def* def) {
   if (!(def->rate_hz >= 1 && def->rate_hz <= 100000)) return tx_set_error("rate %g Hz: expected [1, 100000]", def->rate_hz), NULL;
   if (!(def->force_timeout_s > 0 && def->force_timeout_s <= 1)) return tx_set_error("force timeout %g s: expected (0, 1]", def->force_timeout_s), NULL;
   if (!(def->ramp_s >= 0 && def->ramp_s <= 1)) return tx_set_error("ramp %g s: expected [0, 1]", def->ramp_s), NULL;
-  char spec[64];
-  snprintf(spec, sizeof spec, "%d:%s", def->domain, def->name ? def->name : "device0");
-  int domain;
-  char name[32];
-  if (!tx_device_dds_parse(spec, &domain, name, sizeof name)) return NULL;
   tx_device_dds_server* s = calloc(1, sizeof *s);
   if (!s || !(s->loop = calloc(1, sizeof *s->loop))) return free(s), tx_set_error("out of memory"), NULL;
+  if (!tx_device_dds_parse(def->dds ? def->dds : "0", &s->spec)) return free(s->loop), free(s), NULL;
   s->def = *def;
-  snprintf(s->name, sizeof s->name, "%s", name);
-  s->def.name = s->name;
   pthread_mutex_init(&s->lock, NULL);
   tx_hist_clear(s->loop);
   if (tx_device_open(def->spec, 1 / def->rate_hz, &s->dev)) return tx_device_dds_server_close(s), NULL;
   s->dev.backend->info(s->dev.device, &s->info);
-  s->tag = session_tag(name, domain);
-  if (endpoints(domain, name, true, &s->pp, &s->writer, &s->reader)) return tx_device_dds_server_close(s), NULL;
+  s->tag = session_tag(s->spec.name, s->spec.domain);
+  if (endpoints(&s->spec, true, &s->pp, &s->writer, &s->reader)) return tx_device_dds_server_close(s), NULL;
   return s;
 }
 

@@ -36,10 +36,19 @@
 #define TX_DEVICE_DDS_LOST_S 0.1  // no state this long: the client says the device is lost
 #define TX_DEVICE_DDS_STATE_COLS 22 // pos 3, quat 4, vel 3, grip, buttons, t_ns, max_force, max_stiffness, damping, workspace 6
 #define TX_DEVICE_DDS_FORCE_COLS 4  // force 3, the mono_ns of the state it answers
+#define TX_DEVICE_DDS_PEERS_MAX 8
 
-// "DOMAIN[:NAME]": DOMAIN in [0, 232], NAME of [a-z0-9_] (default device0);
-// false with tx_error() naming what is wrong
-bool tx_device_dds_parse(const char* arg, int* domain, char* name, size_t size);
+// "DOMAIN[:NAME][,peer=HOST]...": DOMAIN in [0, 232], NAME 1-31 of
+// [a-z0-9_] (default device0), the hosts to discover (none: loopback only,
+// as the bridge's net.peers); false with tx_error() naming what is wrong
+typedef struct tx_device_dds_spec {
+  int domain;
+  char name[32];
+  char peer_text[TX_DEVICE_DDS_PEERS_MAX][254];
+  const char* peers[TX_DEVICE_DDS_PEERS_MAX]; // into peer_text
+  int npeers;
+} tx_device_dds_spec;
+bool tx_device_dds_parse(const char* arg, tx_device_dds_spec* out);
 
 // the scale of the force applied at the device, age_s after the last force
 // arrived, since_s after forces resumed (a new or returning simulation):
@@ -49,8 +58,7 @@ double tx_device_dds_scale(double age_s, double since_s, double timeout_s, doubl
 
 typedef struct tx_device_dds_server_def {
   const char* spec;       // the device served: scripted:..., replay:..., sim
-  int domain;             // DDS domain
-  const char* name;       // device name in the topics
+  const char* dds;        // "DOMAIN[:NAME][,peer=HOST]...", as tx_device_dds_parse reads it
   double rate_hz;         // states per second; 1000
   double duration_s;      // stop after this long; 0: until stopped
   double force_timeout_s; // no force this long: ramp to zero; 0.003

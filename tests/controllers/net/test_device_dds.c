@@ -47,17 +47,22 @@ static void the_ramp_rule(void** state) {
 
 static void the_spec(void** state) {
   (void)state;
-  int d;
-  char name[32];
-  assert_true(tx_device_dds_parse("5", &d, name, sizeof name));
-  assert_int_equal(d, 5);
-  assert_string_equal(name, "device0");
-  assert_true(tx_device_dds_parse("232:arm_1", &d, name, sizeof name));
-  assert_int_equal(d, 232);
-  assert_string_equal(name, "arm_1");
-  const char* bad[] = {"", "x", "233", "-1", "5:", "5:Bad", "5:a-b", "1234567", "5:0123456789012345678901234567890123"};
+  tx_device_dds_spec sp;
+  assert_true(tx_device_dds_parse("5", &sp));
+  assert_int_equal(sp.domain, 5);
+  assert_string_equal(sp.name, "device0");
+  assert_int_equal(sp.npeers, 0);
+  assert_true(tx_device_dds_parse("232:arm_1,peer=10.0.0.2,peer=sim-host", &sp));
+  assert_int_equal(sp.domain, 232);
+  assert_string_equal(sp.name, "arm_1");
+  assert_int_equal(sp.npeers, 2);
+  assert_string_equal(sp.peers[0], "10.0.0.2");
+  assert_string_equal(sp.peers[1], "sim-host");
+  const char* bad[] = {"", "x", "233", "-1", "5:", "5:Bad", "5:a-b", "1234567", "5:0123456789012345678901234567890123",
+                       "5:a,peer=10.0.0.300", "5:a,peer=", "5:a,bind=1", "5,peer=a..b",
+                       "5,peer=a,peer=a,peer=a,peer=a,peer=a,peer=a,peer=a,peer=a,peer=a"};
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-    assert_false(tx_device_dds_parse(bad[i], &d, name, sizeof name));
+    assert_false(tx_device_dds_parse(bad[i], &sp));
     assert_true(strlen(tx_error()) > 0);
   }
   tx_device_handle h;
@@ -79,8 +84,9 @@ static void* serve(void* arg) {
 
 static void start(server_run* r, int domain, const char* spec) {
   tx_device_dds_server_def def = tx_device_dds_server_def_default();
-  def.domain = domain;
-  def.name = "t";
+  char dds[32];
+  snprintf(dds, sizeof dds, "%d:t", domain);
+  def.dds = dds;
   def.spec = spec;
   r->s = tx_device_dds_server_open(&def);
   assert_non_null(r->s);

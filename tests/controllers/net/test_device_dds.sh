@@ -12,6 +12,8 @@ domain=$((150 + $$ % 80))
 
 rc=0; "$dev" sim --dds 999 > "$d/bad" 2>&1 || rc=$?
 [ $rc -eq 2 ] && [ "$(grep -c '' "$d/bad")" -eq 1 ] && grep -q -- '--dds 999' "$d/bad" || { echo "bad --dds:"; cat "$d/bad"; exit 1; }
+rc=0; "$dev" sim --dds 5:arm,peer=10.0.0.300 > "$d/bad" 2>&1 || rc=$?
+[ $rc -eq 2 ] && [ "$(grep -c '' "$d/bad")" -eq 1 ] && grep -q peer "$d/bad" || { echo "bad --dds peer:"; cat "$d/bad"; exit 1; }
 rc=0; "$dev" sim --dds 5:Bad-name > "$d/bad" 2>&1 || rc=$?
 [ $rc -eq 2 ] && [ "$(grep -c '' "$d/bad")" -eq 1 ] || { echo "bad --dds name:"; cat "$d/bad"; exit 1; }
 
