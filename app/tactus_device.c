@@ -6,6 +6,11 @@
 #include "../controllers/haptics/recorder.h"
 #include "../scenarios/command.h"
 
+#include <tactus/config.h>
+#if TX_WITH_DDS
+#include "../controllers/net/device_dds.h"
+#endif
+
 #include <arpa/inet.h>
 #include <errno.h>
 #include <getopt.h>
@@ -30,6 +35,10 @@ static const char usage[] =
     "  --rate HZ           state packets per second, up to 100000 (default 1000; a replay's recorded rate)\n"
     "  --duration S        stop S seconds after the first hello (default: until Ctrl-C)\n"
     "  --quiet             no summary at the end\n"
+    "  --dds DOMAIN[:NAME][,peer=HOST]...\n"
+    "                      serve over Cyclone DDS instead (DDS builds): domain in [0, 232], the device's name\n"
+    "                      (default device0); loopback only unless peers are named (or CYCLONEDDS_URI); for\n"
+    "                      `tactus run --device dds:DOMAIN[:NAME]`. No force for 3 ms ramps it to zero over 5 ms\n"
     "\n"
     "ADDR is an IPv4 address or localhost. It listens on loopback unless --listen says otherwise,\n"
     "and takes packets only from its peer. The first line on stdout names the address it serves on.\n"
@@ -66,15 +75,57 @@ static void print_stats(const tx_device_server_stats* s) {
     printf("round trip: no forces came back\n");
 }
 
+// --dds: the same device, over Cyclone DDS (controllers/net/device_dds.h)
+static int serve_dds(const char* arg, const tx_device_server_def* udp, bool quiet) {
+#if TX_WITH_DDS
+  tx_device_dds_server_def def = tx_device_dds_server_def_default();
+  static tx_device_dds_spec spec; // 8 kB of peer names: not on the stack
+  if (!tx_device_dds_parse(arg, &spec)) return tx_bad_input("--dds %s: %s", arg, tx_error());
+  def.dds = arg;
+  def.spec = udp->spec;
+  def.rate_hz = udp->rate_hz;
+  def.duration_s = udp->duration_s;
+  tx_device_dds_server* s = tx_device_dds_server_open(&def);
+  if (!s) return tx_bad_input("%s", tx_error());
+  struct sigaction sa = {0};
+  sa.sa_handler = on_stop;
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
+  printf("tactus-device: serving %s on DDS domain %d as %s at %g Hz, %s\n", def.spec, spec.domain, spec.name, def.rate_hz,
+         spec.npeers ? "discovering only its peers" : "on loopback only");
+  int rc = tx_device_dds_server_run(s, &stop_requested);
+  tx_device_dds_server_stats st;
+  tx_device_dds_server_get_stats(s, &st);
+  tx_device_dds_server_close(s);
+  if (!quiet) {
+    printf("samples: %llu states sent, %llu forces applied; dropped: %llu foreign, %llu malformed\n",
+           (unsigned long long)st.states, (unsigned long long)st.forces, (unsigned long long)st.foreign,
+           (unsigned long long)st.malformed);
+    printf("simulations: %llu lost (force ramped to zero), %llu taken up again; force zero %.1f ms after the last "
+           "force at most; %llu late ticks, %s\n",
+           (unsigned long long)st.timeouts, (unsigned long long)st.resumes, st.zero_after_s * 1e3,
+           (unsigned long long)st.late_ticks, st.fifo ? "SCHED_FIFO" : "SCHED_OTHER (SCHED_FIFO refused)");
+    if (st.forces) printf("round trip (state out, force back): p50 %.1f us p99 %.1f us max %.1f us\n", st.loop.p50 * 1e-3,
+                          st.loop.p99 * 1e-3, st.loop.max * 1e-3);
+  }
+  return rc ? 1 : 0;
+#else
+  (void)udp, (void)quiet;
+  return tx_bad_input("--dds %s: this build has no DDS (configure with -DTX_WITH_DDS=ON)", arg);
+#endif
+}
+
 int main(int argc, char** argv) {
   setvbuf(stdout, NULL, _IOLBF, 0);
   tx_program = "tactus-device";
   static const struct option longs[] = {{"listen", required_argument, 0, 'l'}, {"peer", required_argument, 0, 'p'},
                                         {"rate", required_argument, 0, 'r'},   {"duration", required_argument, 0, 'd'},
                                         {"quiet", no_argument, 0, 'q'},        {"help", no_argument, 0, 'h'},
+                                        {"dds", required_argument, 0, 'D'},
                                         {0, 0, 0, 0}};
   tx_device_server_def def = tx_device_server_def_default();
   bool quiet = false, rate_given = false;
+  const char* dds = NULL;
   const char* why = NULL;
   opterr = 0;
   // GNU getopt moves operands behind the options, so SPEC may stand anywhere
@@ -96,6 +147,7 @@ int main(int argc, char** argv) {
         return tx_bad_input("--duration %s: expected seconds in [0.001, 1000000]", optarg);
       break;
     case 'q': quiet = true; break;
+    case 'D': dds = optarg; break;
     case 'h': return fputs(usage, stdout), 0;
     default:
       if (optopt && strncmp(argv[optind - 1], "--", 2) != 0)
@@ -130,6 +182,7 @@ int main(int argc, char** argv) {
     }
   }
 
+  if (dds) return serve_dds(dds, &def, quiet);
   tx_device_server* s = tx_device_server_open(&def);
   if (!s) return tx_bad_input("%s", tx_error());
   if (*cut_short) fprintf(stderr, "tactus-device: warning: %s\n", cut_short); // once the server has taken it

@@ -6,11 +6,18 @@
 // takes as its next back buffer one that is neither latest nor announced.
 // With sequentially consistent atomics this is the classic hazard-pointer
 // argument: a buffer is never written while a reader may read it.
+//
+// Publish hooks (tx_model_add_hook) live in a fixed table in the model. A
+// component's hook_mask names the slots to call; a call counts itself in its
+// slot's `busy` before it checks `armed`, and removal clears `armed` before it
+// waits for `busy` to drain: with sequentially consistent atomics either the
+// call sees the hook disarmed, or the removal sees the call and waits for it.
 #include "error.h"
 
 #include <tactus/model.h>
 
 #include <ctype.h>
+#include <sched.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -44,7 +51,19 @@ typedef struct component {
   _Alignas(CACHE_LINE) uint32_t back; // writer-private from here on
   uint32_t next_rows;
   uint64_t seq;
+  _Atomic uint32_t hook_mask;    // publish hooks to call: bit i is hooks[i]
 } component;
+
+_Static_assert(TX_PUBLISH_HOOKS_MAX <= 32, "a component's hook mask is 32 bits");
+
+typedef struct hook {
+  tx_publish_hook fn; // written before armed is set, read after it is seen
+  void* user;
+  _Atomic uint32_t comp; // the component id it was added for
+  _Atomic bool armed;
+  _Atomic uint32_t busy; // calls under way
+  bool used;             // under hook_lock
+} hook;
 
 typedef struct reader_slot {
   uint32_t comp;  // component index
@@ -57,6 +76,8 @@ struct tx_model {
   reader_slot* readers; // reader_count
   uint32_t reader_count;
   bool committed;
+  atomic_flag hook_lock; // adding and removing hooks; never taken by a publish
+  hook hooks[TX_PUBLISH_HOOKS_MAX];
 };
 
 static size_t header_size(void) { return (sizeof(header) + CACHE_LINE - 1) / CACHE_LINE * CACHE_LINE; }
@@ -89,7 +110,11 @@ static bool valid_name(const char* s) {
   return true;
 }
 
-tx_model* tx_model_create(void) { return calloc(1, sizeof(tx_model)); }
+tx_model* tx_model_create(void) {
+  tx_model* m = calloc(1, sizeof(tx_model));
+  if (m) atomic_flag_clear(&m->hook_lock);
+  return m;
+}
 
 void tx_model_destroy(tx_model* m) {
   if (!m) return;
@@ -247,7 +272,54 @@ uint64_t tx_model_publish(tx_model* m, tx_comp id, int64_t sim_ns) {
   uint32_t b = 0;
   while (held[b]) b++;
   c->back = b;
-  return c->seq;
+  uint64_t seq = c->seq;
+  for (uint32_t mask = atomic_load_explicit(&c->hook_mask, memory_order_acquire); mask; mask &= mask - 1) {
+    hook* k = &m->hooks[__builtin_ctz(mask)];
+    atomic_fetch_add(&k->busy, 1);
+    // a mask read before a removal may name a slot since given to another component
+    if (atomic_load(&k->armed) && atomic_load_explicit(&k->comp, memory_order_relaxed) == id.id) k->fn(k->user, id, seq);
+    atomic_fetch_sub_explicit(&k->busy, 1, memory_order_release);
+  }
+  return seq;
+}
+
+static void hook_lock(tx_model* m) {
+  while (atomic_flag_test_and_set_explicit(&m->hook_lock, memory_order_acquire)) sched_yield();
+}
+static void hook_unlock(tx_model* m) { atomic_flag_clear_explicit(&m->hook_lock, memory_order_release); }
+
+int tx_model_add_hook(tx_model* m, tx_comp id, tx_publish_hook fn, void* user) {
+  component* c = get(m, id);
+  if (!c || !fn) return tx_set_error("a publish hook needs a component and a function"), 0;
+  hook_lock(m);
+  int i = 0;
+  while (i < TX_PUBLISH_HOOKS_MAX && m->hooks[i].used) i++;
+  if (i == TX_PUBLISH_HOOKS_MAX) {
+    hook_unlock(m);
+    return tx_set_error("%s: more than %d publish hooks in one model", c->name, TX_PUBLISH_HOOKS_MAX), 0;
+  }
+  hook* h = &m->hooks[i];
+  h->used = true;
+  h->fn = fn;
+  h->user = user;
+  atomic_store(&h->comp, id.id);
+  atomic_store(&h->armed, true);
+  atomic_fetch_or(&c->hook_mask, 1u << i);
+  hook_unlock(m);
+  return i + 1;
+}
+
+void tx_model_remove_hook(tx_model* m, int id) {
+  if (!m || id < 1 || id > TX_PUBLISH_HOOKS_MAX) return;
+  hook* h = &m->hooks[id - 1];
+  hook_lock(m);
+  if (!h->used) return hook_unlock(m);
+  component* c = get(m, (tx_comp){atomic_load(&h->comp)});
+  if (c) atomic_fetch_and(&c->hook_mask, ~(1u << (id - 1)));
+  atomic_store(&h->armed, false);
+  while (atomic_load(&h->busy)) sched_yield(); // a call under way ends first
+  h->used = false;
+  hook_unlock(m);
 }
 
 static tx_snapshot snapshot_of(const component* c, uint32_t b) {

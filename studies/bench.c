@@ -364,7 +364,7 @@ static int bench_thread(const bench_args* a) { return tx_bench_thread(a->duratio
 static int bench_organ_collision(const bench_args* a) { return tx_bench_organ_collision(a->duration_s); }
 
 // the bridges' sender threads poll every 50 us (net.poll_us); the echoing sim runs at the HIP's 4 kHz
-static int bench_dds(const bench_args* a) { return tx_bench_dds(a->duration_s, 1000, 4000, 50); }
+static int bench_dds(const bench_args* a) { return tx_bench_dds(a->duration_s, 1000, 4000, 0, true); }
 
 static int bench_hip(const bench_args* a) {
   (void)a;

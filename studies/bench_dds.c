@@ -4,8 +4,11 @@
 // The device process writes a pose at 1 kHz (its send time in the payload);
 // the sim process echoes each new pose as a force; the device process times
 // the force's arrival in its own model (the mirror's publish) against the
-// pose's send time: the round trip, model to model, with both bridges' ticks
-// and the sim's tick in it. Meanwhile the device process publishes a
+// pose's send time: the round trip, model to model. By default the bridges
+// send on publish (the model's publish hook wakes their sender threads) and
+// the sim's force path runs on arrival: a publish hook on the mirrored pose
+// computes and publishes the force at once, as a HIP woken by a new pose
+// would; without on_arrival it answers on its own 4 kHz tick. Meanwhile the device process publishes a
 // 10404 x 3 float mesh at 60 Hz, reliable and transient-local, and the sim
 // side's bridge times each mirror against the writer's publish (one host, one
 // CLOCK_MONOTONIC). A raw DDS ping-pong of the same sample type beside it is
@@ -17,6 +20,7 @@
 
 #if TX_WITH_DDS
 #include "../controllers/net/net.h"
+#include "../controllers/system_internal.h"
 #include "../scenarios/loader.h"
 #include "../model/error.h"
 
@@ -36,6 +40,10 @@ static tx_hist rtt; // device side: pose sent -> force mirrored back, ns
 typedef struct echo {
   tx_port in, out;
   uint64_t last;
+  bool on_arrival;       // sim: the force path runs from the pose's publish hook
+  tx_model* model;       // after init, on_arrival
+  tx_comp pose, force;
+  int hook;
 } echo;
 
 static int device_configure(tx_setup* s, void** self) {
@@ -58,6 +66,10 @@ static void device_step(tx_ctx* c, void* self) {
   if (echoed[0] > 0) tx_hist_add(&rtt, f.mono_ns - (int64_t)echoed[0]); // the force's arrival in this model
 }
 
+static const tx_param_def sim_params[] = {
+    {"on_arrival", TX_PARAM_BOOL, NULL, 0, 0, 1, NULL, "answer each pose from its publish hook, not on the next tick"},
+};
+
 static int sim_configure(tx_setup* s, void** self) {
   echo* e = calloc(1, sizeof *e);
   if (!e) return -1;
@@ -65,10 +77,39 @@ static int sim_configure(tx_setup* s, void** self) {
   e->in = tx_setup_read_as(s, "bench.pose", TX_F64, 2);
   tx_setup_read_as(s, "bench.mesh", TX_F32, 3); // mirrored in, timed by the bridge
   e->out = tx_setup_write(s, &(tx_component_def){"bench.force", TX_F64, 1, 2, "ns, 1"});
+  e->on_arrival = tx_table_bool(s, "on_arrival");
   return 0;
 }
+
+// on the thread that published the pose (the bridge's listener): this hook is
+// then the force's one writer, the step never writes it
+static void sim_on_pose(void* user, tx_comp comp, uint64_t seq) {
+  (void)comp, (void)seq;
+  echo* e = user;
+  tx_snapshot p = tx_model_latest(e->model, e->pose); // the publisher's own thread: no slot needed
+  memcpy(tx_model_back(e->model, e->force), p.data, 2 * sizeof(double));
+  tx_model_publish(e->model, e->force, p.sim_ns);
+}
+
+static int sim_init(tx_ctx* c, void* self) {
+  echo* e = self;
+  if (!e->on_arrival) return 0;
+  e->model = c->sys->model;
+  e->pose = c->in->ports[e->in.id - 1].comp;
+  e->force = c->in->ports[e->out.id - 1].comp;
+  if (!(e->hook = tx_model_add_hook(e->model, e->pose, sim_on_pose, e))) return tx_stop_run(c, "%s", tx_error()), -1;
+  return 0;
+}
+
+static void sim_fini(void* self) {
+  echo* e = self;
+  if (e && e->hook) tx_model_remove_hook(e->model, e->hook);
+  free(e);
+}
+
 static void sim_step(tx_ctx* c, void* self) {
   echo* e = self;
+  if (e->on_arrival) return; // the hook answers
   tx_snapshot p = tx_read(c, e->in);
   if (p.seq == e->last || p.seq == 0) return;
   e->last = p.seq;
@@ -91,7 +132,8 @@ static void mesh_step(tx_ctx* c, void* self) {
 static const tx_controller_class classes[] = {
     {.type = "bench.dds_device", .summary = "writes a timed pose, times the echoed force", .configure = device_configure,
      .step = device_step, .fini = free},
-    {.type = "bench.dds_sim", .summary = "echoes each new pose as a force", .configure = sim_configure, .step = sim_step, .fini = free},
+    {.type = "bench.dds_sim", .summary = "echoes each new pose as a force", .configure = sim_configure, .init = sim_init,
+     .step = sim_step, .fini = sim_fini, .params = sim_params, .nparams = TX_PARAMS_COUNT(sim_params)},
     {.type = "bench.dds_mesh", .summary = "writes a 10404 x 3 float mesh", .configure = mesh_configure, .step = mesh_step,
      .fini = free},
 };
@@ -173,7 +215,7 @@ static int run_role(const char* text, const char* role, double seconds, tx_run_r
   return 0;
 }
 
-int tx_bench_dds(double duration_s, double net_hz, double sim_hz, int poll_us) {
+int tx_bench_dds(double duration_s, double net_hz, double sim_hz, int poll_us, bool on_arrival) {
   for (size_t i = 0; i < sizeof classes / sizeof classes[0]; i++)
     if (!tx_find_controller(classes[i].type)) tx_register_controller(&classes[i]);
   double seconds = duration_s > 0 ? duration_s : 5;
@@ -184,10 +226,10 @@ int tx_bench_dds(double duration_s, double net_hz, double sim_hz, int poll_us) {
            " \"net\": {\"domain\": %d, \"rate_hz\": %g, \"poll_us\": %d, \"fast\": [\"bench.pose\", \"bench.force\"], \"state\": [\"bench.mesh\"]},"
            " \"controllers\": [{\"name\": \"device\", \"type\": \"bench.dds_device\", \"rate_hz\": 1000},"
            " {\"name\": \"mesh\", \"type\": \"bench.dds_mesh\", \"rate_hz\": 60},"
-           " {\"name\": \"sim\", \"type\": \"bench.dds_sim\", \"rate_hz\": %g}]}",
-           (int)getpid(), domain, net_hz, poll_us, sim_hz);
-  printf("bench dds: two processes on loopback (domain %d), %g s; bridges at %g Hz, %s; the echoing sim at %g Hz\n", domain,
-         seconds, net_hz, poll_us ? "a sender thread polling" : "sending from their steps", sim_hz);
+           " {\"name\": \"sim\", \"type\": \"bench.dds_sim\", \"rate_hz\": %g, \"params\": {\"on_arrival\": %s}}]}",
+           (int)getpid(), domain, net_hz, poll_us, sim_hz, on_arrival ? "true" : "false");
+  printf("bench dds: two processes on loopback (domain %d), %g s; bridges at %g Hz, %s; the echoing sim %s\n", domain, seconds,
+         net_hz, poll_us ? "a sender thread polling" : "sending on publish", on_arrival ? "answering on arrival" : "on its tick");
   if (poll_us) printf("  the sender threads poll every %d us\n", poll_us);
   fflush(stdout);
 
@@ -277,8 +319,8 @@ int tx_bench_dds(double duration_s, double net_hz, double sim_hz, int poll_us) {
 
 #include <stdio.h>
 
-int tx_bench_dds(double duration_s, double net_hz, double sim_hz, int poll_us) {
-  (void)duration_s, (void)net_hz, (void)sim_hz, (void)poll_us;
+int tx_bench_dds(double duration_s, double net_hz, double sim_hz, int poll_us, bool on_arrival) {
+  (void)duration_s, (void)net_hz, (void)sim_hz, (void)poll_us, (void)on_arrival;
   fprintf(stderr, "tactus: bench dds: this build has no DDS (configure with -DTX_WITH_DDS=ON)\n");
   return 2;
 }

@@ -6,8 +6,11 @@
 #ifndef TX_STUDIES_BENCH_DDS_H
 #define TX_STUDIES_BENCH_DDS_H
 
+#include <stdbool.h>
+
 // duration_s: seconds of the session (0: 5); net_hz: the bridges' rate; sim_hz: the echoing sim's rate;
-// poll_us: the bridges' sender threads (0: they send from their steps)
-int tx_bench_dds(double duration_s, double net_hz, double sim_hz, int poll_us);
+// poll_us: > 0, the bridges' sender threads poll this often (0: they send on publish);
+// on_arrival: the sim answers each pose from its publish hook (else on its tick)
+int tx_bench_dds(double duration_s, double net_hz, double sim_hz, int poll_us, bool on_arrival);
 
 #endif

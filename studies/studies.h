@@ -25,6 +25,7 @@ void tx_bench_target_us(const char* what, double measured_us, double limit_us);
 
 int tx_study_haptic_stability(const tx_study_args* a);
 int tx_study_needle_fit(const tx_study_args* a);
+int tx_study_network_haptics(const tx_study_args* a);
 int tx_study_needle_stability(const tx_study_args* a);
 int tx_study_skin_paper(const tx_study_args* a);
 int tx_study_skin_stability(const tx_study_args* a);

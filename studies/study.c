@@ -30,6 +30,8 @@ static const struct {
 } studies[] = {
     {"haptic-stability", tx_study_haptic_stability,
      "largest stable wall stiffness vs Colgate's bound, with and without passivity control"},
+    {"network-haptics", tx_study_network_haptics,
+     "the haptics wall across a network (device and simulation apart), stiffest stable wall per delay, with and without passivity control"},
     {"needle-fit", tx_study_needle_fit, "FILE: fit the voxel tissue to a needle recording, RMS vs run time, Figure 5"},
     {"needle-stability", tx_study_needle_stability, "needle in voxels at stiff, elastic, light, fast and overlapping extremes"},
     {"skin-paper", tx_study_skin_paper,

@@ -3,10 +3,16 @@
 
 #include "../../model/error.h"
 
+#include <tactus/config.h>
+
 #include <stdio.h>
 #include <string.h>
 
-static const tx_device_backend* const backends[] = {&tx_device_scripted, &tx_device_replay, &tx_device_sim, &tx_device_udp, &tx_device_mouse};
+static const tx_device_backend* const backends[] = {&tx_device_scripted, &tx_device_replay, &tx_device_sim, &tx_device_udp, &tx_device_mouse,
+#if TX_WITH_DDS
+                                                    &tx_device_dds, // controllers/net/device_dds.c
+#endif
+};
 
 int tx_device_open(const char* spec, double period_s, tx_device_handle* h) {
   *h = (tx_device_handle){0};
@@ -18,7 +24,8 @@ int tx_device_open(const char* spec, double period_s, tx_device_handle* h) {
     h->device = backends[i]->open(colon ? colon + 1 : "", period_s);
     return h->device ? 0 : -1;
   }
-  tx_set_error("device '%s': unknown kind (known: scripted:NAME, scripted:FILE.csv, replay:FILE, sim[:KEY=VALUE,...], udp:HOST:PORT, mouse)", spec);
+  tx_set_error("device '%s': unknown kind (known: scripted:NAME, scripted:FILE.csv, replay:FILE, sim[:KEY=VALUE,...], udp:HOST:PORT, mouse%s)", spec,
+               TX_WITH_DDS ? ", dds:DOMAIN[:NAME]" : "");
   return -1;
 }
 

@@ -44,5 +44,6 @@ extern const tx_device_backend tx_device_replay;
 extern const tx_device_backend tx_device_sim;
 extern const tx_device_backend tx_device_udp;
 extern const tx_device_backend tx_device_mouse; // driven by a window, through window.pointer (device_mouse.h)
+extern const tx_device_backend tx_device_dds;   // across Cyclone DDS, in DDS builds (controllers/net/device_dds.h)
 
 #endif

@@ -1,9 +1,11 @@
 // net.dds: the bridge that carries components and event streams between the
 // processes of one session over Cyclone DDS (docs/distributed.md).
 //
-// Sending: each step reads the components it sends and publishes every new
-// publish (a changed seq) as a sample of its topic; events it listens to go
-// out one sample each. Receiving: a DDS listener, on Cyclone's receive thread,
+// Sending: by default the moment a sent component is published, the model's
+// publish hook wakes the bridge's sender thread, which writes every new
+// publish (a changed seq) as a sample of its topic; else each step (or a
+// thread polling every poll_us) does. Events it listens to go out from the
+// step, one sample each. Receiving: a DDS listener, on Cyclone's receive thread,
 // writes each sample into the local model at once (the bridge is the one
 // writer of a mirrored component there), stamped with the local simulation
 // time of its arrival, so a reader sees it as any publish, without waiting for
@@ -17,7 +19,9 @@
 
 #include <tactus/stats.h>
 
+#include <errno.h>
 #include <pthread.h>
+#include <semaphore.h>
 #include <time.h>
 #include <stdatomic.h>
 #include <stdlib.h>
@@ -38,7 +42,9 @@ static const tx_param_def params[] = {
     {"send_streams", TX_PARAM_STRS, NULL, 0, SEND_MAX, 0, NULL, "event streams this process emits and the others mirror"},
     {"receive_streams", TX_PARAM_JSON, NULL, 0, 0, 0, NULL, "event streams mirrored in: [{name, capacity}]"},
     {"poll_us", TX_PARAM_INT, "us", 0, 100000, 0, NULL,
-     "0: components are sent from the bridge's step; else a thread of its own polls them this often (less latency, a CPU share)"},
+     "> 0: a thread of the bridge's own polls the sent components this often, instead of sending on publish"},
+    {"on_publish", TX_PARAM_BOOL, NULL, 0, 0, 1, NULL,
+     "send a component the moment its writer publishes it (the model's publish hook wakes the sender thread); false: from the bridge's step"},
     {"best_effort", TX_PARAM_STRS, NULL, 0, SEND_MAX, 0, NULL,
      "components that are poses or forces: best effort, keep last 1 (the rest: reliable, transient-local)"},
 };
@@ -54,6 +60,7 @@ typedef struct outbound {
   bool fast;             // best effort, keep last 1 (else reliable, transient-local)
   uint64_t last_seq;     // last publish sent
   dds_entity_t writer;
+  int hook;              // the model's publish hook that wakes the sender, 0 if none
 } outbound;
 
 typedef struct inbound {
@@ -88,6 +95,10 @@ struct bridge {
   pthread_mutex_t lock;  // one listener call at a time writes the model
   _Atomic bool live;     // init done, finish not yet: the listener may write
   int poll_us;           // > 0: the sender thread polls the sent components
+  bool on_publish;       // poll_us 0: the publish hook wakes the sender thread
+  sem_t wake;            // posted by the publish hook
+  bool wake_made;
+  _Atomic bool pending;  // a publish since the sender last looked: one post per batch
   pthread_t sender;
   bool sender_started;
   _Atomic bool sender_stop;
@@ -158,6 +169,7 @@ static int configure(tx_setup* s, void** self) {
   for (int i = 0; i < b->npeers; i++)
     if (!tx_net_peer_valid(b->peers[i])) return tx_setup_fail(s, "peers", "entry %d: %s", i, tx_error());
   b->poll_us = (int)tx_table_int(s, "poll_us");
+  b->on_publish = !b->poll_us && tx_table_bool(s, "on_publish");
   const char* session = tx_table_str(s, "session");
   b->tag = tx_net_session_tag(session ? session : "tactus", b->domain);
   const char* fast[SEND_MAX];
@@ -262,6 +274,15 @@ static void on_event(dds_entity_t reader, void* arg) {
 
 static void* sender(void* arg);
 
+// the model's publish hook, on the writer's thread (the haptic thread, for a
+// force model): one atomic exchange, and a post only when the sender has
+// looked since the last one
+static void on_publish(void* user, tx_comp comp, uint64_t seq) {
+  (void)comp, (void)seq;
+  bridge* b = user;
+  if (!atomic_exchange_explicit(&b->pending, true, memory_order_acq_rel)) sem_post(&b->wake);
+}
+
 static int init(tx_ctx* c, void* self) {
   bridge* b = self;
   b->ctx = c;
@@ -307,10 +328,23 @@ static int init(tx_ctx* c, void* self) {
   for (int k = 0; k < b->nin; k++)
     if (b->in[k].latency) tx_hist_clear(b->in[k].latency), tx_prefault(b->in[k].latency, sizeof *b->in[k].latency);
   atomic_store_explicit(&b->live, true, memory_order_release);
-  if (b->poll_us) {
+  bool any = false;
+  for (int k = 0; k < b->nout; k++) any |= !b->out[k].stream;
+  if (b->on_publish && any) {
+    if (sem_init(&b->wake, 0, 0) != 0) return tx_stop_run(c, "net: cannot make the sender's semaphore"), -1;
+    b->wake_made = true;
+  }
+  if ((b->poll_us || b->on_publish) && any) {
     if (pthread_create(&b->sender, NULL, sender, b) != 0) return tx_stop_run(c, "net: cannot start the sender thread"), -1;
     b->sender_started = true;
   }
+  // hooks after the thread: a publish from now on wakes it; one before is sent by its first pass
+  for (int k = 0; b->on_publish && k < b->nout; k++)
+    if (!b->out[k].stream) {
+      const port* pt = &c->in->ports[b->out[k].port.id - 1];
+      if (!(b->out[k].hook = tx_model_add_hook(b->model, pt->comp, on_publish, b)))
+        return tx_stop_run(c, "net: %s", tx_error()), -1;
+    }
   return 0;
 }
 
@@ -324,17 +358,32 @@ static void send_component(bridge* b, outbound* o, const tx_snapshot* snap) {
   else atomic_fetch_add_explicit(&b->sent, 1, memory_order_relaxed);
 }
 
-// poll_us > 0: sends each publish within poll_us of it, not at the bridge's next tick
+static void send_all(bridge* b) {
+  for (int k = 0; k < b->nout; k++)
+    if (!b->out[k].stream) {
+      tx_snapshot snap = tx_model_acquire(b->model, b->out[k].reader);
+      send_component(b, &b->out[k], &snap);
+    }
+}
+
+// on_publish: sends each publish as soon as the hook wakes it; poll_us > 0:
+// within poll_us of it. Either way not at the bridge's next tick
 static void* sender(void* arg) {
   bridge* b = arg;
+  pthread_setname_np(pthread_self(), "tx-net-send");
+  if (b->on_publish) {
+    while (!atomic_load_explicit(&b->sender_stop, memory_order_acquire)) {
+      // cleared before the pass: a publish during it posts again, and is not lost
+      atomic_store_explicit(&b->pending, false, memory_order_release);
+      send_all(b);
+      while (sem_wait(&b->wake) != 0 && errno == EINTR) {}
+    }
+    return NULL;
+  }
   struct timespec next;
   clock_gettime(CLOCK_MONOTONIC, &next);
   while (!atomic_load_explicit(&b->sender_stop, memory_order_acquire)) {
-    for (int k = 0; k < b->nout; k++)
-      if (!b->out[k].stream) {
-        tx_snapshot snap = tx_model_acquire(b->model, b->out[k].reader);
-        send_component(b, &b->out[k], &snap);
-      }
+    send_all(b);
     next.tv_nsec += (long)b->poll_us * 1000;
     while (next.tv_nsec >= 1000000000) next.tv_nsec -= 1000000000, next.tv_sec++;
     struct timespec now;
@@ -367,17 +416,22 @@ static void step(tx_ctx* c, void* self) {
       }
       continue;
     }
-    if (b->poll_us) continue; // the sender thread's
+    if (b->sender_started) continue; // the sender thread's
     tx_snapshot snap = tx_read(c, o->port);
     send_component(b, o, &snap);
   }
 }
 
 static void stop_sender(bridge* b) {
-  if (!b->sender_started) return;
-  atomic_store_explicit(&b->sender_stop, true, memory_order_release);
-  pthread_join(b->sender, NULL);
-  b->sender_started = false;
+  for (int k = 0; k < b->nout; k++) // waits for a hook call under way: none after this
+    if (b->out[k].hook) tx_model_remove_hook(b->model, b->out[k].hook), b->out[k].hook = 0;
+  if (b->sender_started) {
+    atomic_store_explicit(&b->sender_stop, true, memory_order_release);
+    if (b->wake_made) sem_post(&b->wake);
+    pthread_join(b->sender, NULL);
+    b->sender_started = false;
+  }
+  if (b->wake_made) sem_destroy(&b->wake), b->wake_made = false;
 }
 
 static void finish(tx_ctx* c, void* self) {

@@ -4,6 +4,9 @@
 #include "../../model/error.h"
 
 #include <arpa/inet.h>
+#include <pthread.h>
+#include <sched.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,6 +29,10 @@ bool tx_net_peer_valid(const char* peer) {
 }
 
 int tx_net_config(char* out, size_t size, const char* const* peers, int npeers) {
+  return tx_net_config_priority(out, size, peers, npeers, 0);
+}
+
+int tx_net_config_priority(char* out, size_t size, const char* const* peers, int npeers, int priority) {
   if (npeers < 0 || npeers > TX_NET_PEERS_MAX) return tx_set_error("at most %d peers", TX_NET_PEERS_MAX), -1;
   char list[TX_NET_CONFIG_MAX / 2] = "";
   size_t len = 0;
@@ -38,12 +45,17 @@ int tx_net_config(char* out, size_t size, const char* const* peers, int npeers) 
   // loopback alone unless peers are named; no multicast either way, so
   // discovery goes only where the list says
   const char* iface = npeers ? "<NetworkInterface autodetermine=\"true\"/>" : "<NetworkInterface address=\"127.0.0.1\"/>";
+  char threads[320] = "";
+  if (priority > 0)
+    snprintf(threads, sizeof threads,
+             "<Threads><Thread name=\"recv\"><Scheduling><Class>realtime</Class><Priority>%d</Priority></Scheduling>"
+             "</Thread></Threads><Internal><MultipleReceiveThreads>false</MultipleReceiveThreads></Internal>", priority);
   int w = snprintf(out, size,
                    "<CycloneDDS><Domain id=\"any\"><General><Interfaces>%s</Interfaces>"
                    "<AllowMulticast>false</AllowMulticast></General>"
                    "<Discovery><ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>32</MaxAutoParticipantIndex>"
-                   "<Peers><Peer address=\"127.0.0.1\"/>%s</Peers></Discovery></Domain></CycloneDDS>",
-                   iface, list);
+                   "<Peers><Peer address=\"127.0.0.1\"/>%s</Peers></Discovery>%s</Domain></CycloneDDS>",
+                   iface, list, threads);
   if (w < 0 || (size_t)w >= size) return tx_set_error("the configuration is too long"), -1;
   return 0;
 }
@@ -64,12 +76,36 @@ void tx_net_topic_name(char* out, size_t size, bool stream, const char* name) {
     if (*c == '.') *c = '/';
 }
 
+static void* try_fifo(void* arg) {
+  struct sched_param sp = {.sched_priority = sched_get_priority_min(SCHED_FIFO)};
+  *(bool*)arg = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0;
+  return NULL;
+}
+
+// whether this process may run a thread at SCHED_FIFO (root, CAP_SYS_NICE or
+// an RLIMIT_RTPRIO): asked once, on a thread of its own
+static bool fifo_ok;
+static void ask_fifo(void) {
+  pthread_t t;
+  if (pthread_create(&t, NULL, try_fifo, &fifo_ok) == 0) pthread_join(t, NULL);
+}
+static bool fifo_allowed(void) {
+  static pthread_once_t once = PTHREAD_ONCE_INIT;
+  pthread_once(&once, ask_fifo);
+  return fifo_ok;
+}
+
 dds_entity_t tx_net_participant(int domain, const char* const* peers, int npeers) {
   if (domain < 0 || domain > TX_NET_DOMAIN_MAX) return tx_set_error("domain %d is not in [0, %d]", domain, TX_NET_DOMAIN_MAX), -1;
   const char* uri = getenv("CYCLONEDDS_URI");
   if (!uri || !*uri) {
     char xml[TX_NET_CONFIG_MAX];
-    if (tx_net_config(xml, sizeof xml, peers, npeers)) return -1;
+    // Cyclone's receive thread delivers every sample (a device's state, a
+    // force model): on a busy host at normal priority it runs in bursts, and a
+    // keep-last-1 reader then sees one sample in several. Where SCHED_FIFO is
+    // allowed it runs just below the haptics thread.
+    int priority = fifo_allowed() ? sched_get_priority_max(SCHED_FIFO) - 11 : 0;
+    if (tx_net_config_priority(xml, sizeof xml, peers, npeers, priority)) return -1;
     dds_entity_t d = dds_create_domain((dds_domainid_t)domain, xml);
     // a second bridge in this process shares the domain already made
     if (d < 0 && d != DDS_RETCODE_PRECONDITION_NOT_MET)

@@ -31,6 +31,8 @@ typedef enum tx_net_kind {
 bool tx_net_peer_valid(const char* peer);
 // the domain's XML for these peers (none: loopback only); -1 with tx_error() on a bad peer
 int tx_net_config(char* out, size_t size, const char* const* peers, int npeers);
+// the same, with Cyclone's receive thread at SCHED_FIFO priority (0: as the system gives it)
+int tx_net_config_priority(char* out, size_t size, const char* const* peers, int npeers, int priority);
 // the session's tag: FNV-1a of "SESSION/DOMAIN"; samples of other tags are foreign
 uint64_t tx_net_session_tag(const char* session, int domain);
 // "tx/c/skin/x" (the component skin.x) or "tx/e/tool0/events" (the stream tool0.events)

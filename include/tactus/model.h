@@ -103,6 +103,23 @@ tx_snapshot tx_model_acquire(tx_model* m, tx_reader r);
 tx_snapshot tx_model_latest(tx_model* m, tx_comp c); // writer's own view, no slot needed
 void tx_model_release(tx_model* m, tx_reader r);
 
+// Publish hooks: a callback run by tx_model_publish, on the writer's thread,
+// right after the new publish became the latest, so that a component can be
+// sent on (net.dds) or acted on the moment it is published rather than at the
+// next tick of whoever polls it. A hook must be short and must not block: it
+// runs inside the writer's step (the haptic thread, for a force model); the
+// bridge's hook only posts a semaphore. The table of hooks is fixed memory,
+// made with the model (TX_PUBLISH_HOOKS_MAX per model, no allocation after);
+// a hook is added before commit or after it, before its component's writer
+// runs (a controller's init), and removed by whoever added it (fini). A
+// publish finds its hooks lock-free: with none, one atomic load and a branch.
+#define TX_PUBLISH_HOOKS_MAX 32
+typedef void (*tx_publish_hook)(void* user, tx_comp c, uint64_t seq);
+// a hook on c's publishes; returns its id (> 0), or 0 with tx_error() when the table is full
+int tx_model_add_hook(tx_model* m, tx_comp c, tx_publish_hook fn, void* user);
+// remove a hook; returns once no publish is still running it, so user may be freed after
+void tx_model_remove_hook(tx_model* m, int id);
+
 #ifdef __cplusplus
 }
 #endif

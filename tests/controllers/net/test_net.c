@@ -192,16 +192,17 @@ static const tx_controller_class test_classes[] = {
     {.type = "t.dst", .summary = "test reader", .configure = dst_configure, .step = dst_step, .fini = free},
 };
 
-static const char* scenario_text(int domain) {
+static const char* scenario_text_at(int domain, double net_hz, int poll_us) {
   static char text[1024];
   snprintf(text, sizeof text,
            "{\"name\": \"net-test-%d\", \"roles\": {\"a\": [\"src\"], \"b\": [\"dst\"]},"
-           " \"net\": {\"domain\": %d, \"rate_hz\": 2000, \"poll_us\": 100, \"state\": [\"t.val\"], \"streams\": [\"t.ev\"]},"
+           " \"net\": {\"domain\": %d, \"rate_hz\": %g, \"poll_us\": %d, \"state\": [\"t.val\"], \"streams\": [\"t.ev\"]},"
            " \"controllers\": [{\"name\": \"src\", \"type\": \"t.src\", \"rate_hz\": 500},"
            " {\"name\": \"dst\", \"type\": \"t.dst\", \"rate_hz\": 1000}]}",
-           (int)getpid(), domain);
+           (int)getpid(), domain, net_hz, poll_us);
   return text;
 }
+static const char* scenario_text(int domain) { return scenario_text_at(domain, 2000, 100); }
 
 typedef struct runner {
   tx_scenario* sc;
@@ -308,6 +309,43 @@ static void a_session_in_one_process(void** state) {
   tx_scenario_free(b);
 }
 
+// sending on publish (poll_us 0, the default): the bridges step at 4 Hz, so
+// sending from the step would carry 4 of the writer's 500 publishes a second,
+// each up to 250 ms late; the publish hook sends every one at once. The
+// bridge's finish, after its last tick (0.75 s), ends its counts and hooks
+static void sends_on_publish_not_on_its_tick(void** state) {
+  (void)state;
+  for (size_t i = 0; i < 2; i++)
+    if (!tx_find_controller(test_classes[i].type)) tx_register_controller(&test_classes[i]);
+  int domain = 200 + (int)(getpid() % 30);
+  const char* text = scenario_text_at(domain, 4, 0);
+  tx_load_options oa = {.role = "a"}, ob = {.role = "b"};
+  tx_scenario* a = tx_scenario_load_text("t.json", text, strlen(text), &oa);
+  tx_scenario* b = tx_scenario_load_text("t.json", text, strlen(text), &ob);
+  assert_non_null(a);
+  assert_non_null(b);
+  memset(&got, 0, sizeof got);
+  got.consistent = true;
+  runner rb = {b, 1.4, 0}, ra = {a, 1.0, 0};
+  pthread_t tb, ta;
+  pthread_create(&tb, NULL, run_thread, &rb);
+  usleep(200000);
+  pthread_create(&ta, NULL, run_thread, &ra);
+  pthread_join(ta, NULL);
+  pthread_join(tb, NULL);
+  assert_int_equal(ra.rc, 0);
+  assert_int_equal(rb.rc, 0);
+  double sent = result(a, "net.samples_sent");
+  assert_true(sent >= 300 && sent <= 400); // every publish up to 0.75 s (init's and 375 steps), none twice
+  assert_true(got.seen > 250);              // the reader, at 1 kHz, sees most of them
+  assert_true(got.consistent);
+  // publish -> mirrored, one host: far below the bridge's 500 ms tick (loose, for a loaded machine)
+  assert_true(result(b, "net.t.val.latency_p50_us") > 0);
+  assert_true(result(b, "net.t.val.latency_p50_us") < 20000);
+  tx_scenario_free(a);
+  tx_scenario_free(b);
+}
+
 int main(void) {
   tx_register_builtin();
   const struct CMUnitTest tests[] = {
@@ -318,6 +356,7 @@ int main(void) {
       cmocka_unit_test(received_samples_are_checked),
       cmocka_unit_test(roles_build_the_bridge),
       cmocka_unit_test(a_session_in_one_process),
+      cmocka_unit_test(sends_on_publish_not_on_its_tick),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
