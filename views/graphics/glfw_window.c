@@ -66,6 +66,9 @@ static void on_button(GLFWwindow* w, int button, int action, int mods) {
 
 static void on_cursor(GLFWwindow* w, double x, double y) {
   tx_window* t = glfwGetWindowUserPointer(w);
+#ifdef TX_HAVE_GUI
+  if (t->gui) tx_gui_cursor(t->gui, x, y);
+#endif
   if (t->dragging) {
     t->tool[0] += (x - t->last_x) * DRAG_M_PER_PX;
     t->tool[2] += (y - t->last_y) * DRAG_M_PER_PX; // down the screen is towards the viewer

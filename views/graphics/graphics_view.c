@@ -67,7 +67,8 @@ typedef struct view {
   double first_frame_ms;                // ms, the first frame (shader compilation included)
   tx_hist frame_ns;                     // render + read-back time of every frame, ns
   tx_hist frame_cpu_ns;                 // CPU time of the rendering thread for each, ns
-  tx_result r_frames, r_dropped, r_p50, r_p99, r_threads, r_written, r_first, r_cpu50;
+  double cpu_ms_sum;                    // of the timed frames, for the mean
+  tx_result r_frames, r_dropped, r_p50, r_p99, r_threads, r_written, r_first, r_cpu50, r_cpu_mean;
   tx_warning w_write, w_skipped;
   uint64_t skipped_reported;
   tx_ctx* ctx;                          // the step's context, for warnings from the renderer
@@ -170,6 +171,7 @@ static int configure(tx_setup* s, void** self) {
   v->r_threads = tx_setup_result(s, "render_threads");
   v->r_first = tx_setup_result(s, "first_frame_ms");
   v->r_cpu50 = tx_setup_result(s, "frame_cpu_ms_p50");
+  v->r_cpu_mean = tx_setup_result(s, "frame_cpu_ms_mean");
   v->w_write = tx_setup_warning(s, "frame_not_written");
   v->w_skipped = tx_setup_warning(s, "rows_not_drawn");
   return 0;
@@ -203,6 +205,7 @@ static void record_time(view* v, double ms, double cpu_ms) {
     return;
   }
   tx_hist_add(&v->frame_cpu_ns, llround(cpu_ms * 1e6));
+  v->cpu_ms_sum += cpu_ms;
   tx_hist_add(&v->frame_ns, llround(ms * 1e6));
   v->timed++;
 }
@@ -591,6 +594,7 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, v->r_p50, frame_ms(v, &v->frame_ns, 0.5));
   tx_set_result(c, v->r_p99, frame_ms(v, &v->frame_ns, 0.99));
   tx_set_result(c, v->r_cpu50, frame_ms(v, &v->frame_cpu_ns, 0.5));
+  tx_set_result(c, v->r_cpu_mean, v->timed ? v->cpu_ms_sum / (double)v->timed : NAN);
   tx_set_result(c, v->r_threads, v->target == TARGET_PNG ? v->render_threads : NAN);
   tx_set_result(c, v->r_first, v->rendered ? v->first_frame_ms : NAN);
 }

@@ -22,6 +22,7 @@ bool tx_gui_mouse_button(tx_gui* g, int button, int action, int mods);
 bool tx_gui_scroll(tx_gui* g, double dx, double dy);
 bool tx_gui_key(tx_gui* g, int key, int scancode, int action, int mods);
 void tx_gui_char(tx_gui* g, unsigned c);
+void tx_gui_cursor(tx_gui* g, double x, double y); // window px
 bool tx_gui_wants_mouse(const tx_gui* g);
 
 void tx_gui_set_shown(tx_gui* g, bool shown);
@@ -31,6 +32,8 @@ bool tx_gui_shown(const tx_gui* g);
 // holds tiles_x x tiles_y eyes (sbs 2 x 1, tb 1 x 2): the panels are drawn
 // in each eye at the same place, zero disparity; with quad buffers into both
 // back buffers. Input is read in the eye under the cursor.
+// The panels are laid out and drawn into a texture only on input or at 10 Hz,
+// and copied into the eyes every frame.
 void tx_gui_frame(tx_gui* g, int fb_w, int fb_h, int tiles_x, int tiles_y, bool quad);
 
 // widgets, for gui_panel.c, between tx_gui_frame's call of tx_gui_panels and its draw

@@ -25,8 +25,8 @@ unset TACTUS_SCENARIO_PATH
 failures=0
 fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
 
-# the panel's title bar (Dear ImGui's dark style, active): a colour nothing else in the frame has
-TITLE="40 71 115"
+# the panel's title bar (Dear ImGui's dark style, active, opaque): a colour nothing else in the frame has
+TITLE="41 74 122"
 panel_in() { # PNG X Y W H: pixels of the title bar's colour in that region
   local n
   read -r _ _ _ n < <("$PROBE" "$1" "$2" "$3" "$4" "$5" $TITLE)
@@ -128,9 +128,9 @@ PY
   n=$(panel_in "$png" 0 40 320 440)
   [ "$n" -eq 0 ] || fail "the title bar's colour outside the panel ($n px): the probe cannot tell"
   # the device plots under Devices: |F| (y 338..376) holds a trace in the plots' line colour
-  read -r _ _ _ n < <("$PROBE" "$png" 336 336 196 42 147 148 150)
+  read -r _ _ _ n < <("$PROBE" "$png" 336 336 196 42 156 156 156)
   [ "${n:-0}" -gt 60 ] || fail "no trace in the |F| plot (${n:-0} px of its line colour)"
-  read -r _ _ _ n < <("$PROBE" "$png" 0 40 320 440 147 148 150)
+  read -r _ _ _ n < <("$PROBE" "$png" 0 40 320 440 156 156 156)
   [ "${n:-1}" -eq 0 ] || fail "the plots' line colour outside the panel ($n px): the probe cannot tell"
   [ -n "$SHOTS" ] && cp "$png" "$SHOTS/trainer_mono.png"
 fi
