@@ -336,6 +336,19 @@ TX_LAYOUT_ASSERT(tx_instrument_held, double);
 //   organs.contact (1 row, tx_skin_contact): force, where it holds, its
 //     direction, the tangent stiffness k along it, the indentation
 
+// --- the procedure ------------------------------------------------------------
+
+// procedure.step (1 row), written by whatever runs a procedure, read by the
+// window's panels (docs/trainer.md): the current step as one line of text,
+// NUL-terminated, e.g. "3/7 pass the needle through the far edge"
+typedef struct tx_procedure_step {
+  char text[64];
+} tx_procedure_step;
+#define tx_procedure_step_TYPE TX_U8
+#define tx_procedure_step_COLS 64u
+#define tx_procedure_step_UNITS "1"
+TX_LAYOUT_ASSERT(tx_procedure_step, uint8_t);
+
 #ifdef __cplusplus
 }
 #endif

@@ -244,6 +244,14 @@ void tx_window_sample(tx_window* t, const char* device, double t_s, const double
 #endif
 }
 
+void tx_window_procedure(tx_window* t, const char* text) {
+#ifdef TX_HAVE_GUI
+  if (t->gui) tx_gui_procedure(text);
+#else
+  (void)t, (void)text;
+#endif
+}
+
 bool tx_window_present(tx_window* t) {
   glfwSwapBuffers(t->w);
   glfwPollEvents();

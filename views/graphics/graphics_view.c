@@ -2,6 +2,7 @@
 #include "graphics_view.h"
 
 #include "contact_sheet.h"
+#include "gui_inspect.h"
 #include "png_writer.h"
 #include "renderer.h"
 #include "stereo_frame.h"
@@ -72,6 +73,9 @@ typedef struct view {
   tx_warning w_write, w_skipped;
   uint64_t skipped_reported;
   tx_ctx* ctx;                          // the step's context, for warnings from the renderer
+  bool has_procedure;                   // procedure.step is written: the panels show its text
+  tx_port procedure;
+  char procedure_text[72];              // handed to the renderer with the frame
 } view;
 
 // the layouts of <tactus/components.h> that the renderer draws, by name suffix
@@ -163,6 +167,12 @@ static int configure(tx_setup* s, void** self) {
     }
     v->nports[i] = n;
   }
+  // the procedure's current step, for the panels, where something writes it (docs/trainer.md)
+  for (int k = 0; k < navail && !v->has_procedure; k++)
+    if (strcmp(avail[k], TX_PROCEDURE_COMPONENT) == 0) {
+      v->procedure = TX_READ_OF(s, TX_PROCEDURE_COMPONENT, tx_procedure_step);
+      v->has_procedure = true;
+    }
   v->r_frames = tx_setup_result(s, "frames");
   v->r_written = tx_setup_result(s, "frames_written");
   v->r_dropped = tx_setup_result(s, "frames_dropped");
@@ -323,6 +333,7 @@ static void draw_overlay(view* v, render_state* rs, int w, int h) {
   if (v->stereo == TX_STEREO_TB) tx_overlay_draw(rs->overlay, 0, 0, w, h);
   tx_overlay_clear(rs->overlay);
   // the trainer's panels over it, at zero disparity (glfw_window.h)
+  tx_window_procedure(rs->win, v->has_procedure ? v->procedure_text : NULL);
   tx_window_draw_gui(rs->win, v->stereo == TX_STEREO_SBS ? 2 : 1, v->stereo == TX_STEREO_TB ? 2 : 1);
 }
 #endif
@@ -568,6 +579,10 @@ static void step(tx_ctx* c, void* self) {
       si->rows[k] = s.seq ? s.rows : 0; // never published: nothing to draw
       v->seq[i][k] = s.seq;
     }
+  }
+  if (v->has_procedure) {
+    tx_snapshot p = tx_read(c, v->procedure);
+    tx_procedure_text(&p, v->procedure_text, sizeof v->procedure_text);
   }
   v->frame_sim_ns = tx_sim_ns(c);
   v->frame_index++;

@@ -53,6 +53,8 @@ void tx_gui_table_end(void);
 // the panels (gui_panel.c): the run's controls, inspect and tune
 void tx_gui_panels(float eye_w, float eye_h);
 // a device's position (m) and force (N, or NULL) as the frame drew them, for its plots
+// the procedure's current step, as the frame read it; NULL: the run has none
+void tx_gui_procedure(const char* text);
 void tx_gui_sample(const char* device, double t_s, const double pos[3], const double* force);
 
 #ifdef __cplusplus
