@@ -258,6 +258,35 @@ bool tx_window_present(tx_window* t) {
   return !glfwWindowShouldClose(t->w);
 }
 
+int tx_window_pick(const char* const* names, const char* const* about, int n, bool* mouse) {
+  *mouse = false;
+#ifdef TX_HAVE_GUI
+  tx_window* t = tx_window_open(640, 480, false);
+  if (!t) return -2;
+  glfwSetWindowTitle(t->w, "tactus: choose a scenario");
+  void (*clear_color)(float, float, float, float) = (void (*)(float, float, float, float))glfwGetProcAddress("glClearColor");
+  void (*clear)(unsigned) = (void (*)(unsigned))glfwGetProcAddress("glClear");
+  tx_pick pick = {names, about, n, n > 0 ? 0 : -1, 0, false, "", false};
+  tx_gui_set_pick(t->gui, &pick);
+  while (!pick.start && !glfwWindowShouldClose(t->w)) {
+    glfwWaitEventsTimeout(0.05); // nothing moves here but what the hand does
+    clear_color(0.1f, 0.1f, 0.12f, 1);
+    clear(0x00004000); // GL_COLOR_BUFFER_BIT
+    tx_window_draw_gui(t, 1, 1);
+    glfwSwapBuffers(t->w);
+  }
+  tx_gui_set_pick(t->gui, NULL);
+  bool started = pick.start;
+  tx_window_close(t);
+  tx_window_input_reset(); // the picker's clicks are not the run's input
+  *mouse = pick.device == 1;
+  return started ? pick.chosen : -1;
+#else
+  (void)names, (void)about, (void)n;
+  return tx_set_error("the scenario picker needs Dear ImGui (libimgui-dev)"), -2;
+#endif
+}
+
 void tx_window_take_scope(tx_window* t, double move[3]) {
   for (int i = 0; i < 3; i++) move[i] = t->scope[i], t->scope[i] = 0;
 }

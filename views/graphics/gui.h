@@ -50,6 +50,22 @@ bool tx_gui_table_begin(const char* id, int columns);
 void tx_gui_table_row(const char* const* cells, int columns);
 void tx_gui_table_end(void);
 
+// The scenario picker (tx_window_pick): while set, tx_gui_frame draws it
+// instead of the trainer's panels. It lists n scenarios and, when start is
+// set, the chosen one and the device for hand 0 (0: the scenario's, 1: mouse).
+// A click on a name or typing part of it chooses; Start or Enter starts.
+typedef struct tx_pick {
+  const char* const* names;
+  const char* const* about; // one line each
+  int n;
+  int chosen;
+  int device;
+  bool start;
+  char filter[64]; // typed: only the names holding it are listed; Enter starts the chosen one
+  bool focused;    // the filter had the keyboard once
+} tx_pick;
+void tx_gui_set_pick(tx_gui* g, tx_pick* p);
+
 // the panels (gui_panel.c): the run's controls, inspect and tune
 void tx_gui_panels(float eye_w, float eye_h);
 // a device's position (m) and force (N, or NULL) as the frame drew them, for its plots

@@ -16,6 +16,7 @@ extern "C" {
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <ctime>
 #include <new>
 
@@ -94,6 +95,7 @@ struct tx_gui {
   int nrects;
   ImVec4 bg;           // their background, cleared into the texture
   bool hovered; // the cursor was over a window at its last move
+  tx_pick* pick; // the scenario picker instead of the panels, while set
 };
 
 extern "C" {
@@ -207,6 +209,36 @@ static long long mono_ns() {
 
 static tx_gui* building; // the GUI whose panels are being laid out, for tx_gui_begin
 
+// the scenario picker: the scenarios, the chosen one's line, hand 0's device, Start
+static void pick_panel(tx_pick* p, float w, float h) {
+  if (!tx_gui_begin("choose a scenario", 8, 8, w - 16, h - 16)) {
+    tx_gui_end();
+    return;
+  }
+  if (!p->focused) ImGui::SetKeyboardFocusHere(), p->focused = true;
+  bool enter = ImGui::InputText("type to choose", p->filter, sizeof p->filter, ImGuiInputTextFlags_EnterReturnsTrue);
+  ImGui::TextUnformatted("Scenario");
+  int first = -1;
+  bool chosen_shown = false;
+  for (int i = 0; i < p->n; i++) {
+    if (p->filter[0] && !std::strstr(p->names[i], p->filter)) continue;
+    if (first < 0) first = i;
+    if (ImGui::Selectable(p->names[i], p->chosen == i)) p->chosen = i;
+    chosen_shown = chosen_shown || p->chosen == i;
+  }
+  if (!chosen_shown) p->chosen = first; // typing chooses the first name that holds it
+  if (enter && p->chosen >= 0) p->start = true;
+  ImGui::Separator();
+  if (p->chosen >= 0 && p->chosen < p->n) ImGui::TextWrapped("%s", p->about[p->chosen]);
+  ImGui::Separator();
+  ImGui::TextUnformatted("Device for hand 0");
+  ImGui::RadioButton("the scenario's (scripted)", &p->device, 0);
+  ImGui::SameLine();
+  ImGui::RadioButton("mouse", &p->device, 1);
+  if (ImGui::Button("Start") && p->chosen >= 0) p->start = true;
+  tx_gui_end();
+}
+
 // the texture of one eye's size, made again when the eye's size changes
 static bool ensure_target(tx_gui* g, int w, int h) {
   const gl_fns& gl = g->gl;
@@ -259,7 +291,8 @@ static void build(tx_gui* g, int eye_w, int eye_h) {
   ImGui::NewFrame();
   g->nrects = 0;
   building = g;
-  tx_gui_panels((float)eye_w, (float)eye_h);
+  if (g->pick) pick_panel(g->pick, (float)eye_w, (float)eye_h);
+  else tx_gui_panels((float)eye_w, (float)eye_h);
   building = nullptr;
   ImGui::Render();
   int draw = 0, viewport[4];
@@ -326,6 +359,8 @@ void tx_gui_frame(tx_gui* g, int fb_w, int fb_h, int tiles_x, int tiles_y, bool 
   if (scissor) gl.Enable(GL_SCISSOR_TEST_);
   if (saved) g->draw_buffer((unsigned)saved);
 }
+
+void tx_gui_set_pick(tx_gui* g, tx_pick* p) { g->pick = p, g->dirty = true; }
 
 bool tx_gui_begin(const char* title, float x, float y, float w, float h) {
   ImGui::SetNextWindowPos(ImVec2(x, y), ImGuiCond_FirstUseEver);
