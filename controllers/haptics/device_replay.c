@@ -80,6 +80,7 @@ static tx_device* open_replay(const char* path, double period_s) {
   d->header = rf.header, d->records = rf.records, d->count = rf.count;
   if (load_resets(d, path)) {
     free(d->records);
+    free(d->resets);
     free(d);
     return NULL;
   }
