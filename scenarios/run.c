@@ -154,6 +154,7 @@ int tx_run_scenario(tx_scenario* sc, const tx_run_config* cfg, json_t** report_o
 // the scenario picker (docs/trainer.md): `tactus run --view window` with no
 // scenario lists those on the search path in a window; the chosen one's path
 // is written to path, and hand 0 becomes the mouse where that was chosen
+#if TX_WITH_GLFW
 #define PICK_MAX 64
 typedef struct pick_list {
   char* names[PICK_MAX];
@@ -168,6 +169,7 @@ static void pick_visit(const char* name, const char* path, const char* descripti
   l->names[l->n] = strdup(name), l->paths[l->n] = strdup(path), l->about[l->n] = strdup(description ? description : "");
   l->n++;
 }
+#endif
 
 static int pick_scenario(char* path, size_t size, const char** devices, int* ndevices) {
 #if TX_WITH_GLFW
