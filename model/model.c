@@ -52,6 +52,10 @@ typedef struct component {
   uint32_t next_rows;
   uint64_t seq;
   _Atomic uint32_t hook_mask;    // publish hooks to call: bit i is hooks[i]
+  // tx_model_stamp's copy of the latest header: a sequence lock, odd while the writer changes it
+  _Alignas(CACHE_LINE) _Atomic uint64_t stamp_version;
+  _Atomic uint64_t stamp_seq;
+  _Atomic int64_t stamp_sim_ns, stamp_mono_ns;
 } component;
 
 _Static_assert(TX_PUBLISH_HOOKS_MAX <= 32, "a component's hook mask is 32 bits");
@@ -259,6 +263,13 @@ uint64_t tx_model_publish(tx_model* m, tx_comp id, int64_t sim_ns) {
   *h = (header){++c->seq, sim_ns, tx_mono_ns(), c->next_rows};
   uint32_t published = c->back;
   atomic_store(&c->latest, published);
+  uint64_t v = atomic_load_explicit(&c->stamp_version, memory_order_relaxed);
+  atomic_store_explicit(&c->stamp_version, v + 1, memory_order_relaxed);
+  atomic_thread_fence(memory_order_release); // the odd version is seen before any field changes
+  atomic_store_explicit(&c->stamp_seq, h->seq, memory_order_relaxed);
+  atomic_store_explicit(&c->stamp_sim_ns, h->sim_ns, memory_order_relaxed);
+  atomic_store_explicit(&c->stamp_mono_ns, h->mono_ns, memory_order_relaxed);
+  atomic_store_explicit(&c->stamp_version, v + 2, memory_order_release);
   // next back buffer: neither latest nor announced by a reader. Each hazard is
   // read once: re-reading per candidate would let one reader that moves its
   // slot during the scan block several buffers, and leave none free.
@@ -325,6 +336,19 @@ void tx_model_remove_hook(tx_model* m, int id) {
 static tx_snapshot snapshot_of(const component* c, uint32_t b) {
   const header* h = buffer_header(c, b);
   return (tx_snapshot){buffer_data(c, b), h->rows, c->def.cols, h->seq, h->sim_ns, h->mono_ns};
+}
+
+tx_stamp tx_model_stamp(const tx_model* m, tx_comp id) {
+  component* w = get(m, id); // its stamp atomics are only loaded here
+  if (!w) return (tx_stamp){0};
+  for (;;) { // retried only while a publish is between its two version stores
+    uint64_t v = atomic_load_explicit(&w->stamp_version, memory_order_acquire);
+    tx_stamp t = {atomic_load_explicit(&w->stamp_seq, memory_order_relaxed),
+                  atomic_load_explicit(&w->stamp_sim_ns, memory_order_relaxed),
+                  atomic_load_explicit(&w->stamp_mono_ns, memory_order_relaxed)};
+    atomic_thread_fence(memory_order_acquire); // the fields are read before the version again
+    if (!(v & 1) && atomic_load_explicit(&w->stamp_version, memory_order_relaxed) == v) return t;
+  }
 }
 
 tx_snapshot tx_model_acquire(tx_model* m, tx_reader r) {

@@ -7,6 +7,11 @@
 
 #include <tactus/config.h>
 
+#include "loader.h"
+#if TX_WITH_GLFW
+#include "../views/graphics/glfw_window.h"
+#endif
+
 #include <errno.h>
 #include <getopt.h>
 #include <signal.h>
@@ -17,6 +22,7 @@
 
 static const char run_usage[] =
     "usage: tactus run SCENARIO [OPTIONS]\n"
+    "       (with --view window and no SCENARIO, a window lists them to choose from)\n"
     "\n"
     "  --duration S        run length in seconds (default: the scenario's duration_s)\n"
     "  --lockstep          one thread on a virtual clock: deterministic, writes OUT/trace.csv\n"
@@ -145,6 +151,45 @@ int tx_run_scenario(tx_scenario* sc, const tx_run_config* cfg, json_t** report_o
   return status;
 }
 
+// the scenario picker (docs/trainer.md): `tactus run --view window` with no
+// scenario lists those on the search path in a window; the chosen one's path
+// is written to path, and hand 0 becomes the mouse where that was chosen
+#if TX_WITH_GLFW
+#define PICK_MAX 64
+typedef struct pick_list {
+  char* names[PICK_MAX];
+  char* about[PICK_MAX];
+  char* paths[PICK_MAX];
+  int n;
+} pick_list;
+
+static void pick_visit(const char* name, const char* path, const char* description, void* user) {
+  pick_list* l = user;
+  if (l->n == PICK_MAX) return;
+  l->names[l->n] = strdup(name), l->paths[l->n] = strdup(path), l->about[l->n] = strdup(description ? description : "");
+  l->n++;
+}
+#endif
+
+static int pick_scenario(char* path, size_t size, const char** devices, int* ndevices) {
+#if TX_WITH_GLFW
+  pick_list l = {0};
+  tx_scenario_list(pick_visit, &l);
+  bool mouse = false;
+  int k = tx_window_pick((const char* const*)l.names, (const char* const*)l.about, l.n, &mouse);
+  int rc = 0;
+  if (k >= 0 && k < l.n) snprintf(path, size, "%s", l.paths[k]);
+  else if (k == -1) rc = tx_bad_input("run: no scenario chosen (the picker was closed)");
+  else rc = tx_bad_input("run: the scenario picker: %s", tx_error());
+  if (k >= 0 && mouse && *ndevices == 0) devices[(*ndevices)++] = "mouse";
+  for (int i = 0; i < l.n; i++) free(l.names[i]), free(l.about[i]), free(l.paths[i]);
+  return rc;
+#else
+  (void)path, (void)size, (void)devices, (void)ndevices;
+  return tx_bad_input("run: expected a SCENARIO (tactus list shows them)");
+#endif
+}
+
 int tx_cmd_run(int argc, char** argv) {
   static const struct option longs[] = {
       {"duration", required_argument, 0, 'd'}, {"lockstep", no_argument, 0, 'l'}, {"set", required_argument, 0, 's'},
@@ -204,6 +249,12 @@ int tx_cmd_run(int argc, char** argv) {
   if (cfg.duration_s == 0) cfg.duration_s = tx_replay_duration(devices, ndevices, sets, nsets); // ends with the recording
   if (optind < argc) cfg.scenario = argv[optind++];
   if (optind < argc) return tx_bad_input("run: unexpected argument '%s'", argv[optind]);
+  char picked[PATH_MAX];
+  if (!cfg.scenario && strcmp(view, "window") == 0 && getenv("DISPLAY") && *getenv("DISPLAY")) {
+    int rc = pick_scenario(picked, sizeof picked, devices, &ndevices);
+    if (rc) return rc;
+    cfg.scenario = picked;
+  }
   if (!cfg.scenario) return tx_bad_input("run: expected a SCENARIO (tactus list shows them)");
   if (strcmp(view, "png") == 0 && !TX_WITH_OSMESA)
     return tx_bad_input("--view png: this build has no OSMesa (configure with -DTX_WITH_OSMESA=ON)");

@@ -107,7 +107,7 @@ typedef struct render_case {
   int side;       // skin particles along an edge
   double spacing; // m
   int voxels;     // spheres drawn beside the skin
-  double frames, dropped, p50, p99, cpu50, threads;
+  double frames, dropped, p50, p99, cpu50, cpu_mean, threads;
   tx_controller_stats haptics, view;
   double seconds;
   char scheduler[256];
@@ -163,6 +163,7 @@ static int run_case(render_case* rc, const char* dir, double seconds) {
   rc->p50 = result(sc->system, "view.frame_ms_p50");
   rc->p99 = result(sc->system, "view.frame_ms_p99");
   rc->cpu50 = result(sc->system, "view.frame_cpu_ms_p50");
+  rc->cpu_mean = result(sc->system, "view.frame_cpu_ms_mean");
   rc->threads = result(sc->system, "view.render_threads");
   rc->seconds = r.duration_s > 0 ? r.duration_s : seconds;
   snprintf(rc->scheduler, sizeof rc->scheduler, "%s", r.scheduler);
@@ -188,15 +189,19 @@ static int gui_cost(const char* dir, double seconds) {
        .spacing = 0.0025, .voxels = 1}};
   for (size_t i = 0; i < 2; i++)
     if (run_case(&w[i], dir, seconds)) return 1;
-  printf("  %-24s %8s %9s %9s %9s\n", "case", "frames", "frame p50", "frame p99", "cpu p50");
+  printf("  %-24s %8s %9s %9s %9s %9s\n", "case", "frames", "frame p50", "frame p99", "cpu p50", "cpu mean");
   for (size_t i = 0; i < 2; i++)
-    printf("  %-24s %8.0f %7.2fms %7.2fms %7.2fms\n", w[i].panels ? "with the panels" : "without", w[i].frames,
-           w[i].p50, w[i].p99, w[i].cpu50);
-  double cost = w[0].cpu50 - w[1].cpu50;
+    printf("  %-24s %8.0f %7.2fms %7.2fms %7.2fms %7.2fms\n", w[i].panels ? "with the panels" : "without", w[i].frames,
+           w[i].p50, w[i].p99, w[i].cpu50, w[i].cpu_mean);
+  printf("  (the panels are laid out and drawn into a texture on input or at 10 Hz, and copied into the\n"
+         "   frame every frame: the p50 is a frame with the copy, the mean counts the redraws too)\n");
+  double cost = w[0].cpu50 - w[1].cpu50, mean = w[0].cpu_mean - w[1].cpu_mean;
   char measured[64];
-  snprintf(measured, sizeof measured, "%.2f ms (cpu p50 %.2f - %.2f)", cost, w[0].cpu50, w[1].cpu50);
   printf("\ntargets:\n");
-  tx_bench_target("the panels' cost per frame at 640x480", measured, "<= 2 ms", cost <= 2);
+  snprintf(measured, sizeof measured, "%.2f ms (cpu p50 %.2f - %.2f)", cost, w[0].cpu50, w[1].cpu50);
+  tx_bench_target("the panels' cost per frame at 640x480, p50", measured, "<= 2 ms", cost <= 2);
+  snprintf(measured, sizeof measured, "%.2f ms (cpu mean %.2f - %.2f)", mean, w[0].cpu_mean, w[1].cpu_mean);
+  tx_bench_target("the panels' cost per frame at 640x480, mean", measured, "<= 2 ms", mean <= 2);
 #else
   (void)dir, (void)seconds;
 #endif
@@ -259,9 +264,20 @@ int tx_bench_render(const char* out, double duration_s) {
   printf("frames: %s/{mono,sbs,sbs-10404,voxels-1000,voxels-20000}/frames/\n", dir);
   return gui_cost(dir, seconds);
 }
+
+int tx_bench_render_gui(const char* out, double duration_s) {
+  if (!tx_find_controller(skin_class.type)) tx_register_controller(&skin_class);
+  char dir[4096];
+  if (tx_out_dir(out, "bench-render", dir, sizeof dir)) return tx_bad_input("%s", tx_error());
+  return gui_cost(dir, duration_s > 0 ? duration_s : 5);
+}
 #else
 int tx_bench_render(const char* out, double duration_s) {
   (void)out, (void)duration_s;
   return tx_bad_input("bench render: this build has no OSMesa (configure with -DTX_WITH_OSMESA=ON)");
+}
+int tx_bench_render_gui(const char* out, double duration_s) {
+  (void)out, (void)duration_s;
+  return tx_bad_input("bench render-gui: this build has no OSMesa (configure with -DTX_WITH_OSMESA=ON)");
 }
 #endif

@@ -6,5 +6,7 @@
 
 // frame times of the graphics view, mono and stereo, beside 1 kHz haptics; the exit status
 int tx_bench_render(const char* out, double duration_s);
+// only its last table: the trainer's panels' cost in a 640 x 480 window (render-gui)
+int tx_bench_render_gui(const char* out, double duration_s);
 
 #endif

@@ -360,6 +360,19 @@ typedef struct tx_organ_damage {
 #define tx_organ_damage_UNITS "1"
 TX_LAYOUT_ASSERT(tx_organ_damage, float);
 
+// --- the procedure ------------------------------------------------------------
+
+// procedure.step (1 row), written by whatever runs a procedure, read by the
+// window's panels (docs/trainer.md): the current step as one line of text,
+// NUL-terminated, e.g. "3/7 pass the needle through the far edge"
+typedef struct tx_procedure_step {
+  char text[64];
+} tx_procedure_step;
+#define tx_procedure_step_TYPE TX_U8
+#define tx_procedure_step_COLS 64u
+#define tx_procedure_step_UNITS "1"
+TX_LAYOUT_ASSERT(tx_procedure_step, uint8_t);
+
 #ifdef __cplusplus
 }
 #endif

@@ -98,6 +98,16 @@ void* tx_model_back_copy(tx_model* m, tx_comp c);            // holds the latest
 void tx_model_set_rows(tx_model* m, tx_comp c, uint32_t rows); // for the next publish
 uint64_t tx_model_publish(tx_model* m, tx_comp c, int64_t sim_ns); // returns seq
 
+// the latest publish's number and times, from any thread, with no reader
+// slot: lock-free and read-only (the writer never waits; it reads no data).
+// All zero before the first publish or for an invalid component.
+typedef struct tx_stamp {
+  uint64_t seq;    // publish number
+  int64_t sim_ns;  // simulation time of the publish, ns
+  int64_t mono_ns; // CLOCK_MONOTONIC at the publish, ns
+} tx_stamp;
+tx_stamp tx_model_stamp(const tx_model* m, tx_comp c);
+
 // reader side: one thread per reader
 tx_snapshot tx_model_acquire(tx_model* m, tx_reader r);
 tx_snapshot tx_model_latest(tx_model* m, tx_comp c); // writer's own view, no slot needed

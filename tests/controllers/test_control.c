@@ -5,8 +5,12 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
+#include "controllers/haptics/recorder.h"
 #include "controllers/system.h"
 #include "model/error.h"
+#include "scenarios/loader.h"
+
+#include <tactus/components.h>
 
 #include <math.h>
 #include <pthread.h>
@@ -376,10 +380,169 @@ static void realtime_haptics_runs_through_a_pause(void** state) {
   tx_system_destroy(s);
 }
 
+// test.ramp: a force model whose F0 grows with the steps since its init, so that a reset shows in
+// what haptics records (F0 back to 0)
+typedef struct ramp {
+  tx_port out;
+  long count;
+} ramp;
+
+static int ramp_configure(tx_setup* s, void** self) {
+  ramp* r = calloc(1, sizeof *r);
+  *self = r;
+  r->out = tx_setup_write(s, &TX_COMPONENT_OF("tool0.force_model", tx_force_model, 1));
+  return 0;
+}
+
+static void ramp_publish(tx_ctx* c, ramp* r) {
+  tx_force_model* m = tx_write(c, r->out);
+  memset(m, 0, sizeof *m);
+  m->f0[1] = 0.01 * (double)r->count;
+}
+
+static int ramp_init(tx_ctx* c, void* self) {
+  ramp_publish(c, self);
+  return 0;
+}
+
+static void ramp_step(tx_ctx* c, void* self) {
+  ramp* r = self;
+  r->count++;
+  ramp_publish(c, r);
+}
+
+static const tx_controller_class ramp_cls = {.type = "test.ramp", .summary = "a force model that grows",
+                                             .configure = ramp_configure, .init = ramp_init, .step = ramp_step,
+                                             .fini = accum_fini};
+
+// the session: a reset at 0.3 s from the run's own thread
+static bool reset_once(double t, void* user) {
+  int* done = user;
+  if (t >= 0.3 && !*done) *done = 1, assert_int_equal(tx_system_reset(tx_system_running()), 0);
+  return true;
+}
+
+// a lockstep run of the ramp at 100 Hz and haptics at 1 kHz from DEVICE, recorded into dir
+static void session(const char* device, const char* dir, bool reset) {
+  tx_system* s = tx_system_create();
+  assert_int_equal(tx_system_add(s, "ramp", "test.ramp", 100, NULL), 0);
+  char text[512];
+  snprintf(text, sizeof text, "{\"device\":\"%s\",\"force_model\":\"tool0.force_model\"}", device);
+  json_t* p = json_loads(text, 0, NULL);
+  int rc = tx_system_add(s, "haptics", "haptics", 1000, p);
+  if (rc) fprintf(stderr, "%s\n", tx_error());
+  assert_int_equal(rc, 0);
+  json_decref(p);
+  assert_int_equal(tx_system_finalize(s), 0);
+  int done = 0;
+  tx_run_options o = {.duration_s = 0.6, .lockstep = true, .record_dir = dir, .progress = reset ? reset_once : NULL,
+                      .progress_user = &done};
+  tx_run_result r;
+  assert_int_equal(tx_system_run(s, &o, &r), 0);
+  assert_false(r.halted);
+  tx_system_destroy(s);
+}
+
+static tx_record_file load(const char* dir) {
+  char path[128];
+  snprintf(path, sizeof path, "%s/device0.bin", dir);
+  tx_record_file f;
+  assert_int_equal(tx_record_load(path, &f), 0);
+  return f;
+}
+
+static void clean(const char* dir) {
+  const char* files[] = {"device0.bin", "device0.csv", "controls.csv"};
+  char path[128];
+  for (size_t i = 0; i < 3; i++) snprintf(path, sizeof path, "%s/%s", dir, files[i]), remove(path);
+  rmdir(dir);
+}
+
+// a replayed session with a reset reproduces the original: the force model haptics read each tick, bit for bit
+static void replay_honours_reset_lines(void** state) {
+  (void)state;
+  char a[] = "/tmp/tx_replay_a_XXXXXX", b[] = "/tmp/tx_replay_b_XXXXXX";
+  assert_non_null(mkdtemp(a));
+  assert_non_null(mkdtemp(b));
+  session("scripted:pierce-down", a, true);
+  char spec[64];
+  snprintf(spec, sizeof spec, "replay:%s/device0.bin", a);
+  session(spec, b, false);
+  tx_record_file orig = load(a), again = load(b);
+  assert_int_equal(again.count, orig.count);
+  size_t drops = 0, differ = 0, at = 0;
+  for (size_t k = 0; k < orig.count; k++) {
+    bool same = memcmp(orig.records[k].force_model, again.records[k].force_model, sizeof orig.records[k].force_model) == 0;
+    if (!same) differ++, at = k;
+    drops += k && orig.records[k].force_model[1] < orig.records[k - 1].force_model[1];
+  }
+  assert_int_equal(drops, 1); // the original's reset is in the records: F0 fell once, at 0.3 s
+  // every tick the same but the one at the reset's time, which still read the model from before it
+  assert_true(differ <= 1);
+  if (differ) assert_true(fabs(orig.records[at].t_s - 0.3) < 1e-9);
+  // the replay logged its own reset, at the original's time
+  char path[128], text[256] = "";
+  snprintf(path, sizeof path, "%s/controls.csv", b);
+  FILE* f = fopen(path, "r");
+  assert_non_null(f);
+  text[fread(text, 1, sizeof text - 1, f)] = 0;
+  fclose(f);
+  assert_non_null(strstr(text, "0.300000000,reset,0"));
+  free(again.records);
+  // without the reset lines the replay does not reproduce it
+  snprintf(path, sizeof path, "%s/controls.csv", a);
+  remove(path);
+  clean(b);
+  strcpy(b, "/tmp/tx_replay_b_XXXXXX");
+  assert_non_null(mkdtemp(b));
+  session(spec, b, false);
+  again = load(b);
+  differ = 0;
+  for (size_t k = 0; k < orig.count && k < again.count; k++)
+    differ += memcmp(orig.records[k].force_model, again.records[k].force_model, sizeof orig.records[k].force_model) != 0;
+  assert_true(differ > 200);
+  free(orig.records);
+  free(again.records);
+  clean(a);
+  clean(b);
+}
+
+// a controls.csv that cannot be read as one is refused with its line, before the run
+static void replay_refuses_bad_controls(void** state) {
+  (void)state;
+  char a[] = "/tmp/tx_replay_c_XXXXXX";
+  assert_non_null(mkdtemp(a));
+  session("scripted:pierce-down", a, false);
+  char path[128], spec[64];
+  snprintf(path, sizeof path, "%s/controls.csv", a);
+  FILE* f = fopen(path, "w");
+  fputs("t_s,action,value\n0.5,reset,0\n0.2,reset,0\n", f);
+  fclose(f);
+  snprintf(spec, sizeof spec, "replay:%s/device0.bin", a);
+  char text[256];
+  snprintf(text, sizeof text, "{\"device\":\"%s\",\"force_model\":\"tool0.force_model\"}", spec);
+  const char* bad[][2] = {{"t_s,action,value\n0.5,reset,0\n0.2,reset,0\n", "controls.csv: line 3: a reset before the one above it"},
+                          {"t_s,action,value\nsoon,reset,0\n", "controls.csv: line 2: expected t_s,action,value"}};
+  for (int i = 0; i < 2; i++) {
+    f = fopen(path, "w");
+    fputs(bad[i][0], f);
+    fclose(f);
+    tx_system* s = tx_system_create();
+    json_t* p = json_loads(text, 0, NULL);
+    assert_int_equal(tx_system_add(s, "haptics", "haptics", 1000, p), -1);
+    assert_non_null(strstr(tx_error(), bad[i][1]));
+    json_decref(p);
+    tx_system_destroy(s);
+  }
+  clean(a);
+}
+
 int main(void) {
   tx_register_controller(&accum_cls);
   tx_register_controller(&live_cls);
   tx_register_controller(&fragile_cls);
+  tx_register_controller(&ramp_cls);
+  tx_register_builtin(); // haptics and its replay device
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(lockstep_pause_step_reset),
       cmocka_unit_test(reset_before_run_is_the_start),
@@ -388,6 +551,8 @@ int main(void) {
       cmocka_unit_test(tune_live_parameter),
       cmocka_unit_test(live_needs_tune),
       cmocka_unit_test(realtime_haptics_runs_through_a_pause),
+      cmocka_unit_test(replay_honours_reset_lines),
+      cmocka_unit_test(replay_refuses_bad_controls),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -8,6 +8,8 @@
 #include <tactus/model.h>
 
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <string.h>
 
 static void rejects_bad_definitions_and_keeps_state(void** state) {
@@ -169,6 +171,67 @@ static void hash_is_stable_and_sensitive(void** state) {
   assert_true(tx_hash(TX_HASH_SEED, "", 0) == TX_HASH_SEED);
 }
 
+static void stamp_is_the_latest_publish(void** state) {
+  (void)state;
+  tx_model* m = tx_model_create();
+  tx_comp c = tx_model_add(m, &(tx_component_def){"a", TX_F32, 2, 1, "1"});
+  assert_true(tx_model_commit(m));
+  tx_stamp t = tx_model_stamp(m, c);
+  assert_true(t.seq == 0 && t.sim_ns == 0 && t.mono_ns == 0); // never published
+  int64_t before = tx_mono_ns();
+  tx_model_publish(m, c, 1234);
+  tx_model_publish(m, c, 5678);
+  t = tx_model_stamp(m, c);
+  tx_snapshot s = tx_model_latest(m, c);
+  assert_int_equal(t.seq, 2);
+  assert_int_equal(t.sim_ns, 5678);
+  assert_true(t.mono_ns == s.mono_ns && t.mono_ns >= before && t.mono_ns <= tx_mono_ns());
+  t = tx_model_stamp(m, (tx_comp){2});
+  assert_true(t.seq == 0 && t.sim_ns == 0 && t.mono_ns == 0);
+  t = tx_model_stamp(NULL, c);
+  assert_true(t.seq == 0);
+  tx_model_destroy(m);
+}
+
+// a writer publishing as fast as it can, sim_ns = 10 x seq: every stamp read
+// beside it is whole (never one publish's seq with another's times) and none goes back
+typedef struct stamp_race {
+  tx_model* m;
+  tx_comp c;
+  atomic_bool done;
+} stamp_race;
+
+static void* stamp_writer(void* arg) {
+  stamp_race* r = arg;
+  for (int64_t i = 1; i <= 200000; i++) tx_model_publish(r->m, r->c, 10 * i);
+  atomic_store(&r->done, true);
+  return NULL;
+}
+
+static void stamp_is_whole_beside_a_writer(void** state) {
+  (void)state;
+  stamp_race r = {.m = tx_model_create()};
+  r.c = tx_model_add(r.m, &(tx_component_def){"a", TX_F32, 2, 1, "1"});
+  assert_true(tx_model_commit(r.m));
+  pthread_t w;
+  assert_int_equal(pthread_create(&w, NULL, stamp_writer, &r), 0);
+  tx_stamp last = {0};
+  uint64_t reads = 0, torn = 0, back = 0;
+  while (!atomic_load(&r.done)) {
+    tx_stamp t = tx_model_stamp(r.m, r.c);
+    reads++;
+    torn += t.sim_ns != (int64_t)(10 * t.seq) || (t.seq && !t.mono_ns);
+    back += t.seq < last.seq || t.mono_ns < last.mono_ns;
+    last = t;
+  }
+  pthread_join(w, NULL);
+  assert_true(reads > 0);
+  assert_int_equal(torn, 0);
+  assert_int_equal(back, 0);
+  assert_int_equal(tx_model_stamp(r.m, r.c).seq, 200000);
+  tx_model_destroy(r.m);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(rejects_bad_definitions_and_keeps_state),
@@ -179,6 +242,8 @@ int main(void) {
       cmocka_unit_test(back_copy_and_rows),
       cmocka_unit_test(null_and_invalid_ids_are_harmless),
       cmocka_unit_test(hash_is_stable_and_sensitive),
+      cmocka_unit_test(stamp_is_the_latest_publish),
+      cmocka_unit_test(stamp_is_whole_beside_a_writer),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

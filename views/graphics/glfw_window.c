@@ -66,6 +66,9 @@ static void on_button(GLFWwindow* w, int button, int action, int mods) {
 
 static void on_cursor(GLFWwindow* w, double x, double y) {
   tx_window* t = glfwGetWindowUserPointer(w);
+#ifdef TX_HAVE_GUI
+  if (t->gui) tx_gui_cursor(t->gui, x, y);
+#endif
   if (t->dragging) {
     t->tool[0] += (x - t->last_x) * DRAG_M_PER_PX;
     t->tool[2] += (y - t->last_y) * DRAG_M_PER_PX; // down the screen is towards the viewer
@@ -241,10 +244,47 @@ void tx_window_sample(tx_window* t, const char* device, double t_s, const double
 #endif
 }
 
+void tx_window_procedure(tx_window* t, const char* text) {
+#ifdef TX_HAVE_GUI
+  if (t->gui) tx_gui_procedure(text);
+#else
+  (void)t, (void)text;
+#endif
+}
+
 bool tx_window_present(tx_window* t) {
   glfwSwapBuffers(t->w);
   glfwPollEvents();
   return !glfwWindowShouldClose(t->w);
+}
+
+int tx_window_pick(const char* const* names, const char* const* about, int n, bool* mouse) {
+  *mouse = false;
+#ifdef TX_HAVE_GUI
+  tx_window* t = tx_window_open(640, 480, false);
+  if (!t) return -2;
+  glfwSetWindowTitle(t->w, "tactus: choose a scenario");
+  void (*clear_color)(float, float, float, float) = (void (*)(float, float, float, float))glfwGetProcAddress("glClearColor");
+  void (*clear)(unsigned) = (void (*)(unsigned))glfwGetProcAddress("glClear");
+  tx_pick pick = {names, about, n, n > 0 ? 0 : -1, 0, false, "", false};
+  tx_gui_set_pick(t->gui, &pick);
+  while (!pick.start && !glfwWindowShouldClose(t->w)) {
+    glfwWaitEventsTimeout(0.05); // nothing moves here but what the hand does
+    clear_color(0.1f, 0.1f, 0.12f, 1);
+    clear(0x00004000); // GL_COLOR_BUFFER_BIT
+    tx_window_draw_gui(t, 1, 1);
+    glfwSwapBuffers(t->w);
+  }
+  tx_gui_set_pick(t->gui, NULL);
+  bool started = pick.start;
+  tx_window_close(t);
+  tx_window_input_reset(); // the picker's clicks are not the run's input
+  *mouse = pick.device == 1;
+  return started ? pick.chosen : -1;
+#else
+  (void)names, (void)about, (void)n;
+  return tx_set_error("the scenario picker needs Dear ImGui (libimgui-dev)"), -2;
+#endif
 }
 
 void tx_window_take_scope(tx_window* t, double move[3]) {

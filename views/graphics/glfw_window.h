@@ -42,9 +42,17 @@ void tx_window_resize(tx_window* w, int width, int height);
 // the panels over the frame drawn, in each of tiles_x x tiles_y eyes (nothing without Dear ImGui)
 void tx_window_draw_gui(tx_window* w, int tiles_x, int tiles_y);
 // a drawn device's position (m) and force (N, or NULL), for the panels' plots
+// the procedure's current step for the panels (NULL: no procedure in this run)
+void tx_window_procedure(tx_window* t, const char* text);
 void tx_window_sample(tx_window* w, const char* device, double t_s, const double pos[3], const double* force);
 // show the frame and handle input; false once the window asked to close
 bool tx_window_present(tx_window* w);
+
+// The scenario picker, in a window of its own (tactus run --view window with
+// no scenario): names and one line about each; the index chosen, with
+// *mouse set when hand 0 is to be the mouse; -1 when the window was closed,
+// -2 with tx_error() when it does not open (or the build has no Dear ImGui).
+int tx_window_pick(const char* const* names, const char* const* about, int n, bool* mouse);
 // the laparoscope's moves since the last call: yaw, pitch (rad), insertion (m)
 void tx_window_take_scope(tx_window* w, double move[3]);
 

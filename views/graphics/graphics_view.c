@@ -2,6 +2,7 @@
 #include "graphics_view.h"
 
 #include "contact_sheet.h"
+#include "gui_inspect.h"
 #include "png_writer.h"
 #include "renderer.h"
 #include "stereo_frame.h"
@@ -67,17 +68,22 @@ typedef struct view {
   double first_frame_ms;                // ms, the first frame (shader compilation included)
   tx_hist frame_ns;                     // render + read-back time of every frame, ns
   tx_hist frame_cpu_ns;                 // CPU time of the rendering thread for each, ns
-  tx_result r_frames, r_dropped, r_p50, r_p99, r_threads, r_written, r_first, r_cpu50;
+  double cpu_ms_sum;                    // of the timed frames, for the mean
+  tx_result r_frames, r_dropped, r_p50, r_p99, r_threads, r_written, r_first, r_cpu50, r_cpu_mean;
   tx_warning w_write, w_skipped;
   uint64_t skipped_reported;
   tx_ctx* ctx;                          // the step's context, for warnings from the renderer
+  bool has_procedure;                   // procedure.step is written: the panels show its text
+  tx_port procedure;
+  char procedure_text[72];              // handed to the renderer with the frame
 } view;
 
 // the layouts of <tactus/components.h> that the renderer draws, by name suffix
 #define KIND(suffix, T) {suffix, T##_TYPE, T##_COLS}
 static const struct { const char* suffix; tx_type type; uint32_t cols; } kinds[] = {
     KIND(".x", tx_vertex), KIND(".tri", tx_triangle), KIND(".spheres", tx_sphere), KIND(".segments", tx_segment),
-    KIND(".pose", tx_pose), KIND(".force", tx_force), KIND(".links", tx_pose), KIND(".held", tx_instrument_held)};
+    KIND(".pose", tx_pose), KIND(".force", tx_force), KIND(".links", tx_pose), KIND(".held", tx_instrument_held),
+    KIND(".force_model", tx_force_model)};
 #undef KIND
 
 // the type and width a drawn component must have: by its suffix, and scalars are f32 N x 1
@@ -162,6 +168,12 @@ static int configure(tx_setup* s, void** self) {
     }
     v->nports[i] = n;
   }
+  // the procedure's current step, for the panels, where something writes it (docs/trainer.md)
+  for (int k = 0; k < navail && !v->has_procedure; k++)
+    if (strcmp(avail[k], TX_PROCEDURE_COMPONENT) == 0) {
+      v->procedure = TX_READ_OF(s, TX_PROCEDURE_COMPONENT, tx_procedure_step);
+      v->has_procedure = true;
+    }
   v->r_frames = tx_setup_result(s, "frames");
   v->r_written = tx_setup_result(s, "frames_written");
   v->r_dropped = tx_setup_result(s, "frames_dropped");
@@ -170,6 +182,7 @@ static int configure(tx_setup* s, void** self) {
   v->r_threads = tx_setup_result(s, "render_threads");
   v->r_first = tx_setup_result(s, "first_frame_ms");
   v->r_cpu50 = tx_setup_result(s, "frame_cpu_ms_p50");
+  v->r_cpu_mean = tx_setup_result(s, "frame_cpu_ms_mean");
   v->w_write = tx_setup_warning(s, "frame_not_written");
   v->w_skipped = tx_setup_warning(s, "rows_not_drawn");
   return 0;
@@ -203,6 +216,7 @@ static void record_time(view* v, double ms, double cpu_ms) {
     return;
   }
   tx_hist_add(&v->frame_cpu_ns, llround(cpu_ms * 1e6));
+  v->cpu_ms_sum += cpu_ms;
   tx_hist_add(&v->frame_ns, llround(ms * 1e6));
   v->timed++;
 }
@@ -320,6 +334,7 @@ static void draw_overlay(view* v, render_state* rs, int w, int h) {
   if (v->stereo == TX_STEREO_TB) tx_overlay_draw(rs->overlay, 0, 0, w, h);
   tx_overlay_clear(rs->overlay);
   // the trainer's panels over it, at zero disparity (glfw_window.h)
+  tx_window_procedure(rs->win, v->has_procedure ? v->procedure_text : NULL);
   tx_window_draw_gui(rs->win, v->stereo == TX_STEREO_SBS ? 2 : 1, v->stereo == TX_STEREO_TB ? 2 : 1);
 }
 #endif
@@ -566,6 +581,10 @@ static void step(tx_ctx* c, void* self) {
       v->seq[i][k] = s.seq;
     }
   }
+  if (v->has_procedure) {
+    tx_snapshot p = tx_read(c, v->procedure);
+    tx_procedure_text(&p, v->procedure_text, sizeof v->procedure_text);
+  }
   v->frame_sim_ns = tx_sim_ns(c);
   v->frame_index++;
   sem_post(&v->go);
@@ -591,6 +610,7 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, v->r_p50, frame_ms(v, &v->frame_ns, 0.5));
   tx_set_result(c, v->r_p99, frame_ms(v, &v->frame_ns, 0.99));
   tx_set_result(c, v->r_cpu50, frame_ms(v, &v->frame_cpu_ns, 0.5));
+  tx_set_result(c, v->r_cpu_mean, v->timed ? v->cpu_ms_sum / (double)v->timed : NAN);
   tx_set_result(c, v->r_threads, v->target == TARGET_PNG ? v->render_threads : NAN);
   tx_set_result(c, v->r_first, v->rendered ? v->first_frame_ms : NAN);
 }

@@ -22,6 +22,7 @@ bool tx_gui_mouse_button(tx_gui* g, int button, int action, int mods);
 bool tx_gui_scroll(tx_gui* g, double dx, double dy);
 bool tx_gui_key(tx_gui* g, int key, int scancode, int action, int mods);
 void tx_gui_char(tx_gui* g, unsigned c);
+void tx_gui_cursor(tx_gui* g, double x, double y); // window px
 bool tx_gui_wants_mouse(const tx_gui* g);
 
 void tx_gui_set_shown(tx_gui* g, bool shown);
@@ -31,6 +32,8 @@ bool tx_gui_shown(const tx_gui* g);
 // holds tiles_x x tiles_y eyes (sbs 2 x 1, tb 1 x 2): the panels are drawn
 // in each eye at the same place, zero disparity; with quad buffers into both
 // back buffers. Input is read in the eye under the cursor.
+// The panels are laid out and drawn into a texture only on input or at 10 Hz,
+// and copied into the eyes every frame.
 void tx_gui_frame(tx_gui* g, int fb_w, int fb_h, int tiles_x, int tiles_y, bool quad);
 
 // widgets, for gui_panel.c, between tx_gui_frame's call of tx_gui_panels and its draw
@@ -47,9 +50,27 @@ bool tx_gui_table_begin(const char* id, int columns);
 void tx_gui_table_row(const char* const* cells, int columns);
 void tx_gui_table_end(void);
 
+// The scenario picker (tx_window_pick): while set, tx_gui_frame draws it
+// instead of the trainer's panels. It lists n scenarios and, when start is
+// set, the chosen one and the device for hand 0 (0: the scenario's, 1: mouse).
+// A click on a name or typing part of it chooses; Start or Enter starts.
+typedef struct tx_pick {
+  const char* const* names;
+  const char* const* about; // one line each
+  int n;
+  int chosen;
+  int device;
+  bool start;
+  char filter[64]; // typed: only the names holding it are listed; Enter starts the chosen one
+  bool focused;    // the filter had the keyboard once
+} tx_pick;
+void tx_gui_set_pick(tx_gui* g, tx_pick* p);
+
 // the panels (gui_panel.c): the run's controls, inspect and tune
 void tx_gui_panels(float eye_w, float eye_h);
 // a device's position (m) and force (N, or NULL) as the frame drew them, for its plots
+// the procedure's current step, as the frame read it; NULL: the run has none
+void tx_gui_procedure(const char* text);
 void tx_gui_sample(const char* device, double t_s, const double pos[3], const double* force);
 
 #ifdef __cplusplus

@@ -3,6 +3,7 @@
 // deadlines missed), its live parameters, and each device's force and
 // position as scrolling plots, for the system tx_system_run is running.
 #include "gui.h"
+#include "gui_inspect.h"
 #include "gui_series.h"
 
 #include "../../controllers/system.h"
@@ -61,6 +62,35 @@ static void device_plots(void) {
     snprintf(label, sizeof label, "y mm##%s", e->name);
     tx_gui_plot(label, e->pos[1], e->count, off, 40);
   }
+}
+
+static struct {
+  bool known;    // the run has a procedure.step
+  char text[72];
+} procedure;
+
+void tx_gui_procedure(const char* text) {
+  procedure.known = text != NULL;
+  snprintf(procedure.text, sizeof procedure.text, "%s", text ? text : "");
+}
+
+// each component's publish number, its age (wall clock) and the simulation time of its latest publish
+#define ROWS_MAX 256
+static void components_table(tx_system* s) {
+  static tx_component_row rows[ROWS_MAX];
+  int n = tx_inspect_components(tx_system_model(s), tx_mono_ns(), rows, ROWS_MAX);
+  if (!tx_gui_table_begin("components", 4)) return;
+  static const char* const head[] = {"name", "seq", "age ms", "at s"};
+  tx_gui_table_row(head, 4);
+  for (int i = 0; i < n; i++) {
+    char seq[32], age[32], at[32];
+    snprintf(seq, sizeof seq, "%llu", (unsigned long long)rows[i].seq);
+    snprintf(age, sizeof age, rows[i].seq ? "%.1f" : "-", rows[i].age_ms);
+    snprintf(at, sizeof at, rows[i].seq ? "%.3f" : "-", rows[i].sim_s);
+    const char* row[] = {rows[i].name, seq, age, at};
+    tx_gui_table_row(row, 4);
+  }
+  tx_gui_table_end();
 }
 
 // the live parameters of each controller (tx_controller_class.live), as the scenario
@@ -128,6 +158,7 @@ void tx_gui_panels(float eye_w, float eye_h) {
   double scale = tx_system_time_scale(s);
   if (tx_gui_slider("time scale", &scale, TX_TIME_SCALE_MIN, 1, "x%.2f")) (void)tx_system_set_time_scale(s, scale);
   tx_gui_text("step = %.1f ms; resets %llu", tx_system_step_period(s) * 1e3, (unsigned long long)tx_system_resets_done(s));
+  if (procedure.known) tx_gui_text("step: %s", procedure.text[0] ? procedure.text : "(none yet)");
 
   int n = tx_system_count(s);
   if (n > MAX_SHOWN) n = MAX_SHOWN;
@@ -149,5 +180,6 @@ void tx_gui_panels(float eye_w, float eye_h) {
   }
   if (tx_gui_header("Tune", true)) tune_panel(s, n);
   if (tx_gui_header("Devices", true)) device_plots();
+  if (tx_gui_header("Components", false)) components_table(s);
   tx_gui_end();
 }

@@ -685,6 +685,30 @@ void tx_renderer_upload(tx_renderer* r, const tx_scene* s) {
         for (int c = 0; c < 3; c++) end[c] = p[c] + (float)f->f[c] * it->force_scale;
         if (finite_n(end, 3)) add_cylinder(r, p, end, 0.45f * it->radius, yellow); // wider than the shaft it may run along
       }
+      int pk = it->show_force ? 2 : 1; // the proxy's force model, after the pose and the force
+      if (*it->proxy && si->rows[pk]) {
+        const tx_force_model* fm = si->data[pk];
+        bool contact = false; // a force model of zeros is no contact: nothing holds the tool
+        for (int c = 0; c < 3; c++) contact = contact || fm->f0[c] != 0;
+        for (int c = 0; c < 9; c++) contact = contact || fm->k[c] != 0;
+        // where the local model's force vanishes along F0 (x0 + s F0/|F0|, F0 + s K u = 0 along u):
+        // on the surface, for a wall's spring; x0 itself where the model does not fall off that way
+        double f = sqrt(fm->f0[0] * fm->f0[0] + fm->f0[1] * fm->f0[1] + fm->f0[2] * fm->f0[2]), along = 0, u[3] = {0};
+        if (f > 0) {
+          double uku = 0;
+          for (int c = 0; c < 3; c++) u[c] = fm->f0[c] / f;
+          for (int c = 0; c < 3; c++)
+            for (int e = 0; e < 3; e++) uku += u[c] * fm->k[3 * c + e] * u[e];
+          if (uku < 0) along = -f / uku;
+        }
+        float x0[3];
+        for (int c = 0; c < 3; c++) x0[c] = (float)(fm->x0[c] + along * u[c]);
+        const float cyan[3] = {0.1f, 0.85f, 0.9f};
+        if (contact && finite_n(x0, 3)) {
+          add_sphere(r, x0, 0.7f * it->radius, cyan);
+          add_cylinder(r, p, x0, 0.2f * it->radius, cyan); // from the device to where the surface holds it
+        }
+      }
       break;
     }
     }

@@ -148,7 +148,7 @@ static int read_laparoscope(const json_t* lap, const json_t* cam, tx_view_def* d
 static int read_item(size_t i, const json_t* e, tx_draw_item* it) {
   static const char* const keys[] = {"mesh", "spheres", "segments", "tool", "plane", "instrument", "urdf", "colour",
                                      "colour_by", "range", "texture", "radius_m", "show_force", "force_scale_m_per_n",
-                                     "cut", NULL};
+                                     "proxy", "cut", NULL};
   char at[48], key[96];
   snprintf(at, sizeof at, "draw[%zu]", i);
   if (!json_is_object(e)) return bad(at, "expected an object, got %s", tx_json_kind(e));
@@ -248,6 +248,14 @@ static int read_item(size_t i, const json_t* e, tx_draw_item* it) {
     if (it->kind != TX_DRAW_TOOL) return bad(key, "only tools show a force");
     if (number(key, v, 0, 10, true, &x)) return -1;
     it->force_scale = (float)x;
+  }
+  // the proxy: where the force model's contact holds the tool on the surface (x0)
+  snprintf(key, sizeof key, "%s.proxy", at);
+  if ((v = json_object_get(e, "proxy"))) {
+    if (it->kind != TX_DRAW_TOOL) return bad(key, "only tools show a proxy");
+    if (!json_is_string(v) || !plain_name(json_string_value(v)) || !strstr(json_string_value(v), ".force_model"))
+      return bad(key, "expected a force model component such as tool0.force_model");
+    snprintf(it->proxy, sizeof it->proxy, "%s", json_string_value(v));
   }
   // a cutaway: the inside of a block of voxels, where a needle does its damage
   snprintf(key, sizeof key, "%s.cut", at);
@@ -371,6 +379,8 @@ int tx_view_def_auto_draw(tx_view_def* d, const char* const* written, int count)
       it.colour[0] = 0.85f, it.colour[1] = 0.25f, it.colour[2] = 0.2f;
       snprintf(other, sizeof other, "%s.force", name);
       it.show_force = has(written, count, other);
+      snprintf(other, sizeof other, "tool%s.force_model", name + 6); // deviceN's is toolN's, as the scenarios name them
+      if (has(written, count, other) && strlen(other) < sizeof it.proxy) memcpy(it.proxy, other, strlen(other) + 1);
     } else {
       continue;
     }
@@ -400,6 +410,7 @@ int tx_draw_item_components(const tx_draw_item* it, char out[3][TX_NAME_MAX]) {
   case TX_DRAW_TOOL:
     join(out[n++], it->name, ".pose");
     if (it->show_force) join(out[n++], it->name, ".force");
+    if (*it->proxy) join(out[n++], it->proxy, "");
     break;
   case TX_DRAW_PLANE: break;
   case TX_DRAW_INSTRUMENT:

@@ -52,6 +52,7 @@ typedef struct tx_draw_item {
   bool show_force;          // tools: a line along NAME.force
   float radius;             // m, tools: radius of the HIP sphere
   float force_scale;        // m/N, tools: length of the force line per newton
+  char proxy[TX_NAME_MAX];  // tools: a force model (tx_force_model) whose x0 is drawn as the proxy; "" for none
   float plane[7];           // planes: point (m), unit normal, half size (m)
   bool has_cut;             // spheres: a cutaway plane is given
   float cut[6];             // spheres: point (m) and unit normal of the cutaway; centres on the normal's side are not drawn

@@ -8,6 +8,8 @@
 #include "views/graphics/renderer.h"
 #include "views/graphics/stereo_frame.h"
 
+#include <tactus/components.h>
+
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -373,13 +375,42 @@ static void segments_with_a_gap(void** state) {
   release(&f);
 }
 
+// the proxy: a cyan sphere where the force model's force vanishes along F0 while it holds a contact
+// (a wall's spring, K = -300 n n^T, pushing F0 = 15 N up at x0 0.05 m below its surface: the proxy is
+// on the surface, x0 + F0 / 300), none for a model of zeros
+static void tool_proxy_at_x0(void** state) {
+  (void)state;
+  for (int contact = 0; contact < 2; contact++) {
+    tx_view_def d = scene_def();
+    d.items[0] = (tx_draw_item){.kind = TX_DRAW_TOOL, .colour = {1, 0, 0}, .radius = 0.02f, .proxy = "tool0.force_model"};
+    d.nitems = 1;
+    const tx_pose pose = {{-0.2, 0, 0}, {1, 0, 0, 0}};
+    tx_force_model fm = {{0}, {0.2, -0.05, 0}, {0}};
+    if (contact) fm.k[4] = -300, fm.f0[1] = 15;
+    tx_scene s = {.count = 1};
+    s.items[0] = (tx_scene_item){&d.items[0], {&pose, &fm}, {1, 1}};
+    frame f = {0};
+    render(&f, &d, TX_STEREO_MONO, &s);
+    int x = (int)(W / 2 + 0.2 / tan(20 * M_PI / 180) * (H / 2)); // the proxy (0.2, 0, 0) on the image
+    const uint8_t* p = at(&f, x, H / 2);
+    if (contact && !(p[1] > 2 * p[0] + 8 && p[2] > 2 * p[0] + 8)) fail_msg("(%d, %d, %d) at the surface: no cyan proxy", p[0], p[1], p[2]);
+    if (!contact && lit(p, -1)) fail_msg("(%d, %d, %d): a proxy without a contact", p[0], p[1], p[2]);
+    // not at x0 itself, 0.05 m (16 px) below it
+    const uint8_t* q = at(&f, x, H / 2 + (int)(0.05 / tan(20 * M_PI / 180) * (H / 2)));
+    if (lit(q, -1)) fail_msg("(%d, %d, %d) at x0: the proxy is drawn at x0, not on the surface", q[0], q[1], q[2]);
+    const uint8_t* t = at(&f, (int)(W / 2 - 0.2 / tan(20 * M_PI / 180) * (H / 2)), H / 2);
+    assert_true(t[0] > 2 * t[2]); // the device's own (red) sphere, either way
+    release(&f);
+  }
+}
+
 int main(void) {
   tx_osmesa_bound_threads(-1);
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(sphere_silhouette),        cmocka_unit_test(lit_sphere_centre_colour),
       cmocka_unit_test(stereo_layouts_disparity), cmocka_unit_test(mesh_and_bad_rows),
       cmocka_unit_test(mesh_coloured_by_scalar),  cmocka_unit_test(colour_map_and_png),       cmocka_unit_test(sphere_depth_and_cut),
-      cmocka_unit_test(segments_with_a_gap),
+      cmocka_unit_test(segments_with_a_gap),      cmocka_unit_test(tool_proxy_at_x0),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -7,7 +7,7 @@
 # pause while haptics kept its rate), the change of a parameter (report.json
 # and the recorded force model), and the screenshots: the panel where it
 # belongs with a trace in the device plot, in both eyes of sbs at the same
-# place, and gone after H.
+# place, and gone after H; and the scenario picker (no scenario given).
 # Exit 77 (skipped) only when xvfb-run or xdotool is not installed.
 #
 #   test_trainer_window.sh TACTUS PNG_PROBE [SHOTS_DIR]
@@ -25,8 +25,8 @@ unset TACTUS_SCENARIO_PATH
 failures=0
 fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
 
-# the panel's title bar (Dear ImGui's dark style, active): a colour nothing else in the frame has
-TITLE="40 71 115"
+# the panel's title bar (Dear ImGui's dark style, active, opaque): a colour nothing else in the frame has
+TITLE="41 74 122"
 panel_in() { # PNG X Y W H: pixels of the title bar's colour in that region
   local n
   read -r _ _ _ n < <("$PROBE" "$1" "$2" "$3" "$4" "$5" $TITLE)
@@ -128,9 +128,9 @@ PY
   n=$(panel_in "$png" 0 40 320 440)
   [ "$n" -eq 0 ] || fail "the title bar's colour outside the panel ($n px): the probe cannot tell"
   # the device plots under Devices: |F| (y 338..376) holds a trace in the plots' line colour
-  read -r _ _ _ n < <("$PROBE" "$png" 336 336 196 42 147 148 150)
+  read -r _ _ _ n < <("$PROBE" "$png" 336 336 196 42 156 156 156)
   [ "${n:-0}" -gt 60 ] || fail "no trace in the |F| plot (${n:-0} px of its line colour)"
-  read -r _ _ _ n < <("$PROBE" "$png" 0 40 320 440 147 148 150)
+  read -r _ _ _ n < <("$PROBE" "$png" 0 40 320 440 156 156 156)
   [ "${n:-1}" -eq 0 ] || fail "the plots' line colour outside the panel ($n px): the probe cannot tell"
   [ -n "$SHOTS" ] && cp "$png" "$SHOTS/trainer_mono.png"
 fi
@@ -156,6 +156,47 @@ else
   n=$(panel_in "$WORK/hidden/frames/window.png" 0 0 640 480)
   [ "$n" -eq 0 ] || fail "the panel is still shown after H ($n px)"
 fi
+
+# 4. the scenario picker: `tactus run --view window` with no scenario; part of a name typed and
+#    Enter start it; Escape (once to leave the field, once for the window) closes it: exit 2
+cat >"$WORK/pick.sh" <<'EOF'
+set -u
+out=$1
+shift
+"$TACTUS" run --view window --quiet --out "$out" --duration 0.5 >"$out.log" 2>&1 &
+pid=$!
+wid=""
+for _ in $(seq 100); do
+  wid=$(xdotool search --onlyvisible --name '^tactus: choose' 2>/dev/null | head -n 1)
+  [ -n "$wid" ] && break
+  sleep 0.1
+done
+[ -n "$wid" ] || { echo "no picker" >>"$out.log"; kill $pid; wait $pid; exit 1; }
+sleep 0.5
+xdotool windowfocus --sync "$wid" 2>/dev/null || true
+for keys in "$@"; do
+  # shellcheck disable=SC2086
+  xdotool $keys
+  sleep 0.3
+done
+wait $pid
+echo $? >"$out.rc" # tactus's own status: xvfb-run's can be that of its clean-up
+EOF
+pick_run() { # OUT XDOTOOL-ARGS...: the exit status of tactus in OUT.rc
+  TACTUS="$TACTUS" timeout -k 5 60 xvfb-run -a -s "-screen 0 1280x1024x24" bash "$WORK/pick.sh" "$@"
+}
+pick_run "$WORK/picked" "type --delay 30 suturing" "key Return"
+if [ "$(cat "$WORK/picked.rc" 2>/dev/null)" != 0 ]; then
+  fail "the picker's run failed: $(tail -n 3 "$WORK/picked.log")"
+else
+  name=$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["scenario"])' "$WORK/picked/report.json")
+  [ "$name" = "suturing-skin" ] || fail "the picker started '$name', not suturing-skin"
+fi
+pick_run "$WORK/closed" "key Escape" "key Escape"
+rc=$(cat "$WORK/closed.rc" 2>/dev/null)
+[ "${rc:-x}" = 2 ] || fail "closing the picker: exit ${rc:-unknown}, not 2"
+grep -q "run: no scenario chosen (the picker was closed)" "$WORK/closed.log" || fail "closing the picker: $(cat "$WORK/closed.log")"
+[ -e "$WORK/closed" ] && fail "closing the picker left an output folder"
 
 [ "$failures" -eq 0 ] && echo "trainer window: ok"
 exit $((failures > 0))

@@ -168,6 +168,10 @@ static void automatic_draw_list(void** state) {
   assert_int_equal(d.items[1].kind, TX_DRAW_TOOL);
   assert_string_equal(d.items[1].name, "device0");
   assert_true(d.items[1].show_force);
+  assert_string_equal(d.items[1].proxy, "tool0.force_model"); // device0's force model is tool0's
+  char comps[3][TX_NAME_MAX];
+  assert_int_equal(tx_draw_item_components(&d.items[1], comps), 3);
+  assert_string_equal(comps[2], "tool0.force_model");
   assert_int_equal(d.items[2].kind, TX_DRAW_SPHERES);
   assert_string_equal(d.items[2].scalar, "tissue.damage");
   assert_int_equal(d.items[3].kind, TX_DRAW_SEGMENTS);
@@ -176,6 +180,22 @@ static void automatic_draw_list(void** state) {
 }
 
 // the graphics view gets "view" as text (tx_param_json_text): the same rules, and text that is not JSON is an error
+// a tool's proxy: a force model component, read after its pose (and force); on nothing but a tool
+static void tool_proxy(void** state) {
+  (void)state;
+  tx_view_def d = tx_view_def_default();
+  assert_int_equal(tx_view_def_from_text("{\"draw\": [{\"tool\": \"device1\", \"proxy\": \"tool1.force_model\"}]}", &d), 0);
+  assert_string_equal(d.items[0].proxy, "tool1.force_model");
+  char comps[3][TX_NAME_MAX];
+  assert_int_equal(tx_draw_item_components(&d.items[0], comps), 2);
+  assert_string_equal(comps[0], "device1.pose");
+  assert_string_equal(comps[1], "tool1.force_model");
+  expect_error("{\"draw\": [{\"mesh\": \"skin\", \"proxy\": \"tool0.force_model\"}]}", "draw[0].proxy", "only tools show a proxy");
+  expect_error("{\"draw\": [{\"tool\": \"device0\", \"proxy\": \"tool0.pose\"}]}", "draw[0].proxy",
+               "expected a force model component such as tool0.force_model");
+  expect_error("{\"draw\": [{\"tool\": \"device0\", \"proxy\": 3}]}", "draw[0].proxy", "expected a force model");
+}
+
 static void from_text(void** state) {
   (void)state;
   tx_view_def d = tx_view_def_default();
@@ -198,6 +218,7 @@ int main(void) {
       cmocka_unit_test(wrong_types_named_as_parameters_name_them),
       cmocka_unit_test(automatic_draw_list),
       cmocka_unit_test(from_text),
+      cmocka_unit_test(tool_proxy),
       cmocka_unit_test(instrument_entry),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
