@@ -346,7 +346,9 @@ static void test_needle_punctures_the_skin(void** state) {
                "",
                "\"instrument0\":\"needle_holder\",\"needle\":true,\"needle_in_jaws\":0,\"needle_length_m\":0.03,"
                "\"table_height_m\":-1,\"skin\":\"skin\"",
-               ",{\"name\":\"skin\",\"type\":\"physics.skin\",\"rate_hz\":60,\"params\":{\"pose\":\"needle.tip\"}},"
+               // the skin as scenario instruments has it (its force read at the held particles)
+               ",{\"name\":\"skin\",\"type\":\"physics.skin\",\"rate_hz\":60,"
+               "\"params\":{\"pose\":\"needle.tip\",\"force_reading\":\"held\"}},"
                    "{\"name\":\"listener\",\"type\":\"test.listener\",\"rate_hz\":1000}");
   tx_scenario* s = f.s;
   run(s, seconds + 0.2);
