@@ -56,8 +56,9 @@ typedef struct instruments {
   double pin_bary[TX_NEEDLE_PINS_MAX][3];   // and their weights
   bool at_hole[TX_NEEDLE_PINS_MAX]; // the row is at the hole: where the arc crossed the patch's sheet
   int32_t* hole_scratch; // 2 x HOLE_PARTICLES_MAX: the skin's components (tx_puncture_hole)
-  tx_result clearance;
+  tx_result clearance, hand_clearance[HANDS];
   double clearance_min; // m: the lowest any held instrument's collision shapes came above the skin's sheet
+  double hand_clearance_min[HANDS]; // m: the same for each hand's instruments
   double pin_offset[TX_NEEDLE_PINS_MAX][3]; // from the skin's point to the pin: the tip where it tore through
   double pin_origin[TX_NEEDLE_PINS_MAX][3]; // where each puncture was made
   int npins;
@@ -322,6 +323,8 @@ static int configure(tx_setup* s, void** self) {
     m->pulled_through = tx_setup_result(s, "needle_pulled_through");
     if (*skin) m->reanchors = tx_setup_result(s, "needle_reanchors");
     if (*skin) m->clearance = tx_setup_result(s, "skin_clearance_m");
+    if (*skin) m->hand_clearance[0] = tx_setup_result(s, "hand0_skin_clearance_m");
+    if (*skin) m->hand_clearance[1] = tx_setup_result(s, "hand1_skin_clearance_m");
     m->grasps = tx_setup_result(s, "needle_grasps");
     m->releases = tx_setup_result(s, "needle_releases");
   }
@@ -356,7 +359,7 @@ static int init(tx_ctx* c, void* self) {
       if (!isfinite(start[i][k])) start[i][k] = 0;
   }
   m->npins = m->nreanchors = 0;
-  m->clearance_min = INFINITY;
+  m->clearance_min = m->hand_clearance_min[0] = m->hand_clearance_min[1] = INFINITY;
   m->ncuts = m->nthread_grasps = m->nskin_grasps = 0;
   for (int i = 0; i < m->n; i++) m->blades[i].armed = 0, m->holds_thread[i] = m->holds_skin[i] = false;
   m->contact_seq = 0;
@@ -515,9 +518,10 @@ static void clearance(instruments* m, const float* xs, int nx) {
           memcpy(pts[n], c, sizeof c), pts[n][1] -= sh->size[0], n++;
         }
         for (int j = 0; j < n; j++)
-          if (pts[j][1] < top + 0.01) m->clearance_min = fmin(m->clearance_min, tx_height_above_sheet(xs, nx, pts[j]));
+          if (pts[j][1] < top + 0.01) m->hand_clearance_min[h] = fmin(m->hand_clearance_min[h], tx_height_above_sheet(xs, nx, pts[j]));
       }
     }
+    m->clearance_min = fmin(m->clearance_min, m->hand_clearance_min[h]);
   }
 }
 
@@ -668,6 +672,8 @@ static void finish(tx_ctx* c, void* self) {
     tx_set_result(c, m->pulled_through, through);
     if (m->skin) tx_set_result(c, m->reanchors, m->nreanchors), tx_set_result(c, m->skin_grasps, m->nskin_grasps);
     if (m->skin && isfinite(m->clearance_min)) tx_set_result(c, m->clearance, m->clearance_min);
+    for (int h = 0; h < HANDS; h++)
+      if (m->skin && isfinite(m->hand_clearance_min[h])) tx_set_result(c, m->hand_clearance[h], m->hand_clearance_min[h]);
   }
   // the world goes on the thread that made and stepped it, with ODE's data for that thread
   tx_instrument_world_destroy(m->world);

@@ -303,6 +303,8 @@ static void test_forceps_grasp_the_skin(void** state) {
   // across in y, about the pivot's line 1 mm above the sheet: -1.875 mm
   print_message("  lowest above the skin: %.4f mm\n", 1e3 * result(s, "instruments.skin_clearance_m"));
   assert_true(fabs(result(s, "instruments.skin_clearance_m") + 0.001875) < 1e-4);
+  // one hand: its own lowest is the whole's
+  assert_true(result(s, "instruments.hand0_skin_clearance_m") == result(s, "instruments.skin_clearance_m"));
   fixture_free(&f);
 }
 
