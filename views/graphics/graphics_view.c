@@ -83,7 +83,7 @@ typedef struct view {
 static const struct { const char* suffix; tx_type type; uint32_t cols; } kinds[] = {
     KIND(".x", tx_vertex), KIND(".tri", tx_triangle), KIND(".spheres", tx_sphere), KIND(".segments", tx_segment),
     KIND(".pose", tx_pose), KIND(".force", tx_force), KIND(".links", tx_pose), KIND(".held", tx_instrument_held),
-    KIND(".force_model", tx_force_model)};
+    KIND(".force_model", tx_force_model), KIND(".punctures", tx_puncture)};
 #undef KIND
 
 // the type and width a drawn component must have: by its suffix, and scalars are f32 N x 1

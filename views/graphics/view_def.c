@@ -148,19 +148,19 @@ static int read_laparoscope(const json_t* lap, const json_t* cam, tx_view_def* d
 static int read_item(size_t i, const json_t* e, tx_draw_item* it) {
   static const char* const keys[] = {"mesh", "spheres", "segments", "tool", "plane", "instrument", "urdf", "colour",
                                      "colour_by", "range", "texture", "radius_m", "show_force", "force_scale_m_per_n",
-                                     "proxy", "cut", NULL};
+                                     "proxy", "cut", "markers", NULL};
   char at[48], key[96];
   snprintf(at, sizeof at, "draw[%zu]", i);
   if (!json_is_object(e)) return bad(at, "expected an object, got %s", tx_json_kind(e));
   if (check_keys(at, e, keys)) return -1;
   static const struct { const char* key; tx_draw_kind kind; } kinds[] = {
       {"mesh", TX_DRAW_MESH}, {"spheres", TX_DRAW_SPHERES}, {"segments", TX_DRAW_SEGMENTS}, {"tool", TX_DRAW_TOOL},
-      {"plane", TX_DRAW_PLANE}, {"instrument", TX_DRAW_INSTRUMENT}};
+      {"plane", TX_DRAW_PLANE}, {"instrument", TX_DRAW_INSTRUMENT}, {"markers", TX_DRAW_MARKERS}};
   *it = (tx_draw_item){.colour = {0.8f, 0.8f, 0.8f}, .range = {0, 1}, .radius = 0.005f, .force_scale = 0.01f};
   for (size_t k = 0; k < sizeof kinds / sizeof kinds[0]; k++) {
     const json_t* v = json_object_get(e, kinds[k].key);
     if (!v) continue;
-    if (it->kind) return bad(at, "expected exactly one of mesh, spheres, segments, tool, plane, instrument");
+    if (it->kind) return bad(at, "expected exactly one of mesh, spheres, segments, tool, plane, instrument, markers");
     it->kind = kinds[k].kind;
     snprintf(key, sizeof key, "%s.%s", at, kinds[k].key);
     if (it->kind == TX_DRAW_PLANE) {
@@ -176,11 +176,31 @@ static int read_item(size_t i, const json_t* e, tx_draw_item* it) {
       it->plane[6] = (float)(size / 2);
       continue;
     }
+    if (it->kind == TX_DRAW_MARKERS) { // the punctures, on the skin whose rows they name
+      static const char* const mkeys[] = {"punctures", "skin", NULL};
+      if (!json_is_object(v)) return bad(key, "expected an object, got %s", tx_json_kind(v));
+      if (check_keys(key, v, mkeys)) return -1;
+      char sub[128];
+      const json_t* q = json_object_get(v, "punctures");
+      snprintf(sub, sizeof sub, "%s.punctures", key);
+      size_t n = json_is_string(q) ? strlen(json_string_value(q)) : 0;
+      if (!json_is_string(q) || !plain_name(json_string_value(q)) || n < 11 || strcmp(json_string_value(q) + n - 10, ".punctures") != 0)
+        return bad(sub, "expected a puncture list component such as needle.punctures");
+      snprintf(it->name, sizeof it->name, "%s", json_string_value(q));
+      q = json_object_get(v, "skin");
+      snprintf(sub, sizeof sub, "%s.skin", key);
+      if (!json_is_string(q) || !plain_name(json_string_value(q)))
+        return bad(sub, "expected the skin's component prefix (SKIN.x holds the rows the punctures name), such as skin");
+      snprintf(it->skin, sizeof it->skin, "%s", json_string_value(q));
+      it->radius = 0.0015f;
+      it->colour[0] = 0.9f, it->colour[1] = 0.15f, it->colour[2] = 0.85f; // magenta: apart from skin, steel and thread
+      continue;
+    }
     if (!json_is_string(v) || !plain_name(json_string_value(v)))
       return bad(key, "expected a component prefix of 1-%d characters of a-z 0-9 _ .", TX_NAME_MAX - 10);
     snprintf(it->name, sizeof it->name, "%s", json_string_value(v));
   }
-  if (!it->kind) return bad(at, "expected one of mesh, spheres, segments, tool, plane, instrument");
+  if (!it->kind) return bad(at, "expected one of mesh, spheres, segments, tool, plane, instrument, markers");
   double tmp[3];
   const json_t* v;
   snprintf(key, sizeof key, "%s.colour", at);
@@ -191,6 +211,7 @@ static int read_item(size_t i, const json_t* e, tx_draw_item* it) {
     it->colour[0] = 0.85f, it->colour[1] = 0.25f, it->colour[2] = 0.2f;
   } else if (it->kind == TX_DRAW_PLANE) {
     it->colour[0] = 0.45f, it->colour[1] = 0.5f, it->colour[2] = 0.6f;
+  } else if (it->kind == TX_DRAW_MARKERS) { // set with the kind
   } else if (it->kind == TX_DRAW_INSTRUMENT) { // steel
     it->colour[0] = 0.72f, it->colour[1] = 0.74f, it->colour[2] = 0.78f;
   }
@@ -233,7 +254,7 @@ static int read_item(size_t i, const json_t* e, tx_draw_item* it) {
   double x = 0; // set by number() whenever it returns 0
   snprintf(key, sizeof key, "%s.radius_m", at);
   if ((v = json_object_get(e, "radius_m"))) {
-    if (it->kind != TX_DRAW_TOOL) return bad(key, "only tools take a radius");
+    if (it->kind != TX_DRAW_TOOL && it->kind != TX_DRAW_MARKERS) return bad(key, "only tools and markers take a radius");
     if (number(key, v, 0, 1, true, &x)) return -1;
     it->radius = (float)x;
   }
@@ -416,6 +437,10 @@ int tx_draw_item_components(const tx_draw_item* it, char out[3][TX_NAME_MAX]) {
   case TX_DRAW_INSTRUMENT:
     join(out[n++], it->name, ".links");
     join(out[n++], it->name, ".held");
+    break;
+  case TX_DRAW_MARKERS:
+    join(out[n++], it->name, "");
+    join(out[n++], it->skin, ".x");
     break;
   }
   if (*it->scalar) join(out[n++], it->scalar, "");

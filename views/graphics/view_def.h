@@ -14,6 +14,8 @@
 //   plane          a fixed square (no component): point, normal and size in the view itself
 //   instrument NAME  NAME.links (f64 N x 7: each URDF link's frame) and NAME.held (f64 1 x 1: which of
 //                  the entry's "urdf" list the hand holds), drawn from the URDFs' visual meshes
+//   markers        a puncture list P.punctures (f64 N x 7, tx_puncture) placed on SKIN.x: a small
+//                  sphere where each puncture is, on the triangle it pierced
 #ifndef TX_VIEWS_GRAPHICS_VIEW_DEF_H
 #define TX_VIEWS_GRAPHICS_VIEW_DEF_H
 
@@ -38,19 +40,21 @@ typedef enum tx_draw_kind {
   TX_DRAW_SEGMENTS,
   TX_DRAW_TOOL,
   TX_DRAW_PLANE,
-  TX_DRAW_INSTRUMENT
+  TX_DRAW_INSTRUMENT,
+  TX_DRAW_MARKERS
 } tx_draw_kind;
 
 typedef struct tx_draw_item {
   tx_draw_kind kind;
-  char name[TX_NAME_MAX];   // component prefix ("skin" for skin.x and skin.tri); "" for a plane
+  char name[TX_NAME_MAX];   // component prefix ("skin" for skin.x and skin.tri); "" for a plane; markers: the puncture list
+  char skin[TX_NAME_MAX];   // markers: the mesh prefix the punctures' rows index (SKIN.x)
   char scalar[TX_NAME_MAX]; // colour-map component, e.g. "tissue.damage" (f32 N x 1); "" for a plain colour
   float colour[3];          // 1, linear RGB in [0, 1]
   float range[2];           // scalar values mapped to the ends of the colour map
   bool skin_texture;        // meshes: the procedural skin texture instead of the plain colour
   bool tissue_texture;      // meshes: the colour modulated by the procedural tissue texture (organ_texture.h)
   bool show_force;          // tools: a line along NAME.force
-  float radius;             // m, tools: radius of the HIP sphere
+  float radius;             // m, tools: radius of the HIP sphere; markers: of each marker
   float force_scale;        // m/N, tools: length of the force line per newton
   char proxy[TX_NAME_MAX];  // tools: a force model (tx_force_model) whose x0 is drawn as the proxy; "" for none
   float plane[7];           // planes: point (m), unit normal, half size (m)

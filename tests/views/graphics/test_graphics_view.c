@@ -197,6 +197,13 @@ static void draw_errors_name_the_view(void** state) {
   snprintf(text, sizeof text, wall_scene, ", \"view\": {\"draw\": [{\"spheres\": \"device0.force\"}]}");
   assert_null(tx_scenario_load_text("f.json", text, strlen(text), &o));
   assert_non_null(strstr(tx_error(), "view.draw"));
+  // markers: the key inside the entry, and a puncture list nobody writes
+  snprintf(text, sizeof text, wall_scene, ", \"view\": {\"draw\": [{\"markers\": {\"punctures\": \"needle.pose\", \"skin\": \"skin\"}}]}");
+  assert_null(tx_scenario_load_text("f.json", text, strlen(text), &o));
+  assert_non_null(strstr(tx_error(), "f.json: view.draw[0].markers.punctures: expected a puncture list"));
+  snprintf(text, sizeof text, wall_scene, ", \"view\": {\"draw\": [{\"markers\": {\"punctures\": \"needle.punctures\", \"skin\": \"skin\"}}]}");
+  assert_null(tx_scenario_load_text("f.json", text, strlen(text), &o));
+  assert_non_null(strstr(tx_error(), "needle.punctures"));
   tx_load_options bad = {.view = "png", .stereo = "3d"};
   snprintf(text, sizeof text, wall_scene, view_json);
   assert_null(tx_scenario_load_text("f.json", text, strlen(text), &bad));

@@ -196,6 +196,39 @@ static void tool_proxy(void** state) {
   expect_error("{\"draw\": [{\"tool\": \"device0\", \"proxy\": 3}]}", "draw[0].proxy", "expected a force model");
 }
 
+// markers: a puncture list and the skin its rows index, read in that order; bad input names its key
+static void markers_entry(void** state) {
+  (void)state;
+  tx_view_def d = tx_view_def_default();
+  assert_int_equal(tx_view_def_from_text("{\"draw\": [{\"markers\": {\"punctures\": \"needle.punctures\", \"skin\": \"skin\"}}]}", &d), 0);
+  assert_int_equal(d.items[0].kind, TX_DRAW_MARKERS);
+  assert_true(d.items[0].radius == 0.0015f);
+  assert_true(d.items[0].colour[0] > 2 * d.items[0].colour[1]); // magenta by default
+  char comps[3][TX_NAME_MAX];
+  assert_int_equal(tx_draw_item_components(&d.items[0], comps), 2);
+  assert_string_equal(comps[0], "needle.punctures");
+  assert_string_equal(comps[1], "skin.x");
+  assert_int_equal(tx_view_def_from_text("{\"draw\": [{\"markers\": {\"punctures\": \"a.punctures\", \"skin\": \"s\"}, "
+                                         "\"radius_m\": 0.003, \"colour\": [0, 1, 0]}]}", &d), 0);
+  assert_true(d.items[0].radius == 0.003f && d.items[0].colour[1] == 1);
+  expect_error("{\"draw\": [{\"markers\": \"needle.punctures\"}]}", "draw[0].markers", "expected an object");
+  expect_error("{\"draw\": [{\"markers\": {\"skin\": \"skin\"}}]}", "draw[0].markers.punctures", "expected a puncture list");
+  expect_error("{\"draw\": [{\"markers\": {\"punctures\": \"needle.pose\", \"skin\": \"skin\"}}]}", "draw[0].markers.punctures",
+               "expected a puncture list");
+  expect_error("{\"draw\": [{\"markers\": {\"punctures\": 7, \"skin\": \"skin\"}}]}", "draw[0].markers.punctures",
+               "expected a puncture list");
+  expect_error("{\"draw\": [{\"markers\": {\"punctures\": \"needle.punctures\"}}]}", "draw[0].markers.skin", "expected the skin");
+  expect_error("{\"draw\": [{\"markers\": {\"punctures\": \"needle.punctures\", \"skin\": [1]}}]}", "draw[0].markers.skin",
+               "expected the skin");
+  expect_error("{\"draw\": [{\"markers\": {\"punctures\": \"needle.punctures\", \"skin\": \"skin\", \"grasps\": 1}}]}",
+               "draw[0].markers.grasps", "unknown key");
+  expect_error("{\"draw\": [{\"markers\": {\"punctures\": \"n.punctures\", \"skin\": \"skin\"}, \"radius_m\": -1}]}",
+               "draw[0].radius_m", "expected a number");
+  expect_error("{\"draw\": [{\"mesh\": \"skin\", \"radius_m\": 0.01}]}", "draw[0].radius_m", "only tools and markers take a radius");
+  expect_error("{\"draw\": [{\"markers\": {\"punctures\": \"n.punctures\", \"skin\": \"skin\"}, \"mesh\": \"skin\"}]}", "draw[0]",
+               "expected exactly one of");
+}
+
 static void from_text(void** state) {
   (void)state;
   tx_view_def d = tx_view_def_default();
@@ -219,6 +252,7 @@ int main(void) {
       cmocka_unit_test(automatic_draw_list),
       cmocka_unit_test(from_text),
       cmocka_unit_test(tool_proxy),
+      cmocka_unit_test(markers_entry),
       cmocka_unit_test(instrument_entry),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
