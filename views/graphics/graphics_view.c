@@ -45,6 +45,7 @@ typedef struct view {
   bool wait;                            // lockstep: wait for the renderer instead of dropping a frame
   int render_threads;                   // llvmpipe threads in effect
   tx_port ports[TX_DRAW_MAX][3];        // reads of each item
+  char port_names[TX_DRAW_MAX][3][TX_NAME_MAX]; // their components, to share one read between items
   int nports[TX_DRAW_MAX];
   // handed to the renderer: snapshots held by the step's ports
   tx_scene scene;
@@ -164,7 +165,12 @@ static int configure(tx_setup* s, void** self) {
       tx_type type;
       uint32_t cols;
       schema_of(&v->def.items[i], comps[k], &type, &cols);
-      v->ports[i][k] = tx_setup_read_as(s, comps[k], type, cols);
+      memcpy(v->port_names[i][k], comps[k], TX_NAME_MAX);
+      bool seen = false; // a component two items draw (markers on a drawn skin) is one read
+      for (int j = 0; j < i && !seen; j++)
+        for (int q = 0; q < v->nports[j] && !seen; q++)
+          if (strcmp(v->port_names[j][q], comps[k]) == 0) v->ports[i][k] = v->ports[j][q], seen = true;
+      if (!seen) v->ports[i][k] = tx_setup_read_as(s, comps[k], type, cols);
     }
     v->nports[i] = n;
   }
