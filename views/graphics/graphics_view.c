@@ -46,6 +46,9 @@ typedef struct view {
   int render_threads;                   // llvmpipe threads in effect
   tx_port ports[TX_DRAW_MAX][3];        // reads of each item
   char port_names[TX_DRAW_MAX][3][TX_NAME_MAX]; // their components, to share one read between items
+  tx_port listens[TX_DRAW_MAX][TX_MARKER_STREAMS]; // markers: the event streams of each item
+  tx_marker_list live[TX_DRAW_MAX];     // markers: grasps and knots as the events have left them, every step
+  tx_marker_list handed[TX_DRAW_MAX];   // a copy handed to the renderer with the frame
   int nports[TX_DRAW_MAX];
   // handed to the renderer: snapshots held by the step's ports
   tx_scene scene;
@@ -173,6 +176,7 @@ static int configure(tx_setup* s, void** self) {
       if (!seen) v->ports[i][k] = tx_setup_read_as(s, comps[k], type, cols);
     }
     v->nports[i] = n;
+    for (int k = 0; k < v->def.items[i].nevents; k++) v->listens[i][k] = tx_setup_listen(s, v->def.items[i].events[k]);
   }
   // the procedure's current step, for the panels, where something writes it (docs/trainer.md)
   for (int k = 0; k < navail && !v->has_procedure; k++)
@@ -569,6 +573,10 @@ static int init(tx_ctx* c, void* self) {
 
 static void step(tx_ctx* c, void* self) {
   view* v = self;
+  // events every tick, a dropped frame's too: the stream keeps them only until its readers take them
+  for (int i = 0; i < v->def.nitems; i++)
+    for (int k = 0; k < v->def.items[i].nevents; k++)
+      for (tx_event e; tx_next_event(c, v->listens[i][k], &e);) tx_marker_take(&v->live[i], &e);
   if (v->wait) {
     while (sem_wait(&v->idle) != 0 && errno == EINTR) {}
   } else if (sem_trywait(&v->idle) != 0) {
@@ -585,6 +593,11 @@ static void step(tx_ctx* c, void* self) {
       si->data[k] = s.data;
       si->rows[k] = s.seq ? s.rows : 0; // never published: nothing to draw
       v->seq[i][k] = s.seq;
+    }
+    v->scene.markers[i] = NULL;
+    if (v->def.items[i].nevents) {
+      v->handed[i] = v->live[i];
+      v->scene.markers[i] = &v->handed[i];
     }
   }
   if (v->has_procedure) {

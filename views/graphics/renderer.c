@@ -675,10 +675,35 @@ void tx_renderer_upload(tx_renderer* r, const tx_scene* s) {
     case TX_DRAW_MARKERS: {
       // each puncture on the triangle it pierced, where the skin is now; rows
       // past the list's end (v[0] = -1) are no punctures, not bad rows
-      const tx_puncture* pu = si->data[0];
-      const float* x = si->data[1];
-      uint32_t nx = si->rows[1];
-      for (uint32_t i = 0; i < si->rows[0]; i++) {
+      int dk = 0; // the components, in tx_draw_item_components order
+      const tx_puncture* pu = *it->name ? si->data[dk] : NULL;
+      uint32_t npu = *it->name ? si->rows[dk] : 0;
+      const float* x = *it->name ? si->data[dk + 1] : NULL;
+      uint32_t nx = *it->name ? si->rows[dk + 1] : 0;
+      if (*it->name) dk += 2;
+      const tx_sphere* th = *it->thread ? si->data[dk] : NULL;
+      uint32_t nth = *it->thread ? si->rows[dk] : 0;
+      // grasps green, knots orange, the size of the punctures' markers
+      const float green[3] = {0.2f, 0.85f, 0.3f}, orange[3] = {1.0f, 0.55f, 0.1f};
+      const tx_marker_list* ml = s->markers[k];
+      for (uint32_t i = 0; ml && i < ml->n; i++) {
+        const tx_marker* m = &ml->m[i];
+        if (m->kind == TX_EVENT_GRASP) {
+          add_sphere(r, m->p, it->radius, green);
+          continue;
+        }
+        // the knot's cylinders first..last join nodes first..last + 1
+        if (!th || m->last + 1 >= nth) { // no thread to place it on, or nodes past it
+          r->skipped++;
+          continue;
+        }
+        float c[3] = {0, 0, 0}, w = 1.0f / (float)(m->last - m->first + 2);
+        for (uint32_t j = m->first; j <= m->last + 1; j++)
+          for (int e = 0; e < 3; e++) c[e] += w * th[j].c[e];
+        if (finite_n(c, 3)) add_sphere(r, c, it->radius, orange);
+        else r->skipped++;
+      }
+      for (uint32_t i = 0; i < npu; i++) {
         if (pu[i].v[0] == -1) continue;
         float c[3] = {0, 0, 0};
         bool ok = true;

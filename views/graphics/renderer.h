@@ -35,6 +35,7 @@ typedef struct tx_scene_item {
 typedef struct tx_scene {
   tx_scene_item items[TX_DRAW_MAX];
   int count;
+  const tx_marker_list* markers[TX_DRAW_MAX]; // markers items: their live grasps and knots; NULL for none
 } tx_scene;
 
 typedef struct tx_renderer tx_renderer;

@@ -176,22 +176,41 @@ static int read_item(size_t i, const json_t* e, tx_draw_item* it) {
       it->plane[6] = (float)(size / 2);
       continue;
     }
-    if (it->kind == TX_DRAW_MARKERS) { // the punctures, on the skin whose rows they name
-      static const char* const mkeys[] = {"punctures", "skin", NULL};
+    if (it->kind == TX_DRAW_MARKERS) { // the punctures, on the skin whose rows they name; grasps and knots by events
+      static const char* const mkeys[] = {"punctures", "skin", "events", "thread", NULL};
       if (!json_is_object(v)) return bad(key, "expected an object, got %s", tx_json_kind(v));
       if (check_keys(key, v, mkeys)) return -1;
       char sub[128];
       const json_t* q = json_object_get(v, "punctures");
       snprintf(sub, sizeof sub, "%s.punctures", key);
       size_t n = json_is_string(q) ? strlen(json_string_value(q)) : 0;
-      if (!json_is_string(q) || !plain_name(json_string_value(q)) || n < 11 || strcmp(json_string_value(q) + n - 10, ".punctures") != 0)
+      if (q && (!json_is_string(q) || !plain_name(json_string_value(q)) || n < 11 ||
+                strcmp(json_string_value(q) + n - 10, ".punctures") != 0))
         return bad(sub, "expected a puncture list component such as needle.punctures");
-      snprintf(it->name, sizeof it->name, "%s", json_string_value(q));
+      if (q) snprintf(it->name, sizeof it->name, "%s", json_string_value(q));
+      const json_t* ev = json_object_get(v, "events");
+      if (!q && !ev) return bad(sub, "expected a puncture list component such as needle.punctures, or events");
       q = json_object_get(v, "skin");
       snprintf(sub, sizeof sub, "%s.skin", key);
-      if (!json_is_string(q) || !plain_name(json_string_value(q)))
+      if (*it->name && (!json_is_string(q) || !plain_name(json_string_value(q))))
         return bad(sub, "expected the skin's component prefix (SKIN.x holds the rows the punctures name), such as skin");
-      snprintf(it->skin, sizeof it->skin, "%s", json_string_value(q));
+      if (!*it->name && q) return bad(sub, "a skin places punctures: give punctures too");
+      if (q) snprintf(it->skin, sizeof it->skin, "%s", json_string_value(q));
+      snprintf(sub, sizeof sub, "%s.events", key);
+      if (ev && (!json_is_array(ev) || json_array_size(ev) == 0 || json_array_size(ev) > TX_MARKER_STREAMS))
+        return bad(sub, "expected an array of 1 to %d event stream names, such as [\"instruments.events\"]", TX_MARKER_STREAMS);
+      for (size_t j = 0; ev && j < json_array_size(ev); j++) {
+        const json_t* name = json_array_get(ev, j);
+        if (!json_is_string(name) || !plain_name(json_string_value(name)))
+          return bad(sub, "entry %zu: expected an event stream name such as instruments.events", j);
+        snprintf(it->events[it->nevents++], TX_NAME_MAX, "%s", json_string_value(name));
+      }
+      q = json_object_get(v, "thread");
+      snprintf(sub, sizeof sub, "%s.thread", key);
+      if (q && (!json_is_string(q) || !plain_name(json_string_value(q))))
+        return bad(sub, "expected the thread's component prefix (THREAD.spheres: its nodes), such as thread");
+      if (q && !ev) return bad(sub, "a thread places knots from events: give events too");
+      if (q) snprintf(it->thread, sizeof it->thread, "%s", json_string_value(q));
       it->radius = 0.0015f;
       it->colour[0] = 0.9f, it->colour[1] = 0.15f, it->colour[2] = 0.85f; // magenta: apart from skin, steel and thread
       continue;
@@ -438,11 +457,37 @@ int tx_draw_item_components(const tx_draw_item* it, char out[3][TX_NAME_MAX]) {
     join(out[n++], it->name, ".links");
     join(out[n++], it->name, ".held");
     break;
-  case TX_DRAW_MARKERS:
-    join(out[n++], it->name, "");
-    join(out[n++], it->skin, ".x");
+  case TX_DRAW_MARKERS: // the renderer finds them in this order by which are given
+    if (*it->name) join(out[n++], it->name, ""), join(out[n++], it->skin, ".x");
+    if (*it->thread) join(out[n++], it->thread, ".spheres");
     break;
   }
   if (*it->scalar) join(out[n++], it->scalar, "");
   return n;
+}
+
+void tx_marker_take(tx_marker_list* l, const tx_event* e) {
+  if (e->kind == TX_EVENT_RELEASE) { // every grasp of that hand ends
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < l->n; i++)
+      if (!(l->m[i].kind == TX_EVENT_GRASP && l->m[i].source == e->source)) l->m[k++] = l->m[i];
+    l->n = k;
+    return;
+  }
+  tx_marker m = {.kind = e->kind, .source = e->source};
+  if (e->kind == TX_EVENT_GRASP) {
+    for (int c = 0; c < 3; c++) m.p[c] = (float)e->grasp.point[c];
+    if (!(isfinite(m.p[0]) && isfinite(m.p[1]) && isfinite(m.p[2]))) return;
+  } else if (e->kind == TX_EVENT_KNOT) { // value[0], value[1]: its first and last node
+    double a = e->value[0], b = e->value[1];
+    if (!(a >= 0 && b >= a && b < 1e9)) return;
+    m.first = (uint32_t)a, m.last = (uint32_t)b;
+  } else {
+    return;
+  }
+  if (l->n == TX_MARKERS_MAX) {
+    l->dropped++;
+    return;
+  }
+  l->m[l->n++] = m;
 }

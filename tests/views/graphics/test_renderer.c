@@ -480,6 +480,32 @@ static void puncture_markers(void** state) {
   release(&fr);
 }
 
+// a grasp at its point (green), a knot at the mean of its cylinders' nodes (orange);
+// a knot past the thread's nodes is skipped and counted
+static void grasp_and_knot_markers(void** state) {
+  (void)state;
+  tx_view_def d = scene_def();
+  d.items[0] = (tx_draw_item){.kind = TX_DRAW_MARKERS, .thread = "thread", .nevents = 1, .radius = 0.01f};
+  d.nitems = 1;
+  const tx_sphere nodes[4] = {{{0, -0.1f, 0}, 0.001f}, {{0, 0.1f, 0}, 0.001f}, {{0.2f, 0.1f, 0}, 0.001f}, {{0.2f, -0.1f, 0}, 0.001f}};
+  const tx_marker_list m = {.n = 3,
+                            .m = {{.kind = TX_EVENT_GRASP, .p = {-0.1f, 0, 0}},
+                                  {.kind = TX_EVENT_KNOT, .first = 0, .last = 2}, // nodes 0..3: (0.1, 0, 0)
+                                  {.kind = TX_EVENT_KNOT, .first = 2, .last = 3}}};  // node 4 is past the thread
+  tx_scene s = {.count = 1, .markers = {&m}};
+  s.items[0] = (tx_scene_item){&d.items[0], {nodes}, {4}};
+  frame fr = {0};
+  render(&fr, &d, TX_STEREO_MONO, &s);
+  const uint8_t* p = at(&fr, W / 2 - px_of(0.1), H / 2);
+  if (!(p[1] > 2 * p[0] + 8 && p[1] > 2 * p[2] + 8)) fail_msg("(%d, %d, %d): no green grasp marker", p[0], p[1], p[2]);
+  p = at(&fr, W / 2 + px_of(0.1), H / 2);
+  if (!(p[0] > 3 * p[2] + 8 && p[1] > p[2] + 8 && p[0] > p[1] + 16)) fail_msg("(%d, %d, %d): no orange knot marker", p[0], p[1], p[2]);
+  p = at(&fr, W / 2, H / 2 - px_of(0.1)); // a node itself: nothing there but its own (undrawn) sphere
+  if (lit(p, -1)) fail_msg("(%d, %d, %d) at a node", p[0], p[1], p[2]);
+  assert_int_equal(tx_renderer_skipped(fr.r), 1);
+  release(&fr);
+}
+
 int main(void) {
   tx_osmesa_bound_threads(-1);
   const struct CMUnitTest tests[] = {
@@ -488,6 +514,7 @@ int main(void) {
       cmocka_unit_test(mesh_coloured_by_scalar),  cmocka_unit_test(colour_map_and_png),       cmocka_unit_test(sphere_depth_and_cut),
       cmocka_unit_test(segments_with_a_gap),      cmocka_unit_test(tool_proxy_at_x0),
       cmocka_unit_test(force_arrow_outside_the_tool), cmocka_unit_test(puncture_markers),
+      cmocka_unit_test(grasp_and_knot_markers),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
