@@ -45,6 +45,10 @@ typedef struct view {
   bool wait;                            // lockstep: wait for the renderer instead of dropping a frame
   int render_threads;                   // llvmpipe threads in effect
   tx_port ports[TX_DRAW_MAX][3];        // reads of each item
+  char port_names[TX_DRAW_MAX][3][TX_NAME_MAX]; // their components, to share one read between items
+  tx_port listens[TX_DRAW_MAX][TX_MARKER_STREAMS]; // markers: the event streams of each item
+  tx_marker_list live[TX_DRAW_MAX];     // markers: grasps and knots as the events have left them, every step
+  tx_marker_list handed[TX_DRAW_MAX];   // a copy handed to the renderer with the frame
   int nports[TX_DRAW_MAX];
   // handed to the renderer: snapshots held by the step's ports
   tx_scene scene;
@@ -83,7 +87,7 @@ typedef struct view {
 static const struct { const char* suffix; tx_type type; uint32_t cols; } kinds[] = {
     KIND(".x", tx_vertex), KIND(".tri", tx_triangle), KIND(".spheres", tx_sphere), KIND(".segments", tx_segment),
     KIND(".pose", tx_pose), KIND(".force", tx_force), KIND(".links", tx_pose), KIND(".held", tx_instrument_held),
-    KIND(".force_model", tx_force_model)};
+    KIND(".force_model", tx_force_model), KIND(".punctures", tx_puncture)};
 #undef KIND
 
 // the type and width a drawn component must have: by its suffix, and scalars are f32 N x 1
@@ -164,9 +168,15 @@ static int configure(tx_setup* s, void** self) {
       tx_type type;
       uint32_t cols;
       schema_of(&v->def.items[i], comps[k], &type, &cols);
-      v->ports[i][k] = tx_setup_read_as(s, comps[k], type, cols);
+      memcpy(v->port_names[i][k], comps[k], TX_NAME_MAX);
+      bool seen = false; // a component two items draw (markers on a drawn skin) is one read
+      for (int j = 0; j < i && !seen; j++)
+        for (int q = 0; q < v->nports[j] && !seen; q++)
+          if (strcmp(v->port_names[j][q], comps[k]) == 0) v->ports[i][k] = v->ports[j][q], seen = true;
+      if (!seen) v->ports[i][k] = tx_setup_read_as(s, comps[k], type, cols);
     }
     v->nports[i] = n;
+    for (int k = 0; k < v->def.items[i].nevents; k++) v->listens[i][k] = tx_setup_listen(s, v->def.items[i].events[k]);
   }
   // the procedure's current step, for the panels, where something writes it (docs/trainer.md)
   for (int k = 0; k < navail && !v->has_procedure; k++)
@@ -563,6 +573,10 @@ static int init(tx_ctx* c, void* self) {
 
 static void step(tx_ctx* c, void* self) {
   view* v = self;
+  // events every tick, a dropped frame's too: the stream keeps them only until its readers take them
+  for (int i = 0; i < v->def.nitems; i++)
+    for (int k = 0; k < v->def.items[i].nevents; k++)
+      for (tx_event e; tx_next_event(c, v->listens[i][k], &e);) tx_marker_take(&v->live[i], &e);
   if (v->wait) {
     while (sem_wait(&v->idle) != 0 && errno == EINTR) {}
   } else if (sem_trywait(&v->idle) != 0) {
@@ -579,6 +593,11 @@ static void step(tx_ctx* c, void* self) {
       si->data[k] = s.data;
       si->rows[k] = s.seq ? s.rows : 0; // never published: nothing to draw
       v->seq[i][k] = s.seq;
+    }
+    v->scene.markers[i] = NULL;
+    if (v->def.items[i].nevents) {
+      v->handed[i] = v->live[i];
+      v->scene.markers[i] = &v->handed[i];
     }
   }
   if (v->has_procedure) {

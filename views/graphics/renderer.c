@@ -560,6 +560,21 @@ static void rotate(const double q[4], const float v[3], float out[3]) {
   out[2] = (float)(v[2] + w * t[2] + (x * t[1] - y * t[0]));
 }
 
+void tx_force_arrow_start(const float p[3], const float shaft[3], float radius, const double f[3], float out[3]) {
+  double fl = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]), sl = 0;
+  for (int c = 0; c < 3; c++) sl += (double)shaft[c] * shaft[c];
+  sl = sqrt(sl);
+  memcpy(out, p, 3 * sizeof(float));
+  if (!(fl > 0) || !isfinite(fl) || !(sl > 0)) return;
+  double u[3] = {f[0] / fl, f[1] / fl, f[2] / fl}, cosa = 0;
+  for (int c = 0; c < 3; c++) cosa += u[c] * shaft[c] / sl;
+  // off the HIP sphere; the rod (0.45 r) clears the shaft (0.35 r) once its axis is 0.8 r
+  // from the shaft's, and its distance grows along the force: at the sphere it is r sin(a)
+  double t = radius, sina = sqrt(fmax(0, 1 - cosa * cosa));
+  if (cosa > 0 && sina < 0.8) t = fmax(t, sl / cosa); // within the shaft: start where the shaft ends
+  for (int c = 0; c < 3; c++) out[c] = (float)(p[c] + t * u[c]);
+}
+
 void tx_renderer_upload(tx_renderer* r, const tx_scene* s) {
   r->nmeshes = 0;
   r->nspheres = r->ncyls = 0;
@@ -657,6 +672,54 @@ void tx_renderer_upload(tx_renderer* r, const tx_scene* s) {
       upload_mesh(r, m);
       break;
     }
+    case TX_DRAW_MARKERS: {
+      // each puncture on the triangle it pierced, where the skin is now; rows
+      // past the list's end (v[0] = -1) are no punctures, not bad rows
+      int dk = 0; // the components, in tx_draw_item_components order
+      const tx_puncture* pu = *it->name ? si->data[dk] : NULL;
+      uint32_t npu = *it->name ? si->rows[dk] : 0;
+      const float* x = *it->name ? si->data[dk + 1] : NULL;
+      uint32_t nx = *it->name ? si->rows[dk + 1] : 0;
+      if (*it->name) dk += 2;
+      const tx_sphere* th = *it->thread ? si->data[dk] : NULL;
+      uint32_t nth = *it->thread ? si->rows[dk] : 0;
+      // grasps green, knots orange, the size of the punctures' markers
+      const float green[3] = {0.2f, 0.85f, 0.3f}, orange[3] = {1.0f, 0.55f, 0.1f};
+      const tx_marker_list* ml = s->markers[k];
+      for (uint32_t i = 0; ml && i < ml->n; i++) {
+        const tx_marker* m = &ml->m[i];
+        if (m->kind == TX_EVENT_GRASP) {
+          add_sphere(r, m->p, it->radius, green);
+          continue;
+        }
+        // the knot's cylinders first..last join nodes first..last + 1
+        if (!th || m->last + 1 >= nth) { // no thread to place it on, or nodes past it
+          r->skipped++;
+          continue;
+        }
+        float c[3] = {0, 0, 0}, w = 1.0f / (float)(m->last - m->first + 2);
+        for (uint32_t j = m->first; j <= m->last + 1; j++)
+          for (int e = 0; e < 3; e++) c[e] += w * th[j].c[e];
+        if (finite_n(c, 3)) add_sphere(r, c, it->radius, orange);
+        else r->skipped++;
+      }
+      for (uint32_t i = 0; i < npu; i++) {
+        if (pu[i].v[0] == -1) continue;
+        float c[3] = {0, 0, 0};
+        bool ok = true;
+        for (int j = 0; j < 3 && ok; j++) {
+          double v = pu[i].v[j], b = pu[i].bary[j];
+          ok = v >= 0 && v < (double)nx && v == floor(v) && isfinite(b);
+          for (int e = 0; e < 3 && ok; e++) c[e] += (float)b * x[3 * (uint32_t)v + e];
+        }
+        if (!ok || !finite_n(c, 3)) {
+          r->skipped++;
+          continue;
+        }
+        add_sphere(r, c, it->radius, it->colour);
+      }
+      break;
+    }
     case TX_DRAW_TOOL: {
       const tx_pose* pose = si->data[0];
       if (!si->rows[0]) break;
@@ -680,10 +743,11 @@ void tx_renderer_upload(tx_renderer* r, const tx_scene* s) {
       add_cylinder(r, p, tip, 0.35f * it->radius, grey);
       if (it->show_force && si->rows[1]) {
         const tx_force* f = si->data[1];
-        float end[3];
+        float start[3], end[3];
         const float yellow[3] = {0.95f, 0.85f, 0.1f};
-        for (int c = 0; c < 3; c++) end[c] = p[c] + (float)f->f[c] * it->force_scale;
-        if (finite_n(end, 3)) add_cylinder(r, p, end, 0.45f * it->radius, yellow); // wider than the shaft it may run along
+        tx_force_arrow_start(p, a, it->radius, f->f, start);
+        for (int c = 0; c < 3; c++) end[c] = start[c] + (float)f->f[c] * it->force_scale;
+        if (finite_n(start, 3) && finite_n(end, 3)) add_cylinder(r, start, end, 0.45f * it->radius, yellow);
       }
       int pk = it->show_force ? 2 : 1; // the proxy's force model, after the pose and the force
       if (*it->proxy && si->rows[pk]) {

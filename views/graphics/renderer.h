@@ -35,6 +35,7 @@ typedef struct tx_scene_item {
 typedef struct tx_scene {
   tx_scene_item items[TX_DRAW_MAX];
   int count;
+  const tx_marker_list* markers[TX_DRAW_MAX]; // markers items: their live grasps and knots; NULL for none
 } tx_scene;
 
 typedef struct tx_renderer tx_renderer;
@@ -66,6 +67,11 @@ void tx_renderer_draw(tx_renderer* r, const tx_view_def* d, const tx_camera* c, 
                       unsigned clear);
 // rows skipped so far as not finite or out of range
 uint64_t tx_renderer_skipped(const tx_renderer* r);
+// where a tool's force rod starts, so that the tool never hides it: on the HIP
+// sphere (centre p, radius) along the force f, or, for a force within reach of
+// the shaft (p to p + shaft, 0.35 radius thick), past the shaft's end along f;
+// p itself for no force
+void tx_force_arrow_start(const float p[3], const float shaft[3], float radius, const double f[3], float out[3]);
 // scalar to colour along the map (blue, cyan, green, yellow, red) for t in [0, 1]
 void tx_colour_map(float t, float rgb[3]);
 // the procedural skin texture, size x size RGB (for tests and the renderer)

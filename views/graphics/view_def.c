@@ -148,19 +148,19 @@ static int read_laparoscope(const json_t* lap, const json_t* cam, tx_view_def* d
 static int read_item(size_t i, const json_t* e, tx_draw_item* it) {
   static const char* const keys[] = {"mesh", "spheres", "segments", "tool", "plane", "instrument", "urdf", "colour",
                                      "colour_by", "range", "texture", "radius_m", "show_force", "force_scale_m_per_n",
-                                     "proxy", "cut", NULL};
+                                     "proxy", "cut", "markers", NULL};
   char at[48], key[96];
   snprintf(at, sizeof at, "draw[%zu]", i);
   if (!json_is_object(e)) return bad(at, "expected an object, got %s", tx_json_kind(e));
   if (check_keys(at, e, keys)) return -1;
   static const struct { const char* key; tx_draw_kind kind; } kinds[] = {
       {"mesh", TX_DRAW_MESH}, {"spheres", TX_DRAW_SPHERES}, {"segments", TX_DRAW_SEGMENTS}, {"tool", TX_DRAW_TOOL},
-      {"plane", TX_DRAW_PLANE}, {"instrument", TX_DRAW_INSTRUMENT}};
+      {"plane", TX_DRAW_PLANE}, {"instrument", TX_DRAW_INSTRUMENT}, {"markers", TX_DRAW_MARKERS}};
   *it = (tx_draw_item){.colour = {0.8f, 0.8f, 0.8f}, .range = {0, 1}, .radius = 0.005f, .force_scale = 0.01f};
   for (size_t k = 0; k < sizeof kinds / sizeof kinds[0]; k++) {
     const json_t* v = json_object_get(e, kinds[k].key);
     if (!v) continue;
-    if (it->kind) return bad(at, "expected exactly one of mesh, spheres, segments, tool, plane, instrument");
+    if (it->kind) return bad(at, "expected exactly one of mesh, spheres, segments, tool, plane, instrument, markers");
     it->kind = kinds[k].kind;
     snprintf(key, sizeof key, "%s.%s", at, kinds[k].key);
     if (it->kind == TX_DRAW_PLANE) {
@@ -176,11 +176,50 @@ static int read_item(size_t i, const json_t* e, tx_draw_item* it) {
       it->plane[6] = (float)(size / 2);
       continue;
     }
+    if (it->kind == TX_DRAW_MARKERS) { // the punctures, on the skin whose rows they name; grasps and knots by events
+      static const char* const mkeys[] = {"punctures", "skin", "events", "thread", NULL};
+      if (!json_is_object(v)) return bad(key, "expected an object, got %s", tx_json_kind(v));
+      if (check_keys(key, v, mkeys)) return -1;
+      char sub[128];
+      const json_t* q = json_object_get(v, "punctures");
+      snprintf(sub, sizeof sub, "%s.punctures", key);
+      size_t n = json_is_string(q) ? strlen(json_string_value(q)) : 0;
+      if (q && (!json_is_string(q) || !plain_name(json_string_value(q)) || n < 11 ||
+                strcmp(json_string_value(q) + n - 10, ".punctures") != 0))
+        return bad(sub, "expected a puncture list component such as needle.punctures");
+      if (q) snprintf(it->name, sizeof it->name, "%s", json_string_value(q));
+      const json_t* ev = json_object_get(v, "events");
+      if (!q && !ev) return bad(sub, "expected a puncture list component such as needle.punctures, or events");
+      q = json_object_get(v, "skin");
+      snprintf(sub, sizeof sub, "%s.skin", key);
+      if (*it->name && (!json_is_string(q) || !plain_name(json_string_value(q))))
+        return bad(sub, "expected the skin's component prefix (SKIN.x holds the rows the punctures name), such as skin");
+      if (!*it->name && q) return bad(sub, "a skin places punctures: give punctures too");
+      if (q) snprintf(it->skin, sizeof it->skin, "%s", json_string_value(q));
+      snprintf(sub, sizeof sub, "%s.events", key);
+      if (ev && (!json_is_array(ev) || json_array_size(ev) == 0 || json_array_size(ev) > TX_MARKER_STREAMS))
+        return bad(sub, "expected an array of 1 to %d event stream names, such as [\"instruments.events\"]", TX_MARKER_STREAMS);
+      for (size_t j = 0; ev && j < json_array_size(ev); j++) {
+        const json_t* name = json_array_get(ev, j);
+        if (!json_is_string(name) || !plain_name(json_string_value(name)))
+          return bad(sub, "entry %zu: expected an event stream name such as instruments.events", j);
+        snprintf(it->events[it->nevents++], TX_NAME_MAX, "%s", json_string_value(name));
+      }
+      q = json_object_get(v, "thread");
+      snprintf(sub, sizeof sub, "%s.thread", key);
+      if (q && (!json_is_string(q) || !plain_name(json_string_value(q))))
+        return bad(sub, "expected the thread's component prefix (THREAD.spheres: its nodes), such as thread");
+      if (q && !ev) return bad(sub, "a thread places knots from events: give events too");
+      if (q) snprintf(it->thread, sizeof it->thread, "%s", json_string_value(q));
+      it->radius = 0.0015f;
+      it->colour[0] = 0.9f, it->colour[1] = 0.15f, it->colour[2] = 0.85f; // magenta: apart from skin, steel and thread
+      continue;
+    }
     if (!json_is_string(v) || !plain_name(json_string_value(v)))
       return bad(key, "expected a component prefix of 1-%d characters of a-z 0-9 _ .", TX_NAME_MAX - 10);
     snprintf(it->name, sizeof it->name, "%s", json_string_value(v));
   }
-  if (!it->kind) return bad(at, "expected one of mesh, spheres, segments, tool, plane, instrument");
+  if (!it->kind) return bad(at, "expected one of mesh, spheres, segments, tool, plane, instrument, markers");
   double tmp[3];
   const json_t* v;
   snprintf(key, sizeof key, "%s.colour", at);
@@ -191,6 +230,7 @@ static int read_item(size_t i, const json_t* e, tx_draw_item* it) {
     it->colour[0] = 0.85f, it->colour[1] = 0.25f, it->colour[2] = 0.2f;
   } else if (it->kind == TX_DRAW_PLANE) {
     it->colour[0] = 0.45f, it->colour[1] = 0.5f, it->colour[2] = 0.6f;
+  } else if (it->kind == TX_DRAW_MARKERS) { // set with the kind
   } else if (it->kind == TX_DRAW_INSTRUMENT) { // steel
     it->colour[0] = 0.72f, it->colour[1] = 0.74f, it->colour[2] = 0.78f;
   }
@@ -233,7 +273,7 @@ static int read_item(size_t i, const json_t* e, tx_draw_item* it) {
   double x = 0; // set by number() whenever it returns 0
   snprintf(key, sizeof key, "%s.radius_m", at);
   if ((v = json_object_get(e, "radius_m"))) {
-    if (it->kind != TX_DRAW_TOOL) return bad(key, "only tools take a radius");
+    if (it->kind != TX_DRAW_TOOL && it->kind != TX_DRAW_MARKERS) return bad(key, "only tools and markers take a radius");
     if (number(key, v, 0, 1, true, &x)) return -1;
     it->radius = (float)x;
   }
@@ -417,7 +457,37 @@ int tx_draw_item_components(const tx_draw_item* it, char out[3][TX_NAME_MAX]) {
     join(out[n++], it->name, ".links");
     join(out[n++], it->name, ".held");
     break;
+  case TX_DRAW_MARKERS: // the renderer finds them in this order by which are given
+    if (*it->name) join(out[n++], it->name, ""), join(out[n++], it->skin, ".x");
+    if (*it->thread) join(out[n++], it->thread, ".spheres");
+    break;
   }
   if (*it->scalar) join(out[n++], it->scalar, "");
   return n;
+}
+
+void tx_marker_take(tx_marker_list* l, const tx_event* e) {
+  if (e->kind == TX_EVENT_RELEASE) { // every grasp of that hand ends
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < l->n; i++)
+      if (!(l->m[i].kind == TX_EVENT_GRASP && l->m[i].source == e->source)) l->m[k++] = l->m[i];
+    l->n = k;
+    return;
+  }
+  tx_marker m = {.kind = e->kind, .source = e->source};
+  if (e->kind == TX_EVENT_GRASP) {
+    for (int c = 0; c < 3; c++) m.p[c] = (float)e->grasp.point[c];
+    if (!(isfinite(m.p[0]) && isfinite(m.p[1]) && isfinite(m.p[2]))) return;
+  } else if (e->kind == TX_EVENT_KNOT) { // value[0], value[1]: its first and last node
+    double a = e->value[0], b = e->value[1];
+    if (!(a >= 0 && b >= a && b < 1e9)) return;
+    m.first = (uint32_t)a, m.last = (uint32_t)b;
+  } else {
+    return;
+  }
+  if (l->n == TX_MARKERS_MAX) {
+    l->dropped++;
+    return;
+  }
+  l->m[l->n++] = m;
 }

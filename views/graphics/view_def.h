@@ -14,12 +14,16 @@
 //   plane          a fixed square (no component): point, normal and size in the view itself
 //   instrument NAME  NAME.links (f64 N x 7: each URDF link's frame) and NAME.held (f64 1 x 1: which of
 //                  the entry's "urdf" list the hand holds), drawn from the URDFs' visual meshes
+//   markers        a puncture list P.punctures (f64 N x 7, tx_puncture) placed on SKIN.x: a small
+//                  sphere where each puncture is, on the triangle it pierced; and the live grasps
+//                  and knots of event streams (tx_marker_take), knots on THREAD.spheres
 #ifndef TX_VIEWS_GRAPHICS_VIEW_DEF_H
 #define TX_VIEWS_GRAPHICS_VIEW_DEF_H
 
 #include "laparoscope.h"
 #include "stereo.h"
 
+#include <tactus/events.h>
 #include <tactus/model.h>
 
 #include <jansson.h>
@@ -31,6 +35,8 @@
 
 #define TX_DRAW_URDF_MAX 512     // the instruments named by one instrument entry, as text
 #define TX_DRAW_INSTRUMENT_LINKS 8 // links of one drawn instrument
+#define TX_MARKER_STREAMS 4        // event streams of one markers entry
+#define TX_MARKERS_MAX 64          // live grasps and knots of one markers entry
 
 typedef enum tx_draw_kind {
   TX_DRAW_MESH = 1,
@@ -38,19 +44,24 @@ typedef enum tx_draw_kind {
   TX_DRAW_SEGMENTS,
   TX_DRAW_TOOL,
   TX_DRAW_PLANE,
-  TX_DRAW_INSTRUMENT
+  TX_DRAW_INSTRUMENT,
+  TX_DRAW_MARKERS
 } tx_draw_kind;
 
 typedef struct tx_draw_item {
   tx_draw_kind kind;
-  char name[TX_NAME_MAX];   // component prefix ("skin" for skin.x and skin.tri); "" for a plane
+  char name[TX_NAME_MAX];   // component prefix ("skin" for skin.x and skin.tri); "" for a plane; markers: the puncture list
+  char skin[TX_NAME_MAX];   // markers: the mesh prefix the punctures' rows index (SKIN.x)
+  char events[TX_MARKER_STREAMS][TX_NAME_MAX]; // markers: the event streams listened to
+  int nevents;
+  char thread[TX_NAME_MAX]; // markers: the prefix of THREAD.spheres, whose nodes a knot names; "" for none
   char scalar[TX_NAME_MAX]; // colour-map component, e.g. "tissue.damage" (f32 N x 1); "" for a plain colour
   float colour[3];          // 1, linear RGB in [0, 1]
   float range[2];           // scalar values mapped to the ends of the colour map
   bool skin_texture;        // meshes: the procedural skin texture instead of the plain colour
   bool tissue_texture;      // meshes: the colour modulated by the procedural tissue texture (organ_texture.h)
   bool show_force;          // tools: a line along NAME.force
-  float radius;             // m, tools: radius of the HIP sphere
+  float radius;             // m, tools: radius of the HIP sphere; markers: of each marker
   float force_scale;        // m/N, tools: length of the force line per newton
   char proxy[TX_NAME_MAX];  // tools: a force model (tx_force_model) whose x0 is drawn as the proxy; "" for none
   float plane[7];           // planes: point (m), unit normal, half size (m)
@@ -84,6 +95,23 @@ int tx_view_def_from_json(const json_t* view, tx_view_def* d);
 int tx_view_def_from_text(const char* text, tx_view_def* d);
 // draw entries for every component that follows the naming conventions, from the names written in a model
 int tx_view_def_auto_draw(tx_view_def* d, const char* const* written, int count);
+// a grasp or knot marker: grasps at their point until their hand's release,
+// knots on the thread's nodes first..last (where the thread is now)
+typedef struct tx_marker {
+  uint32_t kind;   // TX_EVENT_GRASP or TX_EVENT_KNOT
+  uint32_t source; // the grasp's hand; the knot's index
+  float p[3];      // m, grasps: the grasp point
+  uint32_t first, last; // knots: the thread's cylinders (node i to i + 1), as physics.thread's event names them
+} tx_marker;
+typedef struct tx_marker_list {
+  tx_marker m[TX_MARKERS_MAX];
+  uint32_t n;
+  uint64_t dropped; // markers refused with the list full
+} tx_marker_list;
+// one event into the live list: a grasp added, its hand's grasps removed on
+// a release, a knot added; other kinds and bad payloads ignored
+void tx_marker_take(tx_marker_list* l, const tx_event* e);
+
 // the components an item reads, in order; returns how many (at most 3)
 int tx_draw_item_components(const tx_draw_item* it, char out[3][TX_NAME_MAX]);
 

@@ -197,10 +197,29 @@ static void draw_errors_name_the_view(void** state) {
   snprintf(text, sizeof text, wall_scene, ", \"view\": {\"draw\": [{\"spheres\": \"device0.force\"}]}");
   assert_null(tx_scenario_load_text("f.json", text, strlen(text), &o));
   assert_non_null(strstr(tx_error(), "view.draw"));
+  // markers: the key inside the entry, and a puncture list nobody writes
+  snprintf(text, sizeof text, wall_scene, ", \"view\": {\"draw\": [{\"markers\": {\"punctures\": \"needle.pose\", \"skin\": \"skin\"}}]}");
+  assert_null(tx_scenario_load_text("f.json", text, strlen(text), &o));
+  assert_non_null(strstr(tx_error(), "f.json: view.draw[0].markers.punctures: expected a puncture list"));
+  snprintf(text, sizeof text, wall_scene, ", \"view\": {\"draw\": [{\"markers\": {\"punctures\": \"needle.punctures\", \"skin\": \"skin\"}}]}");
+  assert_null(tx_scenario_load_text("f.json", text, strlen(text), &o));
+  assert_non_null(strstr(tx_error(), "needle.punctures"));
   tx_load_options bad = {.view = "png", .stereo = "3d"};
   snprintf(text, sizeof text, wall_scene, view_json);
   assert_null(tx_scenario_load_text("f.json", text, strlen(text), &bad));
   assert_non_null(strstr(tx_error(), "stereo_mode"));
+}
+
+// two items drawing one component (markers on a drawn skin read skin.x too) share one read
+static void items_share_a_read(void** state) {
+  (void)state;
+  char text[2048];
+  tx_load_options o = {.view = "png"};
+  snprintf(text, sizeof text, wall_scene,
+           ", \"view\": {\"draw\": [{\"tool\": \"device0\"}, {\"tool\": \"device0\", \"show_force\": true}]}");
+  tx_scenario* sc = tx_scenario_load_text("f.json", text, strlen(text), &o);
+  if (!sc) fail_msg("%s", tx_error());
+  tx_scenario_free(sc);
 }
 
 // in real time the step never waits: each tick gives a frame or counts a dropped one
@@ -237,6 +256,7 @@ int main(void) {
       cmocka_unit_test(stereo_files_and_sizes),
       cmocka_unit_test(automatic_draw_list),
       cmocka_unit_test(draw_errors_name_the_view),
+      cmocka_unit_test(items_share_a_read),
       cmocka_unit_test(real_time_hand_over),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

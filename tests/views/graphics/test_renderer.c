@@ -404,6 +404,108 @@ static void tool_proxy_at_x0(void** state) {
   }
 }
 
+// px right of (or above) the image centre of a point at distance 1 m in the view's plane
+static int px_of(double m) { return (int)lround(m / tan(20 * M_PI / 180) * (H / 2)); }
+static bool yellow(const uint8_t* p) { return p[0] > 3 * p[2] + 8 && p[1] > 3 * p[2] + 8; }
+
+// the force rod starts on the HIP sphere: a force shorter than the radius is
+// still seen; along the shaft it starts past the shaft's end
+static void force_arrow_outside_the_tool(void** state) {
+  (void)state;
+  tx_view_def d = scene_def();
+  d.items[0] = (tx_draw_item){.kind = TX_DRAW_TOOL, .colour = {1, 0, 0}, .radius = 0.05f, .show_force = true, .force_scale = 0.01f};
+  d.nitems = 1;
+  // sideways, 4 N: 40 mm, inside the 50 mm sphere had it started at the HIP
+  const tx_pose pose = {{0, 0, 0}, {1, 0, 0, 0}};
+  tx_force f = {{4, 0, 0}};
+  tx_scene s = {.count = 1};
+  s.items[0] = (tx_scene_item){&d.items[0], {&pose, &f}, {1, 1}};
+  frame fr = {0};
+  render(&fr, &d, TX_STEREO_MONO, &s);
+  const uint8_t* p = at(&fr, W / 2 + px_of(0.07), H / 2);
+  if (!yellow(p)) fail_msg("(%d, %d, %d) 70 mm right of the HIP: no force rod outside the sphere", p[0], p[1], p[2]);
+  p = at(&fr, W / 2 + px_of(0.1), H / 2);
+  if (lit(p, -1)) fail_msg("(%d, %d, %d) at 100 mm: the rod is longer than 4 N x 10 mm/N past the sphere", p[0], p[1], p[2]);
+  release(&fr);
+  // along the shaft (+Y, 16 r = 0.32 m from a HIP at y = -0.2): from the shaft's end, 0.12, to 0.16
+  d.items[0].radius = 0.02f;
+  const tx_pose low = {{0, -0.2, 0}, {1, 0, 0, 0}};
+  f = (tx_force){{0, 4, 0}};
+  s.items[0] = (tx_scene_item){&d.items[0], {&low, &f}, {1, 1}};
+  render(&fr, &d, TX_STEREO_MONO, &s);
+  p = at(&fr, W / 2, H / 2 - px_of(0.14));
+  if (!yellow(p)) fail_msg("(%d, %d, %d) past the shaft's end: no force rod", p[0], p[1], p[2]);
+  for (double y = -0.17; y < 0.1; y += 0.03) {
+    p = at(&fr, W / 2, H / 2 - px_of(y));
+    if (yellow(p)) fail_msg("(%d, %d, %d) at y = %g: the rod runs along the shaft", p[0], p[1], p[2], y);
+  }
+  release(&fr);
+  // the start itself: on the sphere for a force across the shaft, at the HIP for none
+  float start[3];
+  const float c0[3] = {1, 2, 3}, shaft[3] = {0, 0.32f, 0};
+  tx_force_arrow_start(c0, shaft, 0.02f, (const double[3]){0, 0, -5}, start);
+  assert_float_equal(start[2], 3 - 0.02f, 1e-6);
+  tx_force_arrow_start(c0, shaft, 0.02f, (const double[3]){0, -5, 0}, start); // away from the shaft
+  assert_float_equal(start[1], 2 - 0.02f, 1e-6);
+  tx_force_arrow_start(c0, shaft, 0.02f, (const double[3]){0, 0, 0}, start);
+  assert_float_equal(start[0], 1, 0), assert_float_equal(start[1], 2, 0), assert_float_equal(start[2], 3, 0);
+}
+
+// punctures as markers on the skin, where their barycentric coordinates put them
+static void puncture_markers(void** state) {
+  (void)state;
+  tx_view_def d = scene_def();
+  d.items[0] = (tx_draw_item){.kind = TX_DRAW_MARKERS, .name = "needle.punctures", .skin = "skin", .colour = {0.9f, 0.15f, 0.85f},
+                              .radius = 0.01f};
+  d.nitems = 1;
+  const float x[4 * 3] = {0, 0, 0, 0.2f, 0, 0, 0, 0.2f, 0, -0.2f, 0, 0};
+  const tx_puncture pu[4] = {
+      {{0, 1, 2}, {0.5, 0.5, 0}, 1},   // (0.1, 0, 0)
+      {{0, 2, 3}, {0, 0.5, 0.5}, -1},  // (-0.1, 0.1, 0)
+      {{0, 1, 7}, {0.2, 0.4, 0.4}, 1}, // a row past the skin's: skipped, counted
+      {{-1, 0, 0}, {0}, 0},           // past the list's end: nothing
+  };
+  tx_scene s = {.count = 1};
+  s.items[0] = (tx_scene_item){&d.items[0], {pu, x}, {4, 4}};
+  frame fr = {0};
+  render(&fr, &d, TX_STEREO_MONO, &s);
+  const int spots[2][2] = {{W / 2 + px_of(0.1), H / 2}, {W / 2 - px_of(0.1), H / 2 - px_of(0.1)}};
+  for (int k = 0; k < 2; k++) {
+    const uint8_t* p = at(&fr, spots[k][0], spots[k][1]);
+    if (!(p[0] > 2 * p[1] + 8 && p[2] > 2 * p[1] + 8)) fail_msg("(%d, %d, %d): no magenta marker at puncture %d", p[0], p[1], p[2], k);
+  }
+  const uint8_t* p = at(&fr, W / 2, H / 2); // the skin's first corner: no marker there
+  if (lit(p, -1)) fail_msg("(%d, %d, %d) at the triangle's corner", p[0], p[1], p[2]);
+  assert_int_equal(tx_renderer_skipped(fr.r), 1);
+  release(&fr);
+}
+
+// a grasp at its point (green), a knot at the mean of its cylinders' nodes (orange);
+// a knot past the thread's nodes is skipped and counted
+static void grasp_and_knot_markers(void** state) {
+  (void)state;
+  tx_view_def d = scene_def();
+  d.items[0] = (tx_draw_item){.kind = TX_DRAW_MARKERS, .thread = "thread", .nevents = 1, .radius = 0.01f};
+  d.nitems = 1;
+  const tx_sphere nodes[4] = {{{0, -0.1f, 0}, 0.001f}, {{0, 0.1f, 0}, 0.001f}, {{0.2f, 0.1f, 0}, 0.001f}, {{0.2f, -0.1f, 0}, 0.001f}};
+  const tx_marker_list m = {.n = 3,
+                            .m = {{.kind = TX_EVENT_GRASP, .p = {-0.1f, 0, 0}},
+                                  {.kind = TX_EVENT_KNOT, .first = 0, .last = 2}, // nodes 0..3: (0.1, 0, 0)
+                                  {.kind = TX_EVENT_KNOT, .first = 2, .last = 3}}};  // node 4 is past the thread
+  tx_scene s = {.count = 1, .markers = {&m}};
+  s.items[0] = (tx_scene_item){&d.items[0], {nodes}, {4}};
+  frame fr = {0};
+  render(&fr, &d, TX_STEREO_MONO, &s);
+  const uint8_t* p = at(&fr, W / 2 - px_of(0.1), H / 2);
+  if (!(p[1] > 2 * p[0] + 8 && p[1] > 2 * p[2] + 8)) fail_msg("(%d, %d, %d): no green grasp marker", p[0], p[1], p[2]);
+  p = at(&fr, W / 2 + px_of(0.1), H / 2);
+  if (!(p[0] > 3 * p[2] + 8 && p[1] > p[2] + 8 && p[0] > p[1] + 16)) fail_msg("(%d, %d, %d): no orange knot marker", p[0], p[1], p[2]);
+  p = at(&fr, W / 2, H / 2 - px_of(0.1)); // a node itself: nothing there but its own (undrawn) sphere
+  if (lit(p, -1)) fail_msg("(%d, %d, %d) at a node", p[0], p[1], p[2]);
+  assert_int_equal(tx_renderer_skipped(fr.r), 1);
+  release(&fr);
+}
+
 int main(void) {
   tx_osmesa_bound_threads(-1);
   const struct CMUnitTest tests[] = {
@@ -411,6 +513,8 @@ int main(void) {
       cmocka_unit_test(stereo_layouts_disparity), cmocka_unit_test(mesh_and_bad_rows),
       cmocka_unit_test(mesh_coloured_by_scalar),  cmocka_unit_test(colour_map_and_png),       cmocka_unit_test(sphere_depth_and_cut),
       cmocka_unit_test(segments_with_a_gap),      cmocka_unit_test(tool_proxy_at_x0),
+      cmocka_unit_test(force_arrow_outside_the_tool), cmocka_unit_test(puncture_markers),
+      cmocka_unit_test(grasp_and_knot_markers),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

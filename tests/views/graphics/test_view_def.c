@@ -196,6 +196,94 @@ static void tool_proxy(void** state) {
   expect_error("{\"draw\": [{\"tool\": \"device0\", \"proxy\": 3}]}", "draw[0].proxy", "expected a force model");
 }
 
+// markers: a puncture list and the skin its rows index, read in that order; bad input names its key
+static void markers_entry(void** state) {
+  (void)state;
+  tx_view_def d = tx_view_def_default();
+  assert_int_equal(tx_view_def_from_text("{\"draw\": [{\"markers\": {\"punctures\": \"needle.punctures\", \"skin\": \"skin\"}}]}", &d), 0);
+  assert_int_equal(d.items[0].kind, TX_DRAW_MARKERS);
+  assert_true(d.items[0].radius == 0.0015f);
+  assert_true(d.items[0].colour[0] > 2 * d.items[0].colour[1]); // magenta by default
+  char comps[3][TX_NAME_MAX];
+  assert_int_equal(tx_draw_item_components(&d.items[0], comps), 2);
+  assert_string_equal(comps[0], "needle.punctures");
+  assert_string_equal(comps[1], "skin.x");
+  assert_int_equal(tx_view_def_from_text("{\"draw\": [{\"markers\": {\"punctures\": \"a.punctures\", \"skin\": \"s\"}, "
+                                         "\"radius_m\": 0.003, \"colour\": [0, 1, 0]}]}", &d), 0);
+  assert_true(d.items[0].radius == 0.003f && d.items[0].colour[1] == 1);
+  expect_error("{\"draw\": [{\"markers\": \"needle.punctures\"}]}", "draw[0].markers", "expected an object");
+  expect_error("{\"draw\": [{\"markers\": {\"skin\": \"skin\"}}]}", "draw[0].markers.punctures", "expected a puncture list");
+  expect_error("{\"draw\": [{\"markers\": {\"punctures\": \"needle.pose\", \"skin\": \"skin\"}}]}", "draw[0].markers.punctures",
+               "expected a puncture list");
+  expect_error("{\"draw\": [{\"markers\": {\"punctures\": 7, \"skin\": \"skin\"}}]}", "draw[0].markers.punctures",
+               "expected a puncture list");
+  expect_error("{\"draw\": [{\"markers\": {\"punctures\": \"needle.punctures\"}}]}", "draw[0].markers.skin", "expected the skin");
+  expect_error("{\"draw\": [{\"markers\": {\"punctures\": \"needle.punctures\", \"skin\": [1]}}]}", "draw[0].markers.skin",
+               "expected the skin");
+  expect_error("{\"draw\": [{\"markers\": {\"punctures\": \"needle.punctures\", \"skin\": \"skin\", \"grasps\": 1}}]}",
+               "draw[0].markers.grasps", "unknown key");
+  expect_error("{\"draw\": [{\"markers\": {\"punctures\": \"n.punctures\", \"skin\": \"skin\"}, \"radius_m\": -1}]}",
+               "draw[0].radius_m", "expected a number");
+  expect_error("{\"draw\": [{\"mesh\": \"skin\", \"radius_m\": 0.01}]}", "draw[0].radius_m", "only tools and markers take a radius");
+  expect_error("{\"draw\": [{\"markers\": {\"punctures\": \"n.punctures\", \"skin\": \"skin\"}, \"mesh\": \"skin\"}]}", "draw[0]",
+               "expected exactly one of");
+}
+
+// markers of grasps and knots: event streams, and the thread a knot's nodes are on
+static void markers_events(void** state) {
+  (void)state;
+  tx_view_def d = tx_view_def_default();
+  assert_int_equal(tx_view_def_from_text("{\"draw\": [{\"markers\": {\"events\": [\"instruments.events\", \"thread.events\"], "
+                                         "\"thread\": \"thread\"}}]}", &d), 0);
+  assert_int_equal(d.items[0].nevents, 2);
+  assert_string_equal(d.items[0].events[1], "thread.events");
+  char comps[3][TX_NAME_MAX];
+  assert_int_equal(tx_draw_item_components(&d.items[0], comps), 1);
+  assert_string_equal(comps[0], "thread.spheres");
+  assert_int_equal(tx_view_def_from_text("{\"draw\": [{\"markers\": {\"punctures\": \"needle.punctures\", \"skin\": \"skin\", "
+                                         "\"events\": [\"instruments.events\"], \"thread\": \"t\"}}]}", &d), 0);
+  assert_int_equal(tx_draw_item_components(&d.items[0], comps), 3);
+  assert_string_equal(comps[0], "needle.punctures");
+  assert_string_equal(comps[1], "skin.x");
+  assert_string_equal(comps[2], "t.spheres");
+  expect_error("{\"draw\": [{\"markers\": {\"events\": []}}]}", "draw[0].markers.events", "expected an array of 1 to 4");
+  expect_error("{\"draw\": [{\"markers\": {\"events\": \"instruments.events\"}}]}", "draw[0].markers.events", "expected an array");
+  expect_error("{\"draw\": [{\"markers\": {\"events\": [\"a\", \"b\", \"c\", \"d\", \"e\"]}}]}", "draw[0].markers.events",
+               "expected an array of 1 to 4");
+  expect_error("{\"draw\": [{\"markers\": {\"events\": [\"Bad Name\"]}}]}", "draw[0].markers.events", "entry 0");
+  expect_error("{\"draw\": [{\"markers\": {\"events\": [\"e\"], \"thread\": 3}}]}", "draw[0].markers.thread", "expected the thread");
+  expect_error("{\"draw\": [{\"markers\": {\"thread\": \"thread\"}}]}", "draw[0].markers.punctures", "or events");
+  expect_error("{\"draw\": [{\"markers\": {\"events\": [\"e\"], \"skin\": \"skin\"}}]}", "draw[0].markers.skin", "give punctures");
+}
+
+// the live list: a grasp until its hand's release, knots kept, a full list counts what it refuses
+static void marker_list(void** state) {
+  (void)state;
+  tx_marker_list l = {0};
+  tx_event g = {.kind = TX_EVENT_GRASP, .source = 1};
+  g.grasp.point[0] = 0.01, g.grasp.point[1] = 0.02, g.grasp.point[2] = 0.03;
+  tx_marker_take(&l, &g);
+  g.source = 0;
+  tx_marker_take(&l, &g);
+  tx_event k = {.kind = TX_EVENT_KNOT, .source = 0, .value = {3, 9, 0}};
+  tx_marker_take(&l, &k);
+  assert_int_equal(l.n, 3);
+  assert_true(l.m[0].p[1] == 0.02f && l.m[0].source == 1);
+  assert_int_equal(l.m[2].first, 3), assert_int_equal(l.m[2].last, 9);
+  tx_marker_take(&l, &(tx_event){.kind = TX_EVENT_RELEASE, .source = 1}); // hand 1's grasp ends, hand 0's stays
+  assert_int_equal(l.n, 2);
+  assert_int_equal(l.m[0].kind, TX_EVENT_GRASP), assert_int_equal(l.m[0].source, 0);
+  assert_int_equal(l.m[1].kind, TX_EVENT_KNOT);
+  tx_marker_take(&l, &(tx_event){.kind = TX_EVENT_CUT}); // not a marker
+  tx_marker_take(&l, &(tx_event){.kind = TX_EVENT_KNOT, .value = {5, 2, 0}}); // last before first: bad
+  g.grasp.point[0] = NAN;
+  tx_marker_take(&l, &g);
+  assert_int_equal(l.n, 2);
+  for (int i = 0; i < TX_MARKERS_MAX; i++) tx_marker_take(&l, &k);
+  assert_int_equal(l.n, TX_MARKERS_MAX);
+  assert_int_equal(l.dropped, 2);
+}
+
 static void from_text(void** state) {
   (void)state;
   tx_view_def d = tx_view_def_default();
@@ -219,6 +307,9 @@ int main(void) {
       cmocka_unit_test(automatic_draw_list),
       cmocka_unit_test(from_text),
       cmocka_unit_test(tool_proxy),
+      cmocka_unit_test(markers_entry),
+      cmocka_unit_test(markers_events),
+      cmocka_unit_test(marker_list),
       cmocka_unit_test(instrument_entry),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
