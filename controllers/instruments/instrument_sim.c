@@ -14,6 +14,10 @@
 #define TX_JAW_STOP_GUARD 0.02 // rad
 #define TX_NEEDLE_RELEASE_RAD 0.01 // a jaw this much wider than when it took the needle has let it go
 #define STEEL_DENSITY 7900.0 // kg/m^3
+// rad/s: ODE caps every body's spin at this (a radian a step at 1 kHz, far
+// beyond a hand's), so no finite velocity from the solver turns a body's
+// quaternion past what one step's integration can follow
+#define TX_MAX_ANGULAR_SPEED 1000.0
 
 typedef struct instrument {
   const tx_urdf* urdf;
@@ -28,7 +32,16 @@ typedef struct instrument {
   double touch_sum[3]; // the needle's contact points with it this step, summed
   int touch_n;
   bool was_on; // both jaws were on the needle the step before: a grasp is the step they come on
+  // what it overlapped where a fault put it back (owner bits, see owner()):
+  // it passes through them without contact until they are apart
+  unsigned ghost, ghost_now;
 } instrument;
+
+// a body's state, for going back to the last good step
+typedef struct body_state {
+  dReal pos[3], quat[4], vel[3], avel[3];
+} body_state;
+#define TX_WORLD_BODIES_MAX (TX_INSTRUMENTS_MAX * TX_INSTRUMENT_LINKS_MAX + 1)
 
 #define NEEDLE_SEGMENTS 8 // capsules along the arc
 #define NEEDLE_MASS_POINTS 512 // for its mass properties
@@ -56,8 +69,13 @@ struct tx_instrument_world {
   double needle_mass;
   double depth; // deepest contact of the last step, m
   double dt; // the step being taken (s), for the contacts' softness
+  // every body after the last step whose state and inputs were all finite
+  dBodyID bodies[TX_WORLD_BODIES_MAX];
+  body_state good[TX_WORLD_BODIES_MAX];
+  int nbodies, faults, bad_contacts;
 };
 
+static void save_good(tx_instrument_world* w);
 static char needle_tag; // the needle's geoms carry its address
 
 // ODE prints its solver's messages (an LCP it could not finish, then
@@ -164,10 +182,42 @@ double tx_instrument_contact_cfm(const tx_instrument_sim_params* p, double inver
   return isfinite(cfm) && cfm > p->cfm ? cfm : p->cfm;
 }
 
+// a geom's owner as a bit: instrument i is bit i, the needle the next, the
+// static scene (the table) the last
+static unsigned owner(const tx_instrument_world* w, dGeomID g) {
+  void* d = dGeomGetData(g);
+  if (d == &needle_tag) return 1u << TX_INSTRUMENTS_MAX;
+  if (!dGeomGetBody(g) || !d) return 1u << (TX_INSTRUMENTS_MAX + 1);
+  return 1u << ((const instrument*)d - w->ins);
+}
+
+// a contact ODE can take: finite point, unit normal, finite depth (a
+// degenerate geom pair can give a zero normal, whose friction directions
+// are then NaN)
+static bool contact_ok(const dContactGeom* g) {
+  double nn = g->normal[0] * g->normal[0] + g->normal[1] * g->normal[1] + g->normal[2] * g->normal[2];
+  return isfinite(g->pos[0] + g->pos[1] + g->pos[2]) && isfinite(g->depth) && nn > 0.25 && nn < 4;
+}
+
 static void near(void* data, dGeomID a, dGeomID b) {
   tx_instrument_world* w = data;
   dBodyID ba = dGeomGetBody(a), bb = dGeomGetBody(b);
   if (!ba && !bb) return;
+  // an instrument put back by a fault across another body passes through
+  // it until they are apart: pushed out at once by 2 mm-deep contacts (a
+  // welded needle pinched between two blades) is the LCP that ODE's solver
+  // turns into NaN velocities, and ODE then aborts the process (dxNormalize4)
+  {
+    instrument* ia = dGeomGetData(a) != &needle_tag && ba ? dGeomGetData(a) : NULL;
+    instrument* ib = dGeomGetData(b) != &needle_tag && bb ? dGeomGetData(b) : NULL;
+    unsigned oa = owner(w, a), ob = owner(w, b);
+    instrument* g = ia && (ia->ghost & ob) ? ia : ib && (ib->ghost & oa) ? ib : NULL;
+    if (g) {
+      dContactGeom one;
+      if (dCollide(a, b, 1, &one, sizeof one) > 0) g->ghost_now |= g == ia ? ob : oa;
+      return;
+    }
+  }
   // the links of one instrument do not touch each other: a jaw and its root
   // overlap at the pivot by design, and two jaws at their closed stop lie
   // face to face at zero depth, where a box-box test has no separating
@@ -178,7 +228,11 @@ static void near(void* data, dGeomID a, dGeomID b) {
   instrument* other = dGeomGetData(a) == &needle_tag ? dGeomGetData(b) : dGeomGetData(b) == &needle_tag ? dGeomGetData(a) : NULL;
   dBodyID other_body = dGeomGetData(a) == &needle_tag ? bb : ba;
   dContactGeom cg[MAX_CONTACTS];
-  int n = dCollide(a, b, MAX_CONTACTS, cg, sizeof cg[0]);
+  int n = dCollide(a, b, MAX_CONTACTS, cg, sizeof cg[0]), kept = 0;
+  for (int i = 0; i < n; i++)
+    if (contact_ok(&cg[i])) cg[kept++] = cg[i];
+    else w->bad_contacts++;
+  n = kept;
   for (int i = 0; i < n; i++) {
     dContact c = {0};
     c.geom = cg[i];
@@ -436,6 +490,11 @@ tx_instrument_world* tx_instrument_world_create(const tx_instrument_sim_params* 
     for (int j = 0; j < in->urdf->njoints; j++)
       w->hold_angle[j] = in->urdf->joints[j].fixed ? 0 : asin(fmin(1, nd->wire_diameter / 2 / nd->grasp_distance));
   }
+  for (int i = 0; i < n; i++)
+    for (int l = 0; l < w->ins[i].urdf->nlinks; l++) w->bodies[w->nbodies++] = w->ins[i].body[l];
+  if (w->needle) w->bodies[w->nbodies++] = w->needle;
+  for (int b = 0; b < w->nbodies; b++) dBodySetMaxAngularSpeed(w->bodies[b], TX_MAX_ANGULAR_SPEED);
+  save_good(w);
   return w;
 }
 
@@ -471,6 +530,9 @@ void tx_instrument_world_hand_force(const tx_instrument_world* w, int i, double 
 int tx_instrument_world_contacts(const tx_instrument_world* w) { return w->ncontacts; }
 int tx_instrument_world_resets(const tx_instrument_world* w) { return w->resets; }
 int tx_instrument_world_bad_inputs(const tx_instrument_world* w) { return w->bad_inputs; }
+int tx_instrument_world_faults(const tx_instrument_world* w) { return w->faults; }
+int tx_instrument_world_bad_contacts(const tx_instrument_world* w) { return w->bad_contacts; }
+unsigned tx_instrument_world_passing_through(const tx_instrument_world* w, int i) { return w->ins[i].ghost; }
 double tx_instrument_world_depth(const tx_instrument_world* w) { return w->depth; }
 
 static bool finite_input(const tx_instrument_input* d) {
@@ -556,6 +618,12 @@ static void needle_grasp(tx_instrument_world* w) {
   // one holder at a time, so the needle never binds two hands together
   for (int i = 0; i < w->n; i++) {
     instrument* in = &w->ins[i];
+    // jaws passing through the wire (put back across it) have not come on it:
+    // counted as on, they must leave it and close on it again to take it
+    if (in->ghost & (1u << TX_INSTRUMENTS_MAX)) {
+      in->was_on = true;
+      continue;
+    }
     int jaws = 0, touching = 0;
     for (int j = 0; j < in->urdf->njoints; j++)
       if (!in->urdf->joints[j].fixed) jaws++, touching += in->touch[in->urdf->joints[j].child];
@@ -573,17 +641,6 @@ static void needle_grasp(tx_instrument_world* w) {
       w->hold_angle[j] = in->urdf->joints[j].fixed ? 0 : dJointGetHingeAngle(in->joint[j]);
     for (int k = 0; k < 3; k++) w->grasp_point[k] = in->touch_sum[k] / in->touch_n;
   }
-}
-
-static bool finite_state(const instrument* in) {
-  for (int l = 0; l < in->urdf->nlinks; l++) {
-    const dReal* p = dBodyGetPosition(in->body[l]);
-    const dReal* v = dBodyGetLinearVel(in->body[l]);
-    const dReal* o = dBodyGetAngularVel(in->body[l]);
-    for (int k = 0; k < 3; k++)
-      if (!isfinite(p[k]) || !isfinite(v[k]) || !isfinite(o[k])) return false;
-  }
-  return true;
 }
 
 // the skin's force on the tip: f + k n n^T (x - tip) about where the skin
@@ -674,6 +731,89 @@ static void pin_hold(tx_instrument_world* w, int i, double dt) {
   dJointAttach(j, w->needle, 0);
 }
 
+// what instrument i overlaps now (owner bits): each of its geoms against
+// every enabled geom not its own
+static unsigned overlaps(const tx_instrument_world* w, const instrument* in) {
+  unsigned mine = 1u << (in - w->ins), set = 0;
+  int ng = dSpaceGetNumGeoms(w->space);
+  for (int l = 0; l < in->urdf->nlinks; l++)
+    for (dGeomID g = dBodyGetFirstGeom(in->body[l]); g; g = dBodyGetNextGeom(g))
+      for (int k = 0; k < ng; k++) {
+        dGeomID h = dSpaceGetGeom(w->space, k);
+        unsigned o = owner(w, h);
+        dContactGeom one;
+        if (o != mine && !(set & o) && dGeomIsEnabled(h) && dCollide(g, h, 1, &one, sizeof one) > 0) set |= o;
+      }
+  return set;
+}
+
+static bool finite3(const dReal* v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
+
+// every body's state and the step's inputs on it (the forces and torques
+// added, the motors' speeds) finite: what ODE may step without turning a
+// NaN into a quaternion it cannot normalise (it aborts the process)
+static bool step_inputs_ok(const tx_instrument_world* w) {
+  for (int b = 0; b < w->nbodies; b++) {
+    dBodyID body = w->bodies[b];
+    if (!dBodyIsEnabled(body)) continue;
+    const dReal* q = dBodyGetQuaternion(body);
+    if (!finite3(dBodyGetPosition(body)) || !finite3(dBodyGetLinearVel(body)) || !finite3(dBodyGetAngularVel(body)) ||
+        !finite3(dBodyGetForce(body)) || !finite3(dBodyGetTorque(body)) || !isfinite(q[3]) || !finite3(q))
+      return false;
+  }
+  for (int i = 0; i < w->n; i++) {
+    const instrument* in = &w->ins[i];
+    if (in->parked) continue;
+    for (int k = 0; k < 3; k++)
+      if (!isfinite(dJointGetAMotorParam(in->orient, dParamVel + k * dParamGroup))) return false;
+    for (int j = 0; j < in->urdf->njoints; j++)
+      if (!in->urdf->joints[j].fixed && !isfinite(dJointGetHingeParam(in->joint[j], dParamVel))) return false;
+  }
+  return true;
+}
+
+static bool state_ok(const tx_instrument_world* w) {
+  for (int b = 0; b < w->nbodies; b++) {
+    const dReal* q = dBodyGetQuaternion(w->bodies[b]);
+    if (!finite3(dBodyGetPosition(w->bodies[b])) || !finite3(dBodyGetLinearVel(w->bodies[b])) ||
+        !finite3(dBodyGetAngularVel(w->bodies[b])) || !isfinite(q[3]) || !finite3(q))
+      return false;
+  }
+  return true;
+}
+
+static void save_good(tx_instrument_world* w) {
+  for (int b = 0; b < w->nbodies; b++) {
+    body_state* g = &w->good[b];
+    memcpy(g->pos, dBodyGetPosition(w->bodies[b]), sizeof g->pos);
+    memcpy(g->quat, dBodyGetQuaternion(w->bodies[b]), sizeof g->quat);
+    memcpy(g->vel, dBodyGetLinearVel(w->bodies[b]), sizeof g->vel);
+    memcpy(g->avel, dBodyGetAngularVel(w->bodies[b]), sizeof g->avel);
+  }
+}
+
+// a fault: every body back where it was after the last good step, at rest
+// (its velocities may be what led to the fault), nothing left of this
+// step's forces, no hand force; each instrument then passes through what it
+// overlaps there until they are apart, so the same pinch is not solved again
+static void restore_good(tx_instrument_world* w) {
+  for (int b = 0; b < w->nbodies; b++) {
+    const body_state* g = &w->good[b];
+    dBodySetPosition(w->bodies[b], g->pos[0], g->pos[1], g->pos[2]);
+    dBodySetQuaternion(w->bodies[b], g->quat);
+    dBodySetLinearVel(w->bodies[b], 0, 0, 0);
+    dBodySetAngularVel(w->bodies[b], 0, 0, 0);
+    dBodySetForce(w->bodies[b], 0, 0, 0);
+    dBodySetTorque(w->bodies[b], 0, 0, 0);
+  }
+  for (int i = 0; i < w->n; i++) {
+    memset(w->ins[i].hand_force, 0, sizeof w->ins[i].hand_force);
+    w->ins[i].ghost = w->ins[i].parked ? 0 : overlaps(w, &w->ins[i]);
+  }
+  w->faults++;
+  w->resets++;
+}
+
 void tx_instrument_world_step(tx_instrument_world* w, const tx_instrument_input* in, double dt) {
   for (int i = 0; i < w->n; i++) {
     if (w->ins[i].parked) continue;
@@ -697,29 +837,20 @@ void tx_instrument_world_step(tx_instrument_world* w, const tx_instrument_input*
   }
   w->dt = dt;
   dSpaceCollide(w->space, w, near);
+  for (int i = 0; i < w->n; i++) w->ins[i].ghost = w->ins[i].ghost_now, w->ins[i].ghost_now = 0;
+  if (!(dt > 0) || !isfinite(dt) || !step_inputs_ok(w)) { // never handed to ODE
+    dJointGroupEmpty(w->contacts);
+    restore_good(w);
+    return;
+  }
   dWorldStep(w->world, dt);
   dJointGroupEmpty(w->contacts);
-  if (w->needle) needle_grasp(w);
-  for (int i = 0; i < w->n; i++)
-    if (!w->ins[i].parked && !finite_state(&w->ins[i])) { // start over at the device, jaws closed
-      memcpy(w->ins[i].start, in[i].pos, sizeof w->ins[i].start);
-      w->ins[i].start_q[0] = 1, w->ins[i].start_q[1] = w->ins[i].start_q[2] = w->ins[i].start_q[3] = 0;
-      if (!isfinite(in[i].pos[0]) || !isfinite(in[i].pos[1]) || !isfinite(in[i].pos[2]))
-        memset(w->ins[i].start, 0, sizeof w->ins[i].start);
-      place(w, &w->ins[i]);
-      memset(w->ins[i].hand_force, 0, sizeof w->ins[i].hand_force);
-      w->resets++;
-    }
-  if (w->needle) {
-    const dReal* np = dBodyGetPosition(w->needle);
-    const dReal* nv = dBodyGetLinearVel(w->needle);
-    if (!isfinite(np[0] + np[1] + np[2] + nv[0] + nv[1] + nv[2])) {
-      if (w->hold) dJointDestroy(w->hold), w->hold = NULL, w->held_by = -1, w->releases++;
-      needle_place(w);
-      w->npins = 0; // put back on the table: out of the skin
-      w->resets++;
-    }
+  if (!state_ok(w)) {
+    restore_good(w);
+    return;
   }
+  save_good(w);
+  if (w->needle) needle_grasp(w);
 }
 
 // a parked instrument's bodies and geoms are disabled together: ODE neither
@@ -747,6 +878,8 @@ void tx_instrument_world_park(tx_instrument_world* w, int i, const double pos[3]
   memset(in->hand_force, 0, sizeof in->hand_force);
   enable(in, false);
   in->parked = true;
+  in->ghost = in->ghost_now = 0;
+  save_good(w);
 }
 
 void tx_instrument_world_take(tx_instrument_world* w, int i, const double pos[3], const double quat[4]) {
@@ -760,6 +893,8 @@ void tx_instrument_world_take(tx_instrument_world* w, int i, const double pos[3]
   memset(in->hand_force, 0, sizeof in->hand_force);
   enable(in, true);
   in->parked = false;
+  in->ghost = in->ghost_now = 0;
+  save_good(w); // placed by hand: the state to go back to
 }
 
 bool tx_instrument_world_parked(const tx_instrument_world* w, int i) { return w->ins[i].parked; }

@@ -116,6 +116,17 @@ int tx_instrument_world_resets(const tx_instrument_world* w);
 // steps whose device input was not finite (the coupling then pulls on nothing),
 // and the deepest contact of the last step (m)
 int tx_instrument_world_bad_inputs(const tx_instrument_world* w);
+// Faults: steps whose bodies or inputs were not finite before ODE's step
+// (then never stepped) or after it; each puts every body back where it was
+// after the last good step, at rest (also counted in resets). Contacts
+// dropped for a non-finite point or depth or a normal that is not unit.
+int tx_instrument_world_faults(const tx_instrument_world* w);
+int tx_instrument_world_bad_contacts(const tx_instrument_world* w);
+// what an instrument passes through, as owner bits (bit i: instrument i;
+// bit TX_INSTRUMENTS_MAX: the needle; the next: the table): after a fault
+// each instrument makes no contact with what it overlaps where it was put
+// back until they are apart (0 when it overlaps nothing)
+unsigned tx_instrument_world_passing_through(const tx_instrument_world* w, int instrument);
 double tx_instrument_world_depth(const tx_instrument_world* w);
 // Switching instruments. Park: the instrument is put down at pos (identity
 // orientation, jaws at their closed stop) and taken out of the world: its

@@ -798,6 +798,39 @@ static void test_contacts_regularised_by_their_effective_mass(void** state) {
   assert_int_equal(pinch_in_child(TX_CONTACT_RELAX), 0);
 }
 
+// a step that cannot be handed to ODE (here a step of NaN seconds) is a
+// fault: never stepped, every body back where the last good step left it, at rest
+static void test_fault_restores_the_last_good_state(void** state) {
+  (void)state;
+  tx_instrument_desc* a = load("thumb_forceps");
+  tx_instrument_sim_params p = tx_instrument_sim_defaults();
+  p.needle.enabled = true;
+  const tx_urdf* u[1] = {a->urdf};
+  double start[1][3] = {{0, 0.02, 0}};
+  tx_instrument_world* w = tx_instrument_world_create(&p, u, 1, start);
+  assert_non_null(w);
+  tx_instrument_input in[1] = {at(0.01, 0.03, 0, 0.1)};
+  for (int i = 0; i < 50; i++) tx_instrument_world_step(w, in, 1e-3);
+  double pos[3], q[4], np[3], nq[4];
+  tx_instrument_world_link(w, 0, 1, pos, q);
+  tx_instrument_world_needle(w, np, nq);
+  tx_instrument_world_step(w, in, NAN);
+  assert_int_equal(tx_instrument_world_faults(w), 1);
+  assert_int_equal(tx_instrument_world_resets(w), 1);
+  double pos2[3], q2[4], np2[3], nq2[4], f[3];
+  tx_instrument_world_link(w, 0, 1, pos2, q2);
+  tx_instrument_world_needle(w, np2, nq2);
+  assert_true(dist(pos, pos2) < 1e-12 && dist(np, np2) < 1e-12 && fabs(q[0] - q2[0]) < 1e-12);
+  tx_instrument_world_hand_force(w, 0, f);
+  assert_true(f[0] == 0 && f[1] == 0 && f[2] == 0);
+  for (int i = 0; i < 50; i++) tx_instrument_world_step(w, in, 1e-3); // and it goes on
+  tx_instrument_world_link(w, 0, 0, pos2, q2);
+  assert_true(isfinite(pos2[0] + pos2[1] + pos2[2]));
+  assert_int_equal(tx_instrument_world_faults(w), 1);
+  tx_instrument_world_destroy(w);
+  tx_instrument_desc_free(a);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_links_start_where_the_urdf_puts_them),
@@ -818,6 +851,7 @@ int main(void) {
       cmocka_unit_test(test_needle_taken_from_foam),
       cmocka_unit_test(test_park_and_take),
       cmocka_unit_test(test_contacts_regularised_by_their_effective_mass),
+      cmocka_unit_test(test_fault_restores_the_last_good_state),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
