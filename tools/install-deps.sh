@@ -13,6 +13,7 @@ optional=(libbullet-dev libode-dev libassimp-dev liburdfdom-dev libtinyxml-dev
           cyclonedds-dev cyclonedds-tools  # sessions over several processes (docs/distributed.md); idlc
           tetgen
           libimgui-dev xdotool         # the window's panels (Dear ImGui); synthetic input in its test
+          python3                      # the network and window tests read their CSVs with it; the instruments hands' generator
           libgts-dev libnifti2-dev)      # the LAGB asset pipeline: marching cubes, a user's NIfTI volume
 
 want=("${core[@]}")
