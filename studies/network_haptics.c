@@ -56,7 +56,7 @@ static void on_reading(dds_entity_t reader, void* arg) {
     if (!info[i].valid_data || s->session != w->tag || s->data._length != 4 * sizeof(double)) continue;
     double in[4], out[2];
     memcpy(in, s->data._buffer, sizeof in); // K, B, x, v
-    tx_net_wall_force(in[0], in[1], in[2], in[3], &out[0], &out[1]);
+    tx_wall_force(in[0], in[1], in[2], in[3], &out[0], &out[1]);
     tx_snapshot snap = {.data = out, .rows = 1, .cols = 2, .seq = s->seq};
     tx_net_Snapshot reply;
     tx_net_pack(&reply, w->tag, "study.wall_force", TX_F64, &snap);
@@ -164,8 +164,8 @@ static int same_over_dds(wall_link* k, const tx_wall_case* c, int ticks, double 
   tx_wall_case t = *c;
   t.stiffness = K;
   tx_wall_result here, there;
-  tx_net_wall_link l = {exchange, k};
-  if (!tx_net_wall_run(&t, ticks, NULL, &here) || !tx_net_wall_run(&t, ticks, &l, &there)) return -1;
+  tx_wall_link l = {exchange, k};
+  if (!tx_wall_run_delayed(&t, ticks, NULL, &here) || !tx_wall_run_delayed(&t, ticks, &l, &there)) return -1;
   *same = here.stable == there.stable && memcmp(&here.energy_end, &there.energy_end, sizeof(double)) == 0 &&
           here.control_ticks == there.control_ticks;
   return 0;
@@ -224,11 +224,11 @@ int tx_study_network_haptics(const tx_study_args* a) {
     r->exact = tx_net_wall_exact_bound(&c.device, c.damping, r->ticks);
     tx_wall_case cpc = c;
     cpc.passivity = TX_WALL_PC_SPRING;
-    r->off = tx_net_wall_largest_stable(&c, r->ticks, 1, 1e6, 0.01);
-    r->pc = tx_net_wall_largest_stable(&cpc, r->ticks, 1, 1e6, 0.01);
+    r->off = tx_wall_largest_stable_delayed(&c, r->ticks, 1, 1e6, 0.01);
+    r->pc = tx_wall_largest_stable_delayed(&cpc, r->ticks, 1, 1e6, 0.01);
     tx_wall_case cport = c;
     cport.passivity = TX_WALL_PC_PORT;
-    r->port = tx_net_wall_largest_stable(&cport, r->ticks, 1, 1e6, 0.01);
+    r->port = tx_wall_largest_stable_delayed(&cport, r->ticks, 1, 1e6, 0.01);
 #if TX_WITH_DDS
     // the stiffest stable wall and the first unstable one, without and with
     // passivity control (quick: the stable ones)

@@ -18,7 +18,7 @@
 //
 // The case runs in simulated time: the delay is a delay line of n ticks on
 // the device side, exact, where netem's would be in wall time and add the
-// jitter of a loaded host. The link itself is a function (tx_net_wall_link):
+// jitter of a loaded host. The link itself is a function (tx_wall_link):
 // NULL computes the wall in this process; the study also carries every tick
 // over Cyclone DDS to a second process and checks it gives the same result
 // bit for bit (network_haptics.c).
@@ -30,27 +30,6 @@
 #define TX_STUDIES_EXPERIMENTS_NET_WALL_H
 
 #include "wall_stability.h"
-
-#define TX_NET_WALL_DELAY_MAX 512 // round-trip delay, servo periods
-
-// the simulation side of one tick: the wall's force (N, along x) and the
-// energy its spring holds (J) for the reading x (m), v (m/s)
-void tx_net_wall_force(double K, double B, double x, double v, double* force, double* stored);
-
-// carries tick k's reading to the simulation side and its answer back; 0, or
-// -1 with tx_error() set (the run then fails)
-typedef struct tx_net_wall_link {
-  int (*exchange)(void* user, uint64_t k, double K, double B, double x, double v, double* force, double* stored);
-  void* user;
-} tx_net_wall_link;
-
-// one case with a round trip of delay_ticks servo periods, in [0,
-// TX_NET_WALL_DELAY_MAX]; link NULL: the wall in this process. false with
-// tx_error() on bad input or a failed exchange. Allocates nothing.
-bool tx_net_wall_run(const tx_wall_case* c, int delay_ticks, const tx_net_wall_link* link, tx_wall_result* out);
-
-// tx_wall_largest_stable's sweep and bisection, for the delayed wall (in this process)
-tx_wall_search tx_net_wall_largest_stable(const tx_wall_case* c, int delay_ticks, double k_lo, double k_hi, double rel_tol);
 
 // the exact boundary of the delayed loop without quantisation or safety
 // limits: the largest K (N/m, to 1e-9 relative) for which every root of the

@@ -52,10 +52,22 @@ int tx_wall_case_check(const tx_wall_case* c) {
   return -1;
 }
 
-bool tx_wall_run(const tx_wall_case* c, tx_wall_result* out) {
-  if (tx_wall_case_check(c)) {
-    return false;
+void tx_wall_force(double K, double B, double x, double v, double* force, double* stored) {
+  if (x > 0) {
+    double spring[9] = {-K, 0, 0, 0, 0, 0, 0, 0, 0}; // the wall as a force model publishes it: -K n n^T
+    double fs[3] = {-K * x, 0, 0};
+    *force = fs[0] - B * v;
+    *stored = tx_spring_energy(spring, fs);
+  } else {
+    *force = 0;
+    *stored = 0;
   }
+}
+
+bool tx_wall_run_delayed(const tx_wall_case* c, int delay_ticks, const tx_wall_link* link, tx_wall_result* out) {
+  if (tx_wall_case_check(c)) return false;
+  if (delay_ticks < 0 || delay_ticks > TX_WALL_DELAY_MAX)
+    return tx_set_error("wall: delay of %d periods, must be in [0, %d]", delay_ticks, TX_WALL_DELAY_MAX), false;
   tx_sim_device dev;
   if (!tx_sim_device_init(&dev, &c->device)) return false;
   double K = c->stiffness, B = c->damping, T = c->device.period, m = c->device.mass;
@@ -76,8 +88,7 @@ bool tx_wall_run(const tx_wall_case* c, tx_wall_result* out) {
   tx_safety_limits limits = tx_safety_limits_from_device(&info);
   tx_haptic_path path;
   tx_haptic_path_init(&path, &limits, c->passivity != TX_WALL_PC_OFF,
-                      c->passivity == TX_WALL_PC_SPRING ? TX_PASSIVITY_REF_SPRING : TX_PASSIVITY_REF_PORT,
-                      info.damping);
+                      c->passivity == TX_WALL_PC_SPRING ? TX_PASSIVITY_REF_SPRING : TX_PASSIVITY_REF_PORT, info.damping);
   // as if the device had been pressed in from outside: the port has absorbed
   // the spring's store (the reading one period before the start gives it),
   // and the wall's force at the start was held over the period before
@@ -88,6 +99,11 @@ bool tx_wall_run(const tx_wall_case* c, tx_wall_result* out) {
   path.reference_energy = path.reference_min = c->passivity == TX_WALL_PC_SPRING ? 0 : stored0;
   path.held[0] = path.safety.last[0] = dev.state.pos[0] > 0 ? -K * dev.state.pos[0] : 0;
 
+  // the answers in flight: slot k % (n + 1) holds the one computed from tick k
+  double line_f[TX_WALL_DELAY_MAX + 1], line_e[TX_WALL_DELAY_MAX + 1];
+  int slots = delay_ticks + 1;
+  for (int i = 0; i < slots; i++) tx_wall_force(K, 0, x_eq, 0, &line_f[i], &line_e[i]); // the wall at rest
+
   uint64_t n = (uint64_t)llround(c->duration / T);
   uint64_t per_window = n / WINDOWS;
   double window_sum[WINDOWS] = {0};
@@ -96,12 +112,16 @@ bool tx_wall_run(const tx_wall_case* c, tx_wall_result* out) {
   for (uint64_t k = 0; k < n; k++) {
     // the wall, from what the encoder reports: F(k) = -K x(k) - B (x(k) - x(k-1)) / T
     const tx_device_state* s = &dev.state;
-    tx_haptic_input in = {{0, 0, 0}, 0, false, 0, 0};
-    if (s->pos[0] > 0) {
-      double fs[3] = {-K * s->pos[0], 0, 0};
-      in.force[0] = fs[0] - B * s->vel[0];
-      in.stored = tx_spring_energy(spring, fs);
+    double f_k, e_k;
+    if (link) {
+      if (link->exchange(link->user, k, K, B, s->pos[0], s->vel[0], &f_k, &e_k)) return false;
+    } else {
+      tx_wall_force(K, B, s->pos[0], s->vel[0], &f_k, &e_k);
     }
+    line_f[k % (uint64_t)slots] = f_k, line_e[k % (uint64_t)slots] = e_k;
+    // what arrives now was computed n ticks ago (with n = 0, this tick's: tx_wall_run)
+    uint64_t j = (k + 1) % (uint64_t)slots;
+    tx_haptic_input in = {{line_f[j], 0, 0}, line_e[j], false, 0, 0};
     double f[3];
     tx_haptic_tick(&path, T, &in, s->pos, s->vel, f);
     tx_sim_device_step(&dev, f, NULL);
@@ -114,7 +134,6 @@ bool tx_wall_run(const tx_wall_case* c, tx_wall_result* out) {
     if (dev.x[0] > depth_max) depth_max = dev.x[0];
     if (dev.x[0] <= 0) outside++;
   }
-
   // decay or growth: the last quarter against the start
   double last = (window_sum[WINDOWS - 2] + window_sum[WINDOWS - 1]) / (2.0 * (double)per_window);
   // least-squares slope of log window energy over window centres
@@ -124,13 +143,11 @@ bool tx_wall_run(const tx_wall_case* c, tx_wall_result* out) {
     double y = log(window_sum[w] / (double)per_window + 1e-300);
     st += t, sy += y, stt += t * t, sty += t * y;
   }
-  double slope = (WINDOWS * sty - st * sy) / (WINDOWS * stt - st * st);
-
   *out = (tx_wall_result){
       .stable = last < e0,
       .energy_start = e0,
       .energy_end = last,
-      .growth_rate = slope,
+      .growth_rate = (WINDOWS * sty - st * sy) / (WINDOWS * stt - st * st),
       .depth_rest = x_eq,
       .depth_max = depth_max,
       .outside_s = (double)outside * T,
@@ -142,7 +159,7 @@ bool tx_wall_run(const tx_wall_case* c, tx_wall_result* out) {
   return true;
 }
 
-tx_wall_search tx_wall_largest_stable(const tx_wall_case* c, double k_lo, double k_hi, double rel_tol) {
+tx_wall_search tx_wall_largest_stable_delayed(const tx_wall_case* c, int delay_ticks, double k_lo, double k_hi, double rel_tol) {
   tx_wall_search s = {.k = k_lo};
   tx_wall_case t = *c;
   tx_wall_result r;
@@ -151,15 +168,11 @@ tx_wall_search tx_wall_largest_stable(const tx_wall_case* c, double k_lo, double
     s.lo_unstable = true;
     return s;
   }
-  // sweep up to the first unstable stiffness
   double stable = 0, unstable = 0;
-  for (double k = k_lo;; k *= 1.25) {
+  for (double k = k_lo;; k *= 1.25) { // a sweep first: a limit cycle can make a stiffer wall look stable again
     if (k > k_hi) k = k_hi;
     t.stiffness = k;
-    if (!tx_wall_run(&t, &r)) {
-      s.lo_unstable = true;
-      return s;
-    }
+    if (!tx_wall_run_delayed(&t, delay_ticks, NULL, &r)) return s.lo_unstable = true, s;
     s.cases++;
     if (!r.stable) {
       unstable = k;
@@ -168,29 +181,24 @@ tx_wall_search tx_wall_largest_stable(const tx_wall_case* c, double k_lo, double
     stable = k;
     if (k >= k_hi) break;
   }
-  if (stable == 0) {
-    s.lo_unstable = true;
-    s.k_unstable = unstable;
-    return s;
-  }
-  if (unstable == 0) {
-    s.k = stable;
-    s.hi_stable = true;
-    return s;
-  }
-  // bisect on log K
+  if (stable == 0) return s.lo_unstable = true, s.k_unstable = unstable, s;
+  if (unstable == 0) return s.k = stable, s.hi_stable = true, s;
   while (unstable / stable - 1 > rel_tol) {
     t.stiffness = sqrt(stable * unstable);
-    if (!tx_wall_run(&t, &r)) break;
+    if (!tx_wall_run_delayed(&t, delay_ticks, NULL, &r)) break;
     s.cases++;
-    if (r.stable)
-      stable = t.stiffness;
-    else
-      unstable = t.stiffness;
+    if (r.stable) stable = t.stiffness;
+    else unstable = t.stiffness;
   }
   s.k = stable;
   s.k_unstable = unstable;
   return s;
+}
+
+bool tx_wall_run(const tx_wall_case* c, tx_wall_result* out) { return tx_wall_run_delayed(c, 0, NULL, out); }
+
+tx_wall_search tx_wall_largest_stable(const tx_wall_case* c, double k_lo, double k_hi, double rel_tol) {
+  return tx_wall_largest_stable_delayed(c, 0, k_lo, k_hi, rel_tol);
 }
 
 // Jury's test for the monic cubic z^3 + a2 z^2 + a1 z + a0: every root

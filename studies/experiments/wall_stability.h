@@ -111,7 +111,29 @@ tx_wall_case tx_wall_case_default(void);
 // 0 when every field is finite and in range, otherwise -1 with one line in tx_error() naming it
 int tx_wall_case_check(const tx_wall_case* c);
 
-// runs one case for c->duration seconds of simulated time; false (with
+#define TX_WALL_DELAY_MAX 512 // round-trip delay, servo periods
+
+// the simulation side of one tick: the wall's force (N, along x) and the
+// energy its spring holds (J) for the reading x (m), v (m/s)
+void tx_wall_force(double K, double B, double x, double v, double* force, double* stored);
+
+// carries tick k's reading to the simulation side and its answer back; 0, or
+// -1 with tx_error() set (the run then fails)
+typedef struct tx_wall_link {
+  int (*exchange)(void* user, uint64_t k, double K, double B, double x, double v, double* force, double* stored);
+  void* user;
+} tx_wall_link;
+
+// one case with a round trip of delay_ticks servo periods, in [0,
+// TX_WALL_DELAY_MAX]; link NULL: the wall in this process. false with
+// tx_error() on bad input or a failed exchange. Allocates nothing.
+bool tx_wall_run_delayed(const tx_wall_case* c, int delay_ticks, const tx_wall_link* link, tx_wall_result* out);
+
+// tx_wall_largest_stable's sweep and bisection, for the delayed wall (in this process)
+tx_wall_search tx_wall_largest_stable_delayed(const tx_wall_case* c, int delay_ticks, double k_lo, double k_hi, double rel_tol);
+
+// one case for c->duration seconds of simulated time, the wall in this
+// process with no delay (tx_wall_run_delayed's delay 0); false (with
 // tx_error() set, *out untouched) on bad input. Allocates nothing.
 bool tx_wall_run(const tx_wall_case* c, tx_wall_result* out);
 

@@ -43,7 +43,7 @@ static void no_delay_is_the_local_wall_bit_for_bit(void** state) {
       c.passivity = pcs[j];
       tx_wall_result a, b;
       assert_true(tx_wall_run(&c, &a));
-      assert_true(tx_net_wall_run(&c, 0, NULL, &b));
+      assert_true(tx_wall_run_delayed(&c, 0, NULL, &b));
       assert_same(&a, &b);
     }
 }
@@ -67,7 +67,7 @@ static void the_simulation_finds_the_exact_boundary_at_each_delay(void** state) 
   double last = INFINITY;
   for (int i = 0; i < 4; i++) {
     double exact = tx_net_wall_exact_bound(&c.device, 0, ticks[i]);
-    tx_wall_search s = tx_net_wall_largest_stable(&c, ticks[i], 1, 1e6, 0.01);
+    tx_wall_search s = tx_wall_largest_stable_delayed(&c, ticks[i], 1, 1e6, 0.01);
     print_message("round trip %2d ms: exact %7.1f N/m, measured %7.1f N/m\n", ticks[i], exact, s.k);
     assert_false(s.lo_unstable);
     assert_false(s.hi_stable);
@@ -88,7 +88,7 @@ typedef struct tally {
 static int counting(void* user, uint64_t k, double K, double B, double x, double v, double* force, double* stored) {
   tally* t = user;
   if (k != t->next++) t->out_of_order++;
-  tx_net_wall_force(K, B, x, v, force, stored);
+  tx_wall_force(K, B, x, v, force, stored);
   return 0;
 }
 static int failing(void* user, uint64_t k, double K, double B, double x, double v, double* force, double* stored) {
@@ -107,19 +107,19 @@ static void a_link_carries_every_tick_in_order(void** state) {
   c.stiffness = 25;
   c.passivity = TX_WALL_PC_PORT;
   tally t = {0};
-  tx_net_wall_link link = {counting, &t};
+  tx_wall_link link = {counting, &t};
   tx_wall_result here, there;
-  assert_true(tx_net_wall_run(&c, 10, NULL, &here));
-  assert_true(tx_net_wall_run(&c, 10, &link, &there));
+  assert_true(tx_wall_run_delayed(&c, 10, NULL, &here));
+  assert_true(tx_wall_run_delayed(&c, 10, &link, &there));
   assert_int_equal(t.next, 10000);
   assert_int_equal(t.out_of_order, 0);
   assert_same(&here, &there);
   // the delay is really there: another delay gives another result
   tx_wall_result other;
-  assert_true(tx_net_wall_run(&c, 12, NULL, &other));
+  assert_true(tx_wall_run_delayed(&c, 12, NULL, &other));
   assert_true(memcmp(&here.energy_end, &other.energy_end, sizeof(double)) != 0);
-  tx_net_wall_link broken = {failing, NULL};
-  assert_false(tx_net_wall_run(&c, 10, &broken, &there));
+  tx_wall_link broken = {failing, NULL};
+  assert_false(tx_wall_run_delayed(&c, 10, &broken, &there));
   assert_string_equal(tx_error(), "the link broke");
 }
 
@@ -127,12 +127,12 @@ static void bad_delays_are_refused(void** state) {
   (void)state;
   tx_wall_case c = one_khz();
   tx_wall_result r;
-  assert_false(tx_net_wall_run(&c, -1, NULL, &r));
+  assert_false(tx_wall_run_delayed(&c, -1, NULL, &r));
   assert_non_null(strstr(tx_error(), "delay"));
-  assert_false(tx_net_wall_run(&c, TX_NET_WALL_DELAY_MAX + 1, NULL, &r));
+  assert_false(tx_wall_run_delayed(&c, TX_WALL_DELAY_MAX + 1, NULL, &r));
   assert_true(isnan(tx_net_wall_exact_bound(&c.device, 0, -1)));
   c.stiffness = -1;
-  assert_false(tx_net_wall_run(&c, 0, NULL, &r));
+  assert_false(tx_wall_run_delayed(&c, 0, NULL, &r));
   assert_non_null(strstr(tx_error(), "stiffness"));
 }
 
