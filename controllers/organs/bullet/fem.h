@@ -74,6 +74,21 @@ typedef struct tx_fem_tool_info {
   int faces;      // boundary faces it touched in the last step
 } tx_fem_tool_info;
 void tx_fem_tool(const tx_fem* b, tx_fem_tool_info* out);
+// Kinematic nodes, moved by what holds them (a grasper's jaws, a rigid body
+// the soft part is bolted to) instead of by the body. tx_fem_set_kinematic
+// makes node massless and moves it to p over the next tx_fem_step, in equal
+// parts each substep, its velocity the move's; it stays there until the next
+// call. tx_fem_release gives it its mass back, keeping the velocity it had.
+// Its neighbours follow through the solver. Out-of-range nodes, nodes fixed
+// by tx_fem_fix and non-finite p are ignored.
+void tx_fem_set_kinematic(tx_fem* b, int node, const double p[3]);
+void tx_fem_release(tx_fem* b, int node);
+bool tx_fem_is_kinematic(const tx_fem* b, int node);
+// FEM models: the body's elastic force on a kinematic node, N, averaged over
+// the last tx_fem_step (minus the load on what holds it). Links model: false
+// (its position iterations carry no force), f zero.
+bool tx_fem_kinematic_force(const tx_fem* b, int node, double f[3]);
+
 // the state (positions, velocities) kept aside, and brought back
 void tx_fem_save(tx_fem* b);
 void tx_fem_restore(tx_fem* b);

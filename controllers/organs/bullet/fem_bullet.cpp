@@ -50,6 +50,12 @@ struct tx_fem {
   std::vector<btVector3> before;  // (nv) m, the nodes after the last step in which the tool touched nothing
   std::vector<int> hull;     // (nh x 3) the tetrahedra's boundary faces, outward
   std::vector<btVector3> saved_x, saved_v;  // tx_fem_save's state
+  // kinematic nodes (tx_fem_set_kinematic)
+  std::vector<char> kinematic;          // (nv) 1: moved by its holder
+  std::vector<btVector3> kin_from, kin_to;  // (nv) m, this tx_fem_step's move
+  std::vector<btVector3> kin_force;     // (nv) N, elastic force summed over the substeps
+  int kin_count;                        // kinematic nodes now
+  int kin_steps;                        // substeps kin_force sums
   bool has_tool;
   double tool_c[3], tool_r;
   tx_fem_tool_info tool;
@@ -179,6 +185,11 @@ extern "C" tx_fem* tx_fem_create(const tx_fem_def* d, const double* nodes, int n
       b->before[(size_t)i] = btVector3((btScalar)nodes[3 * i], (btScalar)nodes[3 * i + 1], (btScalar)nodes[3 * i + 2]);
     b->saved_x.resize((size_t)nv);
     b->saved_v.resize((size_t)nv);
+    b->kinematic.assign((size_t)nv, 0);
+    b->kin_from.resize((size_t)nv);
+    b->kin_to.resize((size_t)nv);
+    b->kin_force.resize((size_t)nv);
+    b->kin_count = b->kin_steps = 0;
     // the boundary: faces that belong to one tetrahedron only, turned outward
     {
       std::vector<std::array<int, 4>> keyed;  // sorted face, then the tetrahedron's fourth node
@@ -285,6 +296,54 @@ extern "C" tx_fem* tx_fem_create(const tx_fem_def* d, const double* nodes, int n
 
 extern "C" void tx_fem_fix(tx_fem* b, int node) {
   if (node >= 0 && node < b->nv) b->body->setMass(node, 0);
+}
+
+extern "C" void tx_fem_set_kinematic(tx_fem* b, int node, const double p[3]) {
+  if (node < 0 || node >= b->nv || !std::isfinite(p[0] + p[1] + p[2])) return;
+  size_t i = (size_t)node;
+  btSoftBody::Node& n = b->body->m_nodes[node];
+  if (!b->kinematic[i]) {
+    if (!(n.m_im > 0)) return;  // fixed: it stays where tx_fem_fix left it
+    b->body->setMass(node, 0);
+    b->kinematic[i] = 1, b->kin_count++;
+    b->kin_force[i].setZero();
+  }
+  b->kin_from[i] = n.m_x;
+  b->kin_to[i] = btVector3((btScalar)p[0], (btScalar)p[1], (btScalar)p[2]);
+}
+
+extern "C" void tx_fem_release(tx_fem* b, int node) {
+  if (node < 0 || node >= b->nv || !b->kinematic[(size_t)node]) return;
+  b->body->setMass(node, (btScalar)b->mass[(size_t)node]);
+  b->kinematic[(size_t)node] = 0, b->kin_count--;
+}
+
+extern "C" bool tx_fem_is_kinematic(const tx_fem* b, int node) {
+  return node >= 0 && node < b->nv && b->kinematic[(size_t)node];
+}
+
+extern "C" bool tx_fem_kinematic_force(const tx_fem* b, int node, double f[3]) {
+  f[0] = f[1] = f[2] = 0;
+  if (!b->world || !tx_fem_is_kinematic(b, node) || b->kin_steps == 0) return false;
+  const btVector3& s = b->kin_force[(size_t)node];
+  for (int a = 0; a < 3; a++) f[a] = (double)s[a] / b->kin_steps;
+  return true;
+}
+
+// each kinematic node to its place after substep k of steps (k + 1 parts of
+// its move); links: to its place before the substep, at the move's speed,
+// since Bullet's prediction moves every node, massless or not
+static void place_kinematic(tx_fem* b, int k, int steps) {
+  const btScalar h = (btScalar)b->dt;
+  const int part = b->world ? k + 1 : k;
+  for (int i = 0; i < b->nv && b->kin_count > 0; i++) {
+    if (!b->kinematic[(size_t)i]) continue;
+    btSoftBody::Node& n = b->body->m_nodes[i];
+    const btVector3 move = b->kin_to[(size_t)i] - b->kin_from[(size_t)i];
+    n.m_q = n.m_x;
+    n.m_x = b->kin_from[(size_t)i] + move * ((btScalar)part / (btScalar)steps);
+    n.m_v = move / ((btScalar)steps * h);
+  }
 }
 
 extern "C" void tx_fem_set_plate(tx_fem* b, double y) {
@@ -430,12 +489,20 @@ extern "C" bool tx_fem_step(tx_fem* b, int steps) {
   const btVector3 dv((btScalar)(b->def.gravity[0] * b->dt), (btScalar)(b->def.gravity[1] * b->dt),
                     (btScalar)(b->def.gravity[2] * b->dt));
   const bool heavy = b->world && !dv.isZero();
+  for (int i = 0; i < b->nv && b->kin_count > 0; i++) b->kin_force[(size_t)i].setZero();
+  b->kin_steps = steps;
   for (int k = 0; k < steps; k++) {
     if (heavy)
       for (int i = 0; i < b->nv; i++)
         if (nodes[i].m_im > 0) nodes[i].m_v += dv * (btScalar)b->weight[(size_t)i];
-    if (b->world) fem_step(b);
-    else links_step(b);
+    place_kinematic(b, k, steps);
+    if (b->world) {
+      fem_step(b);
+      for (int i = 0; i < b->nv && b->kin_count > 0; i++)
+        if (b->kinematic[(size_t)i]) b->kin_force[(size_t)i] += b->elastic[i];
+    } else {
+      links_step(b);
+    }
     if (b->has_tool) tool += tool_contact(b, touched);
     int on = 0;
     for (int i = 0; i < b->nv; i++) {
@@ -458,6 +525,8 @@ extern "C" bool tx_fem_step(tx_fem* b, int steps) {
     }
     b->contacts = on;
   }
+  for (int i = 0; i < b->nv && b->kin_count > 0; i++)
+    if (b->kinematic[(size_t)i]) b->kin_from[(size_t)i] = b->kin_to[(size_t)i];  // held there until moved again
   b->plate_force = steps > 0 ? impulse / (steps * b->dt) : 0;
   // the body's force on the tool is minus the momentum the tool gave it
   double span = steps > 0 ? steps * b->dt : 1;

@@ -2,7 +2,8 @@
 // hemisphere: at rest it stays at rest; a plate pressed into its pole pushes
 // back with a positive force that grows with the depth, in both models; a
 // frictionless plate holds the pole on it; bad definitions and an inverted
-// tetrahedron are refused with one line.
+// tetrahedron are refused with one line; a node held kinematically sits
+// where it is put and the body pushes back on it.
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -200,12 +201,73 @@ static void test_step_allocations(void** state) {
   }
 }
 
+// the pole held kinematically 0.1 and 0.2 mm down: it sits exactly there,
+// its neighbours follow part of the way, the body pushes it back up with a
+// force linear in the move (small strain: within 2 %), and once released the
+// body springs back up toward its rest; the links model places the node too,
+// with no force to report
+static void test_kinematic(void** state) {
+  (void)state;
+  tx_hemisphere_mesh m;
+  tx_fem_def d = quasi_static(TX_FEM_COROTATED);
+  tx_fem* b = hemisphere(&d, &m);
+  int steps = (int)(0.03 / tx_fem_dt(b));
+  double* x = malloc((size_t)m.nv * 3 * sizeof(double));
+  double f[2][3];
+  for (int k = 0; k < 2; k++) {
+    double p[3] = {0, R - 1e-4 * (k + 1), 0};
+    tx_fem_set_kinematic(b, m.pole, p);
+    assert_true(tx_fem_is_kinematic(b, m.pole));
+    assert_true(tx_fem_step(b, steps));
+    assert_true(tx_fem_step(b, 3 * steps));  // not moved again: it stays
+    tx_fem_positions(b, x);
+    assert_true(fabs(x[3 * m.pole + 1] - p[1]) < 1e-7);
+    assert_true(tx_fem_kinematic_force(b, m.pole, f[k]));
+  }
+  print_message("  pole force %g %g %g, then %g %g %g N\n", f[0][0], f[0][1], f[0][2], f[1][0], f[1][1], f[1][2]);
+  assert_true(f[0][1] > 0);
+  // mostly up: the Kuhn mesh is not symmetric about the axis (11 % aside here)
+  assert_true(fabs(f[0][0]) < 0.15 * f[0][1] && fabs(f[0][2]) < 0.15 * f[0][1]);
+  assert_true(fabs(f[1][1] / f[0][1] - 2) < 0.02);  // linear at rest (0.5 % here)
+  int followed = 0;
+  for (int i = 0; i < m.nv; i++) {
+    double dy = x[3 * i + 1] - m.v[3 * i + 1];
+    if (i != m.pole && dy < -1e-5) followed++;
+    assert_true(dy > -2e-4 - 1e-9);  // nobody goes past the pole's move
+  }
+  assert_true(followed >= 3);
+  tx_fem_release(b, m.pole);
+  assert_false(tx_fem_is_kinematic(b, m.pole));
+  assert_false(tx_fem_kinematic_force(b, m.pole, f[0]));
+  assert_true(tx_fem_step(b, steps));
+  tx_fem_positions(b, x);
+  assert_true(x[3 * m.pole + 1] > R - 0.5e-4);  // free again, most of the way back
+  tx_fem_destroy(b);
+  tx_hemisphere_free(&m);
+
+  d = quasi_static(TX_FEM_LINKS);
+  b = hemisphere(&d, &m);
+  double p[3] = {0, R - 1e-3, 0};
+  tx_fem_set_kinematic(b, m.pole, p);
+  assert_true(tx_fem_step(b, 50));
+  tx_fem_positions(b, x);
+  assert_true(fabs(x[3 * m.pole + 1] - p[1]) < 1e-7);
+  assert_false(tx_fem_kinematic_force(b, m.pole, f[0]));
+  tx_fem_set_kinematic(b, m.nv, p);  // out of range: ignored
+  p[0] = NAN;
+  tx_fem_set_kinematic(b, 0, p);     // not finite: ignored
+  assert_false(tx_fem_is_kinematic(b, 0));
+  free(x);
+  tx_fem_destroy(b);
+  tx_hemisphere_free(&m);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_rest_stays),      cmocka_unit_test(test_press_corotated),
       cmocka_unit_test(test_press_neohookean), cmocka_unit_test(test_press_links),
       cmocka_unit_test(test_refused),          cmocka_unit_test(test_tool),
-      cmocka_unit_test(test_step_allocations),
+      cmocka_unit_test(test_step_allocations), cmocka_unit_test(test_kinematic),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
