@@ -241,7 +241,8 @@ static int apply_devices(const char* file, json_t* root, const tx_load_options* 
 // map[i]: the index in the file of list[i] (a role runs a part of the list), NULL when the same
 static int add_controllers(const char* file, tx_system* sys, json_t* list, const set_origin* origins, int norigins,
                            const int* map) {
-  if (!json_is_array(list) || json_array_size(list) == 0)
+  // a role's part (map) may be empty: a display host runs only its --view
+  if (!json_is_array(list) || (json_array_size(list) == 0 && !map))
     return fail("%s: controllers: expected a non-empty array", file);
   static const char* const keys[] = {"name", "type", "rate_hz", "params", "thread", NULL};
   size_t index;
@@ -329,7 +330,8 @@ static bool plain_name(const char* n, size_t max, bool dot) {
   return true;
 }
 
-// "roles": {ROLE: [CONTROLLER, ...]}: every controller in exactly one role.
+// "roles": {ROLE: [CONTROLLER, ...]}: every controller in exactly one role;
+// a role may be empty (a display host: only the --view it runs with).
 // role_of[i] receives the role index of controllers[i]; *nroles the count
 static int check_roles(const char* file, json_t* roles, json_t* controllers, int* role_of, int* nroles) {
   *nroles = 0;
@@ -344,8 +346,7 @@ static int check_roles(const char* file, json_t* roles, json_t* controllers, int
   int r = 0;
   json_object_foreach(roles, role, list) {
     if (!plain_name(role, 32, false)) return fail("%s: roles.%s: a role name is 1-31 characters of a-z 0-9 _ -", file, role);
-    if (!json_is_array(list) || json_array_size(list) == 0)
-      return fail("%s: roles.%s: expected a non-empty array of controller names", file, role);
+    if (!json_is_array(list)) return fail("%s: roles.%s: expected an array of controller names", file, role);
     size_t k;
     json_t* name;
     json_array_foreach(list, k, name) {
@@ -456,8 +457,8 @@ static bool in_list(json_t* a, const char* name) {
 // the bridge's parameters for one role: what its controllers write and others
 // read goes out, what they read and others write comes in with the writer's
 // schema; a read across roles that the net section does not name is an error
-static json_t* bridge_params(const char* file, const char* scenario, json_t* net, tx_system* full, const int* role_of,
-                             int role, bool* any) {
+static json_t* bridge_params(const char* file, const char* scenario, json_t* net, tx_system* full, int ncontrollers,
+                             const int* role_of, int role, bool* any) {
   json_t *fast = json_object_get(net, "fast"), *state = json_object_get(net, "state"), *streams = json_object_get(net, "streams");
   json_t *send = json_array(), *receive = json_array(), *send_streams = json_array(), *receive_streams = json_array(),
          *best = json_array();
@@ -483,7 +484,10 @@ static json_t* bridge_params(const char* file, const char* scenario, json_t* net
       if (!crosses) {
         json_decref(params), json_decref(send), json_decref(receive), json_decref(send_streams);
         json_decref(receive_streams), json_decref(best);
-        return fail("%s: controllers[%d]: %s '%s', which controller '%s' of another role writes: name it in net.%s", file, i,
+        char who[32]; // a controller of the file, or the --view added after them
+        if (i < ncontrollers) snprintf(who, sizeof who, "controllers[%d]", i);
+        else snprintf(who, sizeof who, "view");
+        return fail("%s: %s: %s '%s', which controller '%s' of another role writes: name it in net.%s", file, who,
                     stream ? "listens to" : "reads", pi.component, tx_system_name(full, w), stream ? "streams" : "fast or net.state"),
                NULL;
       }
@@ -594,7 +598,7 @@ static tx_scenario* load_root(const char* file, const char* dir, json_t* root, c
   s->duration_s = seconds;
   json_t *controllers = json_object_get(root, "controllers"), *roles = json_object_get(root, "roles"),
          *net = json_object_get(root, "net");
-  int role_of[1024], nroles = 0, role = -1;
+  int role_of[1024 + 8], nroles = 0, role = -1; // the file's controllers, then what --view adds
   if (json_is_array(controllers) && json_array_size(controllers) > 1024)
     return tx_scenario_free(s), fail("%s: controllers: at most 1024", file), NULL;
   if (check_roles(file, roles, controllers, role_of, &nroles) || check_net(file, net)) return tx_scenario_free(s), NULL;
@@ -617,9 +621,16 @@ static tx_scenario* load_root(const char* file, const char* dir, json_t* root, c
   json_t* part = NULL;
   int map[1024];
   if (role >= 0) {
+    // the role's --view too, so that what it draws is mirrored in like any read
     if (declare_model(file, full, json_object_get(root, "model")) || add_controllers(file, full, controllers, origins, norigins, NULL) ||
-        finalize(file, full, root, o) || check_net_names(file, net, full))
+        add_view(file, full, json_object_get(root, "view"), o) || finalize(file, full, root, o) || check_net_names(file, net, full))
       return tx_scenario_free(s), NULL;
+    for (int i = (int)json_array_size(controllers); i < tx_system_count(full) && i < 1024 + 8; i++) role_of[i] = role;
+    bool drawn = o->view && strcmp(o->view, "none") != 0;
+    bool alone = true;
+    for (size_t i = 0; i < json_array_size(controllers); i++) alone &= role_of[i] != role;
+    if (alone && !drawn)
+      return tx_scenario_free(s), fail("--role %s: this role of %s runs no controller: give it a view (--view png or --view window)", o->role, file), NULL;
     part = json_array();
     for (size_t i = 0; i < json_array_size(controllers); i++)
       if (role_of[i] == role) map[json_array_size(part)] = (int)i, json_array_append(part, json_array_get(controllers, i));
@@ -629,7 +640,7 @@ static tx_scenario* load_root(const char* file, const char* dir, json_t* root, c
     }
   }
   bool bridge = false;
-  json_t* bp = role >= 0 ? bridge_params(file, s->name, net, full, role_of, role, &bridge) : NULL;
+  json_t* bp = role >= 0 ? bridge_params(file, s->name, net, full, (int)json_array_size(controllers), role_of, role, &bridge) : NULL;
   int rc = role >= 0 && !bp ? -1 : 0;
   if (!rc && role < 0) rc = declare_model(file, s->system, json_object_get(root, "model"));
   else if (!rc) rc = declare_role_model(file, s->system, json_object_get(root, "model"), full, role_of, role);

@@ -103,6 +103,15 @@ static void bad_roles(void** state) {
          "s.json: roles.One: a role name is 1-31 characters of a-z 0-9 _ -");
   expect("{\"name\": \"t\", \"roles\": [], " CONTROLLERS "}", NULL, NULL,
          "s.json: roles: expected an object of ROLE: [CONTROLLER, ...]");
+  expect("{\"name\": \"t\", \"roles\": {\"one\": [\"p\", \"q\", \"r\"], \"two\": \"p\"}, " CONTROLLERS "}", NULL, NULL,
+         "s.json: roles.two: expected an array of controller names");
+  // an empty role is a display host: it runs only the view it is given
+  static const char display[] = "{\"name\": \"t\", \"roles\": {\"one\": [\"p\", \"q\", \"r\"], \"show\": []}, " CONTROLLERS "}";
+  tx_scenario* s = load_role(display, NULL, NULL);
+  assert_non_null(s);
+  tx_scenario_free(s);
+  expect(display, "show", NULL,
+         "--role show: this role of s.json runs no controller: give it a view (--view png or --view window)");
 }
 
 static void bad_net(void** state) {
