@@ -373,6 +373,41 @@ typedef struct tx_procedure_step {
 #define tx_procedure_step_UNITS "1"
 TX_LAYOUT_ASSERT(tx_procedure_step, uint8_t);
 
+// PREFIX.steps (one row per step, in the procedure's order), written by a
+// procedure controller (procedure.suture): each step's progress, read by the
+// scorecard (view.scorecard) in this process or an instructor's
+typedef enum tx_step_status {
+  TX_STEP_NOT_REACHED = 0,
+  TX_STEP_UNDER_WAY = 1,
+  TX_STEP_DONE = 2,
+  TX_STEP_SKIPPED = 3, // a later step was done first
+} tx_step_status;
+typedef struct tx_procedure_step_state {
+  double status;    // a tx_step_status
+  double t_start_s; // s, simulation time it began; NaN: not reached
+  double t_end_s;   // s, when it was done or skipped; NaN: not yet
+} tx_procedure_step_state;
+#define tx_procedure_step_state_TYPE TX_F64
+#define tx_procedure_step_state_COLS 3u
+#define tx_procedure_step_state_UNITS "1, s, s"
+TX_LAYOUT_ASSERT(tx_procedure_step_state, double);
+
+// PREFIX.suture (1 row), written by procedure.suture: the measures of its
+// scorecard (docs/suturing.md gives each one's rule and source)
+typedef struct tx_suture_measures {
+  double bite_entry_m;   // m, the stitch's entry from the wound line; NaN: none yet
+  double bite_exit_m;    // m, its exit from the wound line, on the other edge; NaN: none yet
+  double punctures;      // punctures made
+  double knots;          // knots found (the papers' rule)
+  double knots_fixed;    // knots fixed at the skin
+  double peak_tension_n; // N, the thread's largest tension at the needle
+  double path_m[2];      // m, the path of each hand's tool point
+} tx_suture_measures;
+#define tx_suture_measures_TYPE TX_F64
+#define tx_suture_measures_COLS 8u
+#define tx_suture_measures_UNITS "m, 1, N"
+TX_LAYOUT_ASSERT(tx_suture_measures, double);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,0 +1,232 @@
+// procedure.suture and view.scorecard through the loader, in lockstep, fed
+// by a scripted stand-in for the instruments and the thread (test.suture_feed):
+// four punctures (in and out of the near edge, in and out of the far edge),
+// the thread pulled through to a 2 cm tail, wrapped 1.5 turns around the
+// holder's jaws, a knot, the knot fixed, a second knot, a cut, the hands let
+// go. Every step is done in order at the scripted times; the step text, the
+// step events, the measures (bites 4 and 2.5 mm, knots, peak tension, a
+// hand's 10 cm path) and OUT/scorecard.json agree; bad parameters are named.
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include "scenarios/loader.h"
+#include "tests/scenario_support.h"
+
+#include <tactus/components.h>
+#include <tactus/events.h>
+
+#include <jansson.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define NODES 41
+
+typedef struct feed {
+  tx_port ievents, tevents, punctures, nodes, tension, holder, hand0, hand1;
+} feed;
+
+static const double entry[3] = {0, 0, 0.004};
+// the punctures: time, z (the wound runs along x at z = 0), side
+static const double script[4][3] = {{1.0, 0.004, +1}, {1.2, 0.0005, -1}, {1.6, -0.0005, +1}, {2.0, -0.0025, -1}};
+
+static int feed_configure(tx_setup* s, void** self) {
+  feed* f = calloc(1, sizeof *f);
+  *self = f;
+  f->ievents = tx_setup_emit(s, "instruments.events", 64);
+  f->tevents = tx_setup_emit(s, "thread.events", 64);
+  f->punctures = tx_setup_write(s, &TX_COMPONENT_OF("needle.punctures", tx_puncture, 8));
+  f->nodes = tx_setup_write(s, &TX_COMPONENT_OF("thread.nodes", tx_thread_node, NODES));
+  f->tension = tx_setup_write(s, &TX_COMPONENT_OF("thread.force_model", tx_force_model, 1));
+  f->holder = tx_setup_write(s, &TX_COMPONENT_OF("instrument0.pose", tx_instrument_pose, 1));
+  f->hand0 = tx_setup_write(s, &TX_COMPONENT_OF("device0.pose", tx_pose, 1));
+  f->hand1 = tx_setup_write(s, &TX_COMPONENT_OF("device1.pose", tx_pose, 1));
+  return 0;
+}
+
+static bool at(double t, double when) { return t >= when - 1e-9 && t < when + 0.01 - 1e-9; } // the 100 Hz step at `when`
+
+static void feed_step(tx_ctx* c, void* self) {
+  feed* f = self;
+  double t = (double)tx_sim_ns(c) * 1e-9;
+  // punctures: the event and the row in the same step
+  tx_puncture* p = tx_write(c, f->punctures);
+  for (int i = 0; i < 8; i++) p[i] = (tx_puncture){{-1, 0, 0}, {0, 0, 0}, 0};
+  for (int i = 0; i < 4; i++) {
+    if (t < script[i][0] - 1e-9) continue;
+    p[i] = (tx_puncture){{0, 1, 2}, {1, 0, 0}, script[i][2]};
+    if (at(t, script[i][0])) {
+      tx_event e = {.kind = TX_EVENT_PUNCTURE, .source = 7};
+      e.puncture.point[0] = 0.002, e.puncture.point[1] = 0, e.puncture.point[2] = script[i][1];
+      tx_emit(c, f->ievents, &e);
+    }
+  }
+  // grasps and releases of hand 0 and hand 1
+  const struct { double t; uint32_t kind, hand; } jaws[] = {
+      {0.5, TX_EVENT_GRASP, 0}, {0.7, TX_EVENT_GRASP, 1}, {8.0, TX_EVENT_RELEASE, 1}, {8.5, TX_EVENT_RELEASE, 0}};
+  for (int i = 0; i < 4; i++)
+    if (at(t, jaws[i].t)) tx_emit(c, f->ievents, &(tx_event){.kind = jaws[i].kind, .source = jaws[i].hand});
+  // the thread: straight along +x through the entry, from node j on; pulled
+  // through (a 2 cm tail) at 3 s; from 4 s 1.5 turns around the holder's jaws
+  tx_thread_node* n = tx_write(c, f->nodes);
+  int j = t < 3 ? 0 : 30;
+  for (int i = 0; i < NODES; i++) n[i] = (tx_thread_node){{entry[0] + (i - j) * 0.002, entry[1], entry[2]}, 0.00025};
+  if (t >= 4 && t < 7)
+    for (int i = 0; i < 20; i++) {
+      double a = 3 * M_PI * i / 19.0;
+      n[5 + i] = (tx_thread_node){{0.055 + 0.001 * i, 0.02 + 0.003 * cos(a), 0.003 * sin(a)}, 0.00025};
+    }
+  tx_force_model* m = tx_write(c, f->tension);
+  memset(m, 0, sizeof *m);
+  m->f0[1] = t < 5 ? 0.5 * t : 0; // a tension of up to 2.5 N, along y
+  tx_instrument_pose* h = tx_write(c, f->holder);
+  *h = (tx_instrument_pose){{0.05, 0.02, 0}, {1, 0, 0, 0}, 0};
+  tx_pose* h0 = tx_write(c, f->hand0);
+  *h0 = (tx_pose){{0.1 * fmin(t, 8) / 8, 0.05, 0}, {1, 0, 0, 0}};
+  tx_pose* h1 = tx_write(c, f->hand1);
+  *h1 = (tx_pose){{-0.05, 0.05, 0}, {1, 0, 0, 0}};
+  // the thread's events: a knot, fixed, a second knot, a cut
+  const struct { double t; uint32_t kind, source; double fixed; } thread[] = {
+      {5.0, TX_EVENT_KNOT, 1, 0}, {5.5, TX_EVENT_KNOT, 1, 1}, {6.5, TX_EVENT_KNOT, 2, 0}, {7.5, TX_EVENT_CUT, 20, 0}};
+  for (int i = 0; i < 4; i++)
+    if (at(t, thread[i].t)) {
+      tx_event e = {.kind = thread[i].kind, .source = thread[i].source};
+      e.value[2] = thread[i].fixed;
+      tx_emit(c, f->tevents, &e);
+    }
+}
+
+static void feed_fini(void* self) { free(self); }
+
+static const tx_controller_class feed_class = {.type = "test.suture_feed",
+                                               .summary = "scripted instruments and thread",
+                                               .configure = feed_configure,
+                                               .step = feed_step,
+                                               .fini = feed_fini};
+
+// the step events as they come
+static tx_port heard_port;
+static int heard[32][2]; // source, status
+static int nheard;
+static int listen_configure(tx_setup* s, void** self) {
+  *self = NULL;
+  heard_port = tx_setup_listen(s, "procedure.events");
+  return 0;
+}
+static void listen_step(tx_ctx* c, void* self) {
+  (void)self;
+  for (tx_event e; tx_next_event(c, heard_port, &e);)
+    if (e.kind == TX_EVENT_STEP && nheard < 32) heard[nheard][0] = (int)e.source, heard[nheard][1] = (int)e.value[0], nheard++;
+}
+static const tx_controller_class listen_class = {
+    .type = "test.step_listener", .summary = "hears steps", .configure = listen_configure, .step = listen_step};
+
+static tx_scenario* load(const char* params) {
+  if (!tx_find_controller(feed_class.type)) assert_int_equal(tx_register_controller(&feed_class), 0);
+  if (!tx_find_controller(listen_class.type)) assert_int_equal(tx_register_controller(&listen_class), 0);
+  char text[2048];
+  snprintf(text, sizeof text,
+           "{\"name\":\"t\",\"controllers\":["
+           "{\"name\":\"feed\",\"type\":\"test.suture_feed\",\"rate_hz\":100},"
+           "{\"name\":\"procedure\",\"type\":\"procedure.suture\",\"rate_hz\":100,\"params\":{%s}},"
+           "{\"name\":\"hear\",\"type\":\"test.step_listener\",\"rate_hz\":100},"
+           "{\"name\":\"scorecard\",\"type\":\"view.scorecard\",\"rate_hz\":30,\"params\":{\"scenario\":\"suturing\"}}]}",
+           params);
+  nheard = 0;
+  return tx_scenario_load_text("test", text, strlen(text), NULL);
+}
+
+static void every_step_in_order(void** state) {
+  (void)state;
+  tx_scenario* s = load("\"wound_a_m\":[-0.015,0,0],\"wound_b_m\":[0.015,0,0]");
+  if (!s) fail_msg("%s", tx_error());
+  char dir[] = "/tmp/tx-suture-XXXXXX";
+  assert_non_null(mkdtemp(dir));
+  tx_run_options o = {.duration_s = 9, .lockstep = true, .out_dir = dir};
+  tx_run_result r;
+  assert_int_equal(tx_system_run(s->system, &o, &r), 0);
+
+  // the steps at the scripted times (each at its 100 Hz step)
+  const tx_procedure_step_state* st = (const tx_procedure_step_state*)latest(s, "procedure.steps");
+  const double ends[8] = {2.0, 3.0, 4.0, 5.0, 5.5, 6.5, 7.5, 8.5};
+  for (int i = 0; i < 8; i++) {
+    assert_int_equal((int)st[i].status, TX_STEP_DONE);
+    assert_true(fabs(st[i].t_end_s - ends[i]) < 1e-6);
+    assert_true(fabs(st[i].t_start_s - (i ? ends[i - 1] : 0)) < 1e-6);
+  }
+  assert_true(result(s, "procedure.steps_done") == 8);
+  assert_true(result(s, "procedure.step_F") == TX_STEP_DONE);
+  assert_true(result(s, "scorecard.steps_done") == 8);
+  const tx_procedure_step* text = (const tx_procedure_step*)latest_snapshot(s, "procedure.step").data;
+  assert_string_equal(text->text, "done: 8 of 8 steps");
+  const tx_procedure_step* names = (const tx_procedure_step*)latest_snapshot(s, "procedure.step_names").data;
+  assert_string_equal(names[2].text, "C wrap the thread around the needle holder");
+  // each step began and ended once, in order
+  assert_int_equal(nheard, 16);
+  for (int i = 0; i < 8; i++) {
+    assert_int_equal(heard[2 * i][0], i), assert_int_equal(heard[2 * i][1], TX_STEP_UNDER_WAY);
+    assert_int_equal(heard[2 * i + 1][0], i), assert_int_equal(heard[2 * i + 1][1], TX_STEP_DONE);
+  }
+  const tx_suture_measures* m = (const tx_suture_measures*)latest(s, "procedure.suture");
+  assert_true(fabs(m->bite_entry_m - 0.004) < 1e-12);
+  assert_true(fabs(m->bite_exit_m - 0.0025) < 1e-12);
+  assert_true(m->punctures == 4 && m->knots == 2 && m->knots_fixed == 1);
+  assert_true(fabs(m->peak_tension_n - 2.5) < 0.01);
+  assert_true(fabs(m->path_m[0] - 0.1) < 1e-9);
+  assert_true(m->path_m[1] == 0);
+
+  // the scorecard, as other tools read it
+  char path[128];
+  snprintf(path, sizeof path, "%s/scorecard.json", dir);
+  json_error_t e;
+  json_t* card = json_load_file(path, 0, &e);
+  if (!card) fail_msg("%s: %s", path, e.text);
+  assert_string_equal(json_string_value(json_object_get(card, "scenario")), "suturing");
+  json_t* steps = json_object_get(card, "steps");
+  assert_int_equal(json_array_size(steps), 8);
+  json_t* g = json_array_get(steps, 6);
+  assert_string_equal(json_string_value(json_object_get(g, "id")), "G");
+  assert_string_equal(json_string_value(json_object_get(g, "name")), "cut the thread");
+  assert_true(json_is_true(json_object_get(g, "done")));
+  assert_true(fabs(json_number_value(json_object_get(g, "t_end_s")) - 7.5) < 1e-6);
+  json_t* bite = json_object_get(card, "bite_asymmetry_m");
+  assert_true(fabs(json_number_value(json_object_get(bite, "value")) - 0.0015) < 1e-9);
+  assert_string_equal(json_string_value(json_object_get(bite, "unit")), "m");
+  assert_true(strlen(json_string_value(json_object_get(bite, "rule"))) > 20);
+  assert_true(json_is_false(json_object_get(card, "bite_symmetric"))); // 1.5 mm apart: over the 1 mm tolerance
+  json_decref(card);
+  remove(path);
+  snprintf(path, sizeof path, "%s/scorecard.png", dir);
+  remove(path);
+  rmdir(dir);
+  tx_scenario_free(s);
+}
+
+static void bad_parameters(void** state) {
+  (void)state;
+  const char* bad[][2] = {
+      {"\"wound_a_m\":[0,0]", "test: controllers[1].params.wound_a_m: expected [x, y, z] in m"},
+      {"\"wound_b_m\":[-0.015,0.01,0]", "test: controllers[1].params.wound_b_m: the wound line is under 0.1 mm long across the skin (x-z)"},
+      {"\"tail_m\":0", "test: controllers[1].params.tail_m: 0 is out of range [0.001, 1]"},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    tx_scenario* s = load(bad[i][0]);
+    if (s) {
+      tx_scenario_free(s);
+      fail_msg("loaded %s", bad[i][0]);
+    }
+    if (strcmp(tx_error(), bad[i][1]) != 0) fail_msg("got '%s', expected '%s'", tx_error(), bad[i][1]);
+  }
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(every_step_in_order),
+      cmocka_unit_test(bad_parameters),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,175 @@
+// view.scorecard: a procedure's steps and measures, kept as they are
+// published and written as OUT/scorecard.json and .png when the run ends
+// (scorecard.h).
+#include "scorecard.h"
+
+#include "plot.h"
+
+#include <tactus/components.h>
+#include <tactus/config.h>
+
+#include <jansson.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define STEPS_MAX 16
+
+typedef struct scorecard {
+  char scenario[64];
+  char procedure[64];
+  tx_port steps, names, suture;
+  tx_procedure_step_state step[STEPS_MAX];
+  tx_procedure_step name[STEPS_MAX];
+  int nsteps;
+  tx_suture_measures m;
+  bool have_m;
+  double bite_tolerance;  // m
+  tx_result done_r;
+} scorecard;
+
+static const tx_param_def params[] = {
+    {"procedure", TX_PARAM_STR, NULL, 0, 0, 0, "procedure", "the procedure controller's prefix: PREFIX.steps, PREFIX.step_names, PREFIX.suture"},
+    {"scenario", TX_PARAM_STR, NULL, 0, 0, 0, "", "the scenario's name, written into the scorecard"},
+    {"bite_tolerance_m", TX_PARAM_NUM, "m", 0, 0.01, 0.001, NULL,
+     "the two bites of a stitch are symmetric when their distances from the wound differ by at most this much"},
+};
+
+static int configure(tx_setup* s, void** self) {
+  scorecard* v = calloc(1, sizeof *v);
+  if (!v) return -1;
+  *self = v;
+  const char* prefix = tx_table_str(s, "procedure");
+  const char* scenario = tx_table_str(s, "scenario");
+  v->bite_tolerance = tx_table_num(s, "bite_tolerance_m");
+  if (!prefix || !scenario) return -1;
+  if (!*prefix || strlen(prefix) >= 48) return tx_setup_fail(s, "procedure", "expected a prefix of 1 to 47 characters");
+  snprintf(v->procedure, sizeof v->procedure, "%s", prefix);
+  snprintf(v->scenario, sizeof v->scenario, "%s", scenario);
+  char name[80];
+  snprintf(name, sizeof name, "%s.steps", prefix);
+  v->steps = TX_READ_OF(s, name, tx_procedure_step_state);
+  snprintf(name, sizeof name, "%s.step_names", prefix);
+  v->names = TX_READ_OF(s, name, tx_procedure_step);
+  snprintf(name, sizeof name, "%s.suture", prefix);
+  v->suture = TX_READ_OF(s, name, tx_suture_measures);
+  v->done_r = tx_setup_result(s, "steps_done");
+  return 0;
+}
+
+// keep the latest of each, so the scorecard is the last one published
+static void step(tx_ctx* c, void* self) {
+  scorecard* v = self;
+  tx_snapshot st = tx_read(c, v->steps), nm = tx_read(c, v->names), ms = tx_read(c, v->suture);
+  if (st.seq && nm.seq) {
+    int n = (int)(st.rows < nm.rows ? st.rows : nm.rows);
+    v->nsteps = n < STEPS_MAX ? n : STEPS_MAX;
+    memcpy(v->step, st.data, (size_t)v->nsteps * sizeof v->step[0]);
+    memcpy(v->name, nm.data, (size_t)v->nsteps * sizeof v->name[0]);
+  }
+  if (ms.seq) v->m = *(const tx_suture_measures*)ms.data, v->have_m = true;
+}
+
+static json_t* number_or_null(double x) { return isfinite(x) ? json_real(x) : json_null(); }
+
+static void measure(json_t* root, const char* key, double value, const char* unit, const char* rule) {
+  json_object_set_new(root, key, json_pack("{s:o, s:s, s:s}", "value", number_or_null(value), "unit", unit, "rule", rule));
+}
+
+static const char* const status_names[] = {"not reached", "under way", "done", "skipped"};
+
+static json_t* build(const scorecard* v) {
+  json_t* root = json_object();
+  json_object_set_new(root, "scenario", json_string(v->scenario));
+  json_object_set_new(root, "procedure", json_string(v->procedure));
+  json_t* steps = json_array();
+  for (int i = 0; i < v->nsteps; i++) {
+    char id[8] = "", nm[64] = "";
+    const char* text = v->name[i].text;
+    size_t len = strnlen(text, sizeof v->name[i].text);
+    const char* space = memchr(text, ' ', len);
+    size_t idlen = space ? (size_t)(space - text) : len;
+    snprintf(id, sizeof id, "%.*s", (int)(idlen < 7 ? idlen : 7), text);
+    if (space) snprintf(nm, sizeof nm, "%.*s", (int)(len - idlen - 1), space + 1);
+    int status = (int)v->step[i].status;
+    if (status < 0 || status > 3) status = 0;
+    json_array_append_new(steps, json_pack("{s:s, s:s, s:b, s:s, s:o, s:o}", "id", id, "name", nm, "done", status == TX_STEP_DONE,
+                                           "status", status_names[status], "t_start_s", number_or_null(v->step[i].t_start_s),
+                                           "t_end_s", number_or_null(v->step[i].t_end_s)));
+  }
+  json_object_set_new(root, "steps", steps);
+  if (!v->have_m) return root;
+  const tx_suture_measures* m = &v->m;
+  measure(root, "bite_entry_m", m->bite_entry_m, "m",
+          "the stitch's entry puncture from the wound line, across the skin; bites are placed 3-5 mm from the edge");
+  measure(root, "bite_exit_m", m->bite_exit_m, "m", "its exit puncture, on the other edge, from the wound line");
+  double asym = fabs(m->bite_entry_m - m->bite_exit_m);
+  measure(root, "bite_asymmetry_m", asym, "m",
+          "the difference of the two bites; the two sides of a simple interrupted stitch are placed symmetrically");
+  json_object_set_new(root, "bite_symmetric", isfinite(asym) ? json_boolean(asym <= v->bite_tolerance) : json_null());
+  measure(root, "punctures", m->punctures, "1", "punctures the needle made");
+  measure(root, "knots", m->knots, "1", "knots found by the suturing papers' rule (10 colliding cylinders in two blocks)");
+  measure(root, "knots_fixed", m->knots_fixed, "1", "knots fixed at the skin: within the thread's fix distance of it");
+  measure(root, "peak_tension_n", m->peak_tension_n, "N", "the thread's largest tension at the needle (its force model's F0)");
+  measure(root, "path_hand0_m", m->path_m[0], "m", "the path length of hand 0's tool point: economy of motion (OSATS, time and motion)");
+  measure(root, "path_hand1_m", m->path_m[1], "m", "the path length of hand 1's tool point");
+  return root;
+}
+
+// the steps against time: a bar per step from its start to its end
+static int plot(const scorecard* v, const char* path) {
+  double xs[STEPS_MAX][2], ys[STEPS_MAX][2];
+  char labels[STEPS_MAX][72];
+  tx_plot_series s[STEPS_MAX];
+  int n = 0;
+  for (int i = 0; i < v->nsteps && n < TX_PLOT_SERIES_MAX; i++) {
+    if (!isfinite(v->step[i].t_start_s) || !isfinite(v->step[i].t_end_s)) continue;
+    xs[n][0] = v->step[i].t_start_s, xs[n][1] = v->step[i].t_end_s;
+    ys[n][0] = ys[n][1] = v->nsteps - i;
+    bool done = v->step[i].status == TX_STEP_DONE;
+    snprintf(labels[n], sizeof labels[n], "%.*s (%s)", 60, v->name[i].text, done ? "done" : "skipped");
+    s[n] = (tx_plot_series){labels[n], xs[n], ys[n], 2, false, done ? 1 + n % 14 : 15};
+    n++;
+  }
+  if (n == 0) return 0;
+  tx_plot p = {"the procedure's steps", "time (s)", "step (the first at the top)", false, false, s, n};
+  return tx_plot_png(path, &p);
+}
+
+static void finish(tx_ctx* c, void* self) {
+  scorecard* v = self;
+  step(c, v);
+  int done = 0;
+  for (int i = 0; i < v->nsteps; i++) done += v->step[i].status == TX_STEP_DONE;
+  tx_set_result(c, v->done_r, done);
+  const char* dir = tx_output_dir(c);
+  if (!dir) return;
+  char path[4200], tmp[4300];
+  snprintf(path, sizeof path, "%s/scorecard.json", dir);
+  snprintf(tmp, sizeof tmp, "%s.tmp", path);
+  json_t* root = build(v);
+  int bad = json_dump_file(root, tmp, JSON_INDENT(2) | JSON_REAL_PRECISION(9)) != 0 || rename(tmp, path) != 0;
+  json_decref(root);
+  if (bad) {
+    remove(tmp);
+    tx_stop_run(c, "%s: cannot be written", path);
+    return;
+  }
+  snprintf(path, sizeof path, "%s/scorecard.png", dir);
+  if (TX_WITH_PLPLOT && plot(v, path)) tx_stop_run(c, "%s", tx_error()); // a build without PLplot keeps the JSON
+}
+
+static void fini(void* self) { free(self); }
+
+const tx_controller_class tx_view_scorecard = {
+    .type = "view.scorecard",
+    .summary = "a procedure's scorecard: its steps and measures, written as scorecard.json and scorecard.png",
+    .configure = configure,
+    .step = step,
+    .finish = finish,
+    .fini = fini,
+    .params = params,
+    .nparams = TX_PARAMS_COUNT(params),
+    .view = true,
+};
