@@ -13,6 +13,7 @@
 
 #include "scenarios/loader.h"
 #include "tests/scenario_support.h"
+#include "tests/controllers/procedure/suture_feed.h"
 
 #include <tactus/components.h>
 #include <tactus/events.h>
@@ -23,90 +24,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
-
-#define NODES 41
-
-typedef struct feed {
-  tx_port ievents, tevents, punctures, nodes, tension, holder, hand0, hand1;
-} feed;
-
-static const double entry[3] = {0, 0, 0.004};
-// the punctures: time, z (the wound runs along x at z = 0), side
-static const double script[4][3] = {{1.0, 0.004, +1}, {1.2, 0.0005, -1}, {1.6, -0.0005, +1}, {2.0, -0.0025, -1}};
-
-static int feed_configure(tx_setup* s, void** self) {
-  feed* f = calloc(1, sizeof *f);
-  *self = f;
-  f->ievents = tx_setup_emit(s, "instruments.events", 64);
-  f->tevents = tx_setup_emit(s, "thread.events", 64);
-  f->punctures = tx_setup_write(s, &TX_COMPONENT_OF("needle.punctures", tx_puncture, 8));
-  f->nodes = tx_setup_write(s, &TX_COMPONENT_OF("thread.nodes", tx_thread_node, NODES));
-  f->tension = tx_setup_write(s, &TX_COMPONENT_OF("thread.force_model", tx_force_model, 1));
-  f->holder = tx_setup_write(s, &TX_COMPONENT_OF("instrument0.pose", tx_instrument_pose, 1));
-  f->hand0 = tx_setup_write(s, &TX_COMPONENT_OF("device0.pose", tx_pose, 1));
-  f->hand1 = tx_setup_write(s, &TX_COMPONENT_OF("device1.pose", tx_pose, 1));
-  return 0;
-}
-
-static bool at(double t, double when) { return t >= when - 1e-9 && t < when + 0.01 - 1e-9; } // the 100 Hz step at `when`
-
-static void feed_step(tx_ctx* c, void* self) {
-  feed* f = self;
-  double t = (double)tx_sim_ns(c) * 1e-9;
-  // punctures: the event and the row in the same step
-  tx_puncture* p = tx_write(c, f->punctures);
-  for (int i = 0; i < 8; i++) p[i] = (tx_puncture){{-1, 0, 0}, {0, 0, 0}, 0};
-  for (int i = 0; i < 4; i++) {
-    if (t < script[i][0] - 1e-9) continue;
-    p[i] = (tx_puncture){{0, 1, 2}, {1, 0, 0}, script[i][2]};
-    if (at(t, script[i][0])) {
-      tx_event e = {.kind = TX_EVENT_PUNCTURE, .source = 7};
-      e.puncture.point[0] = 0.002, e.puncture.point[1] = 0, e.puncture.point[2] = script[i][1];
-      tx_emit(c, f->ievents, &e);
-    }
-  }
-  // grasps and releases of hand 0 and hand 1
-  const struct { double t; uint32_t kind, hand; } jaws[] = {
-      {0.5, TX_EVENT_GRASP, 0}, {0.7, TX_EVENT_GRASP, 1}, {8.0, TX_EVENT_RELEASE, 1}, {8.5, TX_EVENT_RELEASE, 0}};
-  for (int i = 0; i < 4; i++)
-    if (at(t, jaws[i].t)) tx_emit(c, f->ievents, &(tx_event){.kind = jaws[i].kind, .source = jaws[i].hand});
-  // the thread: straight along +x through the entry, from node j on; pulled
-  // through (a 2 cm tail) at 3 s; from 4 s 1.5 turns around the holder's jaws
-  tx_thread_node* n = tx_write(c, f->nodes);
-  int j = t < 3 ? 0 : 30;
-  for (int i = 0; i < NODES; i++) n[i] = (tx_thread_node){{entry[0] + (i - j) * 0.002, entry[1], entry[2]}, 0.00025};
-  if (t >= 4 && t < 7)
-    for (int i = 0; i < 20; i++) {
-      double a = 3 * M_PI * i / 19.0;
-      n[5 + i] = (tx_thread_node){{0.055 + 0.001 * i, 0.02 + 0.003 * cos(a), 0.003 * sin(a)}, 0.00025};
-    }
-  tx_force_model* m = tx_write(c, f->tension);
-  memset(m, 0, sizeof *m);
-  m->f0[1] = t < 5 ? 0.5 * t : 0; // a tension of up to 2.5 N, along y
-  tx_instrument_pose* h = tx_write(c, f->holder);
-  *h = (tx_instrument_pose){{0.05, 0.02, 0}, {1, 0, 0, 0}, 0};
-  tx_pose* h0 = tx_write(c, f->hand0);
-  *h0 = (tx_pose){{0.1 * fmin(t, 8) / 8, 0.05, 0}, {1, 0, 0, 0}};
-  tx_pose* h1 = tx_write(c, f->hand1);
-  *h1 = (tx_pose){{-0.05, 0.05, 0}, {1, 0, 0, 0}};
-  // the thread's events: a knot, fixed, a second knot, a cut
-  const struct { double t; uint32_t kind, source; double fixed; } thread[] = {
-      {5.0, TX_EVENT_KNOT, 1, 0}, {5.5, TX_EVENT_KNOT, 1, 1}, {6.5, TX_EVENT_KNOT, 2, 0}, {7.5, TX_EVENT_CUT, 20, 0}};
-  for (int i = 0; i < 4; i++)
-    if (at(t, thread[i].t)) {
-      tx_event e = {.kind = thread[i].kind, .source = thread[i].source};
-      e.value[2] = thread[i].fixed;
-      tx_emit(c, f->tevents, &e);
-    }
-}
-
-static void feed_fini(void* self) { free(self); }
-
-static const tx_controller_class feed_class = {.type = "test.suture_feed",
-                                               .summary = "scripted instruments and thread",
-                                               .configure = feed_configure,
-                                               .step = feed_step,
-                                               .fini = feed_fini};
 
 // the step events as they come
 static tx_port heard_port;
@@ -126,7 +43,7 @@ static const tx_controller_class listen_class = {
     .type = "test.step_listener", .summary = "hears steps", .configure = listen_configure, .step = listen_step};
 
 static tx_scenario* load(const char* params) {
-  if (!tx_find_controller(feed_class.type)) assert_int_equal(tx_register_controller(&feed_class), 0);
+  if (!tx_find_controller(tx_test_suture_feed.type)) assert_int_equal(tx_register_controller(&tx_test_suture_feed), 0);
   if (!tx_find_controller(listen_class.type)) assert_int_equal(tx_register_controller(&listen_class), 0);
   char text[2048];
   snprintf(text, sizeof text,
