@@ -41,6 +41,8 @@ struct tx_picking {
   bool armed[TX_PICK_HANDS_MAX];    // the jaws were open since they last closed
   bool holding[TX_PICK_HANDS_MAX];  // a grasp took something, not yet released
   int nodes[TX_PICK_HANDS_MAX], tris[TX_PICK_HANDS_MAX];
+  tx_instrument_pose taken[TX_PICK_HANDS_MAX];  // the jaws at each hand's grasp
+  double carried[TX_PICK_HANDS_MAX];            // m, how far the jaws put a held node from where they took it
 };
 
 tx_picking* tx_picking_create(const tx_pick_def* d, int hands) {
@@ -294,7 +296,7 @@ void tx_picking_release(tx_picking* p, int h) {
     for (int t = 0; t < p->body[bi].s.nt; t++)
       if (h < 0 || p->body[bi].tri_hand[t] == h) p->body[bi].tri_hand[t] = -1;
   for (int k = 0; k < p->hands; k++)
-    if (h < 0 || k == h) p->nodes[k] = p->tris[k] = 0, p->holding[k] = false;
+    if (h < 0 || k == h) p->nodes[k] = p->tris[k] = 0, p->holding[k] = false, p->carried[k] = 0;
 }
 
 static bool jaws_finite(const tx_instrument_pose* j) {
@@ -320,6 +322,7 @@ bool tx_picking_update(tx_picking* p, int h, const tx_instrument_pose* jaws, con
     double point[3];
     if (grasp(p, h, &j, pos, point) > 0) {
       p->holding[h] = true;
+      p->taken[h] = j;
       *e = (tx_event){.kind = TX_EVENT_GRASP, .source = (uint32_t)h};
       memcpy(e->grasp.point, point, sizeof point);
       e->grasp.jaw = j.jaw;
@@ -328,14 +331,17 @@ bool tx_picking_update(tx_picking* p, int h, const tx_instrument_pose* jaws, con
     }
   }
   // every node this hand holds where its offset in the jaws' frame puts it
+  p->carried[h] = 0;
   for (int i = 0; i < p->nlist && p->holding[h]; i++) {
     pick_body* b = &p->body[p->list[i].body];
     const int n = p->list[i].node;
     if (b->holder[n] != h) continue;
-    double x[3];
+    double x[3], x0[3];
     rotate(j.quat, false, b->offset + 3 * n, x);
-    for (int a = 0; a < 3; a++) x[a] += j.pos[a];
+    rotate(p->taken[h].quat, false, b->offset + 3 * n, x0);
+    for (int a = 0; a < 3; a++) x[a] += j.pos[a], x0[a] += p->taken[h].pos[a];
     tx_fem_set_kinematic(b->fem, n, x);
+    p->carried[h] = fmax(p->carried[h], sqrt(dist2(x, x0)));
   }
   return sent;
 }
@@ -351,6 +357,7 @@ void tx_picking_force(const tx_picking* p, int h, double f[3]) {
   }
 }
 
+double tx_picking_carried(const tx_picking* p, int h) { return h >= 0 && h < p->hands ? p->carried[h] : 0; }
 int tx_picking_nodes(const tx_picking* p, int h) { return h >= 0 && h < p->hands ? p->nodes[h] : 0; }
 int tx_picking_triangles(const tx_picking* p, int h) { return h >= 0 && h < p->hands ? p->tris[h] : 0; }
 int tx_picking_holder(const tx_picking* p, int body, int node) {
@@ -370,8 +377,8 @@ struct tx_pick_ctl {
   double at[TX_PICK_HANDS_MAX][3];  // m, each hand's pivot this step (NaN: no pose yet)
   long grasps, releases;
   int nodes_max;
-  double force_max;
-  tx_result grasps_result, releases_result, nodes_result, force_result;
+  double force_max, carried_max;
+  tx_result grasps_result, releases_result, nodes_result, force_result, carried_result;
   tx_warning bad_jaws;
 };
 
@@ -412,6 +419,7 @@ int tx_pick_configure(tx_setup* s, const char* prefix, int bodies, tx_fem* const
   k->releases_result = tx_setup_result(s, "grasp_releases");
   k->nodes_result = tx_setup_result(s, "grasp_nodes_max");
   k->force_result = tx_setup_result(s, "grasp_force_max_n");
+  k->carried_result = tx_setup_result(s, "grasp_carried_max_m");
   k->bad_jaws = tx_setup_warning(s, "bad_jaws");
   return 0;
 }
@@ -436,7 +444,7 @@ void tx_pick_init(tx_ctx* c, tx_pick_ctl* k) {
   tx_picking_release(k->p, -1);
   for (int h = 0; h < k->hands; h++) k->p->armed[h] = false, k->at[h][0] = k->at[h][1] = k->at[h][2] = NAN;
   k->grasps = k->releases = k->nodes_max = 0;
-  k->force_max = 0;
+  k->force_max = k->carried_max = 0;
   publish(c, k, false);
 }
 
@@ -452,7 +460,9 @@ void tx_pick_before(tx_ctx* c, tx_pick_ctl* k, const double* const* pos) {
     }
     memcpy(k->at[h], jp->pos, sizeof k->at[h]);
     tx_event e;
-    if (!tx_picking_update(k->p, h, jp, pos, &e)) continue;
+    const bool sent = tx_picking_update(k->p, h, jp, pos, &e);
+    k->carried_max = fmax(k->carried_max, tx_picking_carried(k->p, h));
+    if (!sent) continue;
     if (e.kind == TX_EVENT_GRASP) k->grasps++;
     else k->releases++;
     tx_emit(c, k->events, &e);
@@ -471,6 +481,7 @@ void tx_pick_finish(tx_ctx* c, tx_pick_ctl* k) {
   tx_set_result(c, k->releases_result, (double)k->releases);
   tx_set_result(c, k->nodes_result, k->nodes_max);
   tx_set_result(c, k->force_result, k->force_max);
+  tx_set_result(c, k->carried_result, k->carried_max);
 }
 
 void tx_pick_free(tx_pick_ctl* k) {

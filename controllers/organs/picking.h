@@ -80,6 +80,8 @@ void tx_picking_release(tx_picking* p, int h);
 // tx_fem_kinematic_force over its nodes; zero in the links model)
 void tx_picking_force(const tx_picking* p, int h, double f[3]);
 int tx_picking_nodes(const tx_picking* p, int h);               // nodes hand h holds
+// m, the farthest the last update put one of hand h's nodes from where it was taken
+double tx_picking_carried(const tx_picking* p, int h);
 int tx_picking_triangles(const tx_picking* p, int h);           // triangles flagged as picked by it
 int tx_picking_holder(const tx_picking* p, int body, int node); // the hand holding a node, -1 none
 // the hand that picked a triangle of body, -1 none
@@ -104,7 +106,8 @@ typedef struct tx_pick_ctl tx_pick_ctl;
 
 // configure: reads TX_PICK_PARAMS; with grasp poses, reads them, writes
 // PREFIX.grasp (tx_organ_grasp, one row per hand) and emits on PREFIX.events;
-// results grasps, grasp_releases, grasp_nodes_max, grasp_force_max_n. *out
+// results grasps, grasp_releases, grasp_nodes_max, grasp_force_max_n,
+// grasp_carried_max_m (the farthest a held node was carried). *out
 // NULL when nothing picks. -1 after tx_setup_fail.
 int tx_pick_configure(tx_setup* s, const char* prefix, int bodies, tx_fem* const* fem, const tx_pick_surface* surf,
                       tx_pick_ctl** out);

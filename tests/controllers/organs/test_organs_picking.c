@@ -195,6 +195,8 @@ static void grasper_lifts_the_liver(void** state) {
   assert_true(after < 0.5 * LIFT); // falling back
   assert_true(result(s, "organs.grasps") == 1 && result(s, "organs.grasp_releases") == 1);
   assert_true(result(s, "organs.grasp_nodes_max") >= 3 && result(s, "organs.grasp_force_max_n") > 0);
+  print_message("  carried at most %.2f mm\n", result(s, "organs.grasp_carried_max_m") * 1e3);
+  assert_true(fabs(result(s, "organs.grasp_carried_max_m") - LIFT) < 0.0015);
   assert_int_equal(warnings(s, "organs.numerical_fault"), 0);
   assert_int_equal(warnings(s, "organs.bad_jaws"), 0);
   tx_scenario_free(s);

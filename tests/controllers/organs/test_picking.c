@@ -182,6 +182,7 @@ static void test_grasp_lift_release(void** state) {
                 "(%.4f, %.4f, %.4f) N\n",
                 worst, followed, part * 1e3, f[0], f[1], f[2]);
   assert_true(worst < 1e-6);
+  assert_true(fabs(tx_picking_carried(p, 0) - 0.005) < 1e-12); // how far the jaws carried what they hold
   assert_true(followed >= 3 && part > 0.001 && part < 0.0049);
   assert_true(f[1] < 0);                                           // towards the rest
   assert_true(fabs(f[0]) < 0.2 * -f[1] && fabs(f[2]) < 0.2 * -f[1]); // mostly straight back down
