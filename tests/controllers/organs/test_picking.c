@@ -237,6 +237,57 @@ static void test_grasp_lift_release(void** state) {
   unmake(&B);
 }
 
+// The pull against a closed form: one tetrahedron, its base (0,0,0),
+// (a,0,0), (0,a,0) fixed, its apex (0,0,h) picked and lifted d along z.
+// Its displacement gradient is d/h along zz alone, so the corotated force
+// (R = I for this symmetric stretch) gives P_zz = (lambda + 2 mu) d/h
+// exactly, and the body's force on the apex is -V P grad N_apex =
+// -(a^2 / (6 h)) (lambda + 2 mu) d along z, at any d.
+static void test_pull_closed_form(void** state) {
+  (void)state;
+  const double a = 0.01, h = 0.01, d = 0.001;
+  const double v[] = {0, 0, 0, a, 0, 0, 0, a, 0, 0, 0, h};
+  const int e[] = {0, 1, 2, 3};
+  tx_fem_def def = tx_fem_def_default();
+  def.model = TX_FEM_COROTATED;
+  tx_fem* fem = tx_fem_create(&def, v, 4, e, 1);
+  if (!fem) { // TetGen's orientation is the other one
+    const int flipped[] = {0, 2, 1, 3};
+    fem = tx_fem_create(&def, v, 4, flipped, 1);
+  }
+  assert_non_null(fem);
+  for (int i = 0; i < 3; i++) tx_fem_fix(fem, i);
+  const int32_t tri[] = {0, 1, 3, 1, 2, 3, 2, 0, 3, 0, 2, 1}, node[] = {0, 1, 2, 3};
+  tx_pick_surface s = {4, 4, tri, 1, node, NULL};
+  const tx_pick_def def_jaws = {.length = 0.01, .reach = 0.0005, .closed = 0.1, .open = 0.2};
+  tx_picking* p = tx_picking_create(&def_jaws, 1);
+  assert_int_equal(tx_picking_add(p, fem, &s), 0);
+  double x[12];
+  memcpy(x, v, sizeof x);
+  const double* pos[1] = {x};
+  tx_instrument_pose j = {.pos = {-0.005, 0, h}, .quat = {1, 0, 0, 0}, .jaw = 0.5};
+  tx_event ev;
+  tx_picking_update(p, 0, &j, pos, &ev);
+  j.jaw = 0;
+  assert_true(tx_picking_update(p, 0, &j, pos, &ev));
+  assert_int_equal(tx_picking_nodes(p, 0), 1); // the apex: the base is fixed
+  j.pos[2] += d;
+  tx_picking_update(p, 0, &j, pos, &ev);
+  assert_true(tx_fem_step(fem, 1));
+  tx_fem_positions(fem, x);
+  assert_true(fabs(x[11] - (h + d)) < 1e-7);
+  double f[3];
+  tx_picking_force(p, 0, f);
+  const double nu = def.poisson, lambda = def.young * nu / ((1 + nu) * (1 - 2 * nu)), mu = def.young / (2 * (1 + nu));
+  const double want = -(a * a / (6 * h)) * (lambda + 2 * mu) * d;
+  print_message("  one tetrahedron, apex lifted %.0f mm: pull (%.3g, %.3g, %.6f) N, closed form %.6f N\n", d * 1e3, f[0],
+                f[1], f[2], want);
+  assert_true(fabs(f[2] / want - 1) < 1e-4);
+  assert_true(fabs(f[0]) < 1e-6 * fabs(want) + 1e-9 && fabs(f[1]) < 1e-6 * fabs(want) + 1e-9);
+  tx_picking_destroy(p);
+  tx_fem_destroy(fem);
+}
+
 // hand 0 at the pole, hand 1 on the side (jaws along z, at 45 degrees), 4
 // mm jaws on the 4-cell hemisphere: each holds its own nodes and pulls them
 // its way
@@ -386,6 +437,7 @@ static void test_update_allocates_nothing(void** state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_grasp_lift_release),
+      cmocka_unit_test(test_pull_closed_form),
       cmocka_unit_test(test_two_hands),
       cmocka_unit_test(test_embedded_surface),
       cmocka_unit_test(test_update_allocates_nothing),
