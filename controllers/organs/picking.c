@@ -374,7 +374,7 @@ struct tx_pick_ctl {
   int hands;
   tx_port jaws[TX_PICK_HANDS_MAX];  // read: each hand's tx_instrument_pose
   tx_port out, events;              // written: PREFIX.grasp; emitted: PREFIX.events
-  double at[TX_PICK_HANDS_MAX][3];  // m, each hand's pivot this step (NaN: no pose yet)
+  double at[TX_PICK_HANDS_MAX][3];  // m, each hand's pivot, as last read (0 before its first pose)
   long grasps, releases;
   int nodes_max;
   double force_max, carried_max;
@@ -442,7 +442,7 @@ static void publish(tx_ctx* c, tx_pick_ctl* k, bool ok) {
 void tx_pick_init(tx_ctx* c, tx_pick_ctl* k) {
   if (!k) return;
   tx_picking_release(k->p, -1);
-  for (int h = 0; h < k->hands; h++) k->p->armed[h] = false, k->at[h][0] = k->at[h][1] = k->at[h][2] = NAN;
+  for (int h = 0; h < k->hands; h++) k->p->armed[h] = false, k->at[h][0] = k->at[h][1] = k->at[h][2] = 0;
   k->grasps = k->releases = k->nodes_max = 0;
   k->force_max = k->carried_max = 0;
   publish(c, k, false);
