@@ -6,8 +6,8 @@
 // hand 0) and then one release on organs.events; while held, the liver's
 // surface between the jaws is lifted by about the lift, organs.grasp gives
 // the nodes held and the liver's pull on the jaws, down towards its rest;
-// released, the surface falls back. Bad grasp parameters are refused with
-// one line naming the key.
+// released, the surface falls back. Two graspers pick at once, each its
+// own. Bad grasp parameters are refused with one line naming the key.
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -29,24 +29,24 @@
 #define COARSE TX_TEST_DIR "/coarse"
 #define LIFT 0.01 // m
 
-static double spot[3]; // the coarse liver's drawn vertex grasped
-static int spot_row;   // its row of liver.x
+static double spot[3], spot2[3]; // the coarse liver's drawn vertices grasped by hand 0 and hand 1
+static int spot_row, spot2_row;   // their rows of liver.x
 
-// the coarse liver's highest drawn vertex near x = z = 60 mm
-static void find_spot(void) {
+// the coarse liver's highest drawn vertex within 12 mm of (x, z)
+static void find_spot(double x, double z, double out[3], int* out_row) {
   FILE* f = fopen(COARSE "/liver.obj", "r");
   assert_non_null(f);
   char line[256];
-  spot[1] = -1;
+  out[1] = -1;
   int row = 0;
   while (fgets(line, sizeof line, f)) {
     double p[3];
     if (line[0] != 'v' || line[1] != ' ' || sscanf(line + 2, "%lf %lf %lf", p, p + 1, p + 2) != 3) continue;
-    if (hypot(p[0] - 0.06, p[2] - 0.06) < 0.012 && p[1] > spot[1]) memcpy(spot, p, sizeof spot), spot_row = row;
+    if (hypot(p[0] - x, p[2] - z) < 0.012 && p[1] > out[1]) memcpy(out, p, 3 * sizeof(double)), *out_row = row;
     row++;
   }
   fclose(f);
-  assert_true(spot[1] > 0.03);
+  assert_true(out[1] > 0.03);
 }
 
 // a test class that keeps every event of organs.events
@@ -72,35 +72,41 @@ static void listen_step(tx_ctx* c, void* self) {
 static const tx_controller_class listener_class = {
     .type = "test.organs_listener", .summary = "keeps organs.events", .configure = listen_configure, .step = listen_step};
 
-static char hand[64]; // the scripted hand's waypoints (a temporary file)
+static char hand[64], hand2[64]; // the scripted hands' waypoints (temporary files)
 
 // The grasper's pivot 1 mm under the spot, 1 cm behind it along x (its
 // jaws, along x, reach 1 cm past it): 2 cm above from the start with the
-// jaws open (grip 0.6 rad), down by 0.4 s, closed by 0.7 s, lifted LIFT by
-// 1.2 s, held to 1.8 s, opened by 1.9 s, risen 3 cm by 2.5 s.
-static int setup(void** state) {
-  (void)state;
-  find_spot();
-  if (!tx_find_controller(listener_class.type) && tx_register_controller(&listener_class)) return -1;
-  snprintf(hand, sizeof hand, "/tmp/tx_organs_grasp_XXXXXX.csv");
-  int fd = mkstemps(hand, 4);
+// jaws open (grip 0.6 rad), down by 0.4 s, closed by 0.7 s, lifted by 1.2 s,
+// held to 1.8 s, opened by 1.9 s, risen 3 cm by 2.5 s.
+static int write_hand(char* path, const double at[3], double lift) {
+  snprintf(path, 64, "/tmp/tx_organs_grasp_XXXXXX.csv");
+  int fd = mkstemps(path, 4);
   if (fd < 0) return -1;
   close(fd);
-  FILE* f = fopen(hand, "w");
+  FILE* f = fopen(path, "w");
   if (!f) return -1;
-  const double x = spot[0] - 0.01, y = spot[1] - 0.001, z = spot[2];
+  const double x = at[0] - 0.01, y = at[1] - 0.001, z = at[2];
   fprintf(f, "t_s,x_m,y_m,z_m,qw,qx,qy,qz,grip_rad\n");
-  const double rows[][3] = {{0, 0.02, 0.6},    {0.4, 0, 0.6},    {0.5, 0, 0.6},  {0.7, 0, 0},
-                            {1.2, LIFT, 0},    {1.8, LIFT, 0},   {1.9, LIFT, 0.6}, {2.5, LIFT + 0.03, 0.6}};
+  const double rows[][3] = {{0, 0.02, 0.6},    {0.4, 0, 0.6},    {0.5, 0, 0.6},    {0.7, 0, 0},
+                            {1.2, lift, 0},    {1.8, lift, 0},   {1.9, lift, 0.6}, {2.5, lift + 0.03, 0.6}};
   for (size_t i = 0; i < sizeof rows / sizeof rows[0]; i++)
     fprintf(f, "%g,%.9g,%.9g,%.9g,1,0,0,0,%g\n", rows[i][0], x, y + rows[i][1], z, rows[i][2]);
   fclose(f);
   return 0;
 }
 
+static int setup(void** state) {
+  (void)state;
+  find_spot(0.06, 0.06, spot, &spot_row);
+  find_spot(-0.05, 0.06, spot2, &spot2_row); // 11 cm from it along x: the coarse tetrahedra (2 to 3 cm) carry no vertex of both
+  if (!tx_find_controller(listener_class.type) && tx_register_controller(&listener_class)) return -1;
+  return write_hand(hand, spot, LIFT) || write_hand(hand2, spot2, LIFT / 2);
+}
+
 static int teardown(void** state) {
   (void)state;
   unlink(hand);
+  unlink(hand2);
   return 0;
 }
 
@@ -120,11 +126,12 @@ static tx_scenario* load(const char* params) {
   return tx_scenario_load_text("test", text, strlen(text), NULL);
 }
 
-static double spot_height(tx_scenario* s) {
+static double height(tx_scenario* s, int row) {
   tx_snapshot x = latest_snapshot(s, "liver.x");
-  assert_true((int)x.rows > spot_row);
-  return ((const float*)x.data)[3 * spot_row + 1];
+  assert_true((int)x.rows > row);
+  return ((const float*)x.data)[3 * row + 1];
 }
+static double spot_height(tx_scenario* s) { return height(s, spot_row); }
 
 // each run starts the scenario over (its controllers' init), so each
 // question is a scenario of its own: held at 1.8 s, and let go by 2.6 s
@@ -202,6 +209,51 @@ static void grasper_lifts_the_liver(void** state) {
   tx_scenario_free(s);
 }
 
+// two graspers at once (device1 holds instrument1): hand 0 lifts its spot
+// 1 cm, hand 1 its own, 11 cm away, 5 mm; each grasp is its hand's (source,
+// row of organs.grasp), and each spot goes up with its own jaws
+static void two_graspers_at_once(void** state) {
+  (void)state;
+  char text[4096];
+  snprintf(text, sizeof text,
+           "{\"name\":\"t\",\"controllers\":["
+           "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,"
+           "\"params\":{\"device\":\"scripted:%s\",\"force_model\":\"instrument0.force_model\"}},"
+           "{\"name\":\"haptics1\",\"type\":\"haptics\",\"rate_hz\":1000,"
+           "\"params\":{\"device\":\"scripted:%s\",\"hand\":1,\"force_model\":\"instrument1.force_model\"}},"
+           "{\"name\":\"instruments\",\"type\":\"physics.instruments\",\"rate_hz\":1000,"
+           "\"params\":{\"instrument0\":\"lap_grasper\",\"instrument1\":\"lap_grasper\",\"table_height_m\":-1,"
+           "\"gravity_m_s2\":0}},"
+           "{\"name\":\"organs\",\"type\":\"physics.organs\",\"rate_hz\":30,"
+           "\"params\":{\"assets\":\"" COARSE "\",\"tool_radius_m\":0,\"grasp\":[\"instrument0.pose\",\"instrument1.pose\"]}},"
+           "{\"name\":\"listener\",\"type\":\"test.organs_listener\",\"rate_hz\":30}]}",
+           hand, hand2);
+  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+  if (!s) fail_msg("%s", tx_error());
+  the_listener.n = 0;
+  run(s, 1.8);
+  assert_int_equal(the_listener.n, 2);
+  bool by[2] = {false, false};
+  for (int i = 0; i < 2; i++) {
+    assert_int_equal(the_listener.got[i].kind, TX_EVENT_GRASP);
+    assert_true(the_listener.got[i].source < 2);
+    by[the_listener.got[i].source] = true;
+  }
+  assert_true(by[0] && by[1]);
+  tx_snapshot g = latest_snapshot(s, "organs.grasp");
+  assert_int_equal(g.rows, 2);
+  const tx_organ_grasp* r = g.data;
+  const double up0 = height(s, spot_row) - spot[1], up1 = height(s, spot2_row) - spot2[1];
+  print_message("  hand 0: %g nodes, spot up %.2f mm, pull %.3f N down; hand 1: %g nodes, spot up %.2f mm, pull %.3f N down\n",
+                r[0].nodes, up0 * 1e3, -r[0].f[1], r[1].nodes, up1 * 1e3, -r[1].f[1]);
+  assert_true(fabs(r[0].x[0] - (spot[0] - 0.01)) < 1e-3 && fabs(r[1].x[0] - (spot2[0] - 0.01)) < 1e-3); // each row its own pivot
+  assert_true(r[0].nodes >= 3 && r[1].nodes >= 3);
+  assert_true(fabs(up0 - LIFT) < 0.0015 && fabs(up1 - LIFT / 2) < 0.0015);
+  assert_true(r[0].f[1] < 0 && isfinite(r[1].f[0] + r[1].f[1] + r[1].f[2]));
+  assert_true(result(s, "organs.grasps") == 2);
+  tx_scenario_free(s);
+}
+
 static void expect_refused(const char* params, const char* needle) {
   tx_scenario* s = load(params);
   assert_null(s);
@@ -221,6 +273,7 @@ static void bad_grasp_parameters(void** state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(grasper_lifts_the_liver),
+      cmocka_unit_test(two_graspers_at_once),
       cmocka_unit_test(bad_grasp_parameters),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
