@@ -234,7 +234,7 @@ static void vertices(const tx_picking* p, const pick_body* b, const double* pos)
 
 // hand h's jaws closed: the triangles within reach of the jaws' segment, and
 // the free nodes carrying them; returns the triangles picked (point: their
-// nearest points' mean)
+// nearest points' mean), 0 when they carry no free node
 static int grasp(tx_picking* p, int h, const tx_instrument_pose* j, const double* const* pos, double point[3]) {
   double tip[3], ahead[3] = {p->d.length, 0, 0};
   rotate(j->quat, false, ahead, tip);
@@ -273,8 +273,13 @@ static int grasp(tx_picking* p, int h, const tx_instrument_pose* j, const double
       }
     }
   }
-  if (tris)
-    for (int a = 0; a < 3; a++) point[a] /= tris;
+  if (p->nodes[h] == 0) { // all held by the other hand or by the anatomy: nothing to carry, no grasp
+    for (int bi = 0; bi < p->bodies; bi++)
+      for (int t = 0; t < p->body[bi].s.nt; t++)
+        if (p->body[bi].tri_hand[t] == h) p->body[bi].tri_hand[t] = -1;
+    return 0;
+  }
+  for (int a = 0; a < 3; a++) point[a] /= tris;
   p->tris[h] = tris;
   return tris;
 }

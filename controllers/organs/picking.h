@@ -70,7 +70,8 @@ int tx_picking_add(tx_picking* p, tx_fem* fem, const tx_pick_surface* s);
 // set where its offset in the jaws' frame puts it. jaws NULL or not finite:
 // nothing changes and what is held stays where it is. Returns true with *e
 // filled (kind, source = h, for a grasp the mean point picked and the jaw
-// angle) when the jaws grasped or released; a close on nothing is no event.
+// angle) when the jaws grasped or released; a close on nothing, or on
+// triangles whose nodes are all held already or fixed, is no event.
 // Allocates nothing.
 bool tx_picking_update(tx_picking* p, int h, const tx_instrument_pose* jaws, const double* const* pos, tx_event* e);
 // hand h lets go of everything (no event); every hand: h = -1

@@ -242,7 +242,8 @@ static void test_grasp_lift_release(void** state) {
 // Its displacement gradient is d/h along zz alone, so the corotated force
 // (R = I for this symmetric stretch) gives P_zz = (lambda + 2 mu) d/h
 // exactly, and the body's force on the apex is -V P grad N_apex =
-// -(a^2 / (6 h)) (lambda + 2 mu) d along z, at any d.
+// -(a^2 / (6 h)) (lambda + 2 mu) d along z, at any d. Jaws closed on the
+// base alone hold nothing: its nodes are fixed.
 static void test_pull_closed_form(void** state) {
   (void)state;
   const double a = 0.01, h = 0.01, d = 0.001;
@@ -265,8 +266,20 @@ static void test_pull_closed_form(void** state) {
   double x[12];
   memcpy(x, v, sizeof x);
   const double* pos[1] = {x};
-  tx_instrument_pose j = {.pos = {-0.005, 0, h}, .quat = {1, 0, 0, 0}, .jaw = 0.5};
+  // closed on the base alone (1 mm of jaws lying on it, a quarter in): its nodes are fixed, no grasp
+  tx_instrument_pose j = {.pos = {a / 4, a / 4, 0}, .quat = {1, 0, 0, 0}, .jaw = 0.5};
   tx_event ev;
+  const tx_pick_def base_jaws = {.length = 0.001, .reach = 0.0001, .closed = 0.1, .open = 0.2};
+  tx_picking* q = tx_picking_create(&base_jaws, 1);
+  assert_int_equal(tx_picking_add(q, fem, &s), 0);
+  assert_false(tx_picking_update(q, 0, &j, pos, &ev));
+  j.jaw = 0;
+  assert_false(tx_picking_update(q, 0, &j, pos, &ev));
+  assert_int_equal(tx_picking_nodes(q, 0), 0);
+  assert_int_equal(tx_picking_triangle_holder(q, 0, 3), -1); // and the base is not left flagged
+  tx_picking_destroy(q);
+  // closed across the apex
+  j = (tx_instrument_pose){.pos = {-0.005, 0, h}, .quat = {1, 0, 0, 0}, .jaw = 0.5};
   tx_picking_update(p, 0, &j, pos, &ev);
   j.jaw = 0;
   assert_true(tx_picking_update(p, 0, &j, pos, &ev));
