@@ -8,6 +8,7 @@
 #include "organs_controller.h"
 
 #include "bullet/fem.h"
+#include "picking.h" // grasper picking
 
 #include <tactus/components.h>
 #include <tactus/config.h>
@@ -51,6 +52,8 @@ typedef struct organs {
   double max_moved, max_force; // m, N: the largest node displacement from rest, the largest force on the tool
   long faults;
   tx_hist steps; // ns
+  // grasper picking (picking.c): NULL when no grasp poses are given
+  tx_pick_ctl* pick;
 } organs;
 
 static const char* const names[SOFT] = {"liver", "stomach"};
@@ -83,6 +86,8 @@ static const tx_param_def params[] = {
     {"max_speed", TX_PARAM_NUM, "m/s", 0.01, 1e4, 20, NULL, "a faster node is a blow-up"},
     {"tool_radius_m", TX_PARAM_NUM, "m", 0, 0.05, 0.005, NULL, "the tool's tip sphere; 0: no tool"},
     {"pose", TX_PARAM_STR, NULL, 0, 0, 0, "device0.pose", "the pose the tool follows (tx_pose)"},
+    // grasper picking (picking.h)
+    TX_PICK_PARAMS,
 };
 
 // --- reading the assets -------------------------------------------------------
@@ -335,6 +340,18 @@ static int configure(tx_setup* s, void** self) {
   g->moved_result = tx_setup_result(s, "max_displacement_m");
   g->force_result = tx_setup_result(s, "max_force_n");
   tx_hist_clear(&g->steps);
+
+  // grasper picking: both soft organs, their drawn surfaces carried by the tetrahedra they lie in
+  {
+    tx_fem* fem[SOFT];
+    tx_pick_surface surf[SOFT];
+    for (int i = 0; i < SOFT; i++) {
+      const organ* o = &g->soft[i];
+      fem[i] = o->fem;
+      surf[i] = (tx_pick_surface){o->s.nv, o->s.nt, o->s.tri, 4, o->tet, o->w};
+    }
+    if (tx_pick_configure(s, "organs", SOFT, fem, surf, &g->pick)) return -1;
+  }
   return 0;
 }
 
@@ -398,7 +415,9 @@ static void publish(tx_ctx* c, organs* g, const tx_pose* pose) {
 }
 
 static int init(tx_ctx* c, void* self) {
-  publish(c, self, NULL); // the organs at rest, at time 0
+  organs* g = self;
+  publish(c, g, NULL); // the organs at rest, at time 0
+  tx_pick_init(c, g->pick);
   return 0;
 }
 
@@ -417,6 +436,12 @@ static void step(tx_ctx* c, void* self) {
       }
     }
   }
+  // grasper picking: the jaws grasp or release on the organs as the last step left them
+  if (g->pick) {
+    const double* pos[SOFT];
+    for (int i = 0; i < SOFT; i++) pos[i] = g->soft[i].pos;
+    tx_pick_before(c, g->pick, pos);
+  }
   bool ok = true;
   for (int i = 0; i < SOFT && ok; i++) {
     tx_fem_set_tool(g->soft[i].fem, pose ? pose->pos : (const double[3]){0, 0, 0}, pose ? g->tool_r : 0);
@@ -430,6 +455,7 @@ static void step(tx_ctx* c, void* self) {
     for (int i = 0; i < SOFT; i++) tx_fem_restore(g->soft[i].fem);
   }
   publish(c, g, pose);
+  tx_pick_after(c, g->pick, ok); // the organs' pull on the jaws
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t1);
   tx_hist_add(&g->steps, (int64_t)(t1.tv_sec - t0.tv_sec) * 1000000000 + (t1.tv_nsec - t0.tv_nsec));
 }
@@ -446,6 +472,7 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, g->substeps_result, g->substeps);
   tx_set_result(c, g->moved_result, g->max_moved);
   tx_set_result(c, g->force_result, g->max_force);
+  tx_pick_finish(c, g->pick);
 }
 
 static void fini(void* self) {
@@ -463,6 +490,7 @@ static void fini(void* self) {
   }
   free(g->spleen.x);
   free(g->spleen.tri);
+  tx_pick_free(g->pick);
   free(g);
 }
 

@@ -16,6 +16,11 @@
 // step_p50_ms, step_p99_ms, added_mass (fraction), substeps,
 // max_displacement_m (the largest node displacement from rest), max_force_n
 // (the largest force on the tool).
+//
+// Grasper picking (picking.h; params grasp, grasp_*): with grasp poses, the
+// jaws closing pick the drawn surface between them and carry its nodes;
+// writes organs.grasp (tx_organ_grasp, one row per hand), emits
+// TX_EVENT_GRASP and TX_EVENT_RELEASE on organs.events (source = the hand).
 #ifndef TX_CONTROLLERS_ORGANS_ORGANS_CONTROLLER_H
 #define TX_CONTROLLERS_ORGANS_ORGANS_CONTROLLER_H
 

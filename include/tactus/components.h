@@ -336,6 +336,23 @@ TX_LAYOUT_ASSERT(tx_instrument_held, double);
 //   organs.contact (1 row, tx_skin_contact): force, where it holds, its
 //     direction, the tangent stiffness k along it, the indentation
 
+// PREFIX.grasp (one row per grasping hand, in the order of the controller's
+// `grasp` list), written by a soft body's physics that graspers pick from
+// (physics.organs: organs.grasp; controllers/organs/picking.h): what the
+// picked tissue does to the jaws. Apart from organs.contact, which is the
+// tool sphere's one-sided push with a stiffness along its normal: a grasp
+// pulls any way, and each hand has its own.
+typedef struct tx_organ_grasp {
+  double f[3];      // N, the tissue's force on the jaws, averaged over the last physics step (0: holding nothing)
+  double x[3];      // m, the jaws' pivot that step
+  double nodes;     // nodes held
+  double triangles; // surface triangles flagged as picked by these jaws
+} tx_organ_grasp;
+#define tx_organ_grasp_TYPE TX_F64
+#define tx_organ_grasp_COLS 8u
+#define tx_organ_grasp_UNITS "N, m, 1"
+TX_LAYOUT_ASSERT(tx_organ_grasp, double);
+
 // --- gastric banding: the organs' temperature (physics.cautery) --------------
 
 // physics.cautery writes, for each soft organ ORGAN, one row per row of
