@@ -4,6 +4,7 @@
 #include "../../model/error.h"
 
 #include <math.h>
+#include <setjmp.h>
 #include <stdarg.h>
 #include <stdatomic.h>
 #include <ode/ode.h>
@@ -73,9 +74,16 @@ struct tx_instrument_world {
   dBodyID bodies[TX_WORLD_BODIES_MAX];
   body_state good[TX_WORLD_BODIES_MAX];
   int nbodies, faults, bad_contacts;
+  int rebuilds; // steps ODE gave up inside (world_rebuild)
+  // the world's own threading (ODE's self-threaded one): a step left by
+  // longjmp leaves its job in it, so it is abandoned with that world
+  dThreadingImplementationID threading;
 };
 
 static void save_good(tx_instrument_world* w);
+static bool make_world(tx_instrument_world* w);
+static void restore_good(tx_instrument_world* w);
+static void enable(instrument* in, bool on);
 static char needle_tag; // the needle's geoms carry its address
 
 // ODE prints its solver's messages (an LCP it could not finish, then
@@ -86,6 +94,19 @@ static void count_message(int num, const char* msg, va_list ap) {
   ode_messages++;
 }
 int tx_instrument_ode_messages(void) { return ode_messages; }
+
+// ODE's internal checks (dDebug, and dError) end the process after their
+// handler returns. Inside a step this thread's handler leaves the step by
+// longjmp instead: ODE's state is then undefined, so the world is never
+// stepped again but destroyed and rebuilt (world_rebuild). Outside a step
+// the handler returns and ODE aborts, as it would without it.
+static _Thread_local jmp_buf* ode_escape;
+static void leave_step(int num, const char* msg, va_list ap) {
+  (void)num, (void)msg, (void)ap;
+  jmp_buf* j = ode_escape;
+  ode_escape = NULL;
+  if (j) longjmp(*j, 1);
+}
 
 tx_needle_params tx_needle_defaults(void) {
   // 19 mm along the arc over 3/8 of a circle: radius 19 mm / (0.75 pi)
@@ -436,19 +457,14 @@ tx_instrument_world* tx_instrument_world_create(const tx_instrument_sim_params* 
   if (!dInitODE2(0) || !dAllocateODEDataForThread(dAllocateMaskAll))
     return tx_set_error("ODE cannot be started"), NULL;
   dSetMessageHandler(count_message);
+  dSetDebugHandler(leave_step);
+  dSetErrorHandler(leave_step);
   tx_instrument_world* w = calloc(1, sizeof *w);
   if (!w) {
     dCloseODE();
     return tx_set_error("out of memory"), NULL;
   }
   w->p = *p;
-  w->world = dWorldCreate();
-  w->space = dSimpleSpaceCreate(0); // a dozen geoms: every pair is cheaper than a hash
-  w->contacts = dJointGroupCreate(0);
-  dWorldSetGravity(w->world, p->gravity[0], p->gravity[1], p->gravity[2]);
-  dWorldSetERP(w->world, p->erp);
-  dWorldSetCFM(w->world, p->cfm);
-  dCreatePlane(w->space, 0, 1, 0, p->table_height);
   w->n = n;
   w->held_by = -1;
   tx_needle_params* nd = &w->p.needle;
@@ -465,20 +481,19 @@ tx_instrument_world* tx_instrument_world_create(const tx_instrument_sim_params* 
   if (nd->enabled && nd->foam && nd->held_by < 0) {
     nd->quat[0] = cos(-nd->grasp_angle / 2), nd->quat[1] = nd->quat[2] = 0, nd->quat[3] = sin(-nd->grasp_angle / 2);
   }
-  if (p->needle.enabled) needle_build(w);
-  if (nd->enabled && nd->foam && nd->held_by < 0) { // the foam holds it where it stands
-    w->foam = dJointCreateFixed(w->world, 0);
-    dJointAttach(w->foam, w->needle, 0);
-    dJointSetFixed(w->foam);
-  }
   for (int i = 0; i < n; i++) {
     w->ins[i].urdf = urdfs[i];
     memcpy(w->ins[i].start, start[i], sizeof w->ins[i].start);
     w->ins[i].start_q[0] = 1;
-    if (!build(w, &w->ins[i])) {
-      tx_instrument_world_destroy(w);
-      return NULL;
-    }
+  }
+  if (!make_world(w)) {
+    tx_instrument_world_destroy(w);
+    return NULL;
+  }
+  if (nd->enabled && nd->foam && nd->held_by < 0) { // the foam holds it where it stands
+    w->foam = dJointCreateFixed(w->world, 0);
+    dJointAttach(w->foam, w->needle, 0);
+    dJointSetFixed(w->foam);
   }
   if (nd->enabled && nd->held_by >= 0) { // held as a grasp holds it, the jaws on the wire (not counted as a grasp)
     instrument* in = &w->ins[nd->held_by];
@@ -490,19 +505,84 @@ tx_instrument_world* tx_instrument_world_create(const tx_instrument_sim_params* 
     for (int j = 0; j < in->urdf->njoints; j++)
       w->hold_angle[j] = in->urdf->joints[j].fixed ? 0 : asin(fmin(1, nd->wire_diameter / 2 / nd->grasp_distance));
   }
-  for (int i = 0; i < n; i++)
-    for (int l = 0; l < w->ins[i].urdf->nlinks; l++) w->bodies[w->nbodies++] = w->ins[i].body[l];
-  if (w->needle) w->bodies[w->nbodies++] = w->needle;
-  for (int b = 0; b < w->nbodies; b++) dBodySetMaxAngularSpeed(w->bodies[b], TX_MAX_ANGULAR_SPEED);
   save_good(w);
   return w;
 }
 
+// the ODE world from the description: the table, the needle where its
+// parameters put it, each instrument built at its start (its hinges' zero
+// there), and the list of bodies; false with tx_error() set
+static bool make_world(tx_instrument_world* w) {
+  const tx_instrument_sim_params* p = &w->p;
+  w->world = dWorldCreate();
+  w->threading = dThreadingAllocateSelfThreadedImplementation();
+  if (!w->threading) return tx_set_error("ODE cannot make a world"), false;
+  dWorldSetStepThreadingImplementation(w->world, dThreadingImplementationGetFunctions(w->threading), w->threading);
+  w->space = dSimpleSpaceCreate(0); // a dozen geoms: every pair is cheaper than a hash
+  w->contacts = dJointGroupCreate(0);
+  dWorldSetGravity(w->world, p->gravity[0], p->gravity[1], p->gravity[2]);
+  dWorldSetERP(w->world, p->erp);
+  dWorldSetCFM(w->world, p->cfm);
+  dCreatePlane(w->space, 0, 1, 0, p->table_height);
+  w->needle = NULL;
+  if (p->needle.enabled) needle_build(w);
+  for (int i = 0; i < w->n; i++)
+    if (!build(w, &w->ins[i])) return false;
+  w->nbodies = 0;
+  for (int i = 0; i < w->n; i++)
+    for (int l = 0; l < w->ins[i].urdf->nlinks; l++) w->bodies[w->nbodies++] = w->ins[i].body[l];
+  if (w->needle) w->bodies[w->nbodies++] = w->needle;
+  for (int b = 0; b < w->nbodies; b++) dBodySetMaxAngularSpeed(w->bodies[b], TX_MAX_ANGULAR_SPEED);
+  return true;
+}
+
+static void free_world(tx_instrument_world* w) {
+  if (w->contacts) dJointGroupDestroy(w->contacts);
+  if (w->space) dSpaceDestroy(w->space); // and its geoms
+  if (w->world) dWorldDestroy(w->world); // and its bodies and joints
+  if (w->threading) dThreadingFreeImplementation(w->threading);
+  w->contacts = NULL, w->space = NULL, w->world = NULL, w->threading = NULL;
+}
+
+// ODE gave up inside a step (an assertion, left by longjmp): its world is in
+// an undefined state and is never stepped again. A new one is built from the
+// description, every body put where the last good step left it, at rest,
+// with the needle's hold (or its foam) as it was and the parked instruments
+// out of it; then as for any fault (restore_good): each instrument passes
+// through what it overlaps there until they are apart. What ODE allocated
+// inside the step it left is not freed (it cannot be reached).
+static void world_rebuild(tx_instrument_world* w) {
+  bool foam = w->foam != NULL, hold = w->hold != NULL;
+  // its threading still holds the job of the step left: freeing it asserts (ODE
+  // would abort), so it is left as it is, a few hundred bytes lost per rebuild
+  w->threading = NULL;
+  free_world(w);
+  w->foam = w->hold = NULL;
+  if (!make_world(w)) return; // it was built from the same description once: cannot fail
+  for (int b = 0; b < w->nbodies; b++) {
+    const body_state* g = &w->good[b];
+    dBodySetPosition(w->bodies[b], g->pos[0], g->pos[1], g->pos[2]);
+    dBodySetQuaternion(w->bodies[b], g->quat);
+  }
+  if (foam) {
+    w->foam = dJointCreateFixed(w->world, 0);
+    dJointAttach(w->foam, w->needle, 0);
+    dJointSetFixed(w->foam);
+  }
+  if (hold) {
+    w->hold = dJointCreateFixed(w->world, 0);
+    dJointAttach(w->hold, w->needle, w->ins[w->held_by].body[0]);
+    dJointSetFixed(w->hold);
+  }
+  for (int i = 0; i < w->n; i++)
+    if (w->ins[i].parked) enable(&w->ins[i], false);
+  w->rebuilds++;
+  restore_good(w);
+}
+
 void tx_instrument_world_destroy(tx_instrument_world* w) {
   if (!w) return;
-  dJointGroupDestroy(w->contacts);
-  dSpaceDestroy(w->space); // and its geoms
-  dWorldDestroy(w->world); // and its bodies and joints
+  free_world(w);
   free(w);
   dCleanupODEAllDataForThread(); // this thread's ODE data (it may not be the one that made the world)
   dCloseODE();
@@ -531,6 +611,7 @@ int tx_instrument_world_contacts(const tx_instrument_world* w) { return w->ncont
 int tx_instrument_world_resets(const tx_instrument_world* w) { return w->resets; }
 int tx_instrument_world_bad_inputs(const tx_instrument_world* w) { return w->bad_inputs; }
 int tx_instrument_world_faults(const tx_instrument_world* w) { return w->faults; }
+int tx_instrument_world_rebuilds(const tx_instrument_world* w) { return w->rebuilds; }
 int tx_instrument_world_bad_contacts(const tx_instrument_world* w) { return w->bad_contacts; }
 unsigned tx_instrument_world_passing_through(const tx_instrument_world* w, int i) { return w->ins[i].ghost; }
 double tx_instrument_world_depth(const tx_instrument_world* w) { return w->depth; }
@@ -843,7 +924,16 @@ void tx_instrument_world_step(tx_instrument_world* w, const tx_instrument_input*
     restore_good(w);
     return;
   }
+  // ODE asserting inside the step (an all but singular LCP turned into a
+  // quaternion it cannot normalise) comes back here instead of aborting
+  jmp_buf escape;
+  if (setjmp(escape)) {
+    world_rebuild(w);
+    return;
+  }
+  ode_escape = &escape;
   dWorldStep(w->world, dt);
+  ode_escape = NULL;
   dJointGroupEmpty(w->contacts);
   if (!state_ok(w)) {
     restore_good(w);
@@ -893,7 +983,14 @@ void tx_instrument_world_take(tx_instrument_world* w, int i, const double pos[3]
   memset(in->hand_force, 0, sizeof in->hand_force);
   enable(in, true);
   in->parked = false;
-  in->ghost = in->ghost_now = 0;
+  // taken where the hand is, it may start across another body (the
+  // scissors' closed blades through the wire of a needle the forceps hold):
+  // pushed out at once, that pinch is the all but singular LCP ODE's exact
+  // solver gives up on. It passes through what it overlaps until they are
+  // apart, and its jaws, counted as already on the needle, must leave it and
+  // close on it again to take it (needle_grasp)
+  in->ghost = overlaps(w, in);
+  in->ghost_now = 0;
   save_good(w); // placed by hand: the state to go back to
 }
 

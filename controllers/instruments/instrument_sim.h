@@ -121,6 +121,11 @@ int tx_instrument_world_bad_inputs(const tx_instrument_world* w);
 // after the last good step, at rest (also counted in resets). Contacts
 // dropped for a non-finite point or depth or a normal that is not unit.
 int tx_instrument_world_faults(const tx_instrument_world* w);
+// Steps ODE gave up inside (one of its assertions, which would end the
+// process): left by longjmp, the world is destroyed and rebuilt from the
+// description and the last good state, never stepped again; each is also a
+// fault (counted in faults and resets)
+int tx_instrument_world_rebuilds(const tx_instrument_world* w);
 int tx_instrument_world_bad_contacts(const tx_instrument_world* w);
 // what an instrument passes through, as owner bits (bit i: instrument i;
 // bit TX_INSTRUMENTS_MAX: the needle; the next: the table): after a fault
