@@ -89,6 +89,28 @@ bool tx_fem_is_kinematic(const tx_fem* b, int node);
 // (its position iterations carry no force), f zero.
 bool tx_fem_kinematic_force(const tx_fem* b, int node, double f[3]);
 
+// Removal (tissue vaporised by cautery): tetrahedron t stops acting. Its
+// elastic force goes, its mass leaves its four nodes, and a node left in no
+// live tetrahedron leaves the solve (massless, not stepped, where it was;
+// a kinematic one is released). The boundary the tool meets is updated: the
+// removed tetrahedron's faces that were boundary go, its faces shared with a
+// live neighbour become boundary, turned outward from that neighbour.
+// Links model: the links of edges no live tetrahedron has any more go.
+// No allocation (sized at tx_fem_create). false: t out of range or already
+// removed; nothing changes. Removing the last tetrahedron is refused too
+// (false): a body always has one.
+bool tx_fem_remove_tet(tx_fem* b, int t);
+bool tx_fem_tet_live(const tx_fem* b, int t);
+int tx_fem_tet_count(const tx_fem* b);       // tetrahedra as created
+int tx_fem_live_tet_count(const tx_fem* b);  // not removed
+const int* tx_fem_tets(const tx_fem* b);     // (tx_fem_tet_count x 4) the tetrahedra as created
+bool tx_fem_node_live(const tx_fem* b, int node);  // in a live tetrahedron
+// the tetrahedron's signed volume now, m^3 (positive: as created; 0 for a removed one)
+double tx_fem_tet_volume(const tx_fem* b, int t);
+// the live tetrahedra's boundary: *faces rows of 3 node numbers, outward
+// (right-hand rule); valid until the next tx_fem_remove_tet
+const int* tx_fem_hull(const tx_fem* b, int* faces);
+
 // the state (positions, velocities) kept aside, and brought back
 void tx_fem_save(tx_fem* b);
 void tx_fem_restore(tx_fem* b);
