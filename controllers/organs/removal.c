@@ -17,6 +17,13 @@ int tx_compact_surface(const int* faces, int nf, int32_t* row_of, int32_t* node_
   return rows;
 }
 
+int tx_cut_surface(const int* faces, int nf, const double* pos, int32_t* row_of, int32_t* node_of, float* x, int32_t* tri) {
+  int rows = tx_compact_surface(faces, nf, row_of, node_of, tri);
+  for (int r = 0; r < rows; r++)
+    for (int a = 0; a < 3; a++) x[3 * r + a] = (float)pos[3 * node_of[r] + a];
+  return rows;
+}
+
 static int cmp_u64(const void* a, const void* b) {
   uint64_t x = *(const uint64_t*)a, y = *(const uint64_t*)b;
   return (x > y) - (x < y);

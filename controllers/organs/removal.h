@@ -17,6 +17,9 @@
 // return. Returns the rows.
 int tx_compact_surface(const int* faces, int nf, int32_t* row_of, int32_t* node_of, int32_t* tri);
 
+// the same, with the rows' positions: x (rows x 3) from pos (nodes x 3)
+int tx_cut_surface(const int* faces, int nf, const double* pos, int32_t* row_of, int32_t* node_of, float* x, int32_t* tri);
+
 // what tx_surface_check finds; a sound closed surface has every count 0
 // but nonmanifold_edges, which is tissue meeting along an edge only
 typedef struct tx_surface_report {

@@ -65,6 +65,7 @@ struct tx_fem {
   std::vector<int> nbr;        // (ne x 4) the tetrahedron across face k (opposite node k), -1: none
   std::vector<int> hull_at;    // (ne x 4) face k of t: its row in hull, -1: not boundary
   std::vector<int> hull_owner; // (hull rows) 4 t + k of each boundary face
+  std::vector<char> fresh;     // (ne x 4) laid open by a removal inside the tool: not pushed until the tool leaves it
   std::vector<int> node_tets;  // (nv) live tetrahedra at each node; 0: out of the solve
   std::vector<double> tet_mass, tet_true;  // (ne) kg, the mass it lumps (scaled), its true mass
   std::vector<double> true_mass;           // (nv) kg, the true mass at each node
@@ -74,6 +75,7 @@ struct tx_fem {
   std::vector<std::pair<int, int>> edge_nodes;  // links: the nodes of each edge
   bool has_tool;
   double tool_c[3], tool_r;
+  double tool_prev[3];  // m, the centre at the last tx_fem_step: a face it has gone behind since is pushed back
   tx_fem_tool_info tool;
 };
 
@@ -246,6 +248,7 @@ extern "C" tx_fem* tx_fem_create(const tx_fem_def* d, const double* nodes, int n
     for (int t = 0; t < ne; t++) b->slot[(size_t)t] = b->slot_tet[(size_t)t] = t;
     b->nbr.assign(4 * (size_t)ne, -1);
     b->hull_at.assign(4 * (size_t)ne, -1);
+    b->fresh.assign(4 * (size_t)ne, 0);
     b->hull.reserve(12 * (size_t)ne);
     b->hull_owner.reserve(4 * (size_t)ne);
     b->node_tets.assign((size_t)nv, 0);
@@ -497,9 +500,14 @@ static void closest_on_triangle(const btVector3& p, const btVector3& a, const bt
 
 // how far a sphere (c, r) reaches past triangle abc along the face's outward
 // normal side: r minus the signed distance to its closest point (> 0: overlap);
-// n, the unit direction the face must move to leave the sphere
-static double overlap(const btVector3& c, double r, const btVector3& a, const btVector3& b, const btVector3& d, double w[3],
-                      btVector3& n) {
+// n, the unit direction the face must move to leave the sphere. A face the
+// centre is behind is pushed back only if the centre was in front of it at
+// pc, the last step's: it went through. Otherwise it is a face of the far
+// side, or one a removal laid open beside the tool, which the tool has not
+// touched from outside (pushed by r + dist in one step, it would turn
+// elements inside out).
+static double overlap(const btVector3& c, const btVector3& pc, double r, const btVector3& a, const btVector3& b,
+                      const btVector3& d, double w[3], btVector3& n) {
   closest_on_triangle(c, a, b, d, w);
   btVector3 q = a * (btScalar)w[0] + b * (btScalar)w[1] + d * (btScalar)w[2];
   btVector3 face = (b - a).cross(d - a);
@@ -514,6 +522,7 @@ static double overlap(const btVector3& c, double r, const btVector3& a, const bt
     return r - dist;
   }
   if (dist >= r) return 0;  // behind and out of reach: a face of the far side
+  if (!((pc - q).dot(face) > 0)) return 0;  // behind before too: not met from outside
   n = -face;                // the centre went past the face: push it back behind the centre
   return r + dist;
 }
@@ -522,6 +531,7 @@ static double overlap(const btVector3& c, double r, const btVector3& a, const bt
 static btVector3 tool_contact(tx_fem* b, int& touched) {
   btAlignedObjectArray<btSoftBody::Node>& nodes = b->body->m_nodes;
   btVector3 c((btScalar)b->tool_c[0], (btScalar)b->tool_c[1], (btScalar)b->tool_c[2]);
+  btVector3 pc((btScalar)b->tool_prev[0], (btScalar)b->tool_prev[1], (btScalar)b->tool_prev[2]);
   double r = b->tool_r;
   btVector3 impulse(0, 0, 0);
   touched = 0;
@@ -530,9 +540,19 @@ static btVector3 tool_contact(tx_fem* b, int& touched) {
     if ((v[0]->m_x - c).length2() > (btScalar)(16 * r * r) + 2 * ((v[1]->m_x - v[0]->m_x).length2() + (v[2]->m_x - v[0]->m_x).length2()))
       continue;  // far: no face edge is long enough to reach the sphere
     double w[3];
-    btVector3 n;
-    double p = overlap(c, r, v[0]->m_x, v[1]->m_x, v[2]->m_x, w, n);
+    btVector3 n(0, 0, 0);
+    double p = overlap(c, pc, r, v[0]->m_x, v[1]->m_x, v[2]->m_x, w, n);
+    // a face a removal laid open where the tool already was (the cavity the
+    // burn left around the tip) is not thrown out of it in one step, which
+    // would turn its tetrahedron inside out: it is met once the tool has left it
+    char& fresh = b->fresh[(size_t)b->hull_owner[f / 3]];
+    if (fresh && p > 0) continue;
+    fresh = 0;
     if (!(p > 0)) continue;
+    // at most a tenth of the radius a step: a face met edge-on or far in (a
+    // ragged surface after removals) is eased out over a few steps rather
+    // than thrown out at once past the elements behind it
+    p = std::min(p, 0.1 * r);
     // move the face's closest point by p along n: each free node by w_i p / sum(w^2)
     double ww = 0;
     for (int k = 0; k < 3; k++)
@@ -632,8 +652,10 @@ extern "C" bool tx_fem_step(tx_fem* b, int steps) {
 }
 
 extern "C" void tx_fem_set_tool(tx_fem* b, const double c[3], double r) {
+  bool had = b->has_tool;
   b->has_tool = r > 0 && std::isfinite(c[0] + c[1] + c[2] + r);
   if (!b->has_tool) return;
+  for (int a = 0; a < 3; a++) b->tool_prev[a] = had ? b->tool_c[a] : c[a];
   for (int a = 0; a < 3; a++) b->tool_c[a] = c[a];
   b->tool_r = r;
 }
@@ -699,7 +721,7 @@ extern "C" bool tx_fem_remove_tet(tx_fem* b, int t) {
     int n = b->nbr[4 * (size_t)t + (size_t)k];
     if (n < 0 || !b->tet_live[(size_t)n]) continue;
     for (int q = 0; q < 4; q++)
-      if (b->nbr[4 * (size_t)n + (size_t)q] == t) hull_add(b, n, q);
+      if (b->nbr[4 * (size_t)n + (size_t)q] == t) hull_add(b, n, q), b->fresh[4 * (size_t)n + (size_t)q] = 1;
   }
   // links: the edges no live tetrahedron has
   if (!b->world)
