@@ -101,7 +101,7 @@ static const tx_param_def params[] = {
      "a tetrahedron of physics.organs is removed (vaporised) once this fraction of its volume has boiled (its refined "
      "children's nodes at vaporisation_k, each a quarter of each child it is in); 0: nothing is removed"},
     {"events", TX_PARAM_STR, NULL, 0, 0, 0, "cautery.burn",
-     "the stream the removals go out on (TX_EVENT_BURN, one per tetrahedron; physics.organs' burn_events)"},
+     "the stream the removals go out on (TX_EVENT_BURN, one per tetrahedron; physics.organs' burn_events); \"\": none (remove_fraction 0)"},
 };
 
 static double fine_volume(const double* x, const int* t) {
@@ -219,10 +219,8 @@ static int configure(tx_setup* s, void** self) {
   g->remove_fraction = tx_table_num(s, "remove_fraction");
   const char* events = tx_table_str(s, "events");
   if (!events) return -1;
-  if (g->remove_fraction > 0) {
-    if (!events[0]) return tx_setup_fail(s, "events", "names no stream");
-    g->events = tx_setup_emit(s, events, 1024);
-  }
+  if (events[0]) g->events = tx_setup_emit(s, events, 1024); // declared even when nothing is to be removed, so a listener stays valid
+  else if (g->remove_fraction > 0) return tx_setup_fail(s, "events", "names no stream, but remove_fraction is %g", g->remove_fraction);
   g->removed_r = tx_setup_result(s, "removed_tets");
   g->removed_m3_r = tx_setup_result(s, "removed_m3");
   tx_hist_clear(&g->steps);
