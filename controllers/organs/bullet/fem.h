@@ -65,8 +65,11 @@ bool tx_fem_step(tx_fem* b, int steps);
 
 // A kinematic frictionless sphere (the tool) against the tetrahedra's
 // boundary: a face it overlaps is pushed out along the sphere's normal, the
-// push shared by the face's nodes by their barycentric weights; the momentum
-// this takes is its force. r <= 0: no tool.
+// push shared by the face's nodes by their barycentric weights, at most a
+// tenth of r a step; the momentum this takes is its force. A face the
+// centre is behind is pushed back only if the centre was in front of it at
+// the last call (it went through); a face a removal laid open inside the
+// sphere is left until the sphere has left it. r <= 0: no tool.
 void tx_fem_set_tool(tx_fem* b, const double c[3], double r);
 typedef struct tx_fem_tool_info {
   double f[3];    // N, the body's force on the tool, averaged over the last tx_fem_step
