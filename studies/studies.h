@@ -35,6 +35,7 @@ int tx_study_instruments_stability(const tx_study_args* a);
 int tx_study_needle_puncture(const tx_study_args* a);
 int tx_study_organ_hemisphere(const tx_study_args* a);
 int tx_study_organ_stability(const tx_study_args* a);
+int tx_study_organ_removal(const tx_study_args* a);
 int tx_study_thread_accuracy(const tx_study_args* a);
 int tx_study_thread_stability(const tx_study_args* a);
 int tx_study_cautery_heat(const tx_study_args* a);

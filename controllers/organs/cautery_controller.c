@@ -13,6 +13,7 @@
 
 #include <tactus/components.h>
 #include <tactus/config.h>
+#include <tactus/events.h>
 #include <tactus/stats.h>
 
 #include <math.h>
@@ -34,6 +35,18 @@ typedef struct organ {
   double peak;  // K, the hottest surface vertex so far
   tx_port x, temp, damage;
   tx_result peak_r, damaged_r, boiled_r;
+  // removal: physics.organs' tetrahedra (coarse) and their refined children
+  // (the heat's, fine), which fine nodes have boiled, how much of each coarse one
+  int coarse_nodes, coarse, per; // nodes and tetrahedra of physics.organs' mesh, children of each
+  double* fx;                    // (fine nodes x 3) m, at rest
+  int* ft;                       // (coarse x per x 4) the fine tetrahedra, a coarse one's children together
+  int *at_row, *at_tet;          // CSR: the fine tetrahedra at each fine node
+  bool* counted;                 // (fine nodes) boiled and counted
+  double *burnt, *cvol;          // (coarse) m^3 boiled, m^3 in all
+  bool* gone;                    // (coarse) removed
+  int removed;                   // coarse tetrahedra removed
+  double removed_m3;
+  tx_port tri_in, node_in;       // the published surface's triangles and rows' nodes
 } organ;
 
 typedef struct cautery {
@@ -45,6 +58,10 @@ typedef struct cautery {
   tx_warning bad_pose, bad_surface;
   tx_result energy_r, boiled_r, active_r, substeps_r, p50_r, p99_r;
   tx_hist steps; // ns
+  // removal
+  double remove_fraction;   // 0: none
+  tx_port events;           // TX_EVENT_BURN out
+  tx_result removed_r, removed_m3_r;
 } cautery;
 
 // the defaults: IT'IS tissue properties database (docs/lagb.md), Arrhenius
@@ -80,7 +97,19 @@ static const tx_param_def params[] = {
     {"arrhenius_ea", TX_PARAM_NUM, "J/mol", 1e4, 1e6, 2.577e5, NULL, "Arrhenius activation energy Ea (liver)"},
     {"vaporisation_k", TX_PARAM_NUM, "K", 320, 500, TX_VAPORISATION_K, NULL,
      "tissue boils here: no node rises above it, the heat past it is taken by boiling"},
+    {"remove_fraction", TX_PARAM_NUM, "1", 0, 1, 0.5, NULL,
+     "a tetrahedron of physics.organs is removed (vaporised) once this fraction of its volume has boiled (its refined "
+     "children's nodes at vaporisation_k, each a quarter of each child it is in); 0: nothing is removed"},
+    {"events", TX_PARAM_STR, NULL, 0, 0, 0, "cautery.burn",
+     "the stream the removals go out on (TX_EVENT_BURN, one per tetrahedron; physics.organs' burn_events); \"\": none (remove_fraction 0)"},
 };
+
+static double fine_volume(const double* x, const int* t) {
+  const double *a = x + 3 * t[0], *b = x + 3 * t[1], *c = x + 3 * t[2], *d = x + 3 * t[3];
+  double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]},
+         w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+  return fabs(u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2]) + u[2] * (v[0] * w[1] - v[1] * w[0])) / 6;
+}
 
 static int load(tx_setup* s, organ* o, const char* dir, const char* name, const tx_tissue* ts, const tx_arrhenius* d,
                 double dt, int levels) {
@@ -102,10 +131,29 @@ static int load(tx_setup* s, organ* o, const char* dir, const char* name, const 
     free(x), free(tet);
     return -1;
   }
+  o->coarse_nodes = n, o->coarse = nt;
   free(x), free(tet);
   o->h = tx_thermal_create(fx, fn, ft, fnt, ts, d, dt);
-  free(fx), free(ft);
-  return o->h ? 0 : tx_setup_fail(s, "assets", "%s: %s", base, tx_error());
+  o->fx = fx, o->ft = ft;
+  if (!o->h) return tx_setup_fail(s, "assets", "%s: %s", base, tx_error());
+  // removal: the fine tetrahedra at each fine node, each coarse one's volume
+  o->per = fnt / nt;
+  o->at_row = calloc((size_t)fn + 1, sizeof(int));
+  o->at_tet = malloc(sizeof(int) * 4 * (size_t)fnt);
+  o->counted = calloc((size_t)fn, sizeof(bool));
+  o->burnt = calloc((size_t)nt, sizeof(double)), o->cvol = calloc((size_t)nt, sizeof(double));
+  o->gone = calloc((size_t)nt, sizeof(bool));
+  if (!o->at_row || !o->at_tet || !o->counted || !o->burnt || !o->cvol || !o->gone) return -1;
+  for (int f = 0; f < 4 * fnt; f++) o->at_row[ft[f] + 1]++;
+  for (int i = 0; i < fn; i++) o->at_row[i + 1] += o->at_row[i];
+  for (int f = 0; f < fnt; f++) {
+    const int* t = ft + 4 * f;
+    for (int k = 0; k < 4; k++) o->at_tet[o->at_row[t[k]]++] = f;
+    o->cvol[f / o->per] += fine_volume(fx, t);
+  }
+  for (int i = fn; i > 0; i--) o->at_row[i] = o->at_row[i - 1];
+  o->at_row[0] = 0;
+  return 0;
 }
 
 static int configure(tx_setup* s, void** self) {
@@ -145,9 +193,14 @@ static int configure(tx_setup* s, void** self) {
     snprintf(key, sizeof key, "%s.x", names[i]);
     o->x = TX_READ_OF(s, key, tx_vertex);
     snprintf(key, sizeof key, "%s.temperature", names[i]);
-    o->temp = tx_setup_write(s, &TX_COMPONENT_OF(key, tx_temperature, (uint32_t)o->nv));
+    uint32_t rows = (uint32_t)(o->nv > o->coarse_nodes ? o->nv : o->coarse_nodes); // the drawn surface, or the cut one's nodes
+    o->temp = tx_setup_write(s, &TX_COMPONENT_OF(key, tx_temperature, rows));
     snprintf(key, sizeof key, "%s.damage", names[i]);
-    o->damage = tx_setup_write(s, &TX_COMPONENT_OF(key, tx_organ_damage, (uint32_t)o->nv));
+    o->damage = tx_setup_write(s, &TX_COMPONENT_OF(key, tx_organ_damage, rows));
+    snprintf(key, sizeof key, "%s.tri", names[i]);
+    o->tri_in = TX_READ_OF(s, key, tx_triangle);
+    snprintf(key, sizeof key, "%s.surface_node", names[i]);
+    o->node_in = TX_READ_OF(s, key, tx_surface_node);
     snprintf(key, sizeof key, "%s_peak_k", names[i]), o->peak_r = tx_setup_result(s, key);
     snprintf(key, sizeof key, "%s_damaged_m3", names[i]), o->damaged_r = tx_setup_result(s, key);
     snprintf(key, sizeof key, "%s_boiled_m3", names[i]), o->boiled_r = tx_setup_result(s, key);
@@ -162,6 +215,14 @@ static int configure(tx_setup* s, void** self) {
   g->substeps_r = tx_setup_result(s, "substeps");
   g->p50_r = tx_setup_result(s, "step_p50_ms");
   g->p99_r = tx_setup_result(s, "step_p99_ms");
+  // removal
+  g->remove_fraction = tx_table_num(s, "remove_fraction");
+  const char* events = tx_table_str(s, "events");
+  if (!events) return -1;
+  if (events[0]) g->events = tx_setup_emit(s, events, 1024); // declared even when nothing is to be removed, so a listener stays valid
+  else if (g->remove_fraction > 0) return tx_setup_fail(s, "events", "names no stream, but remove_fraction is %g", g->remove_fraction);
+  g->removed_r = tx_setup_result(s, "removed_tets");
+  g->removed_m3_r = tx_setup_result(s, "removed_m3");
   tx_hist_clear(&g->steps);
   return 0;
 }
@@ -174,14 +235,29 @@ static void rotate(const double q[4], const double v[3], double out[3]) {
   out[2] = v[2] + q[0] * t[2] + (q[1] * t[1] - q[2] * t[0]);
 }
 
-// where the tip is against an organ's surface now (cur, or its rest shape):
-// the signed distance (negative inside) and the tip taken to the rest frame
-static double locate(const organ* o, const float* cur, const double tip[3], double mat[3]) {
+// the surface the tip is located on: physics.organs' latest publish (the
+// drawn surface, or once cut its live tetrahedra's boundary, each row a
+// node), or the drawn surface at rest
+typedef struct surface {
+  const float* cur;    // (rows x 3) m, now
+  const int32_t* tri;  // (nt x 3)
+  int rows, nt;
+  const int32_t* node; // (rows) the node of each row (cut), or NULL (drawn: rest is o->rest)
+} surface;
+
+static double rest_of(const organ* o, const surface* f, int row, int a) {
+  return f->node ? o->fx[3 * f->node[row] + a] : o->rest[3 * row + a];
+}
+
+// where the tip is against an organ's surface now: the signed distance
+// (negative inside) and the tip taken to the rest frame
+static double locate(const organ* o, const surface* f, const double tip[3], double mat[3]) {
+  const float* cur = f->cur;
   double best = INFINITY, sign = 1;
   int bt = 0;
   double bb[3] = {1, 0, 0};
-  for (int t = 0; t < o->nt; t++) {
-    const int* v = o->tri + 3 * t;
+  for (int t = 0; t < f->nt; t++) {
+    const int32_t* v = f->tri + 3 * t;
     double p[3][3], cp[3], bary[3];
     for (int k = 0; k < 3; k++)
       for (int a = 0; a < 3; a++) p[k][a] = cur[3 * v[k] + a];
@@ -196,19 +272,32 @@ static double locate(const organ* o, const float* cur, const double tip[3], doub
       memcpy(bb, bary, sizeof bb);
     }
   }
-  const int* v = o->tri + 3 * bt;
+  const int32_t* v = f->tri + 3 * bt;
   for (int a = 0; a < 3; a++) {
     double u = 0;
-    for (int k = 0; k < 3; k++) u += bb[k] * (cur[3 * v[k] + a] - o->rest[3 * v[k] + a]);
+    for (int k = 0; k < 3 && f->nt > 0; k++) u += bb[k] * (cur[3 * v[k] + a] - rest_of(o, f, v[k], a));
     mat[a] = tip[a] - u;
   }
   return sign * sqrt(best);
 }
 
-static void publish(tx_ctx* c, organ* o) {
+// one row per row of the surface: a drawn vertex reads its refined
+// tetrahedron, a node of the cut surface its own value (physics.organs'
+// nodes keep their numbers in the refined mesh: tx_tet_refine)
+static void publish(tx_ctx* c, organ* o, const surface* f) {
   const double *t = tx_thermal_temperature(o->h), *om = tx_thermal_damage(o->h), rest = tx_thermal_damage_rest(o->h);
   tx_temperature* ot = tx_write(c, o->temp);
   tx_organ_damage* od = tx_write(c, o->damage);
+  if (f && f->node) {
+    for (int r = 0; r < f->rows; r++) {
+      int n = f->node[r];
+      ot[r].t = (float)t[n], od[r].omega = (float)fmin(fmax(om[n], 0) + rest, 1e30);
+      o->peak = fmax(o->peak, t[n]);
+    }
+    tx_write_rows(c, o->temp, (uint32_t)f->rows), tx_write_rows(c, o->damage, (uint32_t)f->rows);
+    return;
+  }
+  tx_write_rows(c, o->temp, (uint32_t)o->nv), tx_write_rows(c, o->damage, (uint32_t)o->nv);
   for (int v = 0; v < o->nv; v++) {
     double a = 0, b = 0, lo = INFINITY, hi = -INFINITY;
     for (int k = 0; k < 4; k++) {
@@ -223,9 +312,64 @@ static void publish(tx_ctx* c, organ* o) {
   }
 }
 
+// physics.organs' latest surface of organ o; its rest shape (drawn) when it
+// has published none yet or what it published does not hold together
+static void read_surface(tx_ctx* c, cautery* g, organ* o, surface* f) {
+  *f = (surface){.cur = o->rest, .tri = o->tri, .rows = o->nv, .nt = o->nt, .node = NULL};
+  tx_snapshot xs = tx_read(c, o->x), ts = tx_read(c, o->tri_in), ns = tx_read(c, o->node_in);
+  if (xs.seq == 0) return;
+  // the three from one publish (physics.organs writes them together)
+  const int32_t* node = ns.seq > 0 && ns.rows > 0 ? &((const tx_surface_node*)ns.data)->node : NULL;
+  bool cut = node && ns.seq == xs.seq && ts.seq == xs.seq && ns.rows == xs.rows && node[0] >= 0;
+  if (!cut) { // the drawn surface; or a cut one read across a publish: its rest shape, this once
+    bool drawn = !node || node[0] < 0;
+    if (drawn && xs.rows == (uint32_t)o->nv) f->cur = ((const tx_vertex*)xs.data)->x;
+    else if (drawn) tx_warn(c, g->bad_surface);
+    return;
+  }
+  const int32_t* tri = ((const tx_triangle*)ts.data)->v;
+  for (uint32_t r = 0; r < xs.rows; r++)
+    if (node[r] < 0 || node[r] >= o->coarse_nodes) return tx_warn(c, g->bad_surface);
+  for (uint32_t k = 0; k < 3 * ts.rows; k++)
+    if (tri[k] < 0 || tri[k] >= (int32_t)xs.rows) return tx_warn(c, g->bad_surface);
+  *f = (surface){.cur = ((const tx_vertex*)xs.data)->x, .tri = tri, .rows = (int)xs.rows, .nt = (int)ts.rows, .node = node};
+}
+
+// the nodes that boiled since the last step count a quarter of each fine
+// tetrahedron they are in toward its coarse parent; a coarse tetrahedron
+// past remove_fraction is sent to physics.organs to be removed and its
+// children leave the heat's solve
+static void vaporise(tx_ctx* c, cautery* g, int which) {
+  organ* o = &g->o[which];
+  const bool* reached = tx_thermal_reached(o->h);
+  int n = tx_thermal_nodes(o->h);
+  for (int i = 0; i < n; i++) {
+    if (!reached[i] || o->counted[i]) continue;
+    o->counted[i] = true;
+    for (int a = o->at_row[i]; a < o->at_row[i + 1]; a++) {
+      int f = o->at_tet[a], e = f / o->per;
+      if (o->gone[e]) continue;
+      o->burnt[e] += fine_volume(o->fx, o->ft + 4 * f) / 4;
+      if (o->burnt[e] < g->remove_fraction * o->cvol[e] * (1 - 1e-12)) continue;
+      // gone: its centroid at rest, its children out of the heat's solve
+      tx_event ev = {.kind = TX_EVENT_BURN, .source = (uint32_t)e};
+      ev.burn.organ = which, ev.burn.fraction = o->burnt[e] / o->cvol[e];
+      for (int k = e * o->per; k < (e + 1) * o->per; k++) {
+        const int* t = o->ft + 4 * k;
+        double v = fine_volume(o->fx, t) / o->cvol[e];
+        for (int q = 0; q < 4; q++)
+          for (int ax = 0; ax < 3; ax++) ev.burn.point[ax] += v * o->fx[3 * t[q] + ax] / 4;
+        tx_thermal_remove(o->h, t);
+      }
+      o->gone[e] = true, o->removed++, o->removed_m3 += o->cvol[e];
+      tx_emit(c, g->events, &ev);
+    }
+  }
+}
+
 static int init(tx_ctx* c, void* self) {
   cautery* g = self;
-  for (int i = 0; i < SOFT; i++) publish(c, &g->o[i]); // at rest, at time 0
+  for (int i = 0; i < SOFT; i++) publish(c, &g->o[i], NULL); // at rest, at time 0
   return 0;
 }
 
@@ -249,23 +393,22 @@ static void step(tx_ctx* c, void* self) {
     double b = gs.seq > 0 ? ((const tx_device_grip*)gs.data)->buttons : 0;
     active = b >= 0 && b < 4294967296.0 && (((uint32_t)b >> g->button) & 1u);
   }
+  // each organ's surface as physics.organs last published it
+  surface sf[SOFT];
+  for (int i = 0; i < SOFT; i++) read_surface(c, g, &g->o[i], &sf[i]);
   // the organ the tip touches (the deepest in, if both)
   int hot = -1;
   double best = INFINITY, mat[SOFT][3] = {{0}};
   for (int i = 0; i < SOFT && active && g->power > 0; i++) {
-    organ* o = &g->o[i];
-    tx_snapshot xs = tx_read(c, o->x);
-    const float* cur = o->rest;
-    if (xs.seq > 0 && xs.rows == (uint32_t)o->nv) cur = ((const tx_vertex*)xs.data)->x;
-    else if (xs.seq > 0) tx_warn(c, g->bad_surface);
-    double d = locate(o, cur, tip, mat[i]);
+    double d = locate(&g->o[i], &sf[i], tip, mat[i]);
     if (d <= g->contact && d < best) best = d, hot = i;
   }
   for (int i = 0; i < SOFT; i++) {
     organ* o = &g->o[i];
     tx_thermal_source(o->h, mat[i], g->radius, i == hot ? g->power : 0);
     tx_thermal_step(o->h);
-    publish(c, o);
+    if (g->remove_fraction > 0) vaporise(c, g, i);
+    publish(c, o, &sf[i]);
   }
   if (hot >= 0) g->active_s += g->dt;
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t1);
@@ -296,6 +439,8 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, g->substeps_r, fmax(tx_thermal_substeps(g->o[0].h), tx_thermal_substeps(g->o[1].h)));
   tx_set_result(c, g->p50_r, p.p50 * 1e-6);
   tx_set_result(c, g->p99_r, p.p99 * 1e-6);
+  tx_set_result(c, g->removed_r, g->o[0].removed + g->o[1].removed);
+  tx_set_result(c, g->removed_m3_r, g->o[0].removed_m3 + g->o[1].removed_m3);
 }
 
 static void fini(void* self) {
@@ -305,6 +450,7 @@ static void fini(void* self) {
     organ* o = &g->o[i];
     tx_thermal_destroy(o->h);
     free(o->rest), free(o->tri), free(o->tet), free(o->w);
+    free(o->fx), free(o->ft), free(o->at_row), free(o->at_tet), free(o->counted), free(o->burnt), free(o->cvol), free(o->gone);
   }
   free(g);
 }

@@ -9,9 +9,11 @@
 
 #include "bullet/fem.h"
 #include "picking.h" // grasper picking
+#include "removal.h"
 
 #include <tactus/components.h>
 #include <tactus/config.h>
+#include <tactus/events.h>
 #include <tactus/stats.h>
 
 #include <math.h>
@@ -37,6 +39,11 @@ typedef struct organ {
   int32_t* tet;  // (s.nv x 4) the nodes of the tetrahedron each surface vertex is embedded in
   float* w;      // (s.nv x 4) its barycentric weights there
   tx_port x, tri;
+  // removal (cautery's burns): once cut, the organ is drawn by its live tetrahedra's boundary
+  int tets;        // tetrahedra as loaded
+  bool cut;        // has lost a tetrahedron
+  int32_t* row_of; // (nodes) scratch of tx_cut_surface, all -1
+  tx_port node;    // ORGAN.surface_node
 } organ;
 
 typedef struct organs {
@@ -54,6 +61,11 @@ typedef struct organs {
   tx_hist steps; // ns
   // grasper picking (picking.c): NULL when no grasp poses are given
   tx_pick_ctl* pick;
+  // removal
+  tx_port burns;            // TX_EVENT_BURN listened to, or none
+  tx_warning burn_refused;  // an event naming no organ, no tetrahedron, or one removed already
+  tx_result removed_result; // tetrahedra removed
+  long removed;
 } organs;
 
 static const char* const names[SOFT] = {"liver", "stomach"};
@@ -88,6 +100,8 @@ static const tx_param_def params[] = {
     {"pose", TX_PARAM_STR, NULL, 0, 0, 0, "device0.pose", "the pose the tool follows (tx_pose)"},
     // grasper picking (picking.h)
     TX_PICK_PARAMS,
+    {"burn_events", TX_PARAM_STR, NULL, 0, 0, 0, "",
+     "the stream of TX_EVENT_BURN events (physics.cautery's events) whose tetrahedra are removed; \"\": none"},
 };
 
 // --- reading the assets -------------------------------------------------------
@@ -262,6 +276,12 @@ static int load_organ(tx_setup* s, organs* g, int which, const char* dir, const 
   if (rc == 0 && attach(o->fem, x, nx, which, band) == 0) rc = tx_setup_fail(s, "attach_m", "holds no node of the %s", names[which]);
   if (rc == 0) rc = embed(o, x, t, nt);
   if (rc == 0) {
+    o->tets = nt;
+    o->row_of = malloc(sizeof(int32_t) * (size_t)nx);
+    if (!o->row_of) rc = -1;
+    for (int i = 0; rc == 0 && i < nx; i++) o->row_of[i] = -1;
+  }
+  if (rc == 0) {
     o->nodes = nx;
     o->pos = malloc(sizeof(double) * 3 * (size_t)nx);
     o->rest = x;
@@ -322,9 +342,14 @@ static int configure(tx_setup* s, void** self) {
   for (int i = 0; i < SOFT; i++) {
     char key[64];
     snprintf(key, sizeof key, "%s.x", names[i]);
-    g->soft[i].x = tx_setup_write(s, &TX_COMPONENT_OF(key, tx_vertex, (uint32_t)g->soft[i].s.nv));
+    // room for the drawn surface, or for the live tetrahedra's boundary once cut
+    organ* o = &g->soft[i];
+    uint32_t rows = (uint32_t)(o->s.nv > o->nodes ? o->s.nv : o->nodes), tris = (uint32_t)(o->s.nt > 4 * o->tets ? o->s.nt : 4 * o->tets);
+    o->x = tx_setup_write(s, &TX_COMPONENT_OF(key, tx_vertex, rows));
     snprintf(key, sizeof key, "%s.tri", names[i]);
-    g->soft[i].tri = tx_setup_write(s, &TX_COMPONENT_OF(key, tx_triangle, (uint32_t)g->soft[i].s.nt));
+    o->tri = tx_setup_write(s, &TX_COMPONENT_OF(key, tx_triangle, tris));
+    snprintf(key, sizeof key, "%s.surface_node", names[i]);
+    o->node = tx_setup_write(s, &TX_COMPONENT_OF(key, tx_surface_node, rows));
   }
   g->spleen_x = tx_setup_write(s, &TX_COMPONENT_OF("spleen.x", tx_vertex, (uint32_t)g->spleen.nv));
   g->spleen_tri = tx_setup_write(s, &TX_COMPONENT_OF("spleen.tri", tx_triangle, (uint32_t)g->spleen.nt));
@@ -339,6 +364,12 @@ static int configure(tx_setup* s, void** self) {
   g->substeps_result = tx_setup_result(s, "substeps");
   g->moved_result = tx_setup_result(s, "max_displacement_m");
   g->force_result = tx_setup_result(s, "max_force_n");
+  // removal
+  const char* burns = tx_table_str(s, "burn_events");
+  if (!burns) return -1;
+  if (burns[0]) g->burns = tx_setup_listen(s, burns);
+  g->burn_refused = tx_setup_warning(s, "burn_refused");
+  g->removed_result = tx_setup_result(s, "removed_tets");
   tx_hist_clear(&g->steps);
 
   // grasper picking: both soft organs, their drawn surfaces carried by the tetrahedra they lie in
@@ -401,17 +432,43 @@ static void publish(tx_ctx* c, organs* g, const tx_pose* pose) {
       if (d2 > g->max_moved * g->max_moved) g->max_moved = sqrt(d2);
     }
     float* x = ((tx_vertex*)tx_write(c, o->x))->x;
-    for (int v = 0; v < o->s.nv; v++)
+    int32_t* node = &((tx_surface_node*)tx_write(c, o->node))->node;
+    if (o->cut) { // removal: the live tetrahedra's boundary, one row a node
+      int nf;
+      const int* hull = tx_fem_hull(o->fem, &nf);
+      int rows = tx_cut_surface(hull, nf, o->pos, o->row_of, node, x, ((tx_triangle*)tx_write(c, o->tri))->v);
+      tx_write_rows(c, o->x, (uint32_t)rows), tx_write_rows(c, o->node, (uint32_t)rows), tx_write_rows(c, o->tri, (uint32_t)nf);
+      continue;
+    }
+    for (int v = 0; v < o->s.nv; v++) {
+      node[v] = -1;
       for (int a = 0; a < 3; a++) {
         double p = 0;
         for (int k = 0; k < 4; k++) p += o->w[4 * v + k] * o->pos[3 * o->tet[4 * v + k] + a];
         x[3 * v + a] = (float)p;
       }
+    }
     memcpy(((tx_triangle*)tx_write(c, o->tri))->v, o->s.tri, sizeof(int32_t) * 3 * (size_t)o->s.nt);
+    tx_write_rows(c, o->x, (uint32_t)o->s.nv), tx_write_rows(c, o->node, (uint32_t)o->s.nv), tx_write_rows(c, o->tri, (uint32_t)o->s.nt);
   }
   memcpy(((tx_vertex*)tx_write(c, g->spleen_x))->x, g->spleen.x, sizeof(float) * 3 * (size_t)g->spleen.nv);
   memcpy(((tx_triangle*)tx_write(c, g->spleen_tri))->v, g->spleen.tri, sizeof(int32_t) * 3 * (size_t)g->spleen.nt);
   publish_contact(c, g, pose);
+}
+
+// removal: the tetrahedra the cautery vaporised leave their organ's body
+static void take_burns(tx_ctx* c, organs* g) {
+  tx_event e;
+  while (g->burns.id && tx_next_event(c, g->burns, &e)) {
+    if (e.kind != TX_EVENT_BURN) continue;
+    double which = e.burn.organ;
+    organ* o = which == 0 || which == 1 ? &g->soft[(int)which] : NULL;
+    if (!o || !tx_fem_remove_tet(o->fem, (int)e.source)) {
+      tx_warn(c, g->burn_refused);
+      continue;
+    }
+    o->cut = true, g->removed++;
+  }
 }
 
 static int init(tx_ctx* c, void* self) {
@@ -436,6 +493,7 @@ static void step(tx_ctx* c, void* self) {
       }
     }
   }
+  take_burns(c, g);
   // grasper picking: the jaws grasp or release on the organs as the last step left them
   if (g->pick) {
     const double* pos[SOFT];
@@ -473,6 +531,7 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, g->moved_result, g->max_moved);
   tx_set_result(c, g->force_result, g->max_force);
   tx_pick_finish(c, g->pick);
+  tx_set_result(c, g->removed_result, (double)g->removed);
 }
 
 static void fini(void* self) {
@@ -487,6 +546,7 @@ static void fini(void* self) {
     free(o->s.tri);
     free(o->tet);
     free(o->w);
+    free(o->row_of);
   }
   free(g->spleen.x);
   free(g->spleen.tri);

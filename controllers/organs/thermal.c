@@ -39,6 +39,8 @@ struct tx_thermal {
   int *row, *col;     // the conductances between neighbours, CSR (n + 1, row[n])
   double* cond;       // W/K: -K_ij, heat flows along it from the hotter node
   double* x;          // (n x 3) m, for the source
+  int* tets_at;       // (n) live tetrahedra at each node (tx_thermal_remove); 0: out of the solve
+  double lmax;        // 1/s, Gershgorin's bound on M^-1 (K + P): sets the substeps
 };
 
 double tx_perfusion_coefficient(double ml_min_kg, double tissue_rho) {
@@ -92,10 +94,30 @@ bool tx_tet_barycentric(const double* x, const int* tet, int e, const double p[3
   return true;
 }
 
+// the barycentric gradients of tetrahedron t (4 x 3, 1/m) and its volume;
+// false when it is flatter than the coordinates' rounding (no gradient)
+static bool gradients(const double* x, const int* t, double g[4][3], double* vol) {
+  double j[3][3];
+  double det = edges(x, t, j);
+  *vol = fabs(det) / 6;
+  double span = 0;
+  for (int c = 0; c < 3; c++) span = fmax(span, sqrt(j[0][c] * j[0][c] + j[1][c] * j[1][c] + j[2][c] * j[2][c]));
+  if (!(fabs(det) > 1e-9 * span * span * span) || !isfinite(det)) return false;
+  // rows of J^-1, and minus their sum
+  for (int r = 0; r < 3; r++)
+    for (int c = 0; c < 3; c++) {
+      int r1 = (r + 1) % 3, r2 = (r + 2) % 3, c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+      g[c + 1][r] = (j[r1][c1] * j[r2][c2] - j[r1][c2] * j[r2][c1]) / det; // (J^-1)[c][r] = cofactor(r, c) / det
+    }
+  for (int a = 0; a < 3; a++) g[0][a] = -(g[1][a] + g[2][a] + g[3][a]);
+  return true;
+}
+
 void tx_thermal_destroy(tx_thermal* h) {
   if (!h) return;
   free(h->t), free(h->tn), free(h->omega), free(h->vol), free(h->inv_mass), free(h->perf), free(h->q);
   free(h->reached), free(h->list), free(h->next), free(h->mark), free(h->src), free(h->row), free(h->col), free(h->cond), free(h->x);
+  free(h->tets_at);
   free(h);
 }
 
@@ -122,7 +144,8 @@ tx_thermal* tx_thermal_create(const double* x, int n, const int* tet, int ntet, 
   h->reached = calloc((size_t)n, sizeof(bool));
   h->list = malloc(sizeof(int) * (size_t)n), h->next = malloc(sizeof(int) * (size_t)n);
   h->mark = calloc((size_t)n, sizeof(unsigned)), h->src = malloc(sizeof(int) * (size_t)n);
-  if (!h->list || !h->next || !h->mark || !h->src || !h->reached || !h->t || !h->tn || !h->omega || !h->vol || !h->inv_mass || !h->perf || !h->q || !h->x || !h->row)
+  h->tets_at = calloc((size_t)n, sizeof(int));
+  if (!h->tets_at || !h->list || !h->next || !h->mark || !h->src || !h->reached || !h->t || !h->tn || !h->omega || !h->vol || !h->inv_mass || !h->perf || !h->q || !h->x || !h->row)
     return tx_set_error("thermal: out of memory"), fail(h, NULL);
   memcpy(h->x, x, 3 * sz);
 
@@ -133,6 +156,7 @@ tx_thermal* tx_thermal_create(const double* x, int n, const int* tet, int ntet, 
       int v = tet[4 * e + k];
       if (v < 0 || v >= n) return tx_set_error("thermal: tetrahedron %d names node %d of %d", e, v, n), fail(h, NULL);
       h->row[v + 1] += 3;
+      h->tets_at[v]++;
       for (int a = 0; a < 3; a++) scale = fmax(scale, fabs(x[3 * v + a]));
     }
   for (int i = 0; i < n; i++) h->row[i + 1] += h->row[i];
@@ -143,22 +167,8 @@ tx_thermal* tx_thermal_create(const double* x, int n, const int* tet, int ntet, 
   memcpy(fill, h->row, sizeof(int) * (size_t)n);
   for (int e = 0; e < ntet; e++) {
     const int* t = tet + 4 * e;
-    double j[3][3];
-    double det = edges(x, t, j);
-    double vol = fabs(det) / 6;
-    // a tetrahedron flatter than the coordinates' rounding has no gradient
-    double span = 0;
-    for (int c = 0; c < 3; c++) span = fmax(span, sqrt(j[0][c] * j[0][c] + j[1][c] * j[1][c] + j[2][c] * j[2][c]));
-    if (!(fabs(det) > 1e-9 * span * span * span) || !isfinite(det))
-      return tx_set_error("thermal: tetrahedron %d is degenerate", e), fail(h, fill);
-    // the barycentric gradients: rows of J^-1, and minus their sum
-    double g[4][3];
-    for (int r = 0; r < 3; r++)
-      for (int c = 0; c < 3; c++) {
-        int r1 = (r + 1) % 3, r2 = (r + 2) % 3, c1 = (c + 1) % 3, c2 = (c + 2) % 3;
-        g[c + 1][r] = (j[r1][c1] * j[r2][c2] - j[r1][c2] * j[r2][c1]) / det; // (J^-1)[c][r] = cofactor(r, c) / det
-      }
-    for (int a = 0; a < 3; a++) g[0][a] = -(g[1][a] + g[2][a] + g[3][a]);
+    double g[4][3], vol;
+    if (!gradients(x, t, g, &vol)) return tx_set_error("thermal: tetrahedron %d is degenerate", e), fail(h, fill);
     for (int a = 0; a < 4; a++) {
       h->vol[t[a]] += vol / 4;
       for (int b = 0; b < 4; b++) {
@@ -198,6 +208,7 @@ tx_thermal* tx_thermal_create(const double* x, int n, const int* tet, int ntet, 
     for (int a = h->row[i]; a < h->row[i + 1]; a++) diag += h->cond[a], off += fabs(h->cond[a]);
     lmax = fmax(lmax, (fabs(diag) + off + h->perf[i]) * h->inv_mass[i]);
   }
+  h->lmax = lmax;
   h->stable_dt = 0.9 * 2 / lmax;
   h->substeps = (int)ceil(dt / h->stable_dt - 1e-12);
   if (h->substeps < 1) h->substeps = 1;
@@ -255,7 +266,7 @@ void tx_thermal_source(tx_thermal* h, const double c[3], double radius, double p
   for (int i = 0; i < h->n; i++) {
     const double* p = h->x + 3 * i;
     double d2 = (p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]);
-    if (d2 < best) best = d2, nearest = i;
+    if (d2 < best && h->vol[i] > 0) best = d2, nearest = i; // removed tissue takes no heat
     if (d2 < cut) {
       h->q[i] = exp(-d2 / (2 * radius * radius)) * h->vol[i];
       if (h->q[i] > 0) sum += h->q[i], h->src[h->nsrc++] = i;
@@ -529,3 +540,59 @@ bool tx_thermal_refine_embed(const double* x, int n, const int* tet, int ntet, i
   *xf = cx, *nf = n, *tetf = ct, *ntetf = ntet;
   return true;
 }
+
+// the conductance from i to j in i's row, or NULL
+static double* conductance(tx_thermal* h, int i, int j) {
+  for (int a = h->row[i]; a < h->row[i + 1]; a++)
+    if (h->col[a] == j) return &h->cond[a];
+  return NULL;
+}
+
+bool tx_thermal_remove(tx_thermal* h, const int t[4]) {
+  for (int a = 0; a < 4; a++)
+    if (t[a] < 0 || t[a] >= h->n || h->tets_at[t[a]] <= 0) return false;
+  double g[4][3], vol;
+  if (!gradients(h->x, t, g, &vol)) return false;
+  // its conductances, volume, heat capacity and perfusion go
+  for (int a = 0; a < 4; a++) {
+    for (int b = 0; b < 4; b++) {
+      double* c = b == a ? NULL : conductance(h, t[a], t[b]);
+      if (c) *c += h->tissue.k * vol * (g[a][0] * g[b][0] + g[a][1] * g[b][1] + g[a][2] * g[b][2]);
+    }
+    h->vol[t[a]] -= vol / 4;
+  }
+  for (int a = 0; a < 4; a++) {
+    int i = t[a];
+    if (--h->tets_at[i] == 0) {
+      // out of the solve: no volume, no heat, no conductance either way (not
+      // the rounding left by the subtractions), at T_a so the band passes it by
+      for (int b = h->row[i]; b < h->row[i + 1]; b++) {
+        h->cond[b] = 0;
+        double* back = conductance(h, h->col[b], i);
+        if (back) *back = 0;
+      }
+      h->vol[i] = 0, h->inv_mass[i] = 0, h->perf[i] = 0, h->q[i] = 0;
+      h->t[i] = h->tn[i] = h->tissue.t_arterial;
+      continue;
+    }
+    if (!(h->vol[i] > 0)) h->vol[i] = 1e-30;
+    if (h->inv_mass[i] > 0) h->inv_mass[i] = 1 / (h->tissue.rho * h->tissue.c * h->vol[i]);
+    h->perf[i] = h->tissue.perfusion * h->vol[i];
+    // a node left with a sliver may need a shorter substep
+    double diag = 0, off = 0;
+    for (int b = h->row[i]; b < h->row[i + 1]; b++) diag += h->cond[b], off += fabs(h->cond[b]);
+    double l = (fabs(diag) + off + h->perf[i]) * h->inv_mass[i];
+    if (l > h->lmax) {
+      h->lmax = l;
+      h->stable_dt = 0.9 * 2 / l;
+      int sub = (int)ceil(h->dt / h->stable_dt - 1e-12);
+      h->substeps = sub < 1 ? 1 : sub > 100000 ? 100000 : sub;
+      h->h = h->dt / h->substeps;
+    }
+  }
+  h->rescan = true;
+  return true;
+}
+
+bool tx_thermal_node_live(const tx_thermal* h, int node) { return node >= 0 && node < h->n && h->tets_at[node] > 0; }
+const double* tx_thermal_positions(const tx_thermal* h) { return h->x; }

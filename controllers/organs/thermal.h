@@ -89,6 +89,15 @@ void tx_thermal_step(tx_thermal* h);
 // every node back to t_arterial, no damage, no source
 void tx_thermal_reset(tx_thermal* h);
 
+// tissue removed (vaporised): the tetrahedron of nodes t (4) leaves the
+// solve. Its conductances, volume, heat capacity and perfusion go; a node
+// in no live tetrahedron any more takes no heat and holds T_a; the substeps
+// grow if a node's stable step shrank. false (nothing changes): a node out
+// of range or already out, a flat tetrahedron. No allocation.
+bool tx_thermal_remove(tx_thermal* h, const int t[4]);
+bool tx_thermal_node_live(const tx_thermal* h, int node);
+const double* tx_thermal_positions(const tx_thermal* h); // (n x 3) m, as created
+
 int tx_thermal_nodes(const tx_thermal* h);
 const double* tx_thermal_temperature(const tx_thermal* h); // K, one per node
 double* tx_thermal_temperature_mut(tx_thermal* h);         // to set an initial field

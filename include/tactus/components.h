@@ -332,6 +332,11 @@ TX_LAYOUT_ASSERT(tx_instrument_held, double);
 //   ORGAN.x (N rows, tx_vertex): the surface vertices, m
 //   ORGAN.tri (M rows, tx_triangle): the surface triangles, outward by the
 //     right-hand rule, rows into ORGAN.x
+//   ORGAN.surface_node (as many rows as ORGAN.x, tx_surface_node): the tetrahedral
+//     node each row is, or -1 for a vertex of the drawn surface. An organ
+//     that has lost tetrahedra (cautery's removal, docs/lagb.md) is drawn by
+//     its live tetrahedra's boundary, one row a node; until then by the
+//     drawn surface embedded in them, every row -1
 // and, like SKIN.contact for the skin, the organs' reaction on the tool:
 //   organs.contact (1 row, tx_skin_contact): force, where it holds, its
 //     direction, the tangent stiffness k along it, the indentation
@@ -352,6 +357,13 @@ typedef struct tx_organ_grasp {
 #define tx_organ_grasp_COLS 8u
 #define tx_organ_grasp_UNITS "N, m, 1"
 TX_LAYOUT_ASSERT(tx_organ_grasp, double);
+typedef struct tx_surface_node {
+  int32_t node; // the tetrahedral node (its number in the organ's .node file), -1: a vertex of the drawn surface
+} tx_surface_node;
+#define tx_surface_node_TYPE TX_I32
+#define tx_surface_node_COLS 1u
+#define tx_surface_node_UNITS "1"
+TX_LAYOUT_ASSERT(tx_surface_node, int32_t);
 
 // --- gastric banding: the organs' temperature (physics.cautery) --------------
 

@@ -36,7 +36,7 @@ typedef enum tx_event_kind {
   TX_EVENT_RELEASE,   // jaws opened: source = instrument
   TX_EVENT_PUNCTURE,  // a surface was pierced: source = surface element (for the skin: its skin.tri row at that publish), payload .puncture
   TX_EVENT_CUT,       // something was cut: source = element (thread segment, link), payload .cut
-  TX_EVENT_BURN,      // tissue reached a damage temperature: source = node, value[0] = K
+  TX_EVENT_BURN,      // tissue vaporised: source = tetrahedron (its row of ORGAN.ele), payload .burn
   TX_EVENT_KNOT,      // a knot formed or was fixed: source = knot index
   TX_EVENT_STEP,      // a procedure step began: source = step index
   TX_EVENT_USER = 1000 // kinds of plugins start here
@@ -58,6 +58,11 @@ typedef struct tx_puncture_payload { // TX_EVENT_PUNCTURE, source = surface elem
 typedef struct tx_cut_payload { // TX_EVENT_CUT, source = thread segment (node i to i + 1) or link
   double point[3]; // m, where the blades closed, world frame
 } tx_cut_payload;
+typedef struct tx_burn_payload { // TX_EVENT_BURN, source = tetrahedron of the organ's .ele (physics.organs' numbering)
+  double organ;    // which organ: 0 the liver, 1 the stomach (physics.organs' order), a whole number
+  double fraction; // of its volume that had reached the vaporisation temperature when it was sent
+  double point[3]; // m, its centroid at rest
+} tx_burn_payload;
 typedef struct tx_event {
   uint64_t seq;     // set by the push: 1, 2, ... per stream; a gap means events were lost
   int64_t sim_ns;   // simulation time of the step that sent it, ns
@@ -68,6 +73,7 @@ typedef struct tx_event {
     tx_grasp_payload grasp;      // TX_EVENT_GRASP
     tx_puncture_payload puncture; // TX_EVENT_PUNCTURE
     tx_cut_payload cut;           // TX_EVENT_CUT
+    tx_burn_payload burn;         // TX_EVENT_BURN
   };
 } tx_event;
 #ifdef __cplusplus
@@ -75,11 +81,13 @@ static_assert(sizeof(tx_event) == 64, "one event is one cache line");
 static_assert(sizeof(tx_grasp_payload) <= 5 * sizeof(double), "a grasp fits in an event");
 static_assert(sizeof(tx_puncture_payload) <= 5 * sizeof(double), "a puncture fits in an event");
 static_assert(sizeof(tx_cut_payload) <= 5 * sizeof(double), "a cut fits in an event");
+static_assert(sizeof(tx_burn_payload) <= 5 * sizeof(double), "a burn fits in an event");
 #else
 _Static_assert(sizeof(tx_event) == 64, "one event is one cache line");
 _Static_assert(sizeof(tx_grasp_payload) <= 5 * sizeof(double), "a grasp fits in an event");
 _Static_assert(sizeof(tx_puncture_payload) <= 5 * sizeof(double), "a puncture fits in an event");
 _Static_assert(sizeof(tx_cut_payload) <= 5 * sizeof(double), "a cut fits in an event");
+_Static_assert(sizeof(tx_burn_payload) <= 5 * sizeof(double), "a burn fits in an event");
 #endif
 
 typedef struct tx_stream tx_stream;

@@ -65,8 +65,11 @@ bool tx_fem_step(tx_fem* b, int steps);
 
 // A kinematic frictionless sphere (the tool) against the tetrahedra's
 // boundary: a face it overlaps is pushed out along the sphere's normal, the
-// push shared by the face's nodes by their barycentric weights; the momentum
-// this takes is its force. r <= 0: no tool.
+// push shared by the face's nodes by their barycentric weights, at most a
+// tenth of r a step; the momentum this takes is its force. A face the
+// centre is behind is pushed back only if the centre was in front of it at
+// the last call (it went through); a face a removal laid open inside the
+// sphere is left until the sphere has left it. r <= 0: no tool.
 void tx_fem_set_tool(tx_fem* b, const double c[3], double r);
 typedef struct tx_fem_tool_info {
   double f[3];    // N, the body's force on the tool, averaged over the last tx_fem_step
@@ -88,6 +91,28 @@ bool tx_fem_is_kinematic(const tx_fem* b, int node);
 // the last tx_fem_step (minus the load on what holds it). Links model: false
 // (its position iterations carry no force), f zero.
 bool tx_fem_kinematic_force(const tx_fem* b, int node, double f[3]);
+
+// Removal (tissue vaporised by cautery): tetrahedron t stops acting. Its
+// elastic force goes, its mass leaves its four nodes, and a node left in no
+// live tetrahedron leaves the solve (massless, not stepped, where it was;
+// a kinematic one is released). The boundary the tool meets is updated: the
+// removed tetrahedron's faces that were boundary go, its faces shared with a
+// live neighbour become boundary, turned outward from that neighbour.
+// Links model: the links of edges no live tetrahedron has any more go.
+// No allocation (sized at tx_fem_create). false: t out of range or already
+// removed; nothing changes. Removing the last tetrahedron is refused too
+// (false): a body always has one.
+bool tx_fem_remove_tet(tx_fem* b, int t);
+bool tx_fem_tet_live(const tx_fem* b, int t);
+int tx_fem_tet_count(const tx_fem* b);       // tetrahedra as created
+int tx_fem_live_tet_count(const tx_fem* b);  // not removed
+const int* tx_fem_tets(const tx_fem* b);     // (tx_fem_tet_count x 4) the tetrahedra as created
+bool tx_fem_node_live(const tx_fem* b, int node);  // in a live tetrahedron
+// the tetrahedron's signed volume now, m^3 (positive: as created; 0 for a removed one)
+double tx_fem_tet_volume(const tx_fem* b, int t);
+// the live tetrahedra's boundary: *faces rows of 3 node numbers, outward
+// (right-hand rule); valid until the next tx_fem_remove_tet
+const int* tx_fem_hull(const tx_fem* b, int* faces);
 
 // the state (positions, velocities) kept aside, and brought back
 void tx_fem_save(tx_fem* b);

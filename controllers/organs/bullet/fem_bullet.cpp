@@ -56,8 +56,26 @@ struct tx_fem {
   std::vector<btVector3> kin_force;     // (nv) N, elastic force summed over the substeps
   int kin_count;                        // kinematic nodes now
   int kin_steps;                        // substeps kin_force sums
+  // removal (tx_fem_remove_tet); every array sized at create
+  int ne, live_ne;
+  std::vector<int> tets;       // (ne x 4) as created
+  std::vector<double> rest;    // (nv x 3) m, the nodes as created (faces are turned outward by them)
+  std::vector<char> tet_live;  // (ne)
+  std::vector<int> slot, slot_tet;  // (ne) tetrahedron -> its row in the body's m_tetras, and back
+  std::vector<int> nbr;        // (ne x 4) the tetrahedron across face k (opposite node k), -1: none
+  std::vector<int> hull_at;    // (ne x 4) face k of t: its row in hull, -1: not boundary
+  std::vector<int> hull_owner; // (hull rows) 4 t + k of each boundary face
+  std::vector<char> fresh;     // (ne x 4) laid open by a removal inside the tool: not pushed until the tool leaves it
+  std::vector<int> node_tets;  // (nv) live tetrahedra at each node; 0: out of the solve
+  std::vector<double> tet_mass, tet_true;  // (ne) kg, the mass it lumps (scaled), its true mass
+  std::vector<double> true_mass;           // (nv) kg, the true mass at each node
+  std::vector<char> fixed;     // (nv) tx_fem_fix
+  std::vector<int> tet_edge;   // links: (ne x 6) the edge ids of each tetrahedron
+  std::vector<int> edge_count; // links: live tetrahedra on each edge
+  std::vector<std::pair<int, int>> edge_nodes;  // links: the nodes of each edge
   bool has_tool;
   double tool_c[3], tool_r;
+  double tool_prev[3];  // m, the centre at the last tx_fem_step: a face it has gone behind since is pushed back
   tx_fem_tool_info tool;
 };
 
@@ -84,6 +102,34 @@ static double tet_volume(const double* a, const double* b, const double* c, cons
   return (ab[0] * (ac[1] * ad[2] - ac[2] * ad[1]) + ab[1] * (ac[2] * ad[0] - ac[0] * ad[2]) +
           ab[2] * (ac[0] * ad[1] - ac[1] * ad[0])) /
          6.0;
+}
+
+// face k of tetrahedron t (opposite its node k) made boundary, turned
+// outward: the fourth node behind it (the order the first build used)
+static void hull_add(tx_fem* b, int t, int k) {
+  const int* e = &b->tets[4 * (size_t)t];
+  int f[3] = {e[(k + 1) % 4], e[(k + 2) % 4], e[(k + 3) % 4]};
+  std::sort(f, f + 3);
+  int a = f[0], c = f[1], g = f[2], o = e[k];
+  const double* x = b->rest.data();
+  if (tet_volume(x + 3 * a, x + 3 * c, x + 3 * g, x + 3 * o) > 0) std::swap(c, g);
+  b->hull_at[4 * (size_t)t + (size_t)k] = (int)b->hull_owner.size();
+  b->hull_owner.push_back(4 * t + k);
+  b->hull.push_back(a), b->hull.push_back(c), b->hull.push_back(g);
+}
+
+// face k of t no longer boundary: the last row takes its place
+static void hull_drop(tx_fem* b, int t, int k) {
+  size_t at = (size_t)b->hull_at[4 * (size_t)t + (size_t)k], last = b->hull_owner.size() - 1;
+  b->hull_at[4 * (size_t)t + (size_t)k] = -1;
+  if (at != last) {
+    int owner = b->hull_owner[last];
+    b->hull_owner[at] = owner;
+    b->hull_at[(size_t)owner] = (int)at;
+    for (int q = 0; q < 3; q++) b->hull[3 * at + (size_t)q] = b->hull[3 * last + (size_t)q];
+  }
+  b->hull_owner.pop_back();
+  b->hull.resize(3 * last);
 }
 
 extern "C" void tx_fem_destroy(tx_fem* b) {
@@ -169,9 +215,11 @@ extern "C" tx_fem* tx_fem_create(const tx_fem_def* d, const double* nodes, int n
     b->mass.assign((size_t)nv, 0.0);
     b->weight.assign((size_t)nv, 0.0);
     double true_mass = 0, mass = 0;
+    b->tet_mass.resize((size_t)ne), b->tet_true.resize((size_t)ne);
     for (int t = 0; t < ne; t++) {
       double rho = d->density;
       if (d->mass_scaling && fem) rho = std::max(rho, modulus * std::pow(b->dt / (0.3 * alt[(size_t)t]), 2));
+      b->tet_mass[(size_t)t] = rho * vol[(size_t)t], b->tet_true[(size_t)t] = d->density * vol[(size_t)t];
       for (int k = 0; k < 4; k++) {
         b->mass[(size_t)tets[4 * t + k]] += rho * vol[(size_t)t] / 4;
         b->weight[(size_t)tets[4 * t + k]] += d->density * vol[(size_t)t] / 4;
@@ -179,6 +227,7 @@ extern "C" tx_fem* tx_fem_create(const tx_fem_def* d, const double* nodes, int n
       true_mass += d->density * vol[(size_t)t], mass += rho * vol[(size_t)t];
     }
     b->added_mass = mass / true_mass - 1;
+    b->true_mass = b->weight;
     for (int i = 0; i < nv; i++) b->weight[(size_t)i] /= b->mass[(size_t)i];  // the fraction of each node's mass that gravity pulls
     b->before.resize((size_t)nv);
     for (int i = 0; i < nv; i++)
@@ -190,25 +239,39 @@ extern "C" tx_fem* tx_fem_create(const tx_fem_def* d, const double* nodes, int n
     b->kin_to.resize((size_t)nv);
     b->kin_force.resize((size_t)nv);
     b->kin_count = b->kin_steps = 0;
-    // the boundary: faces that belong to one tetrahedron only, turned outward
+    // removal's bookkeeping, sized once
+    b->ne = b->live_ne = ne;
+    b->tets.assign(tets, tets + 4 * (size_t)ne);
+    b->rest.assign(nodes, nodes + 3 * (size_t)nv);
+    b->tet_live.assign((size_t)ne, 1);
+    b->slot.resize((size_t)ne), b->slot_tet.resize((size_t)ne);
+    for (int t = 0; t < ne; t++) b->slot[(size_t)t] = b->slot_tet[(size_t)t] = t;
+    b->nbr.assign(4 * (size_t)ne, -1);
+    b->hull_at.assign(4 * (size_t)ne, -1);
+    b->fresh.assign(4 * (size_t)ne, 0);
+    b->hull.reserve(12 * (size_t)ne);
+    b->hull_owner.reserve(4 * (size_t)ne);
+    b->node_tets.assign((size_t)nv, 0);
+    for (int t = 0; t < 4 * ne; t++) b->node_tets[(size_t)tets[t]]++;
+    b->fixed.assign((size_t)nv, 0);
+    // the boundary: faces that belong to one tetrahedron only, turned outward;
+    // the others give each tetrahedron its neighbour across them
     {
-      std::vector<std::array<int, 4>> keyed;  // sorted face, then the tetrahedron's fourth node
+      std::vector<std::array<int, 6>> keyed;  // sorted face, the tetrahedron's fourth node, the tetrahedron, the face
       keyed.reserve(4 * (size_t)ne);
       for (int t = 0; t < ne; t++)
         for (int k = 0; k < 4; k++) {
           std::array<int, 3> f = {tets[4 * t + (k + 1) % 4], tets[4 * t + (k + 2) % 4], tets[4 * t + (k + 3) % 4]};
           std::sort(f.begin(), f.end());
-          keyed.push_back({f[0], f[1], f[2], tets[4 * t + k]});
+          keyed.push_back({f[0], f[1], f[2], tets[4 * t + k], t, k});
         }
       std::sort(keyed.begin(), keyed.end());
       for (size_t i = 0; i < keyed.size(); i++) {
-        bool twin = (i + 1 < keyed.size() && std::equal(keyed[i].begin(), keyed[i].begin() + 3, keyed[i + 1].begin())) ||
-                    (i > 0 && std::equal(keyed[i].begin(), keyed[i].begin() + 3, keyed[i - 1].begin()));
-        if (twin) continue;
-        int a = keyed[i][0], c = keyed[i][1], e = keyed[i][2], o = keyed[i][3];
-        // outward: the fourth node is behind the face
-        if (tet_volume(nodes + 3 * a, nodes + 3 * c, nodes + 3 * e, nodes + 3 * o) > 0) std::swap(c, e);
-        b->hull.push_back(a), b->hull.push_back(c), b->hull.push_back(e);
+        bool next = i + 1 < keyed.size() && std::equal(keyed[i].begin(), keyed[i].begin() + 3, keyed[i + 1].begin());
+        bool prev = i > 0 && std::equal(keyed[i].begin(), keyed[i].begin() + 3, keyed[i - 1].begin());
+        if (next) b->nbr[(size_t)(4 * keyed[i][4] + keyed[i][5])] = keyed[i + 1][4];
+        if (prev) b->nbr[(size_t)(4 * keyed[i][4] + keyed[i][5])] = keyed[i - 1][4];
+        if (!next && !prev) hull_add(b, keyed[i][4], keyed[i][5]);
       }
     }
 
@@ -280,6 +343,21 @@ extern "C" tx_fem* tx_fem_create(const tx_fem_def* d, const double* nodes, int n
           }
       s->m_materials[0]->m_kLST = (btScalar)d->link_stiffness;
       for (const auto& e : edges) s->appendLink(e.first, e.second, s->m_materials[0], false);
+      // each tetrahedron's edges by id, for removal
+      b->edge_nodes.assign(edges.begin(), edges.end());
+      b->edge_count.assign(b->edge_nodes.size(), 0);
+      b->tet_edge.resize(6 * (size_t)ne);
+      for (int t = 0; t < ne; t++) {
+        int q = 0;
+        for (int i = 0; i < 4; i++)
+          for (int j = i + 1; j < 4; j++) {
+            int a = tets[4 * t + i], c = tets[4 * t + j];
+            std::pair<int, int> key(std::min(a, c), std::max(a, c));
+            int id = (int)(std::lower_bound(b->edge_nodes.begin(), b->edge_nodes.end(), key) - b->edge_nodes.begin());
+            b->tet_edge[6 * (size_t)t + (size_t)q++] = id;
+            b->edge_count[(size_t)id]++;
+          }
+      }
       s->m_cfg.piterations = d->iterations;
       s->m_cfg.kVC = (btScalar)d->volume_stiffness;
       s->setPose(d->volume_stiffness > 0, false);
@@ -295,11 +373,11 @@ extern "C" tx_fem* tx_fem_create(const tx_fem_def* d, const double* nodes, int n
 }
 
 extern "C" void tx_fem_fix(tx_fem* b, int node) {
-  if (node >= 0 && node < b->nv) b->body->setMass(node, 0);
+  if (node >= 0 && node < b->nv) b->body->setMass(node, 0), b->fixed[(size_t)node] = 1;
 }
 
 extern "C" void tx_fem_set_kinematic(tx_fem* b, int node, const double p[3]) {
-  if (node < 0 || node >= b->nv || !std::isfinite(p[0] + p[1] + p[2])) return;
+  if (node < 0 || node >= b->nv || !std::isfinite(p[0] + p[1] + p[2]) || b->node_tets[(size_t)node] == 0) return;
   size_t i = (size_t)node;
   btSoftBody::Node& n = b->body->m_nodes[node];
   if (!b->kinematic[i]) {
@@ -314,7 +392,7 @@ extern "C" void tx_fem_set_kinematic(tx_fem* b, int node, const double p[3]) {
 
 extern "C" void tx_fem_release(tx_fem* b, int node) {
   if (node < 0 || node >= b->nv || !b->kinematic[(size_t)node]) return;
-  b->body->setMass(node, (btScalar)b->mass[(size_t)node]);
+  if (b->node_tets[(size_t)node] > 0) b->body->setMass(node, (btScalar)b->mass[(size_t)node]);
   b->kinematic[(size_t)node] = 0, b->kin_count--;
 }
 
@@ -422,9 +500,14 @@ static void closest_on_triangle(const btVector3& p, const btVector3& a, const bt
 
 // how far a sphere (c, r) reaches past triangle abc along the face's outward
 // normal side: r minus the signed distance to its closest point (> 0: overlap);
-// n, the unit direction the face must move to leave the sphere
-static double overlap(const btVector3& c, double r, const btVector3& a, const btVector3& b, const btVector3& d, double w[3],
-                      btVector3& n) {
+// n, the unit direction the face must move to leave the sphere. A face the
+// centre is behind is pushed back only if the centre was in front of it at
+// pc, the last step's: it went through. Otherwise it is a face of the far
+// side, or one a removal laid open beside the tool, which the tool has not
+// touched from outside (pushed by r + dist in one step, it would turn
+// elements inside out).
+static double overlap(const btVector3& c, const btVector3& pc, double r, const btVector3& a, const btVector3& b,
+                      const btVector3& d, double w[3], btVector3& n) {
   closest_on_triangle(c, a, b, d, w);
   btVector3 q = a * (btScalar)w[0] + b * (btScalar)w[1] + d * (btScalar)w[2];
   btVector3 face = (b - a).cross(d - a);
@@ -439,6 +522,7 @@ static double overlap(const btVector3& c, double r, const btVector3& a, const bt
     return r - dist;
   }
   if (dist >= r) return 0;  // behind and out of reach: a face of the far side
+  if (!((pc - q).dot(face) > 0)) return 0;  // behind before too: not met from outside
   n = -face;                // the centre went past the face: push it back behind the centre
   return r + dist;
 }
@@ -447,6 +531,7 @@ static double overlap(const btVector3& c, double r, const btVector3& a, const bt
 static btVector3 tool_contact(tx_fem* b, int& touched) {
   btAlignedObjectArray<btSoftBody::Node>& nodes = b->body->m_nodes;
   btVector3 c((btScalar)b->tool_c[0], (btScalar)b->tool_c[1], (btScalar)b->tool_c[2]);
+  btVector3 pc((btScalar)b->tool_prev[0], (btScalar)b->tool_prev[1], (btScalar)b->tool_prev[2]);
   double r = b->tool_r;
   btVector3 impulse(0, 0, 0);
   touched = 0;
@@ -455,9 +540,19 @@ static btVector3 tool_contact(tx_fem* b, int& touched) {
     if ((v[0]->m_x - c).length2() > (btScalar)(16 * r * r) + 2 * ((v[1]->m_x - v[0]->m_x).length2() + (v[2]->m_x - v[0]->m_x).length2()))
       continue;  // far: no face edge is long enough to reach the sphere
     double w[3];
-    btVector3 n;
-    double p = overlap(c, r, v[0]->m_x, v[1]->m_x, v[2]->m_x, w, n);
+    btVector3 n(0, 0, 0);
+    double p = overlap(c, pc, r, v[0]->m_x, v[1]->m_x, v[2]->m_x, w, n);
+    // a face a removal laid open where the tool already was (the cavity the
+    // burn left around the tip) is not thrown out of it in one step, which
+    // would turn its tetrahedron inside out: it is met once the tool has left it
+    char& fresh = b->fresh[(size_t)b->hull_owner[f / 3]];
+    if (fresh && p > 0) continue;
+    fresh = 0;
     if (!(p > 0)) continue;
+    // at most a tenth of the radius a step: a face met edge-on or far in (a
+    // ragged surface after removals) is eased out over a few steps rather
+    // than thrown out at once past the elements behind it
+    p = std::min(p, 0.1 * r);
     // move the face's closest point by p along n: each free node by w_i p / sum(w^2)
     double ww = 0;
     for (int k = 0; k < 3; k++)
@@ -557,8 +652,10 @@ extern "C" bool tx_fem_step(tx_fem* b, int steps) {
 }
 
 extern "C" void tx_fem_set_tool(tx_fem* b, const double c[3], double r) {
+  bool had = b->has_tool;
   b->has_tool = r > 0 && std::isfinite(c[0] + c[1] + c[2] + r);
   if (!b->has_tool) return;
+  for (int a = 0; a < 3; a++) b->tool_prev[a] = had ? b->tool_c[a] : c[a];
   for (int a = 0; a < 3; a++) b->tool_c[a] = c[a];
   b->tool_r = r;
 }
@@ -596,4 +693,90 @@ extern "C" void tx_fem_positions(const tx_fem* b, double* out) {
     const btVector3& x = b->body->m_nodes[i].m_x;
     out[3 * i] = x.getX(), out[3 * i + 1] = x.getY(), out[3 * i + 2] = x.getZ();
   }
+}
+
+// --- removal -------------------------------------------------------------------
+
+extern "C" bool tx_fem_remove_tet(tx_fem* b, int t) {
+  if (t < 0 || t >= b->ne || !b->tet_live[(size_t)t] || b->live_ne <= 1) return false;
+  btSoftBody* s = b->body;
+  // its force goes: the body's last tetrahedron takes its row (the force
+  // reads m_tetras and m_tetraScratches by the same row)
+  int at = b->slot[(size_t)t], last = s->m_tetras.size() - 1;
+  if (at != last) {
+    s->m_tetras.swap(at, last);
+    if (s->m_tetraScratches.size() > last) s->m_tetraScratches.swap(at, last);
+    if (s->m_tetraScratchesTn.size() > last) s->m_tetraScratchesTn.swap(at, last);
+    int moved = b->slot_tet[(size_t)last];
+    b->slot[(size_t)moved] = at, b->slot_tet[(size_t)at] = moved;
+  }
+  s->m_tetras.pop_back();
+  if (s->m_tetraScratches.size() > last) s->m_tetraScratches.pop_back();
+  if (s->m_tetraScratchesTn.size() > last) s->m_tetraScratchesTn.pop_back();
+  b->slot[(size_t)t] = -1;
+  b->tet_live[(size_t)t] = 0, b->live_ne--;
+  // the boundary: its boundary faces go, the faces it shared come out
+  for (int k = 0; k < 4; k++) {
+    if (b->hull_at[4 * (size_t)t + (size_t)k] >= 0) hull_drop(b, t, k);
+    int n = b->nbr[4 * (size_t)t + (size_t)k];
+    if (n < 0 || !b->tet_live[(size_t)n]) continue;
+    for (int q = 0; q < 4; q++)
+      if (b->nbr[4 * (size_t)n + (size_t)q] == t) hull_add(b, n, q), b->fresh[4 * (size_t)n + (size_t)q] = 1;
+  }
+  // links: the edges no live tetrahedron has
+  if (!b->world)
+    for (int q = 0; q < 6; q++) {
+      int id = b->tet_edge[6 * (size_t)t + (size_t)q];
+      if (--b->edge_count[(size_t)id] > 0) continue;
+      const btSoftBody::Node *p0 = &s->m_nodes[b->edge_nodes[(size_t)id].first], *p1 = &s->m_nodes[b->edge_nodes[(size_t)id].second];
+      for (int l = 0; l < s->m_links.size(); l++) {
+        const btSoftBody::Link& k = s->m_links[l];
+        if ((k.m_n[0] == p0 && k.m_n[1] == p1) || (k.m_n[0] == p1 && k.m_n[1] == p0)) {
+          s->m_links.swap(l, s->m_links.size() - 1);
+          s->m_links.pop_back();
+          break;
+        }
+      }
+    }
+  // its mass leaves its nodes; a node in no live tetrahedron leaves the solve
+  for (int k = 0; k < 4; k++) {
+    size_t i = (size_t)b->tets[4 * (size_t)t + (size_t)k];
+    btSoftBody::Node& n = s->m_nodes[(int)i];
+    if (--b->node_tets[i] == 0) {
+      if (b->kinematic[i]) b->kinematic[i] = 0, b->kin_count--;
+      b->mass[i] = b->true_mass[i] = 0, b->weight[i] = 0;
+      s->setMass((int)i, 0);
+      n.m_v.setZero(), n.m_vn.setZero();
+      continue;
+    }
+    b->mass[i] = std::max(b->mass[i] - b->tet_mass[(size_t)t] / 4, 0.0);
+    b->true_mass[i] = std::max(b->true_mass[i] - b->tet_true[(size_t)t] / 4, 0.0);
+    b->weight[i] = b->mass[i] > 0 ? b->true_mass[i] / b->mass[i] : 0;
+    if (!b->fixed[i] && !b->kinematic[i]) s->setMass((int)i, (btScalar)b->mass[i]);
+  }
+  return true;
+}
+
+extern "C" bool tx_fem_tet_live(const tx_fem* b, int t) { return t >= 0 && t < b->ne && b->tet_live[(size_t)t]; }
+extern "C" int tx_fem_tet_count(const tx_fem* b) { return b->ne; }
+extern "C" int tx_fem_live_tet_count(const tx_fem* b) { return b->live_ne; }
+extern "C" const int* tx_fem_tets(const tx_fem* b) { return b->tets.data(); }
+extern "C" bool tx_fem_node_live(const tx_fem* b, int node) {
+  return node >= 0 && node < b->nv && b->node_tets[(size_t)node] > 0;
+}
+
+extern "C" double tx_fem_tet_volume(const tx_fem* b, int t) {
+  if (!tx_fem_tet_live(b, t)) return 0;
+  const int* e = &b->tets[4 * (size_t)t];
+  double p[4][3];
+  for (int k = 0; k < 4; k++) {
+    const btVector3& x = b->body->m_nodes[e[k]].m_x;
+    p[k][0] = x.getX(), p[k][1] = x.getY(), p[k][2] = x.getZ();
+  }
+  return tet_volume(p[0], p[1], p[2], p[3]);
+}
+
+extern "C" const int* tx_fem_hull(const tx_fem* b, int* faces) {
+  *faces = (int)b->hull_owner.size();
+  return b->hull.data();
 }

@@ -5,12 +5,15 @@
 // untouched) and the spot cools once the pedal is up; with the pedal up or
 // the tip off the tissue nothing heats; physics.instruments' L-hook drives
 // it through its root link (with ODE); bad parameters and a missing asset
-// are refused with one line naming the key or the file.
+// are refused with one line naming the key or the file; with physics.organs
+// listening, what boils is removed from both, and the liver is published
+// as its live tetrahedra's boundary, sound (removal).
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
 #include <cmocka.h>
 
+#include "controllers/organs/removal.h"
 #include "scenarios/loader.h"
 #include "tests/scenario_support.h"
 
@@ -147,6 +150,72 @@ static void burns_the_spot_then_cools(void** state) {
   tx_scenario_free(s);
 }
 
+// physics.organs listening to the cautery's burns: the 1 s burn removes
+// the tetrahedra whose boiled fraction passed remove_fraction (the same
+// count in both), the liver is then published as its live tetrahedra's
+// boundary (each row a distinct node, every row used, closed, the
+// temperature one row a row); the hook then sits in the hole, off the
+// tissue, and heats no more; with remove_fraction 0 nothing is removed,
+// the drawn surface stays and the whole 1 s burn is deposited
+static void removes_what_boils(void** state) {
+  (void)state;
+  const char* fractions[] = {"0.01", "0"};
+  for (int k = 0; k < 2; k++) {
+    char text[4096];
+    snprintf(text, sizeof text,
+             "{\"name\":\"t\",\"controllers\":["
+             "{\"name\":\"organs\",\"type\":\"physics.organs\",\"rate_hz\":30,\"params\":{\"assets\":\"" COARSE
+             "\",\"tool_radius_m\":0.002,\"burn_events\":\"cautery.burn\"}},"
+             "{\"name\":\"cautery\",\"type\":\"physics.cautery\",\"rate_hz\":100,"
+             "\"params\":{\"assets\":\"" COARSE "\",\"tip_y_m\":-0.002,\"refine\":2,\"power_w\":100,\"remove_fraction\":%s}},"
+             "{\"name\":\"haptics\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:%s\"}}]}",
+             fractions[k], hook);
+    tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+    if (!s) fail_msg("%s", tx_error());
+    run(s, 2.0);
+    double removed = result(s, "cautery.removed_tets");
+    print_message("  remove_fraction %s: %.0f tetrahedra removed (%.3g m^3), %.1f J deposited in %.2f s\n", fractions[k], removed,
+                  result(s, "cautery.removed_m3"), result(s, "cautery.energy_j"), result(s, "cautery.active_s"));
+    assert_true(result(s, "organs.removed_tets") == removed);
+    assert_int_equal(warnings(s, "organs.burn_refused"), 0);
+    assert_int_equal(warnings(s, "cautery.bad_surface"), 0);
+    // deposited while it touched: once the tissue under it is gone the tip is in the hole, off the tissue
+    double active = result(s, "cautery.active_s");
+    assert_true(fabs(result(s, "cautery.energy_j") - 100 * active) < 1e-9);
+    assert_true(k == 1 ? fabs(active - 1.0) < 0.021 : active < 1.0 - 0.05);
+    tx_snapshot x = latest_snapshot(s, "liver.x"), tri = latest_snapshot(s, "liver.tri"), nd = latest_snapshot(s, "liver.surface_node"),
+                t = latest_snapshot(s, "liver.temperature");
+    assert_int_equal(nd.rows, x.rows);
+    const int32_t* node = &((const tx_surface_node*)nd.data)->node;
+    if (k == 1) {
+      assert_true(removed == 0);
+      for (uint32_t r = 0; r < nd.rows; r++) assert_int_equal(node[r], -1);
+      tx_scenario_free(s);
+      continue;
+    }
+    assert_true(removed >= 1);
+    assert_int_equal(t.rows, x.rows);
+    int nodes = 0;
+    for (uint32_t r = 0; r < nd.rows; r++) nodes = node[r] + 1 > nodes ? node[r] + 1 : nodes;
+    uint64_t* keys = malloc(sizeof(uint64_t) * 3 * tri.rows);
+    int32_t* seen = malloc(sizeof(int32_t) * (size_t)(nodes > (int)x.rows ? nodes : (int)x.rows));
+    tx_surface_report rep;
+    bool sound = tx_surface_check(&((const tx_triangle*)tri.data)->v[0], (int)tri.rows, (int)x.rows, node, nodes, keys, seen, &rep);
+    print_message("  the cut liver: %d rows, %d triangles, %d edges (%d of more than two triangles)\n", rep.rows, rep.triangles,
+                  rep.edges, rep.nonmanifold_edges);
+    assert_true(sound);
+    const tx_temperature* tv = t.data;
+    const float* xv = x.data;
+    for (uint32_t r = 0; r < x.rows; r++) {
+      assert_true(node[r] >= 0);
+      assert_true(isfinite(xv[3 * r] + xv[3 * r + 1] + xv[3 * r + 2]));
+      assert_true(tv[r].t >= 310.15f - 1e-3f && tv[r].t <= 373.15f + 1e-3f);
+    }
+    free(keys), free(seen);
+    tx_scenario_free(s);
+  }
+}
+
 // the pedal on another bit, or the tip 3 cm above the tissue: no heat
 static void nothing_heats_unless_active_and_touching(void** state) {
   (void)state;
@@ -221,6 +290,8 @@ static void bad_parameters_and_assets(void** state) {
   expect_refused("\"vaporisation_k\":320,\"blood_k\":320", "vaporisation_k");
   expect_refused("\"liver_k\":0", "liver_k");
   expect_refused("\"pose\":\"\"", "pose");
+  expect_refused("\"events\":\"\"", "events");
+  expect_refused("\"remove_fraction\":1.5", "remove_fraction");
   expect_refused("\"assets\":\"/nonexistent/lagb\"", "/nonexistent/lagb/liver.node");
   tx_scenario* s = tx_scenario_load_text("test",
       "{\"name\":\"t\",\"controllers\":[{\"name\":\"cautery\",\"type\":\"physics.cautery\",\"rate_hz\":50}]}", 85, NULL);
@@ -233,6 +304,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(burns_the_spot_then_cools),
       cmocka_unit_test(nothing_heats_unless_active_and_touching),
+      cmocka_unit_test(removes_what_boils),
 #if TX_WITH_ODE
       cmocka_unit_test(follows_the_hook_instrument),
 #endif

@@ -7,7 +7,8 @@
 // and keeps the energy; the closed forms against quadrature and their
 // point-source limits; the solver converges on the quick levels; refinement
 // keeps the volume and embeds points exactly; no allocation in a step; bad
-// meshes and files refused with one line.
+// meshes and files refused with one line; tetrahedra removed leave a
+// solver that steps as one built on what is left.
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -15,6 +16,7 @@
 
 #include "tests/alloc_count.h"
 
+#include "controllers/organs/removal.h"
 #include "controllers/organs/thermal.h"
 #include "studies/experiments/cautery_heat.h"
 
@@ -306,6 +308,73 @@ static void bad_meshes_and_files(void** state) {
   free(xs), free(tets);
 }
 
+// a 4 x 2 x 2 block with the half x > 2 h removed, tetrahedron by
+// tetrahedron, steps as a 2 x 2 x 2 block built alone from the same start
+// (a hot node, no perfusion), to rounding; the removed nodes hold T_a, take
+// no heat from a source on them (it goes to the nearest live node) and
+// count no volume; a second removal of their nodes is refused; no allocation
+static void removal_is_a_smaller_mesh(void** state) {
+  (void)state;
+  const double hh = 0.002;
+  double *xa, *xb;
+  int *ta, *tb, na, nb, ea, eb;
+  assert_true(tx_block_mesh(4, 2, 2, hh, &xa, &na, &ta, &ea));
+  assert_true(tx_block_mesh(2, 2, 2, hh, &xb, &nb, &tb, &eb));
+  tx_tissue t = tx_tissue_liver();
+  t.perfusion = 0;
+  tx_thermal* a = tx_thermal_create(xa, na, ta, ea, &t, NULL, 0.5);
+  tx_thermal* b = tx_thermal_create(xb, nb, tb, eb, &t, NULL, 0.5);
+  assert_non_null(a), assert_non_null(b);
+  int removed = 0;
+  for (int e = 0; e < ea; e++) {
+    double cx = 0;
+    for (int k = 0; k < 4; k++) cx += xa[3 * ta[4 * e + k]] / 4;
+    if (cx < 2 * hh) continue;
+    counting = 1, allocations = 0;
+    assert_true(tx_thermal_remove(a, ta + 4 * e));
+    counting = 0;
+#ifndef TX_NO_ALLOC_COUNT
+    assert_int_equal(allocations, 0);
+#endif
+    removed++;
+  }
+  assert_int_equal(removed, ea / 2);
+  // the same node in both: b's (i, j, k) is a's (i, j, k) for i <= 2
+  int map[27];
+  for (int k = 0; k <= 2; k++)
+    for (int j = 0; j <= 2; j++)
+      for (int i = 0; i <= 2; i++) map[i + 3 * (j + 3 * k)] = i + 5 * (j + 3 * k);
+  double va = 0, vb = 0;
+  for (int i = 0; i < na; i++) {
+    bool kept = xa[3 * i] < 2 * hh + 1e-12;
+    assert_true(tx_thermal_node_live(a, i) == kept);
+    va += tx_thermal_volume(a)[i];
+  }
+  for (int i = 0; i < nb; i++) vb += tx_thermal_volume(b)[i];
+  assert_true(fabs(va - vb) < 1e-12 * vb);
+  tx_thermal_temperature_mut(a)[map[13]] += 10, tx_thermal_temperature_mut(b)[13] += 10;
+  // a source on the removed half: its heat goes to the nearest live node
+  double far[3] = {4 * hh, hh, hh};
+  tx_thermal_source(a, far, 1e-5, 1);
+  double near[3] = {2 * hh, hh, hh};
+  tx_thermal_source(b, near, 1e-5, 1);
+  for (int s = 0; s < 20; s++) tx_thermal_step(a), tx_thermal_step(b);
+  const double *fa = tx_thermal_temperature(a), *fb = tx_thermal_temperature(b);
+  double worst = 0;
+  for (int i = 0; i < nb; i++) worst = fmax(worst, fabs(fa[map[i]] - fb[i]));
+  for (int i = 0; i < na; i++)
+    if (!tx_thermal_node_live(a, i)) assert_true(fa[i] == t.t_arterial);
+  print_message("  half removed vs built alone: %.3g K apart at most (peak %.2f K)\n", worst, fb[13]);
+  assert_true(worst < 1e-9);
+  assert_true(fb[13] > t.t_arterial + 1);
+  // out already, or out of range: refused
+  assert_false(tx_thermal_remove(a, ta + 4 * (ea - 1)));
+  int bad[4] = {0, 1, 2, na};
+  assert_false(tx_thermal_remove(a, bad));
+  tx_thermal_destroy(a), tx_thermal_destroy(b);
+  free(xa), free(xb), free(ta), free(tb);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(uniform_field_stays),
@@ -320,6 +389,7 @@ int main(void) {
       cmocka_unit_test(refinement_keeps_volume_and_embeds),
       cmocka_unit_test(no_allocation_in_a_step),
       cmocka_unit_test(bad_meshes_and_files),
+      cmocka_unit_test(removal_is_a_smaller_mesh),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
