@@ -39,6 +39,7 @@ typedef enum tx_event_kind {
   TX_EVENT_BURN,      // tissue reached a damage temperature: source = node, value[0] = K
   TX_EVENT_KNOT,      // a knot formed or was fixed: source = knot index
   TX_EVENT_STEP,      // a procedure step began: source = step index
+  TX_EVENT_LATCH = 20, // the gastric band locked: source = 0, value[0..2] = the buckle's opening, m
   TX_EVENT_USER = 1000 // kinds of plugins start here
 } tx_event_kind;
 
