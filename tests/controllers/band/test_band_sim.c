@@ -1,7 +1,7 @@
 // The band (controllers/band/band_sim.h) on the committed assets
 // (assets/lagb/band_*): the distance joint holds its length within 1 % while
 // the two parts are pulled apart at 5 N; the ring comes back to its curved
-// rest shape after it was bent open and let go; the tube's tip driven through
+// rest shape after it was bent open and let go (1.5 s); the tube's tip driven through
 // the buckle latches, and the latch holds against a pull; driven past the
 // buckle outside its opening it does not latch; bad input is refused.
 #include <stdarg.h>
@@ -45,7 +45,7 @@ static void joint_holds_at_5n(void** state) {
   double worst = 0, rest = tx_band_joint_rest(b);
   double head0[3], head[3];
   tx_band_body_position(b, TX_BAND_TUBE_HEAD, head0);
-  for (int s = 0; s < 120; s++) { // 2 s
+  for (int s = 0; s < 60; s++) { // 1 s: the error peaks in the first 0.2 s
     assert_true(tx_band_step(b));
     worst = fmax(worst, fabs(tx_band_joint_length(b) / rest - 1));
   }
@@ -81,23 +81,23 @@ static void ring_returns_to_rest(void** state) {
   double p[3], c[3], ax[3];
   tx_band_body_position(b, TX_BAND_BUCKLE, p);
   tx_band_buckle(b, c, ax);
-  // open the C: the buckle carried 3 cm outward from the ring's centre, over 0.5 s
+  // open the C: the buckle carried 3 cm outward from the ring's centre, over 0.25 s
   double out[3] = {p[0], p[1], 0}, len = hypot(p[0], p[1]), tail[3];
   tx_band_body_position(b, TX_BAND_RING_TAIL, tail);
   tx_band_drive(b, TX_BAND_RING_TAIL, tail);
-  for (int s = 1; s <= 30; s++) {
-    double q[3] = {p[0] + 0.03 * s / 30 * out[0] / len, p[1] + 0.03 * s / 30 * out[1] / len, p[2]};
+  for (int s = 1; s <= 15; s++) {
+    double q[3] = {p[0] + 0.03 * s / 15 * out[0] / len, p[1] + 0.03 * s / 15 * out[1] / len, p[2]};
     tx_band_drive(b, TX_BAND_BUCKLE, q);
     assert_true(tx_band_step(b));
   }
   double bent = ring_shape_error(b);
   tx_band_free(b, TX_BAND_BUCKLE);
   tx_band_free(b, TX_BAND_RING_TAIL);
-  for (int s = 0; s < 180; s++) assert_true(tx_band_step(b)); // 3 s
+  for (int s = 0; s < 90; s++) assert_true(tx_band_step(b)); // 1.5 s
   double back = ring_shape_error(b);
-  printf("ring: bent open by %.1f mm, %.2f mm from its rest shape 3 s after release\n", bent * 1e3, back * 1e3);
+  printf("ring: bent open by %.1f mm, %.2f mm from its rest shape 1.5 s after release\n", bent * 1e3, back * 1e3);
   assert_true(bent > 0.01);
-  assert_true(back < 0.05 * bent);
+  assert_true(back < 0.02 * bent);
   tx_band_destroy(b);
 }
 
@@ -115,7 +115,7 @@ static bool thread_tip(tx_band* b, double off) {
     for (int s = 0; s < 200; s++) {
       double tip[3], q[3];
       tx_band_body_position(b, TX_BAND_TUBE_TIP, tip);
-      double d = dist(tip, way[w]), v = 0.004; // m per step: 0.24 m/s
+      double d = dist(tip, way[w]), v = 0.006; // m per step: 0.36 m/s
       if (d < 1e-4) break;
       for (int a = 0; a < 3; a++) q[a] = d > v ? tip[a] + (way[w][a] - tip[a]) * v / d : way[w][a];
       tx_band_drive(b, TX_BAND_TUBE_TIP, q);
@@ -142,7 +142,7 @@ static void latch_through_buckle(void** state) {
   tx_band_buckle(b, c, ax);
   tx_band_set_force(b, TX_BAND_TUBE_TIP, (double[3]){-5 * ax[0], -5 * ax[1], -5 * ax[2]});
   tx_band_set_force(b, TX_BAND_BUCKLE, (double[3]){5 * ax[0], 5 * ax[1], 5 * ax[2]});
-  for (int s = 0; s < 60; s++) {
+  for (int s = 0; s < 30; s++) {
     bool ok = tx_band_step(b);
     if (!ok) {
       tx_band_body_position(b, TX_BAND_TUBE_TIP, tip);
@@ -152,7 +152,7 @@ static void latch_through_buckle(void** state) {
   }
   tx_band_body_position(b, TX_BAND_TUBE_TIP, tip);
   tx_band_body_position(b, TX_BAND_BUCKLE, buckle);
-  printf("latched: tip to buckle %.2f mm, %.2f mm after 1 s at 5 N\n", held * 1e3, dist(tip, buckle) * 1e3);
+  printf("latched: tip to buckle %.2f mm, %.2f mm after 0.5 s at 5 N\n", held * 1e3, dist(tip, buckle) * 1e3);
   assert_true(tx_band_locked(b));
   assert_true(fabs(dist(tip, buckle) - held) < 1e-3);
   tx_band_destroy(b);
