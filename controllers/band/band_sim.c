@@ -441,6 +441,9 @@ bool tx_band_step(tx_band* b) {
     }
     check_latch(b);
   }
+  for (int i = 0; i < TX_BAND_BODIES; i++) // a driven body stays where it was taken until driven again
+    if (b->h[i].driven)
+      for (int a = 0; a < 3; a++) b->h[i].from[a] = b->h[i].to[a];
   b->fresh = false;
   return true;
 }
