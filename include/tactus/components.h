@@ -389,6 +389,27 @@ typedef struct tx_organ_damage {
 #define tx_organ_damage_UNITS "1"
 TX_LAYOUT_ASSERT(tx_organ_damage, float);
 
+// --- gastric banding: the band (physics.band) ---------------------------------
+
+// physics.band writes the band's two parts as one surface, for views and
+// collision:
+//   band.x (N rows, tx_vertex): the ring part's nodes, then the tube part's, m
+//   band.tri (M rows, tx_triangle): their tetrahedra's boundary faces,
+//     outward by the right-hand rule, rows into band.x
+// its state:
+//   band.state (1 row, tx_band_state)
+// and, on the event stream band.events, TX_EVENT_LATCH when it locks.
+typedef struct tx_band_state {
+  double locked;        // 1: the tube's tip has latched in the buckle (it stays so), 0: not yet
+  double joint_length;  // m, the distance joint's length now
+  double joint_error;   // its relative error: length over the joint's length, minus 1
+  double tip_to_buckle; // m, from the tube's tip to the centre of the buckle's opening
+} tx_band_state;
+#define tx_band_state_TYPE TX_F64
+#define tx_band_state_COLS 4u
+#define tx_band_state_UNITS "1"
+TX_LAYOUT_ASSERT(tx_band_state, double);
+
 // --- the procedure ------------------------------------------------------------
 
 // procedure.step (1 row), written by whatever runs a procedure, read by the

@@ -38,7 +38,8 @@ typedef enum tx_event_kind {
   TX_EVENT_CUT,       // something was cut: source = element (thread segment, link), payload .cut
   TX_EVENT_BURN,      // tissue vaporised: source = tetrahedron (its row of ORGAN.ele), payload .burn
   TX_EVENT_KNOT,      // a knot formed or was fixed: source = knot index
-  TX_EVENT_STEP,      // a procedure step began: source = step index
+  TX_EVENT_STEP,      // a procedure step began or ended: source = step index, value[0] = its tx_step_status
+  TX_EVENT_LATCH = 20, // the gastric band locked: source = 0, value[0..2] = the buckle's opening, m
   TX_EVENT_USER = 1000 // kinds of plugins start here
 } tx_event_kind;
 

@@ -17,6 +17,7 @@ rm -f "$WORK.out"
 for f in "$ASSETS"/*; do
   name=$(basename "$f")
   [ "$name" = README.md ] && continue
+  [ "${name#band_}" != "$name" ] && continue # the band's meshes: tactus-band-assets, band_assets_reproduce
   [ -e "$WORK/$name" ] || { [ "$name" = phantom.nii.gz ] && continue; echo "FAIL: the generator wrote no $name"; fail=1; continue; }
   cmp -s "$f" "$WORK/$name" || { echo "FAIL: $f differs from the generator's output"; fail=1; }
 done

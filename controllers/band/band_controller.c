@@ -1,0 +1,209 @@
+// physics.band: the gastric band (band_sim.h) as a controller. Each step
+// advances the band, publishes its surfaces and state, and sends a latch
+// event when the band locks. A numerical fault is counted and the band goes
+// back to its last good state, so the model never holds a NaN.
+#include "band_controller.h"
+
+#include "band_sim.h"
+
+#include <tactus/components.h>
+#include <tactus/config.h>
+#include <tactus/events.h>
+#include <tactus/stats.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+typedef struct band {
+  tx_band* b;
+  int nv[TX_BAND_PARTS], nf[TX_BAND_PARTS];
+  double* pos;  // (nodes x 3) m, scratch
+  tx_port x, tri, state, pose, events;
+  bool hold_buckle, release_on_lock, following;
+  tx_warning fault, bad_pose;
+  tx_result locked_result, error_result, fault_result, substeps_result, p50_result, p99_result;
+  double max_error;
+  long faults;
+  bool was_locked;
+  tx_hist steps; // ns
+} band;
+
+// sources of the values: docs/lagb.md, "The band"
+static const tx_param_def params[] = {
+    {"assets", TX_PARAM_STR, NULL, 0, 0, 0, "lagb", "folder of band_ring/band_tube .node/.ele: a name in assets/ or a path (with a /)"},
+    {"ring_young_pa", TX_PARAM_NUM, "Pa", 1e4, 1e8, 5e6, NULL, "the ring's Young's modulus (silicone elastomer, its stiff end)"},
+    {"ring_poisson", TX_PARAM_NUM, "1", 0, 0.49, 0.3, NULL, "the ring's Poisson's ratio (below silicone's 0.49: one layer of tetrahedra would lock)"},
+    {"ring_density", TX_PARAM_NUM, "kg/m^3", 100, 1e5, 1100, NULL, "the ring's density (silicone)"},
+    {"ring_damping", TX_PARAM_NUM, "1/s", 0, 1e4, 60, NULL, "decay rate of the ring's node velocities: highly damped"},
+    {"tube_young_pa", TX_PARAM_NUM, "Pa", 1e4, 1e8, 1e6, NULL, "the tube's Young's modulus (silicone elastomer, its soft end)"},
+    {"tube_poisson", TX_PARAM_NUM, "1", 0, 0.49, 0.3, NULL, "the tube's Poisson's ratio"},
+    {"tube_density", TX_PARAM_NUM, "kg/m^3", 100, 1e5, 1100, NULL, "the tube's density (silicone)"},
+    {"tube_damping", TX_PARAM_NUM, "1/s", 0, 1e4, 2, NULL, "decay rate of the tube's node velocities: little"},
+    {"body_mass_kg", TX_PARAM_NUM, "kg", 1e-5, 1, 0.002, NULL, "each of the four rigid bodies (buckle, connectors)"},
+    {"max_substep_s", TX_PARAM_NUM, "s", 0, 1e-3, 2.5e-5, NULL,
+     "the explicit substep at most; 0: the FEM's own estimate (safe by a factor of about 3, 2.5 times slower)"},
+    {"buckle_radius_m", TX_PARAM_NUM, "m", 1e-4, 0.05, 0.006, NULL, "the buckle's opening: the tube's tip latches within this of its centre"},
+    {"buckle_offset_m", TX_PARAM_NUM, "m", 0, 0.05, 0.006, NULL, "the opening's centre beyond the ring's head, along its tangent"},
+    {"gravity", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "9.81 m/s^2 along -y; off: the band floats (nothing here holds it up)"},
+    {"max_speed", TX_PARAM_NUM, "m/s", 0.01, 1e4, 50, NULL, "a faster node is a blow-up"},
+    {"pull", TX_PARAM_STR, NULL, 0, 0, 0, "", "the pose the tube's tip follows (tx_pose), a grasper's or a device's; \"\": none"},
+    {"hold_buckle", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "the buckle held where it is (the other hand's grasper)"},
+    {"release_on_lock", TX_PARAM_BOOL, NULL, 0, 0, 1, NULL, "the pull lets go of the tip when the band locks"},
+};
+
+static int configure(tx_setup* s, void** self) {
+  band* g = calloc(1, sizeof *g);
+  if (!g) return -1;
+  *self = g;
+  double rate = tx_setup_rate_in(s, TX_BAND_RATE_MIN_HZ, TX_BAND_RATE_MAX_HZ);
+  if (!rate) return -1;
+  const char *assets = tx_table_str(s, "assets"), *pull = tx_table_str(s, "pull");
+  if (!assets || !pull) return -1;
+  tx_band_def d = tx_band_def_default();
+  const char* pre[TX_BAND_PARTS] = {"ring", "tube"};
+  for (int i = 0; i < TX_BAND_PARTS; i++) {
+    char key[64];
+    snprintf(key, sizeof key, "%s_young_pa", pre[i]), d.part[i].young = tx_table_num(s, key);
+    snprintf(key, sizeof key, "%s_poisson", pre[i]), d.part[i].poisson = tx_table_num(s, key);
+    snprintf(key, sizeof key, "%s_density", pre[i]), d.part[i].density = tx_table_num(s, key);
+    snprintf(key, sizeof key, "%s_damping", pre[i]), d.part[i].damping = tx_table_num(s, key);
+  }
+  d.step = 1.0 / rate;
+  d.body_mass = tx_table_num(s, "body_mass_kg");
+  d.max_substep = tx_table_num(s, "max_substep_s");
+  d.buckle_radius = tx_table_num(s, "buckle_radius_m");
+  d.buckle_offset = tx_table_num(s, "buckle_offset_m");
+  d.max_speed = tx_table_num(s, "max_speed");
+  if (tx_table_bool(s, "gravity")) d.gravity[1] = -9.81;
+  g->hold_buckle = tx_table_bool(s, "hold_buckle");
+  g->release_on_lock = tx_table_bool(s, "release_on_lock");
+  char dir[4096];
+  int len = strchr(assets, '/') ? snprintf(dir, sizeof dir, "%s", assets) : snprintf(dir, sizeof dir, "%s/%s", TX_ASSET_DIR, assets);
+  if (len >= (int)sizeof dir - 64) return tx_setup_fail(s, "assets", "%s: path too long", assets);
+  g->b = tx_band_create(&d, dir);
+  if (!g->b) return tx_setup_fail(s, "assets", "%s", tx_error());
+  int nodes = 0, faces = 0;
+  for (int i = 0; i < TX_BAND_PARTS; i++) {
+    g->nv[i] = tx_band_nodes(g->b, i), g->nf[i] = tx_band_faces(g->b, i);
+    nodes += g->nv[i], faces += g->nf[i];
+  }
+  g->pos = malloc(sizeof(double) * 3 * (size_t)nodes);
+  if (!g->pos) return -1;
+  g->x = tx_setup_write(s, &TX_COMPONENT_OF("band.x", tx_vertex, (uint32_t)nodes));
+  g->tri = tx_setup_write(s, &TX_COMPONENT_OF("band.tri", tx_triangle, (uint32_t)faces));
+  g->state = tx_setup_write(s, &TX_COMPONENT_OF("band.state", tx_band_state, 1));
+  g->events = tx_setup_emit(s, "band.events", 16);
+  if (pull[0]) g->pose = TX_READ_OF(s, pull, tx_pose);
+  g->fault = tx_setup_warning(s, "numerical_fault");
+  g->bad_pose = tx_setup_warning(s, "bad_pose");
+  g->locked_result = tx_setup_result(s, "locked");
+  g->error_result = tx_setup_result(s, "joint_error_max");
+  g->fault_result = tx_setup_result(s, "faults");
+  g->substeps_result = tx_setup_result(s, "substeps");
+  g->p50_result = tx_setup_result(s, "step_p50_ms");
+  g->p99_result = tx_setup_result(s, "step_p99_ms");
+  tx_hist_clear(&g->steps);
+  if (g->hold_buckle) {
+    double p[3];
+    tx_band_body_position(g->b, TX_BAND_BUCKLE, p);
+    tx_band_drive(g->b, TX_BAND_BUCKLE, p);
+  }
+  g->following = g->pose.id != 0;
+  return 0;
+}
+
+static void publish(tx_ctx* c, band* g) {
+  float* x = ((tx_vertex*)tx_write(c, g->x))->x;
+  int32_t* t = ((tx_triangle*)tx_write(c, g->tri))->v;
+  int base = 0;
+  for (int i = 0; i < TX_BAND_PARTS; i++) {
+    tx_band_positions(g->b, i, g->pos);
+    for (int k = 0; k < 3 * g->nv[i]; k++) x[3 * base + k] = (float)g->pos[k];
+    const int32_t* f = tx_band_face_nodes(g->b, i);
+    for (int k = 0; k < 3 * g->nf[i]; k++) *t++ = f[k] + base;
+    base += g->nv[i];
+  }
+  tx_band_state* st = tx_write(c, g->state);
+  double l = tx_band_joint_length(g->b), r = tx_band_joint_rest(g->b), tip[3], bc[3], ax[3];
+  tx_band_body_position(g->b, TX_BAND_TUBE_TIP, tip);
+  tx_band_buckle(g->b, bc, ax);
+  st->locked = tx_band_locked(g->b);
+  st->joint_length = l;
+  st->joint_error = l / r - 1;
+  st->tip_to_buckle = sqrt((tip[0] - bc[0]) * (tip[0] - bc[0]) + (tip[1] - bc[1]) * (tip[1] - bc[1]) + (tip[2] - bc[2]) * (tip[2] - bc[2]));
+  g->max_error = fmax(g->max_error, fabs(st->joint_error));
+}
+
+static int init(tx_ctx* c, void* self) {
+  publish(c, self); // the band at rest, at time 0
+  return 0;
+}
+
+static void step(tx_ctx* c, void* self) {
+  band* g = self;
+  struct timespec t0, t1;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t0);
+  if (g->following) {
+    tx_snapshot p = tx_read(c, g->pose);
+    if (p.seq > 0) { // nothing published yet: the tip waits
+      const tx_pose* pose = p.data;
+      if (isfinite(pose->pos[0] + pose->pos[1] + pose->pos[2])) tx_band_drive(g->b, TX_BAND_TUBE_TIP, pose->pos);
+      else tx_warn(c, g->bad_pose);
+    }
+  }
+  if (tx_band_step(g->b)) {
+    tx_band_save(g->b);
+  } else {
+    tx_warn(c, g->fault);
+    g->faults++;
+    tx_band_restore(g->b);
+  }
+  bool locked = tx_band_locked(g->b);
+  if (locked && !g->was_locked) {
+    tx_event e = {.kind = TX_EVENT_LATCH, .source = 0};
+    double bc[3], ax[3];
+    tx_band_buckle(g->b, bc, ax);
+    for (int a = 0; a < 3; a++) e.value[a] = bc[a];
+    tx_emit(c, g->events, &e);
+    if (g->release_on_lock && g->following) g->following = false, tx_band_free(g->b, TX_BAND_TUBE_TIP);
+  }
+  g->was_locked = locked;
+  publish(c, g);
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t1);
+  tx_hist_add(&g->steps, (int64_t)(t1.tv_sec - t0.tv_sec) * 1000000000 + (t1.tv_nsec - t0.tv_nsec));
+}
+
+static void finish(tx_ctx* c, void* self) {
+  band* g = self;
+  tx_percentiles p = tx_hist_percentiles(&g->steps);
+  tx_set_result(c, g->locked_result, tx_band_locked(g->b) ? 1 : 0);
+  tx_set_result(c, g->error_result, g->max_error);
+  tx_set_result(c, g->fault_result, (double)g->faults);
+  tx_set_result(c, g->substeps_result, tx_band_substeps(g->b));
+  tx_set_result(c, g->p50_result, p.p50 * 1e-6);
+  tx_set_result(c, g->p99_result, p.p99 * 1e-6);
+}
+
+static void fini(void* self) {
+  band* g = self;
+  if (!g) return;
+  tx_band_destroy(g->b);
+  free(g->pos);
+  free(g);
+}
+
+const tx_controller_class tx_physics_band = {
+    .type = "physics.band",
+    .summary = "LAGB gastric band on Bullet and ODE: a ring and a tube (FEM), their rigid bodies, a double-ball joint, "
+               "the latch at the buckle; writes band.x/.tri, band.state, band.events",
+    .configure = configure,
+    .init = init,
+    .step = step,
+    .finish = finish,
+    .fini = fini,
+    .params = params,
+    .nparams = TX_PARAMS_COUNT(params),
+};
