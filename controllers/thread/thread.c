@@ -13,6 +13,11 @@
 
 #define PI 3.14159265358979323846
 #define BVH_STACK 128
+// a bend solve moves no node of two crossing cylinders (their axes at more
+// than about 45 degrees) towards the other by more than this fraction of r
+#define BEND_CAP 0.05
+#define CROSSING_SIN 0.7
+#define CROSSING_NEAR 2.2 // cylinders within this many r (2 r: touching)
 
 typedef struct pair {
   int32_t i, j; // cylinders i < j
@@ -101,6 +106,12 @@ struct tx_thread {
   tx_thread_contacts last;
   double head_force[3];      // N, the rod's constraints on the head in the last substep
   int faults;
+  // the rod's bends near crossings (rod_solve, limit_energy)
+  double* dxb;               // (n x 3) the bends' move of each node in one solve, m
+  double* bscale;            // (n) the fraction of it each node takes
+  bool capped;               // some bend move was cut in this substep
+  bool thrown;               // and some would have carried two crossing strands through each other
+  double e_sub;              // J, kinetic, bending and gravity's energy at the start of the substep
 };
 
 // ---------------------------------------------------------------------------
@@ -260,8 +271,10 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   t->pairs = malloc(sizeof(pair) * t->pair_cap);
   t->colliding = calloc((size_t)nseg, 1);
   t->caps = malloc(sizeof(tx_thread_capsule) * (def->max_shapes + 1));
+  t->dxb = malloc(sizeof(double) * 3 * n);
+  t->bscale = malloc(sizeof(double) * n);
   if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->v0 || !t->w || !t->wf || !t->lam || !t->band || !t->bend || !t->rhs || !t->dir || !t->pinned || !t->severed || !t->punct || !t->arc || !t->near_punct || !t->arc_step || !t->arc_sub || !t->plam || !t->pin || !t->held || !t->hold_from || !t->hold_to || !t->box ||
-      !t->order || !t->order_tmp || !t->key || !t->xb || !t->sbox || !t->sb01 || !t->smove || !t->sorder || !t->skey || !t->pairs || !t->colliding || !t->caps)
+      !t->order || !t->order_tmp || !t->key || !t->xb || !t->sbox || !t->sb01 || !t->smove || !t->sorder || !t->skey || !t->pairs || !t->colliding || !t->caps || !t->dxb || !t->bscale)
     goto oom;
   t->nslots = 1 + def->max_meshes;
   t->meshes = calloc((size_t)t->nslots, sizeof(thread_mesh));
@@ -337,6 +350,8 @@ void tx_thread_destroy(tx_thread* t) {
   free(t->pairs);
   free(t->colliding);
   free(t->caps);
+  free(t->dxb);
+  free(t->bscale);
   for (int k = 0; t->meshes && k < t->nslots; k++)
     if (t->meshes[k].have_bvh) tx_tri_bvh_free(&t->meshes[k].bvh);
   free(t->meshes);
@@ -1475,6 +1490,74 @@ static void bend_factor(tx_thread* t, double h) {
   if (nb > 0 && isfinite(ab)) penta_factor(B, nb);
 }
 
+// The bends' solve takes every bend to rest at once (a nylon bend is stiff
+// against a node's mass at any substep: alpha / h^2 << w), and the linear
+// second difference gets there partly by drawing the nodes together; in a
+// tight knot that move (millimetres in a substep) carries strands through
+// the strands they cross, and the contacts, solved after, push them out on
+// the wrong side: the knot flies open. Here, with y the bends' multipliers,
+// a node of two crossing cylinders within 3 r of each other takes no more
+// of the move than brings them BEND_CAP r closer (the iterations and the
+// next substeps take the rest, the contacts between them); the other nodes
+// take it whole. Parallel neighbours (a hairpin's legs) are left to the
+// contacts: their strands cannot pass through each other into a different
+// knot. Returns whether some node's move was cut (the moves are then applied
+// here, with the multipliers each bend took).
+static bool cap_bends(tx_thread* t, const double* y) {
+  int n = t->n, nb = n - 2;
+  const double* w = t->w;
+  double *x = t->x, *dx = t->dxb;
+  double r = t->def.radius, cap = BEND_CAP * r, m2 = 0;
+  for (int j = 0; j < n; j++) {
+    for (int c = 0; c < 3; c++)
+      dx[3 * j + c] = w[j] * ((j >= 2 ? y[3 * (j - 2) + c] : 0) - 2 * (j >= 1 && j - 1 < nb ? y[3 * (j - 1) + c] : 0) +
+                              (j < nb ? y[3 * j + c] : 0));
+    double s = dot3(dx + 3 * j, dx + 3 * j);
+    if (s > m2) m2 = s;
+  }
+  if (m2 <= cap * cap) return false;
+  // a pair listed d0 apart is at least d0 - 2 D apart now (D: the largest move since)
+  double moved = 0;
+  for (int i = 0; i < n; i++) moved = fmax(moved, dist3_sq(x + 3 * i, t->xb + 3 * i));
+  double near = CROSSING_NEAR * r, far = near + 2 * sqrt(moved);
+  bool cut = false;
+  for (int p = 0; p < t->npairs; p++) {
+    if (t->pairs[p].d0 > far) continue;
+    int i = t->pairs[p].i, j = t->pairs[p].j;
+    const double *a0 = x + 3 * i, *a1 = a0 + 3, *b0 = x + 3 * j, *b1 = b0 + 3;
+    double ei[3] = {a1[0] - a0[0], a1[1] - a0[1], a1[2] - a0[2]}, ej[3] = {b1[0] - b0[0], b1[1] - b0[1], b1[2] - b0[2]};
+    double cr[3] = {ei[1] * ej[2] - ei[2] * ej[1], ei[2] * ej[0] - ei[0] * ej[2], ei[0] * ej[1] - ei[1] * ej[0]};
+    if (dot3(cr, cr) < CROSSING_SIN * CROSSING_SIN * dot3(ei, ei) * dot3(ej, ej)) continue;
+    tx_seg_closest cl;
+    tx_seg_closest_points(a0, a1, b0, b1, &cl);
+    if (cl.dist > near || cl.dist <= 0) continue;
+    double ap = 0; // how much closer the bends' move brings the closest points
+    for (int c = 0; c < 3; c++) {
+      double da = (1 - cl.t) * dx[3 * i + c] + cl.t * dx[3 * i + 3 + c];
+      double db = (1 - cl.s) * dx[3 * j + c] + cl.s * dx[3 * j + 3 + c];
+      ap -= (da - db) * (cl.a[c] - cl.b[c]) / cl.dist;
+    }
+    if (ap <= cap) continue;
+    if (ap > 2 * r) t->thrown = true; // the bends alone would carry the strands through each other
+    if (!cut)
+      for (int k = 0; k < n; k++) t->bscale[k] = 1;
+    cut = true;
+    double f = cap / ap;
+    int nd[4] = {i, i + 1, j, j + 1};
+    for (int q = 0; q < 4; q++)
+      if (t->bscale[nd[q]] > f) t->bscale[nd[q]] = f;
+  }
+  if (!cut) return false;
+  for (int j = 0; j < n; j++)
+    for (int c = 0; c < 3; c++) x[3 * j + c] += t->bscale[j] * dx[3 * j + c];
+  double* lam_b = t->lam + t->nseg;
+  for (int k = 0; k < nb; k++) {
+    double f = fmin(t->bscale[k], fmin(t->bscale[k + 1], t->bscale[k + 2]));
+    for (int c = 0; c < 3; c++) lam_b[3 * k + c] += f * y[3 * k + c];
+  }
+  return true;
+}
+
 // one XPBD iteration, the bends then the distances, each group solved
 // exactly: (J W J^T + alpha / h^2) dlambda = -(C + alpha / h^2 lambda).
 // The bends' gradients are constant (1, -2, 1 on each axis), so their
@@ -1483,7 +1566,7 @@ static void bend_factor(tx_thread* t, double h) {
 // Gauss-Seidel sweeps would need O(N^2); bends and stretch barely couple
 // (one moves across the rod, the other along it), so alternating the two
 // exact solves converges fast.
-static void rod_solve(tx_thread* t, double h) {
+static void rod_solve(tx_thread* t, double h, bool self) {
   int n = t->n, nseg = t->nseg, nb = n - 2;
   double* x = t->x;
   const double* w = t->w;
@@ -1501,6 +1584,9 @@ static void rod_solve(tx_thread* t, double h) {
       if (t->severed[k] || t->severed[k + 1]) y[3 * k] = y[3 * k + 1] = y[3 * k + 2] = 0;
     }
     penta_solve3(t->bend, nb, y);
+    if (self && t->npairs && cap_bends(t, y)) {
+      t->capped = true;
+    } else
     for (int k = 0; k < nb; k++) {
       int i = k + 1;
       for (int c = 0; c < 3; c++) {
@@ -1540,12 +1626,55 @@ static void rod_solve(tx_thread* t, double h) {
   }
 }
 
+// the rod's kinetic (free nodes), bending and gravity's energy, J
+static double rod_energy(const tx_thread* t) {
+  int n = t->n;
+  const double *x = t->x, *v = t->v;
+  double e = 0;
+  for (int i = 0; i < n; i++) {
+    double m = 1 / t->wf[i];
+    e += m * t->def.gravity * x[3 * i + 1];
+    if (t->w[i] > 0) e += 0.5 * m * dot3(v + 3 * i, v + 3 * i);
+  }
+  if (isfinite(t->alpha_b))
+    for (int i = 1; i + 1 < n; i++) {
+      if (t->severed[i - 1] || t->severed[i]) continue;
+      double d2 = 0;
+      for (int a = 0; a < 3; a++) {
+        double q = x[3 * i - 3 + a] - 2 * x[3 * i + a] + x[3 * i + 3 + a];
+        d2 += q * q;
+      }
+      e += 0.5 * d2 / t->alpha_b;
+    }
+  return e;
+}
+
+// after a substep whose bends were cut near crossings: the velocities,
+// (x - x0) / h, gain no more kinetic energy than the bends and gravity
+// released. Without it the strands pushed back by the contacts leave with
+// the speed of the whole move (tens of m/s in a 1 mm knot) and the next
+// substep's prediction carries them through each other.
+static void limit_energy(tx_thread* t) {
+  double e1 = rod_energy(t), over = e1 - t->e_sub, k1 = 0;
+  if (!(over > 0)) return;
+  for (int i = 0; i < t->n; i++)
+    if (t->w[i] > 0) k1 += 0.5 / t->wf[i] * dot3(t->v + 3 * i, t->v + 3 * i);
+  if (!(k1 > 0)) return;
+  double f = k1 > over ? sqrt((k1 - over) / k1) : 0;
+  for (int i = 0; i < t->n; i++)
+    if (t->w[i] > 0)
+      for (int a = 0; a < 3; a++) t->v[3 * i + a] *= f;
+}
+
 static void rod_substep(tx_thread* t, double h, double margin) {
   const tx_thread_def* d = &t->def;
   int n = t->n, nseg = t->nseg;
   double* x = t->x;
   double* v = t->v;
   double decay = exp(-d->damping * h);
+  t->capped = false;
+  t->thrown = false;
+  if (d->self_collision && isfinite(t->alpha_b)) t->e_sub = rod_energy(t); // only cap_bends needs it
   for (int i = 0; i < n; i++) {
     if (t->pinned[i]) continue;
     v[3 * i + 1] -= d->gravity * h;
@@ -1560,7 +1689,7 @@ static void rod_substep(tx_thread* t, double h, double margin) {
   bend_factor(t, h);
   if (t->passed) memset(t->plam, 0, sizeof(double) * t->passed);
   for (int it = 0; it < d->iterations; it++) {
-    rod_solve(t, h);
+    rod_solve(t, h, self);
     solve_capsules(t);
     if (self) solve_self(t);
     if (t->passed) solve_punctures(t, h, true);
@@ -1582,6 +1711,7 @@ static void rod_substep(tx_thread* t, double h, double margin) {
   for (int i = 0; i < n; i++)
     for (int a = 0; a < 3; a++)
       v[3 * i + a] = t->pinned[i] && !t->held[i] ? 0 : (x[3 * i + a] - t->x0[3 * i + a]) / h; // a held node lets go at the jaws' speed
+  if (t->thrown) limit_energy(t);
   // the force the constraints put on the (pinned) head: gradient x lambda /
   // h^2 of the first distance and of the bend at node 1 (its coefficient at node 0 is 1)
   for (int a = 0; a < 3; a++) {

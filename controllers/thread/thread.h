@@ -24,7 +24,12 @@
 //         Each iteration solves all the bends at once, then all the
 //         distances at once (a pentadiagonal and a tridiagonal Cholesky,
 //         O(N)), so a stiff rod converges in a few iterations where
-//         constraint-by-constraint sweeps would need O(N^2).
+//         constraint-by-constraint sweeps would need O(N^2). Near two
+//         crossing strands a node takes only the part of the bends' move
+//         that brings them r / 20 closer, and a substep whose bends would
+//         have carried strands through each other gains no more kinetic
+//         energy than the bends and gravity released (a tight knot stays
+//         tied; docs/thread.md).
 //
 // Both models share the contacts (step 2 of the thread's issue): self
 // contact between cylinders (|AB| < 2 r, segment.h) found through a
