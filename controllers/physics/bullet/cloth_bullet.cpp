@@ -137,6 +137,7 @@ struct tx_cloth {
   std::vector<uint8_t> rim;  // (n) the hole's rim: ignored by the contact while pierced
   int pierces;               // pierces so far
   bool touching;             // the contact found a triangle within its reach in this substep
+  bool rim_left;             // pierced, and the HIP has left the hole (beyond rim_radius, or back out)
   bool pierce_dirty;         // the pierce changed since the last save
 
   // pieces cut off from the patch (no link path to a fixed or pinned particle): frozen where they
@@ -1149,6 +1150,7 @@ static void pierce_start(tx_cloth* c) {
   c->contact_pushes = 0;
   if (!c->pierced) c->pierces++;
   c->pierced = true;
+  c->rim_left = false;
   c->rim_radius = R;
   c->pierce_dirty = true;
 }
@@ -1161,7 +1163,8 @@ static void pierce_check_clear(tx_cloth* c, const btVector3& h) {
   const double rc = c->hip_radius + 0.5 * c->def.thickness;
   double d[3], dist2 = 0, along = 0;
   for (int a = 0; a < 3; a++) d[a] = (double)h[a] - c->pierce_at[a], dist2 += d[a] * d[a], along += d[a] * c->pierce_dir[a];
-  if (!(dist2 > c->rim_radius * c->rim_radius) && !(along < -rc)) return;
+  c->rim_left = dist2 > c->rim_radius * c->rim_radius || along < -rc;
+  if (!c->rim_left) return;
   const btAlignedObjectArray<btSoftBody::Node>& nodes = c->body->m_nodes;
   const btScalar reach = (btScalar)(rc + c->reach_factor * c->max_edge), touch = (btScalar)(rc * 1.01);
   for (int i = 0; i < c->n; i++) {
@@ -1208,7 +1211,7 @@ static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& fr
       int32_t t = ts[s];
       if (!c->tri_alive[(size_t)t] || c->tri_stamp[(size_t)t] == c->stamp) continue;
       c->tri_stamp[(size_t)t] = c->stamp;
-      if (c->pierced && on_rim(c, t)) continue; // the hole the HIP went through is no skin to it
+      if (c->pierced && c->rim_left && on_rim(c, t)) continue; // the tip has gone on: flaps slide off behind it
       c->near_tris[(size_t)ncand++] = t;
     }
   }
@@ -1277,7 +1280,9 @@ static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& fr
       if (side_now * side > 0 && dist2 > 1e-20f) dir = dq / btSqrt(dist2); // still on its side: away from the centre
       else dir = nt * -side;                                                // crossed: back to the far side
       btScalar depth = rcs - (q - h).dot(dir);
-      if (count && fix_velocity) { // the particles the HIP holds, and which way it pushes them
+      // the rim of the hole a pierced HIP went through is kept out of it, but its push is no force on the HIP
+      const bool rim = c->pierced && on_rim(c, c->near_tris[(size_t)k]);
+      if (count && fix_velocity && !rim) { // the particles the HIP holds, and which way it pushes them
         for (int j = 0; j < 3; j++)
           if (w[j] > 0) c->in_contact[(size_t)(p[j] - &nodes[0])] = 1;
         for (int a = 0; a < 3; a++) c->contact_dir[a] += dir[a];
@@ -1704,7 +1709,9 @@ extern "C" void tx_cloth_restore(tx_cloth* c) {
 static int link_reaction(const tx_cloth* c, double dt, double h, double out[3]) {
   out[0] = out[1] = out[2] = 0;
   int held = 0;
-  const bool balance = c->def.solver == TX_CLOTH_IMPLICIT && c->def.reading == TX_CLOTH_BALANCE;
+  // pierced, the patch's balance would count the rim's push on the HIP too: what the skin beyond the
+  // rim pushes (none, mostly) is read from the particles it holds
+  const bool balance = c->def.solver == TX_CLOTH_IMPLICIT && c->def.reading == TX_CLOTH_BALANCE && !c->pierced;
   const double ih2 = 1 / (h * h);
   for (int i = 0; i < c->n; i++) {
     const btSoftBody::Node& nd = c->body->m_nodes[i];
@@ -1861,7 +1868,7 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
       // a little off it (second order), beyond the touch test, and still pushes
       const btSoftBody::Node* base = &b->m_nodes[0];
       for (int i = 0; i < c->n; i++) {
-        if (!c->held_solve[(size_t)i]) continue;
+        if (!c->held_solve[(size_t)i] || (c->pierced && c->rim[(size_t)i])) continue;
         c->in_contact[(size_t)i] = 1;
         const btVector3 r = base[i].m_x - h1;
         const btScalar rl = r.length();

@@ -658,7 +658,8 @@ static void stopped_hip_rests_in_the_skin(void** state) {
 // 1 and 5 cm/s and obliquely (a needle's tip): at the tear's step and every
 // step of the 200 ms after it, the force on the HIP along its travel is
 // under 10 mN (the torn flaps closing on it pushed it with up to 1.7 N in the
-// two steps after the tear)
+// two steps after the tear; here, before the pierce, 0.29 N at 1 cm/s, the
+// skin still pressing the HIP after its first link tore)
 static void pierced_hip_is_not_pushed(void** state) {
   (void)state;
   const double vel[4][3] = {{0, -0.01, 0}, {0, -0.05, 0}, {0.004, -0.005, 0}, {0.02, -0.03, 0.005}};
@@ -679,11 +680,12 @@ static void pierced_hip_is_not_pushed(void** state) {
       if (tear < 0) before = fmax(before, along);
       else if (fabs(along) > worst) worst = fabs(along), worst_at = s - tear;
     }
-    print_message("  HIP at (%.0f, %.0f, %.0f) mm/s: %.3f N before the tear, after it at most %.4f N (step +%d)\n",
-                  vel[k][0] * 1e3, vel[k][1] * 1e3, vel[k][2] * 1e3, before, worst, worst_at);
+    print_message("  HIP at (%.0f, %.0f, %.0f) mm/s: %.3f N before the tear, from it on at most %.4f N%s\n",
+                  vel[k][0] * 1e3, vel[k][1] * 1e3, vel[k][2] * 1e3, before, worst, worst_at >= 0 ? "" : " (0 every step)");
     assert_true(tear > 0);
     assert_true(before > 0.1); // it did push the skin until the tear
     assert_true(worst < 0.01);
+    assert_int_equal(tx_cloth_pierces(c), 1);
     tx_cloth_destroy(c);
   }
 }
