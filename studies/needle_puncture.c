@@ -218,7 +218,7 @@ int tx_study_needle_puncture(const tx_study_args* a) {
   printf("  puncture force along the needle: %.3f N at %.2f mm below first contact (t = %.3f s); the event's |f| %.3f N\n",
          pk->along, pk->depth * 1e3, p->punct_t, p->entry.puncture.force);
   printf("  the hand felt %.3f N then; along the needle in the first 50 ms after the tear at most %.3f N (the torn "
-         "flaps), from 50 ms on at most %.3f N\n",
+         "flaps, which no longer push the pierced tip), from 50 ms on at most %.3f N\n",
          pk->hand, flaps, after);
   free(depth);
   free(p->s);

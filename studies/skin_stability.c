@@ -113,8 +113,9 @@ static const tx_skin_stability_case cases[] = {
     {"10 m/s through", "fast-through", 1, 60, 1.0 / 600, 0.004, 100},
     {"10 m/s along, in contact", "fast-sideways", 1, 60, 1.0 / 600, 0.004, 100},
     {"zero thickness", "pierce", 1, 60, 1.0 / 600, 0, 100},
-    // a blow-up bound below what a 10 m/s HIP gives the skin: detected, recovered, counted
-    {"10 m/s through, bound 1 m/s", "fast-through", 1, 60, 1.0 / 600, 0.004, 1},
+    // a blow-up bound below what a 10 m/s HIP gives the skin before it pierces it (it no longer drags the
+    // torn skin after: 1 m/s is not reached): detected, recovered, counted
+    {"10 m/s through, bound 0.3 m/s", "fast-through", 1, 60, 1.0 / 600, 0.004, 0.3},
 };
 
 int tx_skin_stability_cases(const tx_skin_stability_case** out) {

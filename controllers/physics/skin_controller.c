@@ -26,7 +26,7 @@ typedef struct skin {
   double prev_f, prev_w; // N, m: the reaction along its normal and the indentation of the last step in contact (0: none)
   double k;              // N/m, the last tangent stiffness
   tx_warning fault, bad_pose;
-  tx_result torn_result, fault_result;
+  tx_result torn_result, fault_result, pierce_result, freed_result, pieces_result;
   // grasps: the particles between a hand's jaws follow its instrument<h>.pose
   tx_port grasp_in;                     // listened: the grasp stream (0: none)
   tx_port jaws[GRASP_HANDS_MAX];        // read: instrument<h>.pose
@@ -149,6 +149,9 @@ static int configure(tx_setup* s, void** self) {
   k->bad_pose = tx_setup_warning(s, "bad_pose");
   k->torn_result = tx_setup_result(s, "torn_links");
   k->fault_result = tx_setup_result(s, "faults");
+  k->pierce_result = tx_setup_result(s, "pierces");
+  k->freed_result = tx_setup_result(s, "freed_particles");
+  k->pieces_result = tx_setup_result(s, "freed_pieces");
 
   const char* grasps = tx_table_str(s, "grasp_events");
   if (!grasps) return -1;
@@ -224,6 +227,7 @@ static void grasp(tx_ctx* c, skin* k, int h, const double point[3]) {
     tx_cloth_particle(k->cloth, i, x);
     for (int a = 0; a < 3; a++) d2 += (x[a] - point[a]) * (x[a] - point[a]);
     if (!(d2 <= r2)) continue;
+    if (tx_cloth_freed(k->cloth, i)) continue; // a piece cut off is no longer the skin's
     if (tx_cloth_pin(k->cloth, i, x) != TX_CLOTH_OK) continue; // the fixed border stays where it is
     double rel[3] = {x[0] - jp.pos[0], x[1] - jp.pos[1], x[2] - jp.pos[2]};
     rotate(jp.quat, true, rel, &k->offset[(size_t)i * 3]);
@@ -340,6 +344,9 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, k->torn_result, tx_cloth_torn(k->cloth));
   tx_set_result(c, k->fault_result, tx_cloth_faults(k->cloth));
   tx_set_result(c, k->grasp_result, k->grasps);
+  tx_set_result(c, k->pierce_result, tx_cloth_pierces(k->cloth));
+  tx_set_result(c, k->freed_result, tx_cloth_freed_count(k->cloth));
+  tx_set_result(c, k->pieces_result, tx_cloth_pieces_freed(k->cloth));
 }
 
 static void fini(void* self) {

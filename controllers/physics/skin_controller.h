@@ -21,7 +21,9 @@
 // (i32 1 x 1, links broken so far). Warnings: numerical_fault (a step found
 // a NaN, an Inf or a blow-up and went back to the last good state),
 // bad_pose (a non-finite HIP pose, ignored). Results: torn_links, faults,
-// grasps.
+// grasps, pierces (tears at the HIP's contact: the skin no longer pushes it),
+// freed_particles and freed_pieces (cut off from the patch: frozen, out of
+// skin.tri, their rows of skin.x kept).
 #ifndef TX_CONTROLLERS_PHYSICS_SKIN_CONTROLLER_H
 #define TX_CONTROLLERS_PHYSICS_SKIN_CONTROLLER_H
 

@@ -86,7 +86,7 @@ static void fast_hip_tears_the_skin(void** state) {
 // never held the faulty state
 static void blow_up_is_detected_and_recovered(void** state) {
   (void)state;
-  tx_skin_stability_row r = run_case("10 m/s through, bound 1 m/s");
+  tx_skin_stability_row r = run_case("10 m/s through, bound 0.3 m/s");
   assert_true(r.faults > 0);
   assert_non_null(strstr(r.warnings, "skin.numerical_fault="));
   assert_int_equal(r.nan_values, 0);

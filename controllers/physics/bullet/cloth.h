@@ -216,6 +216,22 @@ double tx_cloth_peak_tension(const tx_cloth* c);
 bool tx_cloth_broke_at(const tx_cloth* c, double at[3]);
 // faults found and recovered so far
 int tx_cloth_faults(const tx_cloth* c);
+// the pierce: a link torn where the HIP holds the skin is its puncture; from
+// then on the contact ignores the hole's rim (the particles then within the
+// contact distance plus two of the longest links of the HIP) and the skin
+// does not push the HIP, until it is clear of the rim: no rim triangle within
+// the contact distance, and beyond the rim's radius from where it went
+// through or back out on the side it came from. Whether the HIP is pierced
+// now, and the pierces so far
+bool tx_cloth_pierced(const tx_cloth* c);
+int tx_cloth_pierces(const tx_cloth* c);
+// pieces cut off by tears (no path of links to a fixed or pinned particle)
+// are freed: frozen where they were cut off, without links or triangles,
+// their indices kept. Whether particle i is freed; the particles and the
+// pieces freed so far. A patch without a fixed particle frees nothing
+bool tx_cloth_freed(const tx_cloth* c, int i);
+int tx_cloth_freed_count(const tx_cloth* c);
+int tx_cloth_pieces_freed(const tx_cloth* c);
 // implicit solver, the last step: CG iterations summed over its Newton steps and
 // substeps, and the largest relative residual a Newton step ended with (0: XPBD)
 typedef struct tx_cloth_solve_info {

@@ -124,6 +124,30 @@ struct tx_cloth {
   double max_edge;           // m, longest rest length of a stretch or shear link
   double reach_factor;       // 1, twice the longest live stretch or shear link after the last substep, over
                              // max_edge: a triangle in contact has a corner within rc + reach_factor max_edge
+  double hip_now[3];         // m, the HIP centre the contact last used (a sweep's move, or the substep's end)
+
+  // the pierce: a tear at the contact is the HIP's puncture; from then on the contact ignores the
+  // triangles of the hole's rim (every particle then within rim_radius of the HIP), until the HIP is
+  // clear of them: no rim triangle within the contact distance, and farther than rim_radius from where
+  // it went through or back out on the side it came from (docs/skin.md, "The pierce")
+  bool pierced;
+  double pierce_at[3];       // m, the HIP centre at the tear
+  double pierce_dir[3];      // 1, into the skin at the tear (the contact's push, or the HIP's travel)
+  double rim_radius;         // m
+  std::vector<uint8_t> rim;  // (n) the hole's rim: ignored by the contact while pierced
+  int pierces;               // pierces so far
+  bool touching;             // the contact found a triangle within its reach in this substep
+  bool rim_left;             // pierced, and the HIP has left the hole (beyond rim_radius, or back out)
+  bool pierce_dirty;         // the pierce changed since the last save
+
+  // pieces cut off from the patch (no link path to a fixed or pinned particle): frozen where they
+  // were cut off, without links or triangles, their indices kept (docs/skin.md, "Detached pieces")
+  std::vector<uint8_t> freed;    // (n)
+  std::vector<int32_t> flood;    // (n) scratch: the search's queue
+  std::vector<int32_t> piece_of; // (n) scratch: the search's marks
+  int nfreed, pieces;            // particles and pieces freed so far
+  bool anchored;                 // the patch has a fixed particle: without one nothing is cut off from it
+  bool detach_check;             // links broke or a pin let go since the last search
 
   // last good state
   std::vector<float> good_x, good_v;   // (n x 3) m, m/s
@@ -132,6 +156,10 @@ struct tx_cloth {
   std::vector<float> good_tension;     // (nlink) N, the warm start
   int good_torn;
   double good_hip[3];
+  std::vector<uint8_t> good_rim, good_freed; // (n)
+  bool good_pierced;
+  double good_pierce_at[3], good_pierce_dir[3], good_rim_radius;
+  int good_pierces, good_nfreed, good_pieces;
   bool topology_dirty; // links broke since the last save
 };
 
@@ -422,6 +450,14 @@ static bool build(tx_cloth* c) {
   c->good_link.assign((size_t)c->nlink, 1);
   c->good_tri.assign((size_t)c->ntri, 1);
   c->good_tension.assign((size_t)c->nlink, 0);
+  c->rim.assign((size_t)c->n, 0);
+  c->good_rim.assign((size_t)c->n, 0);
+  c->freed.assign((size_t)c->n, 0);
+  c->good_freed.assign((size_t)c->n, 0);
+  c->flood.assign((size_t)c->n, 0);
+  c->piece_of.assign((size_t)c->n, 0);
+  c->anchored = false;
+  for (int i = 0; i < c->n; i++) c->anchored |= !(c->im0[(size_t)i] > 0);
   if (d.solver == TX_CLOTH_IMPLICIT) {
     const size_t n3 = (size_t)c->n * 3;
     for (std::vector<double>* v : {&c->y, &c->dx, &c->rr, &c->zz, &c->pp, &c->qq, &c->warm, &c->grad, &c->hold_n})
@@ -1076,6 +1112,78 @@ static void closest_on_triangle(const btVector3& p, const btVector3& a, const bt
   w[0] = 1 - v - u, w[1] = v, w[2] = u;
 }
 
+// a triangle with a corner on the rim of the hole the HIP went through
+static inline bool on_rim(const tx_cloth* c, int32_t t) {
+  const int32_t* v = &c->tri[(size_t)t * 3];
+  return c->rim[(size_t)v[0]] || c->rim[(size_t)v[1]] || c->rim[(size_t)v[2]];
+}
+
+// The HIP's puncture: a tear at its contact. Every particle within
+// rim_radius of the HIP (a triangle it touches has a corner within rc +
+// reach_factor max_edge) is the hole's rim, which the contact ignores from
+// now on; what the contact held is let go, so nothing of it pushes the HIP
+// after the tear. A further tear at the contact while pierced widens the rim.
+static void pierce_start(tx_cloth* c) {
+  const double rc = c->hip_radius + 0.5 * c->def.thickness, R = rc + c->reach_factor * c->max_edge;
+  const btVector3 h((btScalar)c->hip_now[0], (btScalar)c->hip_now[1], (btScalar)c->hip_now[2]);
+  const btScalar R2 = (btScalar)(R * R);
+  const btAlignedObjectArray<btSoftBody::Node>& nodes = c->body->m_nodes;
+  const bool implicit = c->def.solver == TX_CLOTH_IMPLICIT;
+  for (int i = 0; i < c->n; i++) {
+    if ((nodes[i].m_x - h).length2() > R2) continue;
+    c->rim[(size_t)i] = 1;
+    c->in_contact[(size_t)i] = 0;
+    if (implicit) c->hold[(size_t)i] = c->held_solve[(size_t)i] = 0;
+  }
+  // into the skin: the way the contact pushed it, else the way the HIP went
+  double d[3] = {c->contact_dir[0], c->contact_dir[1], c->contact_dir[2]};
+  double l = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  if (!(l > 0)) {
+    for (int a = 0; a < 3; a++) d[a] = c->hip[a] - c->hip_prev[a];
+    l = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  }
+  for (int a = 0; a < 3; a++) {
+    c->pierce_dir[a] = l > 0 ? d[a] / l : (a == 1 ? -1 : 0);
+    c->pierce_at[a] = c->hip_now[a];
+    c->contact_dir[a] = 0;
+  }
+  c->contact_pushes = 0;
+  if (!c->pierced) c->pierces++;
+  c->pierced = true;
+  c->rim_left = false;
+  c->rim_radius = R;
+  c->pierce_dirty = true;
+}
+
+// the pierce ends once the HIP at h is clear of the hole: farther than rim_radius from where it went
+// through, or back out on the side it came from by the contact distance, and no rim triangle within
+// the contact distance of it (a flap still on it keeps it pierced)
+static void pierce_check_clear(tx_cloth* c, const btVector3& h) {
+  if (!c->pierced) return;
+  const double rc = c->hip_radius + 0.5 * c->def.thickness;
+  double d[3], dist2 = 0, along = 0;
+  for (int a = 0; a < 3; a++) d[a] = (double)h[a] - c->pierce_at[a], dist2 += d[a] * d[a], along += d[a] * c->pierce_dir[a];
+  c->rim_left = dist2 > c->rim_radius * c->rim_radius || along < -rc;
+  if (!c->rim_left) return;
+  const btAlignedObjectArray<btSoftBody::Node>& nodes = c->body->m_nodes;
+  const btScalar reach = (btScalar)(rc + c->reach_factor * c->max_edge), touch = (btScalar)(rc * 1.01);
+  for (int i = 0; i < c->n; i++) {
+    if (!c->rim[(size_t)i] || (nodes[i].m_x - h).length2() > reach * reach) continue;
+    const int32_t* ts = &c->node_tris[(size_t)i * 8];
+    for (int s = 0; s < 8 && ts[s] >= 0; s++) {
+      if (!c->tri_alive[(size_t)ts[s]]) continue;
+      const int32_t* t = &c->tri[(size_t)ts[s] * 3];
+      btScalar w[3];
+      closest_on_triangle(h, nodes[t[0]].m_x, nodes[t[1]].m_x, nodes[t[2]].m_x, w);
+      const btVector3 q = nodes[t[0]].m_x * w[0] + nodes[t[1]].m_x * w[1] + nodes[t[2]].m_x * w[2];
+      if ((q - h).length2() < touch * touch) return;
+    }
+  }
+  c->pierced = false;
+  std::fill(c->rim.begin(), c->rim.end(), 0);
+  c->pierce_dirty = true;
+}
+
 // the HIP at h, at `from` when the substep began: every live triangle closer
 // than the contact distance is pushed out to it, away from the side the HIP
 // came from. With count set, records the indentation and (after the links,
@@ -1103,6 +1211,7 @@ static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& fr
       int32_t t = ts[s];
       if (!c->tri_alive[(size_t)t] || c->tri_stamp[(size_t)t] == c->stamp) continue;
       c->tri_stamp[(size_t)t] = c->stamp;
+      if (c->pierced && c->rim_left && on_rim(c, t)) continue; // the tip has gone on: flaps slide off behind it
       c->near_tris[(size_t)ncand++] = t;
     }
   }
@@ -1122,6 +1231,7 @@ static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& fr
       const btScalar touch = rcs * (btScalar)1.01;
       int32_t* held = &c->held_tri[(size_t)c->near_tris[(size_t)k]];
       bool near = dist2 < touch * touch;
+      if (near) c->touching = true;
       // after the links, a triangle the HIP touched (this substep before them, or at the end of
       // the last) is checked however far it went: links stretched far enough pull it across
       // the sphere in one solve, and it must come back to the HIP's side instead of leaving
@@ -1170,7 +1280,9 @@ static void project_contact(tx_cloth* c, const btVector3& h, const btVector3& fr
       if (side_now * side > 0 && dist2 > 1e-20f) dir = dq / btSqrt(dist2); // still on its side: away from the centre
       else dir = nt * -side;                                                // crossed: back to the far side
       btScalar depth = rcs - (q - h).dot(dir);
-      if (count && fix_velocity) { // the particles the HIP holds, and which way it pushes them
+      // the rim of the hole a pierced HIP went through is kept out of it, but its push is no force on the HIP
+      const bool rim = c->pierced && on_rim(c, c->near_tris[(size_t)k]);
+      if (count && fix_velocity && !rim) { // the particles the HIP holds, and which way it pushes them
         for (int j = 0; j < 3; j++)
           if (w[j] > 0) c->in_contact[(size_t)(p[j] - &nodes[0])] = 1;
         for (int a = 0; a < 3; a++) c->contact_dir[a] += dir[a];
@@ -1221,6 +1333,8 @@ static void sweep_contact(tx_cloth* c, const btVector3& h0, const btVector3& h1,
   int moves = (int)std::ceil(len / (0.5 * rc));
   if (moves < 1) moves = 1;
   if (moves > 64) moves = 64; // a teleport: the path is sampled, not followed
+  pierce_check_clear(c, h0);
+  c->touching = false;
   // a HIP this fast drags the skin further than the links can follow within
   // the substep, and the solve would spread the strain before anyone saw it:
   // what it overstretched tears now, move by move (a substep of the implicit
@@ -1228,6 +1342,7 @@ static void sweep_contact(tx_cloth* c, const btVector3& h0, const btVector3& h1,
   // dragged centimetres with the HIP)
   for (int k = 1; k <= moves; k++) {
     btVector3 h = h0.lerp(h1, (btScalar)k / (btScalar)moves);
+    for (int a = 0; a < 3; a++) c->hip_now[a] = h[a];
     project_contact(c, h, h0, dt, count, false);
     if (moves > 1) rupture(c, &h);
   }
@@ -1420,10 +1535,17 @@ static void rupture(tx_cloth* c, const btVector3* near) {
     }
     if (best >= 0) c->breaking[(size_t)nb++] = best;
   }
+  const double rc = c->hip_radius + 0.5 * c->def.thickness;
+  const btScalar at_hip = (btScalar)(rc + c->reach_factor * c->max_edge);
+  const btVector3 hip((btScalar)c->hip_now[0], (btScalar)c->hip_now[1], (btScalar)c->hip_now[2]);
+  bool at_contact = false; // a link torn where the HIP holds the skin: its puncture
   for (int k = 0; k < nb; k++) {
     int id = c->breaking[(size_t)k];
     link_info& li = c->info[(size_t)id];
     if (li.slot < 0) continue;
+    if (c->hip_radius > 0 && c->touching)
+      for (int e = 0; e < 2; e++) at_contact |= (base[li.end[e]].m_x - hip).length2() <= at_hip * at_hip;
+    c->detach_check = true;
     remove_link(c, id);
     c->tension[(size_t)id] = 0;
     c->torn++;
@@ -1432,6 +1554,62 @@ static void rupture(tx_cloth* c, const btVector3* near) {
       if (li.tri[j] >= 0) c->tri_alive[(size_t)li.tri[j]] = 0, c->live_dirty = true;
       if (li.dep[j] >= 0) remove_link(c, li.dep[j]), c->tension[(size_t)li.dep[j]] = 0;
     }
+  }
+  if (at_contact) pierce_start(c);
+}
+
+// Pieces cut off from the patch: particles with no path of live links to a
+// fixed or pinned particle. Each is frozen where it is (no mass, no
+// velocity), loses its links and its triangles, and keeps its index: what
+// the readers of skin.x hold (puncture rows, the thread's points) stays a
+// valid index, and nothing they draw or collide with (skin.tri) has it. A
+// patch with no fixed particle (fixed_border off, no clamp) floats whole:
+// nothing is cut off from it.
+static void free_detached(tx_cloth* c) {
+  c->detach_check = false;
+  if (!c->anchored) return;
+  int32_t* q = c->flood.data();
+  int32_t* mark = c->piece_of.data(); // 0 not reached, 1 the patch, 2 a piece cut off
+  std::fill(c->piece_of.begin(), c->piece_of.end(), 0);
+  auto flood = [&](int tail, int32_t label) {
+    for (int head = 0; head < tail; head++) {
+      const int32_t* ls = &c->node_links[(size_t)q[head] * 12];
+      for (int k = 0; k < 12 && ls[k] >= 0; k++) {
+        const link_info& li = c->info[(size_t)ls[k]];
+        if (li.slot < 0) continue;
+        const int o = li.end[0] == q[head] ? li.end[1] : li.end[0];
+        if (mark[o]) continue;
+        mark[o] = label;
+        q[tail++] = o;
+      }
+    }
+  };
+  int tail = 0;
+  for (int i = 0; i < c->n; i++)
+    if (!c->freed[(size_t)i] && (!(c->im0[(size_t)i] > 0) || c->pinned[(size_t)i])) mark[i] = 1, q[tail++] = i;
+  flood(tail, 1);
+  for (int i = 0; i < c->n; i++) {
+    if (mark[i] || c->freed[(size_t)i]) continue;
+    mark[i] = 2;
+    q[0] = i;
+    flood(1, 2);
+    c->pieces++;
+  }
+  btAlignedObjectArray<btSoftBody::Node>& nodes = c->body->m_nodes;
+  for (int i = 0; i < c->n; i++) {
+    if (mark[i] != 2) continue;
+    c->freed[(size_t)i] = 1;
+    c->nfreed++;
+    nodes[i].m_im = 0;
+    nodes[i].m_v = btVector3(0, 0, 0);
+    c->rim[(size_t)i] = 0;
+    const int32_t* ls = &c->node_links[(size_t)i * 12];
+    for (int k = 0; k < 12 && ls[k] >= 0; k++)
+      if (c->info[(size_t)ls[k]].slot >= 0) remove_link(c, ls[k]), c->tension[(size_t)ls[k]] = 0;
+    const int32_t* ts = &c->node_tris[(size_t)i * 8];
+    for (int k = 0; k < 8 && ts[k] >= 0; k++)
+      if (c->tri_alive[(size_t)ts[k]]) c->tri_alive[(size_t)ts[k]] = 0, c->live_dirty = true;
+    c->topology_dirty = true;
   }
 }
 
@@ -1445,7 +1623,18 @@ extern "C" void tx_cloth_save(tx_cloth* c) {
   if (c->topology_dirty) {
     for (int id = 0; id < c->nlink; id++) c->good_link[(size_t)id] = c->info[(size_t)id].slot >= 0;
     std::memcpy(c->good_tri.data(), c->tri_alive.data(), (size_t)c->ntri);
+    c->good_freed = c->freed; // same size: a copy, no allocation
+    c->good_nfreed = c->nfreed;
+    c->good_pieces = c->pieces;
     c->topology_dirty = false;
+  }
+  if (c->pierce_dirty) {
+    c->good_rim = c->rim;
+    c->good_pierced = c->pierced;
+    c->good_pierces = c->pierces;
+    c->good_rim_radius = c->rim_radius;
+    for (int a = 0; a < 3; a++) c->good_pierce_at[a] = c->pierce_at[a], c->good_pierce_dir[a] = c->pierce_dir[a];
+    c->pierce_dirty = false;
   }
   c->good_torn = c->torn;
   std::memcpy(c->good_tension.data(), c->tension.data(), (size_t)c->nlink * sizeof(float));
@@ -1473,8 +1662,22 @@ extern "C" void tx_cloth_restore(tx_cloth* c) {
     }
     std::memcpy(c->tri_alive.data(), c->good_tri.data(), (size_t)c->ntri);
     c->live_dirty = true;
+    c->freed = c->good_freed;
+    c->nfreed = c->good_nfreed;
+    c->pieces = c->good_pieces;
+    for (int i = 0; i < c->n; i++) // a particle freed in the faulty step gets its mass back
+      nodes[i].m_im = c->freed[(size_t)i] || c->pinned[(size_t)i] ? 0 : c->im0[(size_t)i];
     c->topology_dirty = false;
   }
+  if (c->pierce_dirty) {
+    c->rim = c->good_rim;
+    c->pierced = c->good_pierced;
+    c->pierces = c->good_pierces;
+    c->rim_radius = c->good_rim_radius;
+    for (int a = 0; a < 3; a++) c->pierce_at[a] = c->good_pierce_at[a], c->pierce_dir[a] = c->good_pierce_dir[a];
+    c->pierce_dirty = false;
+  }
+  c->detach_check = false;
   c->torn = c->good_torn;
   std::memcpy(c->tension.data(), c->good_tension.data(), (size_t)c->nlink * sizeof(float));
   for (int a = 0; a < 3; a++) c->hip_prev[a] = c->good_hip[a];
@@ -1506,7 +1709,9 @@ extern "C" void tx_cloth_restore(tx_cloth* c) {
 static int link_reaction(const tx_cloth* c, double dt, double h, double out[3]) {
   out[0] = out[1] = out[2] = 0;
   int held = 0;
-  const bool balance = c->def.solver == TX_CLOTH_IMPLICIT && c->def.reading == TX_CLOTH_BALANCE;
+  // pierced, the patch's balance would count the rim's push on the HIP too: what the skin beyond the
+  // rim pushes (none, mostly) is read from the particles it holds
+  const bool balance = c->def.solver == TX_CLOTH_IMPLICIT && c->def.reading == TX_CLOTH_BALANCE && !c->pierced;
   const double ih2 = 1 / (h * h);
   for (int i = 0; i < c->n; i++) {
     const btSoftBody::Node& nd = c->body->m_nodes[i];
@@ -1584,6 +1789,10 @@ extern "C" tx_cloth_status tx_cloth_pin(tx_cloth* c, int i, const double x[3]) {
     tx_set_error("skin: particle %d is fixed (border or clamp), it cannot be pinned", i);
     return TX_CLOTH_BAD;
   }
+  if (c->freed[(size_t)i]) {
+    tx_set_error("skin: particle %d is cut off from the patch, it cannot be pinned", i);
+    return TX_CLOTH_BAD;
+  }
   btSoftBody::Node& nd = c->body->m_nodes[i];
   if (!c->pinned[(size_t)i]) {
     c->pinned[(size_t)i] = 1;
@@ -1600,6 +1809,7 @@ extern "C" bool tx_cloth_unpin(tx_cloth* c, int i) {
   c->pinned[(size_t)i] = 0;
   c->npinned--;
   c->body->m_nodes[i].m_im = c->im0[(size_t)i]; // it keeps the jaws' last velocity
+  c->detach_check = true; // what only the jaws held is cut off
   return true;
 }
 
@@ -1635,6 +1845,7 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
     btVector3 h1 = start.lerp(end, (btScalar)(s + 1) / (btScalar)substeps);
     const int torn0 = c->torn;
     c->sub_peak = 0;
+    if (c->detach_check) free_detached(c);
     predict(c, h);
     if (c->npinned > 0) place_pinned(c, (double)(s + 1) / substeps);
     sweep_contact(c, h0, h1, h, true);
@@ -1650,13 +1861,14 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
     std::fill(c->in_contact.begin(), c->in_contact.end(), 0);
     for (int a = 0; a < 3; a++) c->contact_dir[a] = 0;
     c->contact_pushes = 0;
+    for (int a = 0; a < 3; a++) c->hip_now[a] = h1[a];
     project_contact(c, h1, h0, h, true, true);
     if (c->def.solver == TX_CLOTH_IMPLICIT) {
       // the solve's active set holds the HIP too: a vertex sliding across its sphere ends
       // a little off it (second order), beyond the touch test, and still pushes
       const btSoftBody::Node* base = &b->m_nodes[0];
       for (int i = 0; i < c->n; i++) {
-        if (!c->held_solve[(size_t)i]) continue;
+        if (!c->held_solve[(size_t)i] || (c->pierced && c->rim[(size_t)i])) continue;
         c->in_contact[(size_t)i] = 1;
         const btVector3 r = base[i].m_x - h1;
         const btScalar rl = r.length();
@@ -1685,6 +1897,7 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
     }
     c->prev_peak = c->sub_peak;
   }
+  if (c->detach_check) free_detached(c); // the mesh published after this step has none of it
   c->contact_held = link_reaction(c, dt, h, c->contact_force);
   for (int a = 0; a < 3; a++) {
     c->contact_at[a] = c->hip[a];
@@ -1791,6 +2004,12 @@ extern "C" bool tx_cloth_broke_at(const tx_cloth* c, double at[3]) {
   for (int a = 0; a < 3; a++) at[a] = c->broke ? c->broke_at[a] : 0;
   return c->broke;
 }
+
+extern "C" bool tx_cloth_pierced(const tx_cloth* c) { return c->pierced; }
+extern "C" int tx_cloth_pierces(const tx_cloth* c) { return c->pierces; }
+extern "C" bool tx_cloth_freed(const tx_cloth* c, int i) { return i >= 0 && i < c->n && c->freed[(size_t)i]; }
+extern "C" int tx_cloth_freed_count(const tx_cloth* c) { return c->nfreed; }
+extern "C" int tx_cloth_pieces_freed(const tx_cloth* c) { return c->pieces; }
 
 extern "C" void tx_cloth_solve_stats(const tx_cloth* c, tx_cloth_solve_info* out) { *out = c->stats; }
 

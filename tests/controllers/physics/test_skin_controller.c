@@ -290,6 +290,36 @@ static void tear_beside_the_jaws(void** state) {
   assert_true(torn > 0);
   assert_int_equal(on, 4);
   assert_int_equal(warnings(s, "skin.numerical_fault"), 0);
+  assert_true(result(s, "skin.freed_particles") == 0); // the jaws hold what they tore loose
+  tx_scenario_free(s);
+}
+
+// jaws that lift a piece out of the skin and let go of it: the piece, held
+// by nothing, is freed (counted in the report) and leaves skin.tri; skin.x
+// keeps its rows, so every index a reader holds stays valid, and the piece
+// stays where it was let go instead of falling (no gravity: it would float)
+static void piece_let_go_is_freed(void** state) {
+  (void)state;
+  jaws_plan = (__typeof__(jaws_plan)){{0, 0, 0}, 0.03, 0, 0.1, 1.0};
+  tx_scenario* s = load_with_jaws(",\"rupture_tension_n_per_m\":20");
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 1.5);
+  tx_snapshot xs = latest_snapshot(s, "skin.x"), tri = latest_snapshot(s, "skin.tri");
+  const float* x = xs.data;
+  const int* t = tri.data;
+  assert_int_equal(xs.rows, 1764);
+  int up = 0;
+  for (int i = 0; i < 1764; i++) up += x[i * 3 + 1] > 0.01f;
+  for (uint32_t k = 0; k < tri.rows * 3; k++) {
+    assert_true(t[k] >= 0 && t[k] < 1764);
+    assert_true(x[t[k] * 3 + 1] < 0.01f); // no triangle of the piece
+  }
+  print_message("  %g particles in %g piece(s) freed, %d of them still up where they were let go, %u triangles left\n",
+                result(s, "skin.freed_particles"), result(s, "skin.freed_pieces"), up, tri.rows);
+  assert_true(result(s, "skin.freed_particles") >= 4);
+  assert_true(result(s, "skin.freed_pieces") >= 1);
+  assert_true(up >= 4);
+  assert_int_equal(warnings(s, "skin.numerical_fault"), 0);
   tx_scenario_free(s);
 }
 
@@ -302,6 +332,7 @@ int main(void) {
       cmocka_unit_test(grasped_skin_follows_the_jaws),
       cmocka_unit_test(grasp_out_of_reach_does_nothing),
       cmocka_unit_test(tear_beside_the_jaws),
+      cmocka_unit_test(piece_let_go_is_freed),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
