@@ -465,6 +465,16 @@ static void hole_row(instruments* m, int i, const float* xs, int nx, const int32
     if (m->at_hole[i] && !tx_puncture_attached(nx, tri, ntri, m->hole_scratch, 2 * HOLE_PARTICLES_MAX, rv)) m->at_hole[i] = false;
     return;
   }
+  if (!m->at_hole[i])
+    for (int j = 0; j < m->npins; j++) { // another puncture's hole (the entry, before the arc is out at the exit): not this one's
+      if (j == i || !m->at_hole[j]) continue;
+      double pj[3] = {0}, e2 = 0;
+      for (int v = 0; v < 3; v++)
+        for (int k = 0; k < 3 && m->rows[j].v[v] >= 0 && m->rows[j].v[v] < nx; k++)
+          pj[k] += m->rows[j].bary[v] * xs[3 * (int)m->rows[j].v[v] + k];
+      for (int k = 0; k < 3; k++) e2 += (on_arc[k] - pj[k]) * (on_arc[k] - pj[k]);
+      if (e2 < m->pin_capture * m->pin_capture) return;
+    }
   for (int k = 0; k < 3; k++) m->rows[i].v[k] = tri[3 * hole + k], m->rows[i].bary[k] = bary[k];
   m->at_hole[i] = true;
 }
