@@ -459,22 +459,24 @@ static void hole_row(instruments* m, int i, const float* xs, int nx, const int32
     rv[v] = (int32_t)m->rows[i].v[v];
     for (int k = 0; k < 3 && rv[v] >= 0 && rv[v] < nx; k++) at[k] += m->rows[i].bary[v] * xs[3 * rv[v] + k];
   }
+  // until it is at its hole, the other punctures' holes are not its own
+  double taken[TX_NEEDLE_PINS_MAX][3];
+  int ntaken = 0;
+  for (int j = 0; j < m->npins && !m->at_hole[i]; j++) {
+    if (j == i || !m->at_hole[j]) continue;
+    memset(taken[ntaken], 0, sizeof taken[ntaken]);
+    for (int v = 0; v < 3; v++)
+      for (int k = 0; k < 3 && m->rows[j].v[v] >= 0 && m->rows[j].v[v] < nx; k++)
+        taken[ntaken][k] += m->rows[j].bary[v] * xs[3 * (int)m->rows[j].v[v] + k];
+    ntaken++;
+  }
   int hole = tx_puncture_hole(xs, nx, tri, ntri, (const double(*)[3])arc, HOLE_SAMPLES + 1, m->at_hole[i] ? at : NULL,
-                              m->pin_capture, m->hole_scratch, 2 * HOLE_PARTICLES_MAX, bary, point, on_arc);
+                              m->pin_capture, (const double(*)[3])taken, ntaken, m->tracker.separation, m->hole_scratch,
+                              2 * HOLE_PARTICLES_MAX, bary, point, on_arc);
   if (hole < 0) { // lost: its triangle torn or cut off from the patch, the next publish looks from the tip again
     if (m->at_hole[i] && !tx_puncture_attached(nx, tri, ntri, m->hole_scratch, 2 * HOLE_PARTICLES_MAX, rv)) m->at_hole[i] = false;
     return;
   }
-  if (!m->at_hole[i])
-    for (int j = 0; j < m->npins; j++) { // another puncture's hole (the entry, before the arc is out at the exit): not this one's
-      if (j == i || !m->at_hole[j]) continue;
-      double pj[3] = {0}, e2 = 0;
-      for (int v = 0; v < 3; v++)
-        for (int k = 0; k < 3 && m->rows[j].v[v] >= 0 && m->rows[j].v[v] < nx; k++)
-          pj[k] += m->rows[j].bary[v] * xs[3 * (int)m->rows[j].v[v] + k];
-      for (int k = 0; k < 3; k++) e2 += (on_arc[k] - pj[k]) * (on_arc[k] - pj[k]);
-      if (e2 < m->pin_capture * m->pin_capture) return;
-    }
   for (int k = 0; k < 3; k++) m->rows[i].v[k] = tri[3 * hole + k], m->rows[i].bary[k] = bary[k];
   m->at_hole[i] = true;
 }

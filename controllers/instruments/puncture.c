@@ -125,13 +125,13 @@ bool tx_puncture_attached(int nx, const int32_t* tri, int ntri, int32_t* scratch
 }
 
 int tx_puncture_hole(const float* x, int nx, const int32_t* tri, int ntri, const double (*arc)[3], int narc,
-                     const double near_to[3], double within, int32_t* scratch, int nscratch, double bary[3],
-                     double point[3], double on_arc[3]) {
+                     const double near_to[3], double within, const double (*taken)[3], int ntaken, double apart,
+                     int32_t* scratch, int nscratch, double bary[3], double point[3], double on_arc[3]) {
   int32_t patch = 0;
   const int32_t* root = components(tri, nx, ntri, scratch, nscratch, &patch) ? scratch : NULL;
   // the crossings of the sheet along the arc (the side flips between two
   // points, where the signed distance goes through zero): the first from the
-  // tip, or the one nearest near_to within `within` of it
+  // tip, or the one nearest near_to within `within` of it; none taken
   double d0 = 0, d1 = 0, best = INFINITY;
   int s0 = 0, found = 0;
   for (int k = 0; k < narc; k++) {
@@ -147,10 +147,16 @@ int tx_puncture_hole(const float* x, int nx, const int32_t* tri, int ntri, const
     if (s0 && s1 && s1 != s0) {
       double u = d0 + d1 > 0 ? d0 / (d0 + d1) : 0.5, c[3], e2 = 0;
       for (int j = 0; j < 3; j++) c[j] = arc[k - 1][j] + u * (arc[k][j] - arc[k - 1][j]);
+      bool other = false; // another puncture's hole
+      for (int h = 0; h < ntaken && !other; h++) {
+        double o2 = 0;
+        for (int j = 0; j < 3; j++) o2 += (c[j] - taken[h][j]) * (c[j] - taken[h][j]);
+        other = o2 < apart * apart;
+      }
       if (near_to)
         for (int j = 0; j < 3; j++) e2 += (c[j] - near_to[j]) * (c[j] - near_to[j]);
-      if (e2 < best) best = e2, found = 1, memcpy(on_arc, c, sizeof c);
-      if (!near_to) break;
+      if (!other && e2 < best) best = e2, found = 1, memcpy(on_arc, c, sizeof c);
+      if (found && !near_to) break;
     }
     s0 = s1, d0 = d1;
   }

@@ -60,7 +60,10 @@ int tx_nearest_triangle(const float* x, int nx, const int32_t* tri, int ntri, co
 // first point back from the tip on the other side of the patch's sheet than
 // the tip (the side: the nearest triangle's normal) brackets the crossing
 // (with near_to: of the arc's points within `within` of near_to, the
-// crossing nearest it, for a hole the needle slides through);
+// crossing nearest it, for a hole the needle slides through); a crossing
+// within `apart` of one of the ntaken points of taken is another
+// puncture's hole and is passed over (an exit torn before the arc has
+// crossed the sheet there would otherwise find the entry's);
 // on_arc is the crossing, between the two points where the distance to the
 // sheet goes through zero, and the result is the patch's triangle nearest
 // it (the hole's rim), with the crossing's barycentric coordinates in its
@@ -68,8 +71,8 @@ int tx_nearest_triangle(const float* x, int nx, const int32_t* tri, int ntri, co
 // rim) and that point (the crossing projected on the plane); -1 when the arc
 // does not cross the sheet.
 int tx_puncture_hole(const float* x, int nx, const int32_t* tri, int ntri, const double (*arc)[3], int narc,
-                     const double near_to[3], double within, int32_t* scratch, int nscratch, double bary[3],
-                     double point[3], double on_arc[3]);
+                     const double near_to[3], double within, const double (*taken)[3], int ntaken, double apart,
+                     int32_t* scratch, int nscratch, double bary[3], double point[3], double on_arc[3]);
 
 // whether the triangle of particles v is still a live triangle (in tri) of
 // the patch (as in tx_puncture_hole; scratch NULL: any live one is)

@@ -232,7 +232,7 @@ static void test_hole_at_the_crossing_on_the_patch(void** state) {
   double arc[21][3];
   for (int k = 0; k <= 20; k++) arc[k][0] = -0.005, arc[k][1] = -0.01 + 0.001 * k, arc[k][2] = -0.005;
   double bary[3], point[3], on[3];
-  int h = tx_puncture_hole(x, nx, t, n, (const double(*)[3])arc, 21, NULL, 0, scratch, 2 * nx, bary, point, on);
+  int h = tx_puncture_hole(x, nx, t, n, (const double(*)[3])arc, 21, NULL, 0, NULL, 0, 0, scratch, 2 * nx, bary, point, on);
   print_message("  hole: triangle %d (%d %d %d), crossing (%.2f, %.2f, %.2f) mm, bary (%.3f, %.3f, %.3f)\n", h, t[3 * h],
                 t[3 * h + 1], t[3 * h + 2], 1e3 * on[0], 1e3 * on[1], 1e3 * on[2], bary[0], bary[1], bary[2]);
   assert_true(h >= 0 && h < n - 1); // of the patch
@@ -245,10 +245,10 @@ static void test_hole_at_the_crossing_on_the_patch(void** state) {
   }
   // near a given point: the crossing within reach of it, none beyond
   double near_to[3] = {-0.005, 0.001, -0.004}, far_to[3] = {0.03, 0, 0};
-  assert_int_equal(tx_puncture_hole(x, nx, t, n, (const double(*)[3])arc, 21, near_to, 0.003, scratch, 2 * nx, bary, point, on), h);
-  assert_int_equal(tx_puncture_hole(x, nx, t, n, (const double(*)[3])arc, 21, far_to, 0.003, scratch, 2 * nx, bary, point, on), -1);
+  assert_int_equal(tx_puncture_hole(x, nx, t, n, (const double(*)[3])arc, 21, near_to, 0.003, NULL, 0, 0, scratch, 2 * nx, bary, point, on), h);
+  assert_int_equal(tx_puncture_hole(x, nx, t, n, (const double(*)[3])arc, 21, far_to, 0.003, NULL, 0, 0, scratch, 2 * nx, bary, point, on), -1);
   // an arc that stays under the sheet crosses nothing
-  assert_int_equal(tx_puncture_hole(x, nx, t, n, (const double(*)[3])arc, 8, NULL, 0, scratch, 2 * nx, bary, point, on), -1);
+  assert_int_equal(tx_puncture_hole(x, nx, t, n, (const double(*)[3])arc, 8, NULL, 0, NULL, 0, 0, scratch, 2 * nx, bary, point, on), -1);
   // attached: a live triangle of the patch in any turn of its order; not
   // the flap, not a torn one, not a particle out of range
   int32_t live[3] = {t[4], t[5], t[3]}, flap_t[3] = {N * N, N * N + 1, N * N + 2}, torn[3] = {tris[30], tris[31], tris[32]};
@@ -260,6 +260,37 @@ static void test_hole_at_the_crossing_on_the_patch(void** state) {
   assert_false(tx_puncture_attached(nx, t, n, scratch, 2 * nx, out));
 }
 
+// another puncture's hole is not this one's: an arc from its tip above the
+// sheet, down under it and up again (a 12.7 mm half circle about 3 mm over
+// the sheet) crosses at x = +12.34 mm (the first from the tip) and at
+// -12.34 mm. With the first taken (an entry's row within `apart`), the hole
+// is the second; with both taken, none: an exit torn before the arc is
+// out there waits, rather than taking the entry's hole
+static void test_hole_taken_by_another_puncture(void** state) {
+  (void)state;
+  int32_t scratch[2 * N * N];
+  double arc[65][3], R = 0.0127, c = 0.003, xa = sqrt(R * R - c * c);
+  for (int k = 0; k <= 64; k++) {
+    double th = -M_PI * k / 64;
+    arc[k][0] = R * cos(th), arc[k][1] = c + R * sin(th), arc[k][2] = -0.005;
+  }
+  double bary[3], point[3], on[3], taken[2][3] = {{xa, 0.0002, -0.005}, {-xa, -0.0003, -0.005}};
+  int first = tx_puncture_hole(xs, N * N, tris, ntri, (const double(*)[3])arc, 65, NULL, 0, NULL, 0, 0, scratch, 2 * N * N,
+                               bary, point, on);
+  assert_true(first >= 0 && fabs(on[0] - xa) < 2e-4 && fabs(on[1]) < 1e-12);
+  int second = tx_puncture_hole(xs, N * N, tris, ntri, (const double(*)[3])arc, 65, NULL, 0, (const double(*)[3])taken, 1,
+                                0.003, scratch, 2 * N * N, bary, point, on);
+  print_message("  first from the tip taken: triangle %d, crossing (%.2f, %.2f, %.2f) mm\n", second, 1e3 * on[0], 1e3 * on[1],
+                1e3 * on[2]);
+  assert_true(second >= 0 && second != first && fabs(on[0] + xa) < 2e-4 && fabs(on[1]) < 1e-12);
+  assert_int_equal(tx_puncture_hole(xs, N * N, tris, ntri, (const double(*)[3])arc, 65, NULL, 0, (const double(*)[3])taken, 2,
+                                    0.003, scratch, 2 * N * N, bary, point, on),
+                   -1);
+  // farther than `apart` from the crossing: not that hole
+  assert_int_equal(tx_puncture_hole(xs, N * N, tris, ntri, (const double(*)[3])arc, 65, NULL, 0, (const double(*)[3])taken, 2,
+                                    1e-4, scratch, 2 * N * N, bary, point, on),
+                   first);
+}
 
 // the height above the sheet: of the particle nearest across; over the
 // patch only; a particle that is not finite is skipped
@@ -281,6 +312,7 @@ int main(void) {
       cmocka_unit_test_setup(test_nearest_triangle, patch),
       cmocka_unit_test_setup(test_entry_then_exit, patch),
       cmocka_unit_test_setup(test_hole_at_the_crossing_on_the_patch, patch),
+      cmocka_unit_test_setup(test_hole_taken_by_another_puncture, patch),
       cmocka_unit_test_setup(test_height_above_sheet, patch),
       cmocka_unit_test(test_scissors_cut_between_the_blades),
       cmocka_unit_test(test_jaws_pinch_the_skin),
