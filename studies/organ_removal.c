@@ -57,49 +57,6 @@ static double now_s(void) {
   return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-static int cmp_face(const void* a, const void* b) {
-  const int *x = a, *y = b;
-  for (int k = 0; k < 3; k++)
-    if (x[k] != y[k]) return x[k] < y[k] ? -1 : 1;
-  return 0;
-}
-
-static void sort3(int* f) {
-  if (f[0] > f[1]) { int w = f[0]; f[0] = f[1], f[1] = w; }
-  if (f[1] > f[2]) { int w = f[1]; f[1] = f[2], f[2] = w; }
-  if (f[0] > f[1]) { int w = f[0]; f[0] = f[1], f[1] = w; }
-}
-
-// the boundary faces tx_fem_hull gives against the live tetrahedra's found
-// afresh (faces of one live tetrahedron only), as sets; a and b: scratch of
-// 12 ne ints
-static bool boundary_matches(const tx_fem* f, const int* tet, int ne, int* a, int* b) {
-  int n = 0;
-  for (int e = 0; e < ne; e++) {
-    if (!tx_fem_tet_live(f, e)) continue;
-    for (int k = 0; k < 4; k++) {
-      int* s = a + 3 * n++;
-      s[0] = tet[4 * e + (k + 1) % 4], s[1] = tet[4 * e + (k + 2) % 4], s[2] = tet[4 * e + (k + 3) % 4];
-      sort3(s);
-    }
-  }
-  qsort(a, (size_t)n, 3 * sizeof(int), cmp_face);
-  int m = 0;
-  for (int i = 0; i < n;) {
-    int j = i + 1;
-    while (j < n && cmp_face(a + 3 * i, a + 3 * j) == 0) j++;
-    if (j - i == 1) memmove(a + 3 * m++, a + 3 * i, 3 * sizeof(int));
-    i = j;
-  }
-  int nf;
-  const int* hull = tx_fem_hull(f, &nf);
-  if (nf != m) return false;
-  memcpy(b, hull, sizeof(int) * 3 * (size_t)nf);
-  for (int i = 0; i < nf; i++) sort3(b + 3 * i);
-  qsort(b, (size_t)nf, 3 * sizeof(int), cmp_face);
-  return memcmp(a, b, sizeof(int) * 3 * (size_t)nf) == 0;
-}
-
 static int cmp_double(const void* a, const void* b) {
   double x = *(const double*)a, y = *(const double*)b;
   return (x > y) - (x < y);
@@ -129,16 +86,15 @@ int tx_study_organ_removal(const tx_study_args* a) {
   float* xs = malloc(sizeof(float) * 3 * (size_t)nv);
   double* pos = malloc(sizeof(double) * 3 * (size_t)nv);
   uint64_t* keys = malloc(sizeof(uint64_t) * 12 * (size_t)ne);
-  int *order = malloc(sizeof(int) * (size_t)ne), *sa = malloc(sizeof(int) * 12 * (size_t)ne),
-      *sb = malloc(sizeof(int) * 12 * (size_t)ne);
+  int* order = malloc(sizeof(int) * (size_t)ne);
   double* frame_ms = malloc(sizeof(double) * (size_t)removals);
   double *plot_x = malloc(sizeof(double) * (size_t)removals), *plot_live = malloc(sizeof(double) * (size_t)removals);
-  if (!body || !row_of || !node_of || !seen || !tri || !xs || !pos || !keys || !order || !sa || !sb || !frame_ms || !plot_x ||
+  if (!body || !row_of || !node_of || !seen || !tri || !xs || !pos || !keys || !order || !frame_ms || !plot_x ||
       !plot_live) {
     fprintf(stderr, "tactus: study organ-removal: %s\n", body ? "out of memory" : tx_error());
     tx_fem_destroy(body);
     free(x0), free(tet), free(row_of), free(node_of), free(seen), free(tri), free(xs), free(pos), free(keys), free(order);
-    free(sa), free(sb), free(frame_ms), free(plot_x), free(plot_live);
+    free(frame_ms), free(plot_x), free(plot_live);
     return 1;
   }
   for (int i = 0; i < nv; i++) row_of[i] = -1;
@@ -169,7 +125,7 @@ int tx_study_organ_removal(const tx_study_args* a) {
   if (!csv) {
     tx_fem_destroy(body);
     free(x0), free(tet), free(row_of), free(node_of), free(seen), free(tri), free(xs), free(pos), free(keys), free(order);
-    free(sa), free(sb), free(frame_ms), free(plot_x), free(plot_live);
+    free(frame_ms), free(plot_x), free(plot_live);
     return tx_bad_input("--out %s: cannot write organ-removal.csv", a->out_dir);
   }
   fprintf(csv, "removal,tet,live_tets,live_nodes,surface_rows,surface_triangles,nonmanifold_edges,faults,inverted,"
@@ -227,7 +183,7 @@ int tx_study_organ_removal(const tx_study_args* a) {
     frames_nonmanifold += rep.nonmanifold_edges > 0;
     int reference = -1;
     if ((r + 1) % reference_every == 0 || r == removals - 1) {
-      reference = boundary_matches(body, tet, ne, sa, sb);
+      reference = tx_fem_hull_is_live_boundary(body);
       references++, reference_bad += !reference;
     }
     plot_x[r] = r + 1, plot_live[r] = tx_fem_live_tet_count(body);
@@ -258,7 +214,6 @@ int tx_study_organ_removal(const tx_study_args* a) {
   int live_end = tx_fem_live_tet_count(body);
   tx_fem_destroy(body);
   free(x0), free(tet), free(row_of), free(node_of), free(seen), free(tri), free(xs), free(pos), free(keys), free(order);
-  free(sa), free(sb);
   int rc = 0;
   if (fclose(csv) != 0 || rename(tmp, csv_path) != 0) {
     remove(tmp);

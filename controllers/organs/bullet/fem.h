@@ -113,6 +113,11 @@ double tx_fem_tet_volume(const tx_fem* b, int t);
 // the live tetrahedra's boundary: *faces rows of 3 node numbers, outward
 // (right-hand rule); valid until the next tx_fem_remove_tet
 const int* tx_fem_hull(const tx_fem* b, int* faces);
+// the check on that boundary, which tx_fem_remove_tet keeps up a face at a
+// time: true when it equals, as a set of faces, the live tetrahedra's found
+// afresh (the faces of exactly one live tetrahedron). Allocates: for tests
+// and the removal study, not for a step.
+bool tx_fem_hull_is_live_boundary(const tx_fem* b);
 
 // the state (positions, velocities) kept aside, and brought back
 void tx_fem_save(tx_fem* b);

@@ -765,6 +765,36 @@ extern "C" bool tx_fem_node_live(const tx_fem* b, int node) {
   return node >= 0 && node < b->nv && b->node_tets[(size_t)node] > 0;
 }
 
+extern "C" bool tx_fem_hull_is_live_boundary(const tx_fem* b) {
+  // every live tetrahedron's faces, as sorted triples; those seen once are the boundary
+  std::vector<std::array<int, 3>> all, once, kept;
+  for (int t = 0; t < b->ne; t++) {
+    if (!b->tet_live[(size_t)t]) continue;
+    const int* e = &b->tets[4 * (size_t)t];
+    for (int k = 0; k < 4; k++) {
+      std::array<int, 3> f = {e[(k + 1) % 4], e[(k + 2) % 4], e[(k + 3) % 4]};
+      std::sort(f.begin(), f.end());
+      all.push_back(f);
+    }
+  }
+  std::sort(all.begin(), all.end());
+  for (size_t i = 0; i < all.size();) {
+    size_t j = i + 1;
+    while (j < all.size() && all[j] == all[i]) j++;
+    if (j - i == 1) once.push_back(all[i]);
+    i = j;
+  }
+  int nf;
+  const int* hull = tx_fem_hull(b, &nf);
+  for (int i = 0; i < nf; i++) {
+    std::array<int, 3> f = {hull[3 * i], hull[3 * i + 1], hull[3 * i + 2]};
+    std::sort(f.begin(), f.end());
+    kept.push_back(f);
+  }
+  std::sort(kept.begin(), kept.end());
+  return kept == once;
+}
+
 extern "C" double tx_fem_tet_volume(const tx_fem* b, int t) {
   if (!tx_fem_tet_live(b, t)) return 0;
   const int* e = &b->tets[4 * (size_t)t];
