@@ -2,7 +2,8 @@
 # A lost peer, and one that comes back (docs/distributed.md, "A lost peer"):
 # suturing-skin's device process renders the sim process's force; the sim
 # process is killed (SIGKILL, nothing said goodbye) while the hand presses the
-# skin, and a new one starts 0.3 s later. With haptics.model_timeout_s = 5 ms
+# skin (a scripted press, short of a tear), and a new one starts 0.3 s
+# later. With haptics.model_timeout_s = 5 ms
 # the force must be zero within 10 ms of the last force model that arrived,
 # stay zero while no sim runs, and the force models of the new sim process
 # must be taken up again.
@@ -19,10 +20,15 @@ cd "$work"
 sim() { exec "$tactus" run suturing-skin --role sim --duration "$1" --set net.domain=$domain \
   --set skin.spacing_m=0.0025 --set skin.coarse_block=0 --out "$2" --quiet >"$2.log" 2>&1; }
 
+# the hand presses 2 mm into the skin by 2 s, then on at 0.5 mm/s (0.15 to
+# 0.2 N, short of a tear; moving, so each force model differs from the one
+# before), so that the sim is lost while it presses however late either
+# process started
+printf 't_s,x_m,y_m,z_m\n0,0,0.010,0\n0.5,0,0.010,0\n2.0,0,-0.002,0\n4.0,0,-0.003,0\n' >press.csv
 sim 6 sim1 & sim1=$!
 sleep 0.5
 "$tactus" run suturing-skin --role device --duration 4 --set net.domain=$domain --set haptics.model_timeout_s=0.005 \
-  --out device --quiet >device.log 2>&1 & device=$!
+  --device scripted:$PWD/press.csv --out device --quiet >device.log 2>&1 & device=$!
 sleep 3.1
 kill -9 $sim1
 sleep 0.3
