@@ -89,6 +89,20 @@ json_t* tx_param_json(tx_setup* s, const char* key) {
   return param(s, key);
 }
 
+int tx_param_point(tx_setup* s, const char* key, const double def[3], double out[3]) {
+  json_t* j = tx_param_json(s, key);
+  memcpy(out, def, 3 * sizeof(double));
+  if (!j || json_is_null(j)) return 0;
+  if (!json_is_array(j) || json_array_size(j) != 3) return tx_setup_fail(s, key, "expected [x, y, z] in m");
+  for (int a = 0; a < 3; a++) {
+    json_t* v = json_array_get(j, (size_t)a);
+    if (!json_is_number(v) || !isfinite(json_number_value(v)) || fabs(json_number_value(v)) > 10)
+      return tx_setup_fail(s, key, "element %d must be a number in [-10, 10]", a);
+    out[a] = json_number_value(v);
+  }
+  return 0;
+}
+
 const char* tx_json_kind(const json_t* v) {
   switch (json_typeof(v)) {
   case JSON_OBJECT: return "an object";

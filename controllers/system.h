@@ -112,6 +112,9 @@ const tx_controller_class* tx_controller_class_at(int i);
 
 // for built-in classes only: params.KEY as JSON (borrowed, marked as used), or NULL
 json_t* tx_param_json(tx_setup* s, const char* key);
+// a point params.KEY ([x, y, z], m, each within 10 m of the origin; a JSON
+// entry of the table) into out, def when absent; -1 after tx_setup_fail
+int tx_param_point(tx_setup* s, const char* key, const double def[3], double out[3]);
 // tx_output_dir (tactus/controller.h) is the run's tx_run_options.out_dir
 
 // Run control (system_control.c, docs/trainer.md), from any thread, before or

@@ -24,6 +24,14 @@ static inline tx_snapshot latest_snapshot(tx_scenario* s, const char* name) {
 
 static inline const double* latest(tx_scenario* s, const char* name) { return latest_snapshot(s, name).data; }
 
+// a load that must be refused: no scenario, and one line naming the key (needle)
+static inline void assert_refused(tx_scenario* s, const char* needle) {
+  assert_null(s);
+  print_message("  %s\n", tx_error());
+  assert_non_null(strstr(tx_error(), needle));
+  assert_null(strchr(tx_error(), '\n'));
+}
+
 // a reported result by its key ("INSTANCE.key")
 static inline double result(tx_scenario* s, const char* key) {
   for (int i = 0; i < tx_system_results(s->system); i++)

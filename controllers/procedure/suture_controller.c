@@ -4,7 +4,7 @@
 #include "suture_controller.h"
 
 #include "suture_steps.h"
-#include "../system.h" // tx_param_json
+#include "../system.h" // tx_param_point
 
 #include <tactus/components.h>
 #include <tactus/events.h>
@@ -57,20 +57,6 @@ static const tx_param_def params[] = {
     {"wrap_length_m", TX_PARAM_NUM, "m", 0.005, 0.3, 0.03, NULL, "the jaws' length ahead of the pivot, along which a wrap counts"},
 };
 
-static int read_point(tx_setup* s, const char* key, const double def[3], double out[3]) {
-  json_t* j = tx_param_json(s, key);
-  memcpy(out, def, 3 * sizeof(double));
-  if (!j || json_is_null(j)) return 0;
-  if (!json_is_array(j) || json_array_size(j) != 3) return tx_setup_fail(s, key, "expected [x, y, z] in m");
-  for (int a = 0; a < 3; a++) {
-    json_t* v = json_array_get(j, (size_t)a);
-    if (!json_is_number(v) || !isfinite(json_number_value(v)) || fabs(json_number_value(v)) > 10)
-      return tx_setup_fail(s, key, "element %d must be a number in [-10, 10]", a);
-    out[a] = json_number_value(v);
-  }
-  return 0;
-}
-
 // a read that the scenario may leave out with an empty name
 static tx_port optional_read(tx_setup* s, const char* name, tx_type type, uint32_t cols) {
   return name && *name ? tx_setup_read_as(s, name, type, cols) : (tx_port){0};
@@ -80,8 +66,8 @@ static int configure(tx_setup* s, void** self) {
   suture* k = calloc(1, sizeof *k);
   if (!k) return -1;
   *self = k;
-  if (read_point(s, "wound_a_m", (const double[3]){-0.015, 0, 0}, k->wound_a) ||
-      read_point(s, "wound_b_m", (const double[3]){0.015, 0, 0}, k->wound_b))
+  if (tx_param_point(s, "wound_a_m", (const double[3]){-0.015, 0, 0}, k->wound_a) ||
+      tx_param_point(s, "wound_b_m", (const double[3]){0.015, 0, 0}, k->wound_b))
     return -1;
   double dx = k->wound_b[0] - k->wound_a[0], dz = k->wound_b[2] - k->wound_a[2];
   if (!(dx * dx + dz * dz > 1e-8)) return tx_setup_fail(s, "wound_b_m", "the wound line is under 0.1 mm long across the skin (x-z)");

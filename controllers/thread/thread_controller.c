@@ -20,7 +20,7 @@
 
 #include "knot.h"
 #include "thread.h"
-#include "../system.h" // tx_param_json
+#include "../system.h" // tx_param_json, tx_param_point
 
 #include <tactus/components.h>
 #include <tactus/events.h>
@@ -139,20 +139,6 @@ static const tx_param_def params[] = {
     {"grasp_hands", TX_PARAM_INT, "1", 1, TX_THREAD_HANDS, 2, NULL, "with grasp_events: the jaws' frames read, instrument0.pose .. instrument<this - 1>.pose"},
 };
 
-static int read_tail(tx_setup* s, double tail[3]) {
-  json_t* j = tx_param_json(s, "tail_m");
-  tail[0] = 0.2, tail[1] = tail[2] = 0;
-  if (!j || json_is_null(j)) return 0;
-  if (!json_is_array(j) || json_array_size(j) != 3) return tx_setup_fail(s, "tail_m", "expected [x, y, z] in m");
-  for (int a = 0; a < 3; a++) {
-    json_t* v = json_array_get(j, (size_t)a);
-    if (!json_is_number(v) || !isfinite(json_number_value(v)) || fabs(json_number_value(v)) > 10)
-      return tx_setup_fail(s, "tail_m", "element %d must be a number in [-10, 10]", a);
-    tail[a] = json_number_value(v);
-  }
-  return 0;
-}
-
 static int configure(tx_setup* s, void** self) {
   thread_ctl* k = calloc(1, sizeof *k);
   if (!k) return -1;
@@ -192,7 +178,7 @@ static int configure(tx_setup* s, void** self) {
   k->classify_every = (int)tx_table_int(s, "classify_every");
   k->rod_after_s = tx_table_num(s, "rod_after_s");
   double tail[3];
-  if (read_tail(s, tail)) return -1;
+  if (tx_param_point(s, "tail_m", (const double[3]){0.2, 0, 0}, tail)) return -1;
   const char* head = tx_table_str(s, "head");
   const char* start_shape = tx_table_str(s, "start_shape");
   if (!start_shape) return -1;
