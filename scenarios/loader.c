@@ -215,7 +215,8 @@ static int declare_model(const char* file, tx_system* sys, json_t* model) {
   return 0;
 }
 
-// the i-th --device goes to the i-th controller of type "haptics"
+// the i-th --device goes to the i-th controller of type "haptics"; "scenario"
+// keeps the file's own device for that hand
 static int apply_devices(const char* file, json_t* root, const tx_load_options* o, set_origin* origins, int* norigins) {
   json_t* controllers = json_object_get(root, "controllers");
   size_t index = 0, used = 0;
@@ -227,6 +228,10 @@ static int apply_devices(const char* file, json_t* root, const tx_load_options* 
     json_t* params = json_object_get(c, "params");
     if (!params) json_object_set_new(c, "params", params = json_object());
     if (!json_is_object(params)) return fail("%s: controllers[%zu].params: expected an object", file, index);
+    if (strcmp(o->devices[used], "scenario") == 0) {
+      used++;
+      continue;
+    }
     json_object_set_new(params, "device", json_string(o->devices[used]));
     origins[*norigins] = (set_origin){(int)index, "params.device", "--device", o->devices[used]};
     (*norigins)++;

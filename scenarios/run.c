@@ -27,7 +27,8 @@ static const char run_usage[] =
     "  --duration S        run length in seconds (default: the scenario's duration_s)\n"
     "  --lockstep          one thread on a virtual clock: deterministic, writes OUT/trace.csv\n"
     "  --set KEY=VALUE     override CONTROLLER.PARAM, CONTROLLER.rate_hz or duration_s (repeatable)\n"
-    "  --device SPEC       a haptic device per hand: scripted:NAME|FILE.csv, replay:FILE, sim, udp:HOST:PORT, mouse\n"
+    "  --device SPEC       a haptic device per hand, in turn: scripted:NAME|FILE.csv, replay:FILE, sim, udp:HOST:PORT,\n"
+    "                      mouse, dds:DOMAIN[:NAME], or scenario (this hand keeps the scenario's own device)\n"
     "  --view SPEC         none|png|window (default none): png writes OUT/frames/ (OSMesa), window needs DISPLAY\n"
     "  --stereo MODE       mono|sbs|tb|anaglyph|lr (default mono): side by side, top-bottom, red-cyan, or left and right files\n"
     "  --out DIR           output folder (default out/SCENARIO-TIMESTAMP); one that holds files is refused\n"
@@ -175,13 +176,16 @@ static int pick_scenario(char* path, size_t size, const char** devices, int* nde
 #if TX_WITH_GLFW
   pick_list l = {0};
   tx_scenario_list(pick_visit, &l);
-  bool mouse = false;
-  int k = tx_window_pick((const char* const*)l.names, (const char* const*)l.about, l.n, &mouse);
+  static char chosen[2][128]; // the devices' specs live as long as the run's arguments
+  int k = tx_window_pick((const char* const*)l.names, (const char* const*)l.about, l.n, chosen);
   int rc = 0;
   if (k >= 0 && k < l.n) snprintf(path, size, "%s", l.paths[k]);
   else if (k == -1) rc = tx_bad_input("run: no scenario chosen (the picker was closed)");
   else rc = tx_bad_input("run: the scenario picker: %s", tx_error());
-  if (k >= 0 && mouse && *ndevices == 0) devices[(*ndevices)++] = "mouse";
+  // each hand's choice, up to the last hand given one; a hand left to the scenario keeps the file's device
+  int last = chosen[1][0] ? 2 : chosen[0][0] ? 1 : 0;
+  if (k >= 0 && *ndevices == 0)
+    for (int h = 0; h < last; h++) devices[(*ndevices)++] = chosen[h][0] ? chosen[h] : "scenario";
   for (int i = 0; i < l.n; i++) free(l.names[i]), free(l.about[i]), free(l.paths[i]);
   return rc;
 #else

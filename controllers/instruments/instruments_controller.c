@@ -34,7 +34,10 @@ typedef struct instruments {
   int slot[HANDS][PER_HAND], nslot[HANDS], cur[HANDS], hand_of[TX_INSTRUMENTS_MAX];
   uint32_t switch_bit;
   bool button_was[HANDS];
+  int first[HANDS]; // the index each hand holds at the start (handN_holds)
+  int want[HANDS]; // asked for during the run (tune handN_holds): the index to hold, -1: nothing asked
   tx_result switches;
+  tx_warning switch_refused;
   int nswitches;
   tx_port dev_pose[HANDS], dev_vel[HANDS], dev_grip[HANDS];
   tx_port pose[HANDS], links[HANDS], model[HANDS], held[HANDS];
@@ -90,6 +93,9 @@ static const tx_param_def params[] = {
     {"hand1", TX_PARAM_STR, NULL, 0, 0, 0, "", "device1's instruments, as hand0; \"\": instrument1 alone"},
     {"switch_button", TX_PARAM_INT, "1", 0, 31, 0, NULL,
      "the device button (bit of deviceN.grip's buttons) whose press puts the held instrument down and takes the hand's next"},
+    {"hand0_holds", TX_PARAM_INT, "1", 0, PER_HAND - 1, 0, NULL,
+     "which of device0's instruments it holds (0: the first of hand0); changed during a run (the trainer's Tune panel), the hand puts down what it holds and takes that one, as its switch button does"},
+    {"hand1_holds", TX_PARAM_INT, "1", 0, PER_HAND - 1, 0, NULL, "the same for device1"},
     {"coupling_stiffness", TX_PARAM_NUM, "N/m", 0, 1e5, 200, NULL,
      "the virtual coupling's spring between a device and its instrument's root"},
     {"coupling_damping", TX_PARAM_NUM, "N s/m", 0, 1e3, 1, NULL, "the virtual coupling's damper"},
@@ -294,9 +300,18 @@ static int configure(tx_setup* s, void** self) {
   }
   if (m->n == 0) return tx_setup_fail(s, "instrument0", "no instrument: give instrument0");
   if (nd->held_by >= m->nhands) return tx_setup_fail(s, "needle_in_jaws", "there is no instrument%d", nd->held_by);
-  if (nd->held_by >= 0) nd->held_by = m->slot[nd->held_by][0]; // the world counts slots
+  for (int h = 0; h < HANDS; h++) {
+    char key[32];
+    snprintf(key, sizeof key, "hand%d_holds", h);
+    m->first[h] = (int)tx_table_int(s, key);
+    if (m->first[h] > 0 && m->first[h] >= m->nslot[h])
+      return tx_setup_fail(s, key, "device%d has %d instrument%s: give 0%s", h, m->nslot[h], m->nslot[h] == 1 ? "" : "s",
+                           m->nslot[h] > 1 ? " or 1" : "");
+  }
+  if (nd->held_by >= 0) nd->held_by = m->slot[nd->held_by][m->first[nd->held_by]]; // the world counts slots
   m->switch_bit = 1u << tx_table_int(s, "switch_button");
   m->switches = tx_setup_result(s, "switches");
+  m->switch_refused = tx_setup_warning(s, "switch_refused");
   const char* thread = tx_table_str(s, "thread");
   if (!thread) return -1;
   if (*thread) {
@@ -371,21 +386,24 @@ static int init(tx_ctx* c, void* self) {
     return -1;
   }
   m->nswitches = 0;
+  for (int h = 0; h < HANDS; h++) m->want[h] = -1;
   for (int h = 0; h < m->nhands; h++) { // each hand holds its first; a button held from the start is no press
-    m->cur[h] = 0;
-    for (int k = 1; k < m->nslot[h]; k++) tx_instrument_world_park(m->world, m->slot[h][k], park_at(m->slot[h][k]));
+    m->cur[h] = m->first[h];
+    for (int k = 0; k < m->nslot[h]; k++)
+      if (k != m->cur[h]) tx_instrument_world_park(m->world, m->slot[h][k], park_at(m->slot[h][k]));
     tx_snapshot g = tx_read(c, m->dev_grip[h]);
     m->button_was[h] = g.seq && button(m, g.data);
   }
   return 0;
 }
 
-// the press of the switch button (an edge) puts the hand's instrument down
-// and takes its next, at the device's pose, its coupling at rest
-static void switch_instrument(tx_ctx* c, instruments* m, int h, const tx_instrument_input* dev) {
-  int from = m->slot[h][m->cur[h]];
-  m->cur[h] = (m->cur[h] + 1) % m->nslot[h];
-  int to = m->slot[h][m->cur[h]];
+// the press of the switch button (an edge), or a tune of handN_holds, puts
+// the hand's instrument down and takes another (index k of its list), at the
+// device's pose, its coupling at rest
+static void switch_instrument(tx_ctx* c, instruments* m, int h, int k, const tx_instrument_input* dev) {
+  int from = m->slot[h][m->cur[h]], was = m->cur[h];
+  m->cur[h] = k;
+  int to = m->slot[h][k];
   tx_instrument_world_park(m->world, from, park_at(from));
   tx_instrument_world_take(m->world, to, dev->pos, dev->quat);
   if (m->holds_thread[from] || m->holds_skin[from]) // put down: what it held is let go
@@ -395,8 +413,16 @@ static void switch_instrument(tx_ctx* c, instruments* m, int h, const tx_instrum
   m->nswitches++;
   tx_event e = {.kind = TX_EVENT_INSTRUMENT_SWITCH, .source = (uint32_t)h};
   e.value[0] = m->cur[h];
-  e.value[1] = (m->cur[h] + m->nslot[h] - 1) % m->nslot[h];
+  e.value[1] = was;
   tx_emit(c, m->events, &e);
+}
+
+// handN_holds, asked for while the run goes: taken at the hand's next step
+static void tune(tx_ctx* c, void* self, const char* key, double value) {
+  (void)c;
+  instruments* m = self;
+  int h = strcmp(key, "hand1_holds") == 0;
+  m->want[h] = (int)value;
 }
 
 // the point on the needle's arc at angle a (rad from the swage), world
@@ -604,10 +630,15 @@ static void step(tx_ctx* c, void* self) {
     if (v.seq) memcpy(dev[h].vel, ((const tx_velocity*)v.data)->v, sizeof dev[h].vel);
     dev[h].grip = g.seq ? ((const tx_device_grip*)g.data)->grip : 0;
     bool pressed = g.seq && button(m, g.data);
-    if (pressed && !m->button_was[h] && m->nslot[h] > 1) switch_instrument(c, m, h, &dev[h]);
+    if (pressed && !m->button_was[h] && m->nslot[h] > 1) switch_instrument(c, m, h, (m->cur[h] + 1) % m->nslot[h], &dev[h]);
     m->button_was[h] = pressed;
+    if (m->want[h] >= m->nslot[h]) tx_warn(c, m->switch_refused); // the hand has no such instrument
+    else if (m->want[h] >= 0 && m->want[h] != m->cur[h]) switch_instrument(c, m, h, m->want[h], &dev[h]);
+    m->want[h] = -1;
     in[m->slot[h][m->cur[h]]] = dev[h];
   }
+  for (int h = m->nhands; h < HANDS; h++)
+    if (m->want[h] >= 0) tx_warn(c, m->switch_refused), m->want[h] = -1; // a hand with no instrument
   if (m->skin) pierce(c, m);
   tx_instrument_world_step(m->world, in, 1.0 / tx_rate(c));
   if (tx_instrument_world_bad_inputs(m->world) > m->bad_seen) tx_warn(c, m->bad_input);
@@ -718,4 +749,6 @@ const tx_controller_class tx_physics_instruments = {
     .fini = fini,
     .params = params,
     .nparams = TX_PARAMS_COUNT(params),
+    .live = (const char* const[]){"hand0_holds", "hand1_holds", NULL},
+    .tune = tune,
 };

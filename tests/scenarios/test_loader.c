@@ -531,6 +531,40 @@ static void the_shipped_rates_scenario_loads(void** state) {
   tx_scenario_free(s);
 }
 
+// --device: the i-th goes to the i-th haptics controller; "scenario" keeps
+// that hand's device from the file (the picker's choice for a hand it leaves
+// alone); one more than the hands is refused
+static void devices_per_hand(void** state) {
+  (void)state;
+  static const char text[] =
+      "{\"name\":\"t\",\"controllers\":["
+      "{\"name\":\"wall0\",\"type\":\"collision.wall\",\"rate_hz\":100},"
+      "{\"name\":\"wall1\",\"type\":\"collision.wall\",\"rate_hz\":100,\"params\":{\"pose\":\"device1.pose\","
+      "\"force_model\":\"tool1.force_model\"}},"
+      "{\"name\":\"h0\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:pierce-down\"}},"
+      "{\"name\":\"h1\",\"type\":\"haptics\",\"rate_hz\":1000,\"params\":{\"device\":\"scripted:pierce-down\",\"hand\":1,"
+      "\"force_model\":\"tool1.force_model\"}}]}";
+  const char* const chosen[] = {"scenario", "sim"};
+  tx_load_options o = {.devices = chosen, .ndevices = 2};
+  tx_scenario* s = tx_scenario_load_text(LABEL, text, strlen(text), &o);
+  if (!s) fail_msg("%s", tx_error());
+  assert_string_equal(json_string_value(json_object_get(tx_system_params(s->system, 2), "device")), "scripted:pierce-down");
+  assert_string_equal(json_string_value(json_object_get(tx_system_params(s->system, 3), "device")), "sim");
+  tx_scenario_free(s);
+  const char* const kept[] = {"scenario", "scenario"};
+  o = (tx_load_options){.devices = kept, .ndevices = 2};
+  s = tx_scenario_load_text(LABEL, text, strlen(text), &o);
+  if (!s) fail_msg("%s", tx_error()); // both kept: the file as it is
+  assert_string_equal(json_string_value(json_object_get(tx_system_params(s->system, 3), "device")), "scripted:pierce-down");
+  tx_scenario_free(s);
+  static const char one_hand[] = "{\"name\":\"t\",\"controllers\":["
+                                 "{\"name\":\"wall0\",\"type\":\"collision.wall\",\"rate_hz\":100},"
+                                 "{\"name\":\"h0\",\"type\":\"haptics\",\"rate_hz\":1000}]}";
+  o = (tx_load_options){.devices = chosen, .ndevices = 2};
+  assert_null(tx_scenario_load_text(LABEL, one_hand, strlen(one_hand), &o));
+  expect_error("--device sim: " LABEL " has 1 haptics controller, so it takes at most 1 --device", NULL);
+}
+
 static void locate_unknown_names_and_missing_files(void** state) {
   (void)state;
   char path[512];
@@ -543,6 +577,7 @@ static void locate_unknown_names_and_missing_files(void** state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(minimal_scenario_loads_with_defaults),
+      cmocka_unit_test(devices_per_hand),
       cmocka_unit_test(data_flow_through_a_declared_component),
       cmocka_unit_test(rate_at_the_upper_limit_is_accepted),
       cmocka_unit_test(malformed_json_gives_label_line_column),

@@ -258,15 +258,15 @@ bool tx_window_present(tx_window* t) {
   return !glfwWindowShouldClose(t->w);
 }
 
-int tx_window_pick(const char* const* names, const char* const* about, int n, bool* mouse) {
-  *mouse = false;
+int tx_window_pick(const char* const* names, const char* const* about, int n, char devices[2][128]) {
+  devices[0][0] = devices[1][0] = 0;
 #ifdef TX_HAVE_GUI
   tx_window* t = tx_window_open(640, 480, false);
   if (!t) return -2;
   glfwSetWindowTitle(t->w, "tactus: choose a scenario");
   void (*clear_color)(float, float, float, float) = (void (*)(float, float, float, float))glfwGetProcAddress("glClearColor");
   void (*clear)(unsigned) = (void (*)(unsigned))glfwGetProcAddress("glClear");
-  tx_pick pick = {names, about, n, n > 0 ? 0 : -1, 0, false, "", false};
+  tx_pick pick = {.names = names, .about = about, .n = n, .chosen = n > 0 ? 0 : -1};
   tx_gui_set_pick(t->gui, &pick);
   while (!pick.start && !glfwWindowShouldClose(t->w)) {
     glfwWaitEventsTimeout(0.05); // nothing moves here but what the hand does
@@ -279,7 +279,8 @@ int tx_window_pick(const char* const* names, const char* const* about, int n, bo
   bool started = pick.start;
   tx_window_close(t);
   tx_window_input_reset(); // the picker's clicks are not the run's input
-  *mouse = pick.device == 1;
+  for (int h = 0; h < TX_PICK_HANDS && h < 2; h++)
+    snprintf(devices[h], 128, "%s", pick.device[h] == TX_PICK_MOUSE ? "mouse" : pick.device[h] == TX_PICK_SPEC ? pick.spec[h] : "");
   return started ? pick.chosen : -1;
 #else
   (void)names, (void)about, (void)n;

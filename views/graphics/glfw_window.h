@@ -49,10 +49,11 @@ void tx_window_sample(tx_window* w, const char* device, double t_s, const double
 bool tx_window_present(tx_window* w);
 
 // The scenario picker, in a window of its own (tactus run --view window with
-// no scenario): names and one line about each; the index chosen, with
-// *mouse set when hand 0 is to be the mouse; -1 when the window was closed,
-// -2 with tx_error() when it does not open (or the build has no Dear ImGui).
-int tx_window_pick(const char* const* names, const char* const* about, int n, bool* mouse);
+// no scenario): names and one line about each; the index chosen, with each
+// hand's device in devices[h] as a --device spec ("mouse", "sim", ...; ""
+// for the scenario's own); -1 when the window was closed, -2 with tx_error()
+// when it does not open (or the build has no Dear ImGui).
+int tx_window_pick(const char* const* names, const char* const* about, int n, char devices[2][128]);
 // the laparoscope's moves since the last call: yaw, pitch (rad), insertion (m)
 void tx_window_take_scope(tx_window* w, double move[3]);
 

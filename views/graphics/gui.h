@@ -52,14 +52,19 @@ void tx_gui_table_end(void);
 
 // The scenario picker (tx_window_pick): while set, tx_gui_frame draws it
 // instead of the trainer's panels. It lists n scenarios and, when start is
-// set, the chosen one and the device for hand 0 (0: the scenario's, 1: mouse).
-// A click on a name or typing part of it chooses; Start or Enter starts.
+// set, the chosen one and each hand's device: TX_PICK_SCENARIO (the file's
+// own), TX_PICK_MOUSE (one hand at most) or TX_PICK_SPEC (a --device spec
+// typed into spec). A click on a name or typing part of it chooses; Start or
+// Enter starts.
+enum { TX_PICK_SCENARIO, TX_PICK_MOUSE, TX_PICK_SPEC };
+#define TX_PICK_HANDS 2
 typedef struct tx_pick {
   const char* const* names;
   const char* const* about; // one line each
   int n;
   int chosen;
-  int device;
+  int device[TX_PICK_HANDS];
+  char spec[TX_PICK_HANDS][128];
   bool start;
   char filter[64]; // typed: only the names holding it are listed; Enter starts the chosen one
   bool focused;    // the filter had the keyboard once

@@ -209,7 +209,7 @@ static long long mono_ns() {
 
 static tx_gui* building; // the GUI whose panels are being laid out, for tx_gui_begin
 
-// the scenario picker: the scenarios, the chosen one's line, hand 0's device, Start
+// the scenario picker: the scenarios, the chosen one's line, each hand's device, Start
 static void pick_panel(tx_pick* p, float w, float h) {
   if (!tx_gui_begin("choose a scenario", 8, 8, w - 16, h - 16)) {
     tx_gui_end();
@@ -231,10 +231,21 @@ static void pick_panel(tx_pick* p, float w, float h) {
   ImGui::Separator();
   if (p->chosen >= 0 && p->chosen < p->n) ImGui::TextWrapped("%s", p->about[p->chosen]);
   ImGui::Separator();
-  ImGui::TextUnformatted("Device for hand 0");
-  ImGui::RadioButton("the scenario's (scripted)", &p->device, 0);
-  ImGui::SameLine();
-  ImGui::RadioButton("mouse", &p->device, 1);
+  for (int hand = 0; hand < TX_PICK_HANDS; hand++) {
+    ImGui::PushID(hand);
+    ImGui::Text("Device for hand %d", hand);
+    int was = p->device[hand];
+    ImGui::RadioButton("the scenario's", &p->device[hand], TX_PICK_SCENARIO);
+    ImGui::SameLine();
+    ImGui::RadioButton("mouse", &p->device[hand], TX_PICK_MOUSE);
+    ImGui::SameLine();
+    ImGui::RadioButton("other:", &p->device[hand], TX_PICK_SPEC);
+    if (p->device[hand] == TX_PICK_MOUSE && was != TX_PICK_MOUSE) // one mouse: the other hand gives it up
+      for (int o = 0; o < TX_PICK_HANDS; o++)
+        if (o != hand && p->device[o] == TX_PICK_MOUSE) p->device[o] = TX_PICK_SCENARIO;
+    if (p->device[hand] == TX_PICK_SPEC) ImGui::InputText("--device: sim, udp:HOST:PORT, ...", p->spec[hand], sizeof p->spec[hand]);
+    ImGui::PopID();
+  }
   if (ImGui::Button("Start") && p->chosen >= 0) p->start = true;
   tx_gui_end();
 }

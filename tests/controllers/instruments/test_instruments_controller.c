@@ -460,6 +460,78 @@ static void test_button_switches_instruments(void** state) {
                  "0,0,0,0,1,0,0,0,0\n0.5,0,0,0,1,0,0,0,0\n1.0,0.02,0,0,1,0,0,0,0.4\n"); // as setup() wrote it
 }
 
+// hand0_holds, tuned during the run as the trainer's window does (from the
+// run's progress callback): the hand puts the forceps down and takes the
+// scissors at its next step (one switch event, instrument0.held 1); a tune
+// to what it holds already changes nothing, one for hand1, which holds
+// nothing, is refused with a warning, and back to 0 takes the forceps again.
+// Given in the file, the hand starts with the scissors; a hand of one
+// instrument cannot start with a second.
+typedef struct tune_script {
+  tx_scenario* s;
+  int ins, done;
+  double held_mid;
+} tune_script;
+
+static bool tune_on_time(double t, void* user) {
+  tune_script* k = user;
+  if (k->done == 0 && t >= 0.3) {
+    assert_int_equal(tx_system_tune(k->s->system, k->ins, "hand0_holds", 1), 0);
+    k->done++;
+  } else if (k->done == 1 && t >= 0.6) {
+    k->held_mid = latest(k->s, "instrument0.held")[0];
+    assert_int_equal(tx_system_tune(k->s->system, k->ins, "hand0_holds", 1), 0);  // held already
+    assert_int_equal(tx_system_tune(k->s->system, k->ins, "hand1_holds", 1), 0);  // no such hand: refused as it steps
+    assert_int_equal(tx_system_tune(k->s->system, k->ins, "hand0_holds", 2), -1); // out of the table's range
+    k->done++;
+  } else if (k->done == 2 && t >= 0.9) {
+    assert_int_equal(tx_system_tune(k->s->system, k->ins, "hand0_holds", 0), 0);
+    k->done++;
+  }
+  return true;
+}
+
+static void test_tune_switches_instruments(void** state) {
+  (void)state;
+  register_tests();
+  instruments_fixture f;
+  fixture_path(&f, "tune");
+  fixture_load(&f, "t_s,x_m,y_m,z_m,qw,qx,qy,qz,grip_rad\n0,0,0,0.0012,1,0,0,0,0\n",
+               "{\"name\":\"thread\",\"type\":\"test.thread\",\"rate_hz\":100},",
+               "\"hand0\":\"thumb_forceps metzenbaum_scissors\",\"thread\":\"thread\",\"gravity_m_s2\":0",
+               ",{\"name\":\"listener\",\"type\":\"test.listener\",\"rate_hz\":1000}");
+  tx_scenario* s = f.s;
+  tune_script k = {s, -1, 0, -1};
+  for (int i = 0; i < tx_system_count(s->system); i++)
+    if (strcmp(tx_system_name(s->system, i), "instruments") == 0) k.ins = i;
+  tx_run_options o = {.duration_s = 1.2, .lockstep = true, .progress = tune_on_time, .progress_user = &k};
+  tx_run_result r;
+  assert_int_equal(tx_system_run(s->system, &o, &r), 0);
+  print_message("  %d events; switches %g, held at 0.6 s: %g\n", the_listener.n, result(s, "instruments.switches"), k.held_mid);
+  assert_int_equal(k.done, 3);
+  assert_true(k.held_mid == 1);
+  assert_int_equal(the_listener.n, 2);
+  assert_int_equal(the_listener.got[0].kind, TX_EVENT_USER + 1); // TX_EVENT_INSTRUMENT_SWITCH
+  assert_true(the_listener.got[0].value[0] == 1 && the_listener.got[0].value[1] == 0);
+  assert_true(the_listener.got[1].value[0] == 0 && the_listener.got[1].value[1] == 1);
+  assert_true(latest(s, "instrument0.held")[0] == 0);
+  assert_true(result(s, "instruments.switches") == 2);
+  assert_int_equal(warnings(s, "instruments.switch_refused"), 1);
+  const double* dev = latest(s, "device0.pose");
+  const double* pose = latest(s, "instrument0.pose");
+  assert_true(fabs(pose[0] - dev[0]) < 1e-4 && fabs(pose[1] - dev[1]) < 1e-4 && fabs(pose[2] - dev[2]) < 1e-4);
+  fixture_free(&f);
+  // given in the file: the second from the start
+  fixture_path(&f, "tune-start");
+  fixture_load(&f, "t_s,x_m,y_m,z_m,qw,qx,qy,qz,grip_rad\n0,0,0,0.0012,1,0,0,0,0\n", "",
+               "\"hand0\":\"thumb_forceps metzenbaum_scissors\",\"hand0_holds\":1,\"gravity_m_s2\":0", "");
+  run(f.s, 0.1);
+  assert_true(latest(f.s, "instrument0.held")[0] == 1);
+  assert_true(result(f.s, "instruments.switches") == 0);
+  fixture_free(&f);
+  assert_refused(load("\"instrument0\":\"needle_holder\",\"hand0_holds\":1"), "params.hand0_holds: device0 has 1 instrument: give 0");
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_follows_the_hand_and_renders_the_weight),
@@ -470,6 +542,7 @@ int main(void) {
       cmocka_unit_test(test_forceps_grasp_the_skin),
       cmocka_unit_test(test_needle_punctures_the_skin),
       cmocka_unit_test(test_button_switches_instruments),
+      cmocka_unit_test(test_tune_switches_instruments),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }

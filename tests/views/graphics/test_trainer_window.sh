@@ -158,7 +158,8 @@ else
 fi
 
 # 4. the scenario picker: `tactus run --view window` with no scenario; part of a name typed and
-#    Enter start it; Escape (once to leave the field, once for the window) closes it: exit 2
+#    Enter start it; Escape (once to leave the field, once for the window) closes it: exit 2;
+#    a device chosen for a hand
 cat >"$WORK/pick.sh" <<'EOF'
 set -u
 out=$1
@@ -197,6 +198,19 @@ rc=$(cat "$WORK/closed.rc" 2>/dev/null)
 [ "${rc:-x}" = 2 ] || fail "closing the picker: exit ${rc:-unknown}, not 2"
 grep -q "run: no scenario chosen (the picker was closed)" "$WORK/closed.log" || fail "closing the picker: $(cat "$WORK/closed.log")"
 [ -e "$WORK/closed" ] && fail "closing the picker left an output folder"
+
+# each hand's device: hand 0 "other:" with a spec typed reaches the loader as that hand's --device (a
+# bad one: exit 2 naming it); hand 1 given the mouse in a one-hand scenario is refused as a second --device
+pick_run "$WORK/spec" "type --delay 30 haptics-wall" "mousemove --sync 221 157 click 1" \
+  "mousemove --sync 150 177 click 1" "type --delay 30 bogus" "mousemove --sync 37 240 click 1"
+rc=$(cat "$WORK/spec.rc" 2>/dev/null)
+[ "${rc:-x}" = 2 ] || fail "hand 0's typed device: exit ${rc:-unknown}, not 2"
+grep -q "^tactus: --device bogus: device 'bogus': unknown kind" "$WORK/spec.log" || fail "hand 0's typed device: $(cat "$WORK/spec.log")"
+pick_run "$WORK/hand1" "type --delay 30 haptics-wall" "mousemove --sync 155 197 click 1" "mousemove --sync 37 220 click 1"
+rc=$(cat "$WORK/hand1.rc" 2>/dev/null)
+[ "${rc:-x}" = 2 ] || fail "hand 1's mouse in a one-hand scenario: exit ${rc:-unknown}, not 2"
+grep -q "^tactus: --device mouse: .*haptics-wall.json has 1 haptics controller, so it takes at most 1 --device" "$WORK/hand1.log" ||
+  fail "hand 1's mouse: $(cat "$WORK/hand1.log")"
 
 [ "$failures" -eq 0 ] && echo "trainer window: ok"
 exit $((failures > 0))
