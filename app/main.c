@@ -61,27 +61,6 @@ int tx_cmd_list(int argc, char** argv) {
   return 0;
 }
 
-// a number as the docs write it: the shortest %g that reads back, without the
-// "+" and leading zeros of the exponent
-static const char* num_text(double x, char* buf, size_t n) {
-  char raw[64];
-  for (int digits = 6; digits <= 17; digits++) { // the shortest text that reads back as x
-    snprintf(raw, sizeof raw, "%.*g", digits, x);
-    if (strtod(raw, NULL) == x) break;
-  }
-  size_t o = 0;
-  for (const char* p = raw; *p && o + 1 < n; p++) {
-    buf[o++] = *p;
-    if (*p == 'e') {
-      if (p[1] == '+') p++;
-      else if (p[1] == '-') buf[o++] = *++p;
-      while (p[1] == '0' && p[2]) p++;
-    }
-  }
-  buf[o] = 0;
-  return buf;
-}
-
 static const char* kind_text(tx_param_kind k) {
   switch (k) {
   case TX_PARAM_NUM: return "number";
@@ -94,27 +73,11 @@ static const char* kind_text(tx_param_kind k) {
   return "?";
 }
 
-// the default as the table gives it; md: strings as Markdown code
-static const char* default_text(const tx_param_def* d, bool md, char* buf, size_t n) {
-  switch (d->kind) {
-  case TX_PARAM_NUM: case TX_PARAM_INT:
-    if (d->def_str) return snprintf(buf, n, "%s", d->def_str), buf;
-    return num_text(d->def_num, buf, n);
-  case TX_PARAM_BOOL: return d->def_num != 0 ? "true" : "false";
-  case TX_PARAM_STR:
-    if (!d->def_str) return "none";
-    return snprintf(buf, n, md ? "`%s`" : "\"%s\"", *d->def_str || !md ? d->def_str : "\"\""), buf;
-  case TX_PARAM_STRS: return "[]";
-  case TX_PARAM_JSON: return "none";
-  }
-  return "?";
-}
-
 static const char* range_text(const tx_param_def* d, char* buf, size_t n) {
   char lo[32], hi[32];
   if (d->kind == TX_PARAM_NUM || d->kind == TX_PARAM_INT)
-    return snprintf(buf, n, "[%s, %s]", num_text(d->min, lo, sizeof lo), num_text(d->max, hi, sizeof hi)), buf;
-  if (d->kind == TX_PARAM_STRS) return snprintf(buf, n, "at most %s", num_text(d->max, hi, sizeof hi)), buf;
+    return snprintf(buf, n, "[%s, %s]", tx_param_num_text(d->min, lo, sizeof lo), tx_param_num_text(d->max, hi, sizeof hi)), buf;
+  if (d->kind == TX_PARAM_STRS) return snprintf(buf, n, "at most %s", tx_param_num_text(d->max, hi, sizeof hi)), buf;
   return "-";
 }
 
@@ -128,7 +91,7 @@ static int describe_class(const char* type) {
   for (int k = 0; k < cls->nparams; k++) {
     const tx_param_def* d = &cls->params[k];
     char def[128], range[96];
-    printf("| `%s` | %s | %s | %s | %s | %s |\n", d->key, kind_text(d->kind), default_text(d, true, def, sizeof def),
+    printf("| `%s` | %s | %s | %s | %s | %s |\n", d->key, kind_text(d->kind), tx_param_default_text(d, true, def, sizeof def),
            d->units ? d->units : "-", range_text(d, range, sizeof range), d->meaning);
   }
   return 0;
@@ -144,19 +107,8 @@ static void describe_params(tx_system* s, int i) {
   json_t* given = tx_system_params(s, i);
   for (int k = 0; k < cls->nparams; k++) {
     const tx_param_def* d = &cls->params[k];
-    json_t* v = given ? json_object_get(given, d->key) : NULL;
-    char value[64], def[128], range[96];
-    if (v && json_is_number(v)) {
-      num_text(json_number_value(v), value, sizeof value);
-    } else if (v) {
-      char* text = json_dumps(v, JSON_COMPACT | JSON_ENCODE_ANY);
-      // a long value (the view object) is cut: describe shows, the scenario holds
-      if (text && strlen(text) > 30) snprintf(value, sizeof value, "%.27s...", text);
-      else snprintf(value, sizeof value, "%s", text ? text : "?");
-      free(text);
-    } else {
-      snprintf(value, sizeof value, "%s (default)", default_text(d, false, def, sizeof def));
-    }
+    char value[64], range[96];
+    tx_param_value_text(d, given, 30, value, sizeof value);
     printf("  %-20s %-30s %-8s %-22s %s\n", d->key, value, d->units ? d->units : "-", range_text(d, range, sizeof range),
            d->meaning);
   }

@@ -390,3 +390,55 @@ tx_warning tx_setup_warning(tx_setup* s, const char* key) {
   if (sys->nwarnings > before) atomic_init(&sys->warning_counts[id - 1], 0);
   return (tx_warning){id};
 }
+
+// --- parameters as text, for `tactus describe` and the trainer's panel -------
+
+const char* tx_param_num_text(double x, char* buf, size_t n) {
+  char raw[64];
+  for (int digits = 6; digits <= 17; digits++) { // the shortest text that reads back as x
+    snprintf(raw, sizeof raw, "%.*g", digits, x);
+    if (strtod(raw, NULL) == x) break;
+  }
+  size_t o = 0;
+  for (const char* p = raw; *p && o + 1 < n; p++) {
+    buf[o++] = *p;
+    if (*p == 'e') {
+      if (p[1] == '+') p++;
+      else if (p[1] == '-') buf[o++] = *++p;
+      while (p[1] == '0' && p[2]) p++;
+    }
+  }
+  buf[o] = 0;
+  return buf;
+}
+
+const char* tx_param_default_text(const tx_param_def* d, bool md, char* buf, size_t n) {
+  switch (d->kind) {
+  case TX_PARAM_NUM: case TX_PARAM_INT:
+    if (d->def_str) return snprintf(buf, n, "%s", d->def_str), buf;
+    return tx_param_num_text(d->def_num, buf, n);
+  case TX_PARAM_BOOL: return d->def_num != 0 ? "true" : "false";
+  case TX_PARAM_STR:
+    if (!d->def_str) return "none";
+    return snprintf(buf, n, md ? "`%s`" : "\"%s\"", *d->def_str || !md ? d->def_str : "\"\""), buf;
+  case TX_PARAM_STRS: return "[]";
+  case TX_PARAM_JSON: return "none";
+  }
+  return "?";
+}
+
+const char* tx_param_value_text(const tx_param_def* d, json_t* given, int width, char* buf, size_t n) {
+  json_t* v = given ? json_object_get(given, d->key) : NULL;
+  if (v && json_is_number(v)) return tx_param_num_text(json_number_value(v), buf, n);
+  if (v) {
+    char* text = json_dumps(v, JSON_COMPACT | JSON_ENCODE_ANY);
+    // a long value (the view object) is cut: the text shows, the scenario holds
+    if (text && width > 3 && strlen(text) > (size_t)width) snprintf(buf, n, "%.*s...", width - 3, text);
+    else snprintf(buf, n, "%s", text ? text : "?");
+    free(text);
+    return buf;
+  }
+  char def[128];
+  snprintf(buf, n, "%s (default)", tx_param_default_text(d, false, def, sizeof def));
+  return buf;
+}

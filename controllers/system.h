@@ -152,6 +152,14 @@ double tx_system_sim_time(const tx_system* s); // the simulation clock now, s
 #define TX_TUNES_MAX 256 // logged per run; later ones are applied, not logged
 int tx_system_tune(tx_system* s, int i, const char* key, double value);
 bool tx_param_live(const tx_controller_class* cls, const char* key); // in cls->live
+// a parameter as text: a number as the docs write it (the shortest %g that
+// reads back, no "+" or leading zeros in the exponent); the table's default
+// (md: strings as Markdown code); the value the scenario gave (given: the
+// instance's params, tx_system_params; a given text or JSON value longer than
+// width cut to it with "...") or the default with "(default)" after it
+const char* tx_param_num_text(double x, char* buf, size_t n);
+const char* tx_param_default_text(const tx_param_def* d, bool md, char* buf, size_t n);
+const char* tx_param_value_text(const tx_param_def* d, json_t* given, int width, char* buf, size_t n);
 typedef struct tx_tune_info {
   double t_s;             // simulation time it took effect
   const char* controller; // instance

@@ -295,9 +295,35 @@ static void builtin_tables_hold_the_library_defaults(void** state) {
 #endif
 }
 
+// a parameter as `tactus describe` and the trainer's panel show it: a number
+// in its shortest text that reads back, a given string or JSON value (cut
+// to the width with "..."), and the table's default marked as such
+static void parameters_as_text(void** state) {
+  (void)state;
+  static const tx_param_def num = {"gain", TX_PARAM_NUM, "N/m", 0, 1e9, 300, NULL, "a gain"};
+  static const tx_param_def str = {"device", TX_PARAM_STR, NULL, 0, 0, 0, "scripted:pierce-down", "a device"};
+  static const tx_param_def obj = {"view", TX_PARAM_JSON, NULL, 0, 0, 0, NULL, "a view"};
+  char buf[96];
+  assert_string_equal(tx_param_num_text(0.1, buf, sizeof buf), "0.1");
+  assert_string_equal(tx_param_num_text(2e-05, buf, sizeof buf), "2e-5");
+  assert_string_equal(tx_param_num_text(1e+100, buf, sizeof buf), "1e100");
+  json_error_t e;
+  json_t* given = json_loads("{\"gain\":1500.5,\"device\":\"sim\",\"view\":{\"camera\":[0,1,2],\"draw\":[\"skin\"]}}", 0, &e);
+  assert_non_null(given);
+  assert_string_equal(tx_param_value_text(&num, given, 30, buf, sizeof buf), "1500.5");
+  assert_string_equal(tx_param_value_text(&str, given, 30, buf, sizeof buf), "\"sim\"");
+  assert_string_equal(tx_param_value_text(&obj, given, 20, buf, sizeof buf), "{\"camera\":[0,1,2]...");
+  assert_int_equal(strlen(buf), 20);
+  assert_string_equal(tx_param_value_text(&num, NULL, 30, buf, sizeof buf), "300 (default)");
+  assert_string_equal(tx_param_value_text(&str, NULL, 30, buf, sizeof buf), "\"scripted:pierce-down\" (default)");
+  assert_string_equal(tx_param_default_text(&str, true, buf, sizeof buf), "`scripted:pierce-down`");
+  json_decref(given);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(defaults_come_from_the_table),
+      cmocka_unit_test(parameters_as_text),
       cmocka_unit_test(values_are_read_and_range_checked),
       cmocka_unit_test(unknown_keys_are_refused_before_configure_naming_the_valid_ones),
       cmocka_unit_test(misuse_of_the_table_is_a_programming_error),

@@ -40,6 +40,8 @@ void tx_gui_frame(tx_gui* g, int fb_w, int fb_h, int tiles_x, int tiles_y, bool 
 bool tx_gui_begin(const char* title, float x, float y, float w, float h);
 void tx_gui_end(void);
 bool tx_gui_header(const char* label, bool open);
+bool tx_gui_tree_begin(const char* label); // a closed node, indented; tx_gui_tree_end when it returns true
+void tx_gui_tree_end(void);
 bool tx_gui_button(const char* label);
 void tx_gui_same_line(void);
 void tx_gui_text(const char* fmt, ...) __attribute__((format(printf, 1, 2)));

@@ -392,6 +392,9 @@ bool tx_gui_header(const char* label, bool open) {
   return ImGui::CollapsingHeader(label, open ? ImGuiTreeNodeFlags_DefaultOpen : 0);
 }
 
+bool tx_gui_tree_begin(const char* label) { return ImGui::TreeNode(label); }
+void tx_gui_tree_end(void) { ImGui::TreePop(); }
+
 bool tx_gui_button(const char* label) { return ImGui::Button(label); }
 void tx_gui_same_line(void) { ImGui::SameLine(); }
 

@@ -13,6 +13,7 @@
 #include <jansson.h>
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #define RATE_WINDOW_NS 500000000 // the live rate is counted over half a second
 #define MAX_SHOWN 64             // controllers listed
@@ -137,6 +138,27 @@ static void tune_panel(tx_system* s, int n) {
   if (tune.error[0]) tx_gui_text("%s", tune.error);
 }
 
+// the rest of each controller's table, as the scenario gave it: fixed for the run
+static void params_panel(tx_system* s, int n) {
+  for (int i = 0; i < n; i++) {
+    const tx_controller_class* cls = tx_system_class(s, i);
+    char label[160], value[96];
+    snprintf(label, sizeof label, "%s (%s)##params%d", tx_system_name(s, i), cls->type, i);
+    if (!tx_gui_tree_begin(label)) continue;
+    int shown = 0;
+    for (int p = 0; cls->params && p < cls->nparams; p++) {
+      const tx_param_def* d = &cls->params[p];
+      if (tx_param_live(cls, d->key)) continue; // a field above
+      tx_param_value_text(d, tx_system_params(s, i), 40, value, sizeof value);
+      bool unit = d->units && strcmp(d->units, "1") != 0;
+      tx_gui_text("%s = %s%s%s", d->key, value, unit ? " " : "", unit ? d->units : "");
+      shown++;
+    }
+    if (!shown) tx_gui_text(cls->params ? "no fixed parameters" : "no parameter table");
+    tx_gui_tree_end();
+  }
+}
+
 void tx_gui_panels(float eye_w, float eye_h) {
   tx_system* s = tx_system_running();
   if (!tx_gui_begin("tactus", eye_w - 312, 8, 304, eye_h - 16 < 300 ? 300 : eye_h - 16)) {
@@ -180,6 +202,7 @@ void tx_gui_panels(float eye_w, float eye_h) {
   }
   if (tx_gui_header("Tune", true)) tune_panel(s, n);
   if (tx_gui_header("Devices", true)) device_plots();
+  if (tx_gui_header("Parameters", false)) params_panel(s, n);
   if (tx_gui_header("Components", false)) components_table(s);
   tx_gui_end();
 }
