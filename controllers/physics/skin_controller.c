@@ -6,6 +6,7 @@
 #include "skin_controller.h"
 
 #include "bullet/cloth.h"
+#include "../system.h" // tx_param_json, tx_param_point
 
 #include <tactus/components.h>
 #include <tactus/events.h>
@@ -39,7 +40,21 @@ typedef struct skin {
   int nheld;
   int grasps;                           // grasps that took particles
   tx_result grasp_result;
+  int wound_links;                      // links the wound cut (wound_a_m to wound_b_m), 0: none
+  tx_result wound_result;
 } skin;
+
+// the wound's ends (wound_a_m, wound_b_m, both or neither): 1 with them, 0 for none, -1 refused
+static int read_wound(tx_setup* s, double w[2][3]) {
+  json_t* a = tx_param_json(s, "wound_a_m");
+  json_t* b = tx_param_json(s, "wound_b_m");
+  bool has_a = a && !json_is_null(a), has_b = b && !json_is_null(b);
+  if (has_a != has_b) return tx_setup_fail(s, has_a ? "wound_b_m" : "wound_a_m", "the wound needs both ends (wound_a_m, wound_b_m)");
+  if (!has_a) return 0;
+  static const double none[3] = {0, 0, 0};
+  if (tx_param_point(s, "wound_a_m", none, w[0]) || tx_param_point(s, "wound_b_m", none, w[1])) return -1;
+  return 1;
+}
 
 // defaults are tx_cloth_def_default()'s (tests/controllers/test_param_tables.c checks)
 static const tx_param_def params[] = {
@@ -78,6 +93,9 @@ static const tx_param_def params[] = {
      "a grasp takes the free particles this close to its point; none in reach: not the skin's"},
     {"grasp_hands", TX_PARAM_INT, "1", 1, GRASP_HANDS_MAX, 2, NULL,
      "with grasp_events: hands 0 to this less one, each with its instrument<h>.pose"},
+    {"wound_a_m", TX_PARAM_JSON, NULL, 0, 0, 0, NULL,
+     "[x, y, z], m: one end of a straight wound cut through the skin (in x-z) before the run; with wound_b_m; none by default"},
+    {"wound_b_m", TX_PARAM_JSON, NULL, 0, 0, 0, NULL, "[x, y, z], m: the wound's other end"},
 };
 
 static int configure(tx_setup* s, void** self) {
@@ -136,6 +154,12 @@ static int configure(tx_setup* s, void** self) {
   if (tx_cloth_def_check(&d)) return tx_setup_fail(s, NULL, "%s", tx_error());
   k->cloth = tx_cloth_create(&d);
   if (!k->cloth) return tx_setup_fail(s, NULL, "%s", tx_error());
+  double wound[2][3];
+  int has_wound = read_wound(s, wound);
+  if (has_wound < 0) return -1;
+  if (has_wound && !(k->wound_links = tx_cloth_cut(k->cloth, wound[0], wound[1])))
+    return tx_setup_fail(s, "wound_a_m", "the wound to wound_b_m crosses no link of the patch");
+  k->wound_result = tx_setup_result(s, "wound_links_cut");
 
   uint32_t n = (uint32_t)tx_cloth_particle_count(k->cloth), m = (uint32_t)tx_cloth_triangle_count(k->cloth);
   if (k->hip_radius > 0) k->pose = TX_READ_OF(s, pose, tx_pose);
@@ -342,6 +366,7 @@ static void step(tx_ctx* c, void* self) {
 static void finish(tx_ctx* c, void* self) {
   skin* k = self;
   tx_set_result(c, k->torn_result, tx_cloth_torn(k->cloth));
+  tx_set_result(c, k->wound_result, k->wound_links);
   tx_set_result(c, k->fault_result, tx_cloth_faults(k->cloth));
   tx_set_result(c, k->grasp_result, k->grasps);
   tx_set_result(c, k->pierce_result, tx_cloth_pierces(k->cloth));

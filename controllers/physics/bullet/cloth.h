@@ -216,6 +216,12 @@ double tx_cloth_peak_tension(const tx_cloth* c);
 bool tx_cloth_broke_at(const tx_cloth* c, double at[3]);
 // faults found and recovered so far
 int tx_cloth_faults(const tx_cloth* c);
+// A cut through the skin (a wound, made before a run): every stretch and
+// shear link whose particles at rest lie on either side of the segment a-b
+// (in x-z, Y up) goes, with the triangles it borders and the bending links
+// across it, as a tear would take them, but not counted as torn. Returns the
+// links cut (0: the segment crosses none)
+int tx_cloth_cut(tx_cloth* c, const double a[3], const double b[3]);
 // the pierce: a link torn where the HIP holds the skin is its puncture; from
 // then on the contact ignores the hole's rim (the particles then within the
 // contact distance plus two of the longest links of the HIP) and the skin

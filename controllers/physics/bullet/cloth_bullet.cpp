@@ -1558,6 +1558,37 @@ static void rupture(tx_cloth* c, const btVector3* near) {
   if (at_contact) pierce_start(c);
 }
 
+// whether p-q and a-b cross in x-z, each strictly between the other's ends
+static bool crosses_xz(const float* p, const float* q, const double* a, const double* b) {
+  auto side = [](double ox, double oz, double ux, double uz, double px, double pz) {
+    return (ux - ox) * (pz - oz) - (uz - oz) * (px - ox);
+  };
+  const double d1 = side(a[0], a[2], b[0], b[2], p[0], p[2]), d2 = side(a[0], a[2], b[0], b[2], q[0], q[2]);
+  const double d3 = side(p[0], p[2], q[0], q[2], a[0], a[2]), d4 = side(p[0], p[2], q[0], q[2], b[0], b[2]);
+  return d1 * d2 < 0 && d3 * d4 < 0;
+}
+
+extern "C" int tx_cloth_cut(tx_cloth* c, const double a[3], const double b[3]) {
+  int cut = 0;
+  for (int id = 0; id < c->nlink; id++) {
+    link_info& li = c->info[(size_t)id];
+    if (li.slot < 0 || li.kind == BEND) continue;
+    if (!crosses_xz(&c->rest_x[(size_t)li.end[0] * 3], &c->rest_x[(size_t)li.end[1] * 3], a, b)) continue;
+    remove_link(c, id);
+    c->tension[(size_t)id] = 0;
+    for (int j = 0; j < 2; j++) {
+      if (li.tri[j] >= 0) c->tri_alive[(size_t)li.tri[j]] = 0;
+      if (li.dep[j] >= 0) remove_link(c, li.dep[j]), c->tension[(size_t)li.dep[j]] = 0;
+    }
+    cut++;
+  }
+  if (cut) {
+    c->topology_dirty = c->live_dirty = c->detach_check = true;
+    tx_cloth_save(c); // a fault goes back to the cut skin, not the whole one
+  }
+  return cut;
+}
+
 // Pieces cut off from the patch: particles with no path of live links to a
 // fixed or pinned particle. Each is frozen where it is (no mass, no
 // velocity), loses its links and its triangles, and keeps its index: what

@@ -146,6 +146,62 @@ static void bad_parameters_are_named(void** state) {
   }
 }
 
+// the gap across the wound at its middle: the particles nearest (-1.25, 0,
+// -+1.25) mm at rest, the two rows beside the line z = 0 (the default 42 x
+// 42 patch has none on it)
+static double wound_gap(tx_scenario* s, const float* rest, int n) {
+  const float* x = latest_snapshot(s, "skin.x").data;
+  int side[2] = {-1, -1};
+  for (int e = 0; e < 2; e++) {
+    double best = 1e9, z = e ? 0.00125 : -0.00125;
+    for (int i = 0; i < n; i++) {
+      double d = hypot(rest[3 * i] + 0.00125, rest[3 * i + 2] - z);
+      if (d < best) best = d, side[e] = i;
+    }
+  }
+  const float *p = x + 3 * side[0], *q = x + 3 * side[1];
+  return sqrt(pow(p[0] - q[0], 2) + pow(p[1] - q[1], 2) + pow(p[2] - q[2], 2));
+}
+
+// A wound cut along z = 0 from x = -15 to 15 mm before the run: the links
+// across it go (the 12 stretch links between x = -13.75 and 13.75 mm and
+// both shear links of each of the 13 cells it crosses: 38), with the cells'
+// 26 triangles, none counted as torn. Without tension
+// the edges rest a spacing apart; with the skin pre-tensioned they draw
+// back, as a cut through tensed skin gapes, and further the more tension.
+// Ends given alone, or a wound off the patch, are refused naming the key.
+static void wound_is_cut_and_gapes_under_tension(void** state) {
+  (void)state;
+  static float rest[3 * 1764];
+  double gap[3];
+  const char* tension[] = {"0", "20", "40"};
+  for (int k = 0; k < 3; k++) {
+    char params[256];
+    snprintf(params, sizeof params, "\"wound_a_m\":[-0.015,0,0],\"wound_b_m\":[0.015,0,0],\"pretension_n_per_m\":%s", tension[k]);
+    tx_scenario* s = load(params, 60);
+    if (!s) fail_msg("%s", tx_error());
+    run(s, 1.0 / 60);
+    if (k == 0) memcpy(rest, latest_snapshot(s, "skin.x").data, sizeof rest);
+    run(s, 1.0);
+    tx_snapshot tri = latest_snapshot(s, "skin.tri");
+    gap[k] = wound_gap(s, rest, 1764);
+    print_message("  pretension %s N/m: %g links cut, %u of 3362 triangles live, the gap %.3f mm\n", tension[k],
+                  result(s, "skin.wound_links_cut"), tri.rows, 1e3 * gap[k]);
+    assert_true(result(s, "skin.wound_links_cut") == 38);
+    assert_int_equal(tri.rows, 3362 - 26); // each cell it crosses loses both triangles
+    assert_true(result(s, "skin.torn_links") == 0);
+    tx_scenario_free(s);
+  }
+  assert_true(fabs(gap[0] - 0.0025) < 1e-4); // at rest: one spacing
+  assert_true(gap[1] > gap[0] + 1e-4 && gap[2] > gap[1] + 1e-4);
+  static const char* const bad[][2] = {
+      {"\"wound_a_m\":[-0.015,0,0]", "params.wound_b_m: the wound needs both ends"},
+      {"\"wound_a_m\":[0.2,0,0.2],\"wound_b_m\":[0.3,0,0.2]", "params.wound_a_m: the wound to wound_b_m crosses no link"},
+      {"\"wound_a_m\":[0,0],\"wound_b_m\":[0.01,0,0]", "params.wound_a_m: expected [x, y, z]"},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) assert_refused(load(bad[i][0], 60), bad[i][1]);
+}
+
 // a test class standing for physics.instruments: hand 0's jaws (instrument0.pose)
 // and their grasps on instruments.events. At grasp_at it grasps at point; from
 // 0.2 s to 0.7 s the jaws rise by lift along y and turn by turn rad about y;
@@ -333,6 +389,7 @@ int main(void) {
       cmocka_unit_test(grasp_out_of_reach_does_nothing),
       cmocka_unit_test(tear_beside_the_jaws),
       cmocka_unit_test(piece_let_go_is_freed),
+      cmocka_unit_test(wound_is_cut_and_gapes_under_tension),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
