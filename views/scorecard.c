@@ -114,6 +114,14 @@ static json_t* build(const scorecard* v) {
   measure(root, "peak_tension_n", m->peak_tension_n, "N", "the thread's largest tension at the needle (its force model's F0)");
   measure(root, "path_hand0_m", m->path_m[0], "m", "the path length of hand 0's tool point: economy of motion (OSATS, time and motion)");
   measure(root, "path_hand1_m", m->path_m[1], "m", "the path length of hand 1's tool point");
+  json_object_set_new(root, "wound_gap_m",
+                      json_pack("{s:o, s:o, s:s, s:s}", "before", number_or_null(m->wound_gap_before_m), "after",
+                                number_or_null(m->wound_gap_after_m), "unit", "m", "rule",
+                                "the distance across the wound where the stitch crosses it, between its two edges' skin "
+                                "nearest there: as the run found the skin, and at its end; a stitch draws the edges together"));
+  measure(root, "tissue_force_max_n", m->tissue_force_max_n, "N",
+          "the largest force of the skin on the needle's tip; OSATS's respect for tissue asks for no unnecessary force");
+  measure(root, "tears", m->tears, "1", "links the skin tore (the punctures' own included), the wound's cut not counted");
   return root;
 }
 

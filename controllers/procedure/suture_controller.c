@@ -16,6 +16,7 @@
 
 #define HANDS 2
 #define PUNCTURES_MAX 64 // rows of the punctures component read
+#define SKIN_PARTICLES_MAX 16384 // the wound gap is measured on skins up to this many particles (102 x 102 at 1 mm)
 
 typedef struct suture {
   tx_suture_steps steps;
@@ -33,11 +34,18 @@ typedef struct suture {
   double puncture_at[PUNCTURES_MAX][3]; // m, each puncture event's point
   bool have_entry;
   double entry[3];         // m, the stitch's entry (its bite on the near edge)
+  bool have_exit;
+  double exit[3];          // m, its exit, on the far edge
   tx_suture_measures m;
   double last_hand[HANDS][3];
   bool hand_seen[HANDS];
   uint32_t holding;        // bit h: hand h's jaws hold something
   bool cut;
+  // the skin (skin: SKIN.x and SKIN.contact), for the wound gap, the force on the tissue and the tears
+  tx_port skin_x, skin_contact;
+  float* rest;             // (SKIN_PARTICLES_MAX x 3) m, SKIN.x as the run found it
+  uint32_t nrest;          // its particles, 0 until the first publish
+  tx_warning skin_too_large;
 } suture;
 
 static const tx_param_def params[] = {
@@ -55,6 +63,8 @@ static const tx_param_def params[] = {
     {"wrap_turns", TX_PARAM_NUM, "1", 0.25, 10, 1, NULL, "C is done once the thread winds around the holder's jaws this many times"},
     {"wrap_reach_m", TX_PARAM_NUM, "m", 0.001, 0.1, 0.008, NULL, "thread nodes within this distance of the jaws' axis count for the wrap"},
     {"wrap_length_m", TX_PARAM_NUM, "m", 0.005, 0.3, 0.03, NULL, "the jaws' length ahead of the pivot, along which a wrap counts"},
+    {"skin", TX_PARAM_STR, NULL, 0, 0, 0, "",
+     "the skin's prefix: SKIN.x for the wound gap at the stitch, SKIN.contact for the force on the tissue and the tears; empty: none"},
 };
 
 // a read that the scenario may leave out with an empty name
@@ -113,7 +123,31 @@ static int configure(tx_setup* s, void** self) {
     k->step_r[i] = tx_setup_result(s, name);
   }
   k->lost_w = tx_setup_warning(s, "punctures_unmatched");
-  k->m = (tx_suture_measures){.bite_entry_m = NAN, .bite_exit_m = NAN};
+  const char* skin = tx_table_str(s, "skin");
+  if (skin && *skin) {
+    snprintf(name, sizeof name, "%s.x", skin);
+    k->skin_x = TX_READ_OF(s, name, tx_vertex);
+    snprintf(name, sizeof name, "%s.contact", skin);
+    k->skin_contact = TX_READ_OF(s, name, tx_skin_contact);
+    k->rest = malloc(sizeof(float) * 3 * SKIN_PARTICLES_MAX);
+    if (!k->rest) return tx_setup_fail(s, NULL, "out of memory");
+    k->skin_too_large = tx_setup_warning(s, "skin_too_large");
+  }
+  return 0;
+}
+
+// a run starts with nothing seen (a reset runs init again)
+static int init(tx_ctx* c, void* self) {
+  (void)c;
+  suture* k = self;
+  tx_suture_rules r = k->steps.rules;
+  tx_suture_steps_start(&k->steps, &r, 0);
+  k->punctures_seen = k->punctures_placed = 0;
+  k->have_entry = k->have_exit = k->cut = false;
+  k->holding = 0;
+  memset(k->hand_seen, 0, sizeof k->hand_seen);
+  k->nrest = 0;
+  k->m = (tx_suture_measures){.bite_entry_m = NAN, .bite_exit_m = NAN, .wound_gap_before_m = NAN, .wound_gap_after_m = NAN};
   return 0;
 }
 
@@ -167,7 +201,11 @@ static void place_punctures(tx_ctx* c, suture* k, double t) {
       memcpy(k->entry, p, sizeof k->entry);
       k->m.bite_entry_m = fabs(off);
     }
-    if (tx_suture_steps_puncture(&k->steps, t, side, edge)) k->m.bite_exit_m = fabs(off);
+    if (tx_suture_steps_puncture(&k->steps, t, side, edge)) {
+      k->m.bite_exit_m = fabs(off);
+      k->have_exit = true;
+      memcpy(k->exit, p, sizeof k->exit);
+    }
     k->punctures_placed++;
   }
 }
@@ -253,6 +291,59 @@ static double wrap_turns(const suture* k, const tx_thread_node* n, uint32_t rows
   return swept / (2 * M_PI);
 }
 
+// Across the wound at the stitch: the point of the wound line nearest the
+// middle of the stitch's entry and exit (the entry alone before the exit,
+// the wound's middle before either); on each side of the line the particle
+// nearest it at rest (the wound's two edges there), and their distance on
+// the skin x, in m
+static double wound_gap(const suture* k, const float* x) {
+  double ux = k->wound_b[0] - k->wound_a[0], uz = k->wound_b[2] - k->wound_a[2], len = sqrt(ux * ux + uz * uz);
+  ux /= len, uz /= len;
+  double at[3];
+  for (int a = 0; a < 3; a++) at[a] = 0.5 * (k->wound_a[a] + k->wound_b[a]);
+  if (k->have_entry) memcpy(at, k->entry, sizeof at);
+  if (k->have_exit)
+    for (int a = 0; a < 3; a++) at[a] = 0.5 * (k->entry[a] + k->exit[a]);
+  double s = (at[0] - k->wound_a[0]) * ux + (at[2] - k->wound_a[2]) * uz;
+  s = fmin(fmax(s, 0), len);
+  int side[2] = {-1, -1};
+  double best[2] = {INFINITY, INFINITY};
+  for (uint32_t i = 0; i < k->nrest; i++) {
+    const float* r = k->rest + 3 * i;
+    double along = (r[0] - k->wound_a[0]) * ux + (r[2] - k->wound_a[2]) * uz - s;
+    double off = wound_offset(k, (const double[3]){r[0], r[1], r[2]});
+    int e = off >= 0;
+    double d = along * along + off * off;
+    if (d < best[e]) best[e] = d, side[e] = (int)i;
+  }
+  if (side[0] < 0 || side[1] < 0) return NAN;
+  const float *p = x + 3 * side[0], *q = x + 3 * side[1];
+  return sqrt((double)(p[0] - q[0]) * (p[0] - q[0]) + (double)(p[1] - q[1]) * (p[1] - q[1]) + (double)(p[2] - q[2]) * (p[2] - q[2]));
+}
+
+// the skin: kept as the run found it, the gap on it and on the latest, the tip's force, the tears
+static void read_skin(tx_ctx* c, suture* k) {
+  tx_snapshot x = tx_read(c, k->skin_x);
+  if (x.seq && k->nrest == 0) {
+    if (x.rows > SKIN_PARTICLES_MAX) {
+      tx_warn(c, k->skin_too_large);
+    } else {
+      memcpy(k->rest, x.data, sizeof(float) * 3 * x.rows);
+      k->nrest = x.rows;
+    }
+  }
+  if (x.seq && k->nrest == x.rows) {
+    k->m.wound_gap_before_m = wound_gap(k, k->rest);
+    k->m.wound_gap_after_m = wound_gap(k, x.data);
+  }
+  tx_snapshot f = tx_read(c, k->skin_contact);
+  if (f.seq) {
+    const tx_skin_contact* sc = f.data;
+    k->m.tissue_force_max_n = fmax(k->m.tissue_force_max_n, sqrt(sc->f[0] * sc->f[0] + sc->f[1] * sc->f[1] + sc->f[2] * sc->f[2]));
+    k->m.tears = sc->torn;
+  }
+}
+
 static void step(tx_ctx* c, void* self) {
   suture* k = self;
   double t = (double)tx_sim_ns(c) * 1e-9;
@@ -276,6 +367,7 @@ static void step(tx_ctx* c, void* self) {
       k->m.peak_tension_n = fmax(k->m.peak_tension_n, sqrt(f0[0] * f0[0] + f0[1] * f0[1] + f0[2] * f0[2]));
     }
   }
+  if (k->skin_x.id) read_skin(c, k);
   if (k->holding == 0 && k->cut) tx_suture_steps_hands_free(&k->steps, t);
   for (int h = 0; h < k->nhands; h++) {
     if (!k->hand[h].id) continue;
@@ -303,12 +395,17 @@ static void finish(tx_ctx* c, void* self) {
   for (int i = 0; i < TX_SUTURE_STEPS; i++) tx_set_result(c, k->step_r[i], k->steps.step[i].status);
 }
 
-static void fini(void* self) { free(self); }
+static void fini(void* self) {
+  suture* k = self;
+  if (k) free(k->rest);
+  free(k);
+}
 
 const tx_controller_class tx_procedure_suture = {
     .type = "procedure.suture",
     .summary = "steps A-H of a simple interrupted suture and its scorecard's measures, from the instruments' and the thread's events",
     .configure = configure,
+    .init = init,
     .step = step,
     .finish = finish,
     .fini = fini,

@@ -452,9 +452,13 @@ typedef struct tx_suture_measures {
   double knots_fixed;    // knots fixed at the skin
   double peak_tension_n; // N, the thread's largest tension at the needle
   double path_m[2];      // m, the path of each hand's tool point
+  double wound_gap_before_m; // m, across the wound at the stitch, the skin as the run found it; NaN: no skin read
+  double wound_gap_after_m;  // m, the same on the latest skin
+  double tissue_force_max_n; // N, the largest force of the skin on the needle's tip (SKIN.contact)
+  double tears;              // links the skin tore (SKIN.contact's count), the wound's cut not counted
 } tx_suture_measures;
 #define tx_suture_measures_TYPE TX_F64
-#define tx_suture_measures_COLS 8u
+#define tx_suture_measures_COLS 12u
 #define tx_suture_measures_UNITS "m, 1, N"
 TX_LAYOUT_ASSERT(tx_suture_measures, double);
 
