@@ -158,7 +158,7 @@ else
 fi
 
 # 4. the scenario picker: `tactus run --view window` with no scenario; part of a name typed and
-#    Enter start it; Escape (once to leave the field, once for the window) closes it: exit 2;
+#    Enter start it (the first name holding it); Escape (once to leave the field, once for the window) closes it: exit 2;
 #    a device chosen for a hand
 cat >"$WORK/pick.sh" <<'EOF'
 set -u
@@ -186,7 +186,7 @@ EOF
 pick_run() { # OUT XDOTOOL-ARGS...: the exit status of tactus in OUT.rc
   TACTUS="$TACTUS" timeout -k 5 60 xvfb-run -a -s "-screen 0 1280x1024x24" bash "$WORK/pick.sh" "$@"
 }
-pick_run "$WORK/picked" "type --delay 30 suturing" "key Return"
+pick_run "$WORK/picked" "type --delay 30 suturing-s" "key Return"
 if [ "$(cat "$WORK/picked.rc" 2>/dev/null)" != 0 ]; then
   fail "the picker's run failed: $(tail -n 3 "$WORK/picked.log")"
 else
