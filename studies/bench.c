@@ -383,7 +383,7 @@ static const struct {
     {"haptics", bench_haptics, "haptics tick cost, 1 kHz under load, 10 kHz idle"},
     {"voxels", bench_voxels, "needle in 250 to 100000 voxels: haptic Hz beside the voxel paper's Table 1"},
     {"render", bench_render, "graphics view frame times, mono and 2x640x480 stereo, beside 1 kHz haptics"},
-    {"render-gui", bench_render_gui, "the trainer's panels' cost per frame in a 640x480 window (render's last table)"},
+    {"render-gui", bench_render_gui, "the trainer's panels in a 640x480 window: their cost per frame, and haptics' rate beside them (render's last tables)"},
     {"cloth", bench_cloth, "skin physics step at 10404 particles with rupture; overhead vs a bare Bullet loop"},
     {"hip", bench_hip, "collision.hip query (98 rays) on 10404 and 102400 particles, and the refit"},
     {"organ-collision", bench_organ_collision, "collision.organ query against the committed liver and stomach, and the refit"},
