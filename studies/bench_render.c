@@ -120,6 +120,27 @@ static double result(tx_system* s, const char* key) {
   return NAN;
 }
 
+// a loaded scenario in real time for seconds, its output in DIR/SUB, the
+// window's panels shown or not; 0, or 1 with the reason printed
+static int run_in(tx_scenario* sc, const char* dir, const char* sub, double seconds, bool panels, tx_run_result* r) {
+  char path[4300], made[4400];
+  snprintf(path, sizeof path, "%s/%s", dir, sub);
+  if (tx_out_dir(path, "bench-render", made, sizeof made)) return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
+  tx_run_options o = {.duration_s = seconds, .realtime_priority = true, .pin_threads = true, .keep_cpus_awake = true,
+                      .out_dir = made};
+#if TX_WITH_GLFW
+  tx_window_show_panels(panels); // the window opens as the run starts
+#else
+  (void)panels;
+#endif
+  int failed = tx_system_run(sc->system, &o, r);
+#if TX_WITH_GLFW
+  tx_window_show_panels(true);
+#endif
+  if (failed) fprintf(stderr, "tactus: %s\n", tx_error());
+  return failed ? 1 : 0;
+}
+
 static int run_case(render_case* rc, const char* dir, double seconds) {
   char text[2048];
   snprintf(text, sizeof text,
@@ -136,24 +157,8 @@ static int run_case(render_case* rc, const char* dir, double seconds) {
   tx_load_options lo = {.view = rc->target ? rc->target : "png", .stereo = rc->stereo};
   tx_scenario* sc = tx_scenario_load_text("bench-render", text, strlen(text), &lo);
   if (!sc) return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
-  char sub[4300];
-  snprintf(sub, sizeof sub, "%s/%s", dir, rc->name);
-  char made[4400];
-  if (tx_out_dir(sub, "bench-render", made, sizeof made)) {
-    fprintf(stderr, "tactus: %s\n", tx_error());
-    return tx_scenario_free(sc), 1;
-  }
-  tx_run_options o = {.duration_s = seconds, .realtime_priority = true, .pin_threads = true, .keep_cpus_awake = true,
-                      .out_dir = made};
-  tx_run_result r;
-#if TX_WITH_GLFW
-  tx_window_show_panels(!rc->target || rc->panels); // the window opens as the run starts
-#endif
-  int failed = tx_system_run(sc->system, &o, &r);
-#if TX_WITH_GLFW
-  tx_window_show_panels(true);
-#endif
-  if (failed) fprintf(stderr, "tactus: %s\n", tx_error());
+  tx_run_result r = {0};
+  int failed = run_in(sc, dir, rc->name, seconds, !rc->target || rc->panels, &r);
   for (int i = 0; !failed && i < tx_system_count(sc->system); i++) {
     if (strcmp(tx_system_name(sc->system, i), "haptics") == 0) rc->haptics = tx_system_stats(sc->system, i);
     if (strcmp(tx_system_name(sc->system, i), "view") == 0) rc->view = tx_system_stats(sc->system, i);
@@ -248,20 +253,10 @@ static int gui_rates(const char* dir, double seconds) {
   for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
     tx_scenario* sc = tx_load_for_command_view(names[k], NULL, 0, NULL, 0, "window", "mono", false);
     if (!sc) return 1;
-    char sub[4300], made[4400];
-    snprintf(sub, sizeof sub, "%s/gui-%s", dir, names[k]);
-    if (tx_out_dir(sub, "bench-render", made, sizeof made)) {
-      fprintf(stderr, "tactus: %s\n", tx_error());
-      return tx_scenario_free(sc), 1;
-    }
-    tx_run_options o = {.duration_s = seconds, .realtime_priority = true, .pin_threads = true, .keep_cpus_awake = true,
-                        .out_dir = made};
-    tx_run_result r;
-    tx_window_show_panels(true);
-    if (tx_system_run(sc->system, &o, &r)) {
-      fprintf(stderr, "tactus: %s\n", tx_error());
-      return tx_scenario_free(sc), 1;
-    }
+    char sub[64];
+    snprintf(sub, sizeof sub, "gui-%s", names[k]);
+    tx_run_result r = {0};
+    if (run_in(sc, dir, sub, seconds, true, &r)) return tx_scenario_free(sc), 1;
     for (int i = 0; i < tx_system_count(sc->system); i++) {
       double hz = tx_system_rate(sc->system, i);
       if (hz < 1000) continue;
