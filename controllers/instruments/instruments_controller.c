@@ -387,7 +387,7 @@ static int init(tx_ctx* c, void* self) {
   }
   m->nswitches = 0;
   for (int h = 0; h < HANDS; h++) m->want[h] = -1;
-  for (int h = 0; h < m->nhands; h++) { // each hand holds its first; a button held from the start is no press
+  for (int h = 0; h < m->nhands; h++) { // each hand holds handN_holds; a button held from the start is no press
     m->cur[h] = m->first[h];
     for (int k = 0; k < m->nslot[h]; k++)
       if (k != m->cur[h]) tx_instrument_world_park(m->world, m->slot[h][k], park_at(m->slot[h][k]));
