@@ -1375,6 +1375,19 @@ static void remove_link(tx_cloth* c, int id) {
   li.slot = -1;
 }
 
+// a stretch or shear link goes, as a tear or a cut takes it: with the
+// triangles it borders and the bending links across it
+static void sever_link(tx_cloth* c, int id) {
+  const link_info& li = c->info[(size_t)id];
+  remove_link(c, id);
+  c->tension[(size_t)id] = 0;
+  for (int j = 0; j < 2; j++) {
+    if (li.tri[j] >= 0) c->tri_alive[(size_t)li.tri[j]] = 0, c->live_dirty = true;
+    if (li.dep[j] >= 0) remove_link(c, li.dep[j]), c->tension[(size_t)li.dep[j]] = 0;
+  }
+  c->topology_dirty = c->detach_check = true;
+}
+
 // largest eigenvalue of the symmetric 3 x 3 matrix (xx, yy, zz, xy, xz, yz)
 // (the trigonometric solution of the characteristic cubic)
 static double largest_eigenvalue(const double m[6]) {
@@ -1545,15 +1558,8 @@ static void rupture(tx_cloth* c, const btVector3* near) {
     if (li.slot < 0) continue;
     if (c->hip_radius > 0 && c->touching)
       for (int e = 0; e < 2; e++) at_contact |= (base[li.end[e]].m_x - hip).length2() <= at_hip * at_hip;
-    c->detach_check = true;
-    remove_link(c, id);
-    c->tension[(size_t)id] = 0;
+    sever_link(c, id);
     c->torn++;
-    c->topology_dirty = true;
-    for (int j = 0; j < 2; j++) {
-      if (li.tri[j] >= 0) c->tri_alive[(size_t)li.tri[j]] = 0, c->live_dirty = true;
-      if (li.dep[j] >= 0) remove_link(c, li.dep[j]), c->tension[(size_t)li.dep[j]] = 0;
-    }
   }
   if (at_contact) pierce_start(c);
 }
@@ -1574,18 +1580,10 @@ extern "C" int tx_cloth_cut(tx_cloth* c, const double a[3], const double b[3]) {
     link_info& li = c->info[(size_t)id];
     if (li.slot < 0 || li.kind == BEND) continue;
     if (!crosses_xz(&c->rest_x[(size_t)li.end[0] * 3], &c->rest_x[(size_t)li.end[1] * 3], a, b)) continue;
-    remove_link(c, id);
-    c->tension[(size_t)id] = 0;
-    for (int j = 0; j < 2; j++) {
-      if (li.tri[j] >= 0) c->tri_alive[(size_t)li.tri[j]] = 0;
-      if (li.dep[j] >= 0) remove_link(c, li.dep[j]), c->tension[(size_t)li.dep[j]] = 0;
-    }
+    sever_link(c, id);
     cut++;
   }
-  if (cut) {
-    c->topology_dirty = c->live_dirty = c->detach_check = true;
-    tx_cloth_save(c); // a fault goes back to the cut skin, not the whole one
-  }
+  if (cut) tx_cloth_save(c); // a fault goes back to the cut skin, not the whole one
   return cut;
 }
 
