@@ -293,10 +293,10 @@ static double wrap_turns(const suture* k, const tx_thread_node* n, uint32_t rows
 
 // Across the wound at the stitch: the point of the wound line nearest the
 // middle of the stitch's entry and exit (the entry alone before the exit,
-// the wound's middle before either); on each side of the line the particle
-// nearest it at rest (the wound's two edges there), and their distance on
-// the skin x, in m
-static double wound_gap(const suture* k, const float* x) {
+// the wound's middle before either), and on each side of the line the
+// particle nearest it at rest: the wound's two edges there (false: a side
+// has none)
+static bool wound_edges(const suture* k, int edge[2]) {
   double ux = k->wound_b[0] - k->wound_a[0], uz = k->wound_b[2] - k->wound_a[2], len = sqrt(ux * ux + uz * uz);
   ux /= len, uz /= len;
   double at[3];
@@ -306,18 +306,22 @@ static double wound_gap(const suture* k, const float* x) {
     for (int a = 0; a < 3; a++) at[a] = 0.5 * (k->entry[a] + k->exit[a]);
   double s = (at[0] - k->wound_a[0]) * ux + (at[2] - k->wound_a[2]) * uz;
   s = fmin(fmax(s, 0), len);
-  int side[2] = {-1, -1};
   double best[2] = {INFINITY, INFINITY};
+  edge[0] = edge[1] = -1;
   for (uint32_t i = 0; i < k->nrest; i++) {
     const float* r = k->rest + 3 * i;
     double along = (r[0] - k->wound_a[0]) * ux + (r[2] - k->wound_a[2]) * uz - s;
     double off = wound_offset(k, (const double[3]){r[0], r[1], r[2]});
     int e = off >= 0;
     double d = along * along + off * off;
-    if (d < best[e]) best[e] = d, side[e] = (int)i;
+    if (d < best[e]) best[e] = d, edge[e] = (int)i;
   }
-  if (side[0] < 0 || side[1] < 0) return NAN;
-  const float *p = x + 3 * side[0], *q = x + 3 * side[1];
+  return edge[0] >= 0 && edge[1] >= 0;
+}
+
+// the distance of particles i and j of x (m)
+static double particle_distance(const float* x, int i, int j) {
+  const float *p = x + 3 * i, *q = x + 3 * j;
   return sqrt((double)(p[0] - q[0]) * (p[0] - q[0]) + (double)(p[1] - q[1]) * (p[1] - q[1]) + (double)(p[2] - q[2]) * (p[2] - q[2]));
 }
 
@@ -332,9 +336,10 @@ static void read_skin(tx_ctx* c, suture* k) {
       k->nrest = x.rows;
     }
   }
-  if (x.seq && k->nrest == x.rows) {
-    k->m.wound_gap_before_m = wound_gap(k, k->rest);
-    k->m.wound_gap_after_m = wound_gap(k, x.data);
+  int edge[2];
+  if (x.seq && k->nrest == x.rows && wound_edges(k, edge)) {
+    k->m.wound_gap_before_m = particle_distance(k->rest, edge[0], edge[1]);
+    k->m.wound_gap_after_m = particle_distance(x.data, edge[0], edge[1]);
   }
   tx_snapshot f = tx_read(c, k->skin_contact);
   if (f.seq) {
