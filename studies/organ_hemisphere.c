@@ -1,10 +1,11 @@
 // tactus study organ-hemisphere: the LAGB paper's check of its soft bodies
 // (its Figure 14). A hemisphere (R = 2 cm, E = 5 kPa, nu = 0.45) with its
-// base fixed is indented at its pole by a rigid frictionless plate, on
+// base fixed is indented at its pole by a tool's tip (a rigid frictionless
+// sphere of 5 mm; or a flat plate), on
 // Bullet's FEM deformables (corotated) at three refinements and on Bullet's
 // classic soft body (links) at several iteration counts. The force against
 // Hertz, F = (4/3) E / (1 - nu^2) sqrt(R) d^(3/2) ((16/9) E sqrt(R) d^(3/2)
-// at nu = 0.5); the force's observed order and Richardson limit; the
+// at nu = 0.5, R the two curvatures' Ri Rh / (Ri + Rh)); the force's observed order and Richardson limit; the
 // deformation profile against the finest FEM mesh; error against CPU time.
 // Quasi-static: each depth is held until the body is at rest (mass-scaled
 // explicit steps, damping), so the answers do not depend on density or time.
@@ -37,7 +38,14 @@ static json_t* num(double v) { return isfinite(v) ? json_real(v) : json_null(); 
 #if TX_WITH_BULLET
 enum { DEPTHS = 5, LEVELS = 3, LINK_RUNS = 4 };
 
-static const double RADIUS = 0.02, YOUNG = 5e3, GRADE = 1.5;
+static const double RADIUS = 0.02, YOUNG = 5e3;
+
+// what presses the pole: a sphere of radius `indenter` (m; 0: a flat plate);
+// Hertz's radius for the two curvatures; the 3-D meshes' grading toward the
+// pole (stronger under a tip, whose contact is smaller)
+typedef struct indenter {
+  double radius, hertz_radius, grade;
+} indenter;
 // the continuum's elements per side (quick: the coarser three) and grading toward the pole
 static const int AXI_FULL[LEVELS] = {16, 32, 64}, AXI_QUICK[LEVELS] = {8, 16, 32};
 static const double AXI_GRADE = 2;
@@ -69,9 +77,9 @@ static int meridian(const tx_hemisphere_mesh* m, int* ids) {
 
 // indent to each depth in turn, each ramped over half a settling time and
 // then held for one, the force averaged over the last quarter
-static bool indent(const tx_fem_def* d, int n, run_result* r) {
+static bool indent(const tx_fem_def* d, const indenter* in, int n, run_result* r) {
   tx_hemisphere_mesh m;
-  if (!tx_hemisphere_build_graded(RADIUS, n, GRADE, &m)) return false;
+  if (!tx_hemisphere_build_graded(RADIUS, n, in->grade, &m)) return false;
   tx_fem* b = tx_fem_create(d, m.v, m.nv, m.e, m.ne);
   if (!b) {
     tx_hemisphere_free(&m);
@@ -87,9 +95,12 @@ static bool indent(const tx_fem_def* d, int n, run_result* r) {
   if (d->model == TX_FEM_LINKS) settle = 400;
   double t0 = cpu_now();
   for (int l = 0; l < DEPTHS && r->finite; l++) {
-    double from = RADIUS - 0.02 * l * RADIUS, to = RADIUS - 0.02 * (l + 1) * RADIUS;
+    // the indenter's lowest point, from the last depth to this one
+    double from = RADIUS - 0.02 * l * in->hertz_radius, to = RADIUS - 0.02 * (l + 1) * in->hertz_radius;
     for (int s = 1; s <= settle / 2 && r->finite; s++) {
-      tx_fem_set_plate(b, from + (to - from) * s / (settle / 2));
+      double y = from + (to - from) * s / (settle / 2);
+      if (in->radius > 0) tx_fem_set_ball(b, (const double[3]){0, y + in->radius, 0}, in->radius);
+      else tx_fem_set_plate(b, y);
       r->finite = tx_fem_step(b, 1);
     }
     r->finite = r->finite && tx_fem_step(b, settle - settle / 4) && tx_fem_step(b, settle / 4);
@@ -124,9 +135,9 @@ enum { CONT_SAMPLES = 181 };  // the continuum's surface displacement at 0, 0.5,
 
 // RMS over a run's meridian nodes, pole to base rim, of the difference to the
 // continuum's surface displacement (linear between its samples), over d
-static double continuum_profile_error(const run_result* r, int n, const double* uc, double depth) {
+static double continuum_profile_error(const run_result* r, const indenter* in, int n, const double* uc, double depth) {
   tx_hemisphere_mesh m;
-  if (!tx_hemisphere_build_graded(RADIUS, n, GRADE, &m)) return NAN;
+  if (!tx_hemisphere_build_graded(RADIUS, n, in->grade, &m)) return NAN;
   int ids[200], c = meridian(&m, ids);
   double s = 0;
   for (int i = 0; i < c; i++) {
@@ -142,7 +153,7 @@ static double continuum_profile_error(const run_result* r, int n, const double* 
 
 int tx_study_organ_hemisphere(const tx_study_args* a) {
   bool quick = false;
-  double nu = 0.45;
+  double nu = 0.45, tip_mm = 0;
   for (int i = 0; i < a->nsets; i++) {
     const char* eq = strchr(a->sets[i], '=');
     double v;
@@ -152,12 +163,15 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
       quick = v == 1;
     } else if (eq && k == 7 && strncmp(a->sets[i], "poisson", 7) == 0) {
       if (!tx_parse_num(eq + 1, 0, 0.49, &nu)) return tx_bad_input("--set %s: expected 0 to 0.49", a->sets[i]);
+    } else if (eq && k == 11 && strncmp(a->sets[i], "indenter_mm", 11) == 0) {
+      if (!tx_parse_num(eq + 1, 0, 20, &tip_mm) || (tip_mm > 0 && tip_mm < 1))
+        return tx_bad_input("--set %s: expected 0 (a flat plate) or 1 to 20 mm", a->sets[i]);
     } else {
-      return tx_bad_input("--set %s: unknown key (known: quick, poisson)", a->sets[i]);
+      return tx_bad_input("--set %s: unknown key (known: quick, poisson, indenter_mm)", a->sets[i]);
     }
   }
 #if !TX_WITH_BULLET
-  (void)num, (void)quick, (void)nu;
+  (void)num, (void)quick, (void)nu, (void)tip_mm;
   return tx_bad_input("study organ-hemisphere: this build has no Bullet (configured with TX_WITH_BULLET=OFF)");
 #else
   // refinements at ratio 2 (cells per radius); quick: the coarsest three
@@ -165,8 +179,16 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
   const int* levels = quick ? quick_levels : full_levels;
   const int link_iterations[LINK_RUNS] = {2, 5, 10, 20};
   const int link_n = levels[1];
-  printf("study organ-hemisphere: R = %g cm, E = %g kPa, nu = %g, base fixed, a rigid frictionless plate at the pole%s\n\n",
-         RADIUS * 1e2, YOUNG * 1e-3, nu, quick ? ", quick" : "");
+  indenter in = {tip_mm * 1e-3, RADIUS, 1.5};
+  if (in.radius > 0) in.hertz_radius = in.radius * RADIUS / (in.radius + RADIUS), in.grade = 2.5;
+  const double RH = in.hertz_radius;  // Hertz's R: d/R below is over it
+  if (in.radius > 0)
+    printf("study organ-hemisphere: R = %g cm, E = %g kPa, nu = %g, base fixed, a tool's tip (a rigid frictionless sphere of"
+           " %g mm) at the pole; Hertz's R = %g mm%s\n\n",
+           RADIUS * 1e2, YOUNG * 1e-3, nu, in.radius * 1e3, RH * 1e3, quick ? ", quick" : "");
+  else
+    printf("study organ-hemisphere: R = %g cm, E = %g kPa, nu = %g, base fixed, a rigid frictionless plate at the pole%s\n\n",
+           RADIUS * 1e2, YOUNG * 1e-3, nu, quick ? ", quick" : "");
 
   char csv_path[4200], tmp[4300];
   snprintf(csv_path, sizeof csv_path, "%s/organ-hemisphere.csv", a->out_dir);
@@ -182,7 +204,7 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
   d.damping = 4 * sqrt(YOUNG * (1 - nu) / ((1 + nu) * (1 - 2 * nu)) / d.density) / RADIUS;  // about critical, lowest mode
   bool ok = true;
   for (int l = 0; l < LEVELS && ok; l++) {
-    ok = indent(&d, levels[l], &fem[l]);
+    ok = indent(&d, &in, levels[l], &fem[l]);
     if (ok) printf("  FEM corotated, %2d cells per radius, %6d tetrahedra: %.2f s of CPU\n", levels[l], fem[l].tets, fem[l].cpu);
     fflush(stdout);
   }
@@ -190,7 +212,7 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
   dl.model = TX_FEM_LINKS, dl.dt = 1e-3, dl.damping = 20, dl.mass_scaling = false;
   for (int k = 0; k < LINK_RUNS && ok; k++) {
     dl.iterations = link_iterations[k];
-    ok = indent(&dl, link_n, &links[k]);
+    ok = indent(&dl, &in, link_n, &links[k]);
   }
   if (!ok) {
     fclose(csv), remove(tmp);
@@ -211,7 +233,7 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
     tx_axisym* c = tx_axisym_create(RADIUS, YOUNG, nu, axl[l], AXI_GRADE);
     bool good = c != NULL;
     for (int i = 0; i < ALL && good; i++)
-      good = tx_axisym_indent(c, (i < SHALLOW ? shallow[i] : 0.02 * (i - SHALLOW + 1)) * RADIUS, &axi[l][i]);
+      good = tx_axisym_indent(c, (i < SHALLOW ? shallow[i] : 0.02 * (i - SHALLOW + 1)) * RH, in.radius, &axi[l][i]);
     axi_dofs[l] = c ? tx_axisym_dofs(c) : 0;
     if (good && l == LEVELS - 1)  // the finest at d / R = 0.1, the last depth
       for (int k = 0; k < CONT_SAMPLES; k++) uc[k] = tx_axisym_surface_uz(c, M_PI / 2 * k / (CONT_SAMPLES - 1));
@@ -230,7 +252,7 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
   printf(" %6s %10s %8s %7s\n", "order", "reference", "spread", "/Hertz");
   json_t* jcont = json_array();
   for (int i = 0; i < ALL; i++) {
-    double dr = i < SHALLOW ? shallow[i] : 0.02 * (i - SHALLOW + 1), h = tx_hertz_force(YOUNG, nu, RADIUS, dr * RADIUS);
+    double dr = i < SHALLOW ? shallow[i] : 0.02 * (i - SHALLOW + 1), h = tx_hertz_force(YOUNG, nu, RH, dr * RH);
     // Richardson where the three give an order; else the finest, its change from the one before as the spread
     double p = tx_observed_order(axi[0][i], axi[1][i], axi[2][i], 2);
     cont[i] = isfinite(p) && p > 0.5 ? tx_richardson(axi[1][i], axi[2][i], 2, p) : axi[2][i];
@@ -248,7 +270,7 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
 
   // FEM: force against Hertz at each depth and refinement
   const int top = LEVELS - 1;
-  double depth_max = 0.1 * RADIUS;
+  double depth_max = 0.1 * RH;
   printf("\n  force (N) against Hertz; FEM by refinement, and Richardson's limit from the three\n  %6s %10s", "d/R",
          "Hertz");
   for (int l = 0; l < LEVELS; l++) printf("   n=%-2d %6s", levels[l], "error");
@@ -257,8 +279,8 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
   bool all_finite = true;
   json_t* jdepths = json_array();
   for (int i = 0; i < DEPTHS; i++) {
-    double dd = 0.02 * (i + 1) * RADIUS, h = tx_hertz_force(YOUNG, nu, RADIUS, dd);
-    printf("  %6.2f %10.5f", dd / RADIUS, h);
+    double dd = 0.02 * (i + 1) * RH, h = tx_hertz_force(YOUNG, nu, RH, dd);
+    printf("  %6.2f %10.5f", dd / RH, h);
     json_t* jl = json_array();
     for (int l = 0; l < LEVELS; l++) {
       double e = fem[l].force[i] / h - 1;
@@ -270,14 +292,14 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
     double lim = isfinite(p) ? tx_richardson(fem[1].force[i], fem[2].force[i], 2, p) : NAN;
     limits_within &= fabs(lim / h - 1) <= 0.10;
     printf(" %6.2f %9.5f %5.1f%%\n", p, lim, 100 * (lim / h - 1));
-    json_array_append_new(jdepths, json_pack("{s:f,s:f,s:o,s:o,s:o}", "d_over_r", dd / RADIUS, "hertz_n", h, "fem_force_n",
+    json_array_append_new(jdepths, json_pack("{s:f,s:f,s:o,s:o,s:o}", "d_over_r", dd / RH, "hertz_n", h, "fem_force_n",
                                              jl, "observed_order", num(p), "richardson_limit_n", num(lim)));
   }
   // Richardson on the force at d / R = 0.1
   double f1 = fem[0].force[DEPTHS - 1], f2 = fem[1].force[DEPTHS - 1], f3 = fem[2].force[DEPTHS - 1];
   double order = tx_observed_order(f1, f2, f3, 2);
   double limit = isfinite(order) ? tx_richardson(f2, f3, 2, order) : NAN;
-  double hertz_max = tx_hertz_force(YOUNG, nu, RADIUS, depth_max);
+  double hertz_max = tx_hertz_force(YOUNG, nu, RH, depth_max);
   double finest_error = f3 / hertz_max - 1, limit_error = limit / hertz_max - 1;
   bool within = fabs(finest_error) <= 0.10;
   // what each part contributes: the finite body (the continuum against
@@ -288,12 +310,12 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
   double disc_max = 0;
   json_t* jparts = json_array();
   for (int i = 0; i < DEPTHS; i++) {
-    double dd = 0.02 * (i + 1) * RADIUS, h = tx_hertz_force(YOUNG, nu, RADIUS, dd), c = cont[SHALLOW + i];
+    double dd = 0.02 * (i + 1) * RH, h = tx_hertz_force(YOUNG, nu, RH, dd), c = cont[SHALLOW + i];
     double body = c / h - 1, tets = fem[top].force[i] / c - 1;
     continuum_within &= fabs(tets) <= 0.10;
     disc_max = fmax(disc_max, fabs(tets));
-    printf("  %6.2f %+11.1f%% %+13.1f%% %+11.1f%%\n", dd / RADIUS, 100 * body, 100 * tets, 100 * (fem[top].force[i] / h - 1));
-    json_array_append_new(jparts, json_pack("{s:f,s:f,s:f,s:f}", "d_over_r", dd / RADIUS, "finite_body", body,
+    printf("  %6.2f %+11.1f%% %+13.1f%% %+11.1f%%\n", dd / RH, 100 * body, 100 * tets, 100 * (fem[top].force[i] / h - 1));
+    json_array_append_new(jparts, json_pack("{s:f,s:f,s:f,s:f}", "d_over_r", dd / RH, "finite_body", body,
                                             "tetrahedra", tets, "together", fem[top].force[i] / h - 1));
   }
   printf("  finest FEM mesh within 10%% of the converged continuum at every d/R <= 0.1: %s (largest %.1f%%)\n",
@@ -314,15 +336,15 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
   for (int l = 0; l < LEVELS; l++) {
     double fe = fem[l].force[DEPTHS - 1] / hertz_max - 1;
     double pe = l < top ? profile_error(fem[l].profile, levels[l], fem[top].profile, levels[top] / levels[l], depth_max) : 0;
-    double ce = fem[l].force[DEPTHS - 1] / cont[ALL - 1] - 1, cpe = continuum_profile_error(&fem[l], levels[l], uc, depth_max);
+    double ce = fem[l].force[DEPTHS - 1] / cont[ALL - 1] - 1, cpe = continuum_profile_error(&fem[l], &in, levels[l], uc, depth_max);
     printf("  %-10s %6d %10s %8.1f %10.3f %11.1f%% %9.2f%% %+9.1f%% %9.2f%%\n", "FEM", fem[l].tets, "-", fem[l].dt * 1e6,
            fem[l].cpu, 100 * fe, 100 * pe, 100 * ce, 100 * cpe);
     char pe_text[32] = "";  // the finest is the reference: no error of its own
     if (l < top) snprintf(pe_text, sizeof pe_text, "%.6g", pe);
     for (int i = 0; i < DEPTHS; i++) {
-      double dd = 0.02 * (i + 1) * RADIUS, h = tx_hertz_force(YOUNG, nu, RADIUS, dd);
+      double dd = 0.02 * (i + 1) * RH, h = tx_hertz_force(YOUNG, nu, RH, dd);
       fprintf(csv, "fem_corotated,%d,%d,,%.6g,%.6g,%.2f,%.9g,%.9g,%.6g,%s,%.9g,%.6g,%.6g\n", levels[l], fem[l].tets, fem[l].dt, fem[l].cpu,
-              dd / RADIUS, fem[l].force[i], h, fem[l].force[i] / h - 1, pe_text, cont[SHALLOW + i],
+              dd / RH, fem[l].force[i], h, fem[l].force[i] / h - 1, pe_text, cont[SHALLOW + i],
               fem[l].force[i] / cont[SHALLOW + i] - 1, cpe);
     }
     json_array_append_new(jruns, json_pack("{s:s,s:i,s:i,s:f,s:f,s:o,s:o}", "model", "fem_corotated", "cells_per_radius",
@@ -337,13 +359,13 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
     double fe = links[k].force[DEPTHS - 1] / hertz_max - 1;
     double pe = profile_error(links[k].profile, link_n, fem[top].profile, levels[top] / link_n, depth_max);
     all_finite &= links[k].finite;
-    double ce = links[k].force[DEPTHS - 1] / cont[ALL - 1] - 1, cpe = continuum_profile_error(&links[k], link_n, uc, depth_max);
+    double ce = links[k].force[DEPTHS - 1] / cont[ALL - 1] - 1, cpe = continuum_profile_error(&links[k], &in, link_n, uc, depth_max);
     printf("  %-10s %6d %10d %8.1f %10.3f %11.1f%% %9.2f%% %+9.1f%% %9.2f%%\n", "links", links[k].tets, link_iterations[k],
            links[k].dt * 1e6, links[k].cpu, 100 * fe, 100 * pe, 100 * ce, 100 * cpe);
     for (int i = 0; i < DEPTHS; i++) {
-      double dd = 0.02 * (i + 1) * RADIUS, h = tx_hertz_force(YOUNG, nu, RADIUS, dd);
+      double dd = 0.02 * (i + 1) * RH, h = tx_hertz_force(YOUNG, nu, RH, dd);
       fprintf(csv, "links,%d,%d,%d,%.6g,%.6g,%.2f,%.9g,%.9g,%.6g,%.6g,%.9g,%.6g,%.6g\n", link_n, links[k].tets,
-              link_iterations[k], links[k].dt, links[k].cpu, dd / RADIUS, links[k].force[i], h, links[k].force[i] / h - 1, pe,
+              link_iterations[k], links[k].dt, links[k].cpu, dd / RH, links[k].force[i], h, links[k].force[i] / h - 1, pe,
               cont[SHALLOW + i], links[k].force[i] / cont[SHALLOW + i] - 1, cpe);
     }
     json_array_append_new(jruns, json_pack("{s:s,s:i,s:i,s:i,s:f,s:f,s:o,s:o}", "model", "links", "cells_per_radius",
@@ -365,17 +387,19 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
   }
   json_t* doc = json_pack("{s:s,s:b,s:{s:f,s:f,s:f,s:f,s:s},s:o,s:o,s:{s:o,s:o,s:o,s:f},s:b,s:b,s:b,s:b}", "study",
                           "organ-hemisphere", "quick", quick, "case", "radius_m", RADIUS, "young_pa", YOUNG, "poisson",
-                          nu, "grading", GRADE, "hertz", "F = 4/3 E / (1 - nu^2) sqrt(R) d^(3/2)", "depths", jdepths,
+                          nu, "grading", in.grade, "hertz", "F = 4/3 E / (1 - nu^2) sqrt(R) d^(3/2)", "depths", jdepths,
                           "runs", jruns, "richardson_at_0_1", "observed_order", num(order), "limit_n", num(limit),
                           "limit_error", num(limit_error), "finest_error", finest_error, "fem_error_falls", falls,
                           "hertz_within_10_percent", within, "finite", all_finite,
                           "richardson_limits_within_10_percent", limits_within);
-  if (doc)
+  if (doc) {
+    json_object_update_new(json_object_get(doc, "case"), json_pack("{s:f,s:f,s:b}", "indenter_radius_m", in.radius,
+                                                                   "hertz_radius_m", RH, "nodal_pressure", d.nodal_pressure));
     json_object_update_new(doc, json_pack("{s:{s:s,s:f,s:[i,i,i],s:o},s:o,s:b}", "continuum", "model",
                                           "axisymmetric, 9-node elements, exact frictionless contact", "grading",
                                           AXI_GRADE, "elements_per_side", axl[0], axl[1], axl[2], "depths", jcont,
                                           "parts", jparts, "fem_within_10_percent_of_continuum", continuum_within));
-  else
+  } else
     json_decref(jcont), json_decref(jparts);
   if (!doc || tx_report_save(doc, a->out_dir, "organ-hemisphere.json")) {
     json_decref(doc);

@@ -47,7 +47,7 @@ static const struct {
     {"skin-accuracy", tx_study_skin_accuracy,
      "spacing, iterations and step refined together: observed order, Richardson reference, error vs CPU time"},
     {"organ-hemisphere", tx_study_organ_hemisphere,
-     "a hemisphere indented at its pole: Bullet FEM and links against Hertz, Richardson, error vs CPU time (Fig. 14)"},
+     "a hemisphere indented at its pole (a plate or a tip): Bullet FEM and links against Hertz and the continuum (Fig. 14)"},
     {"organ-stability", tx_study_organ_stability,
      "the hemisphere under scale x0.1..x10, stiffness, density, damping, FEM and links: blow-ups detected (Fig. 15)"},
     {"organ-removal", tx_study_organ_removal,

@@ -247,11 +247,20 @@ static bool active_solve(tx_axisym* a) {
   return true;
 }
 
-bool tx_axisym_indent(tx_axisym* a, double depth, double* force) {
+bool tx_axisym_indent(tx_axisym* a, double depth, double indenter, double* force) {
   int nc = a->nc, top = (a->m - 1) * a->m;
-  // gap at rest to the flat at z = R - d; a pressure p (downward force) moves
-  // the surface by -W p, so the gap is q + W p
-  for (int k = 0; k < nc; k++) a->q[k] = (a->radius - depth) - a->z[top + k];
+  if (!(indenter >= 0)) {
+    tx_set_error("axisymmetric hemisphere: indenter radius %g m: need >= 0 (0: a flat)", indenter);
+    return false;
+  }
+  // gap at rest to the indenter's underside, at z = R - d on the axis (a
+  // flat, or the sphere's lower cap, which rises as r^2 / 2 Ri near the axis);
+  // a pressure p (downward force) moves the surface by -W p, so the gap is q + W p
+  for (int k = 0; k < nc; k++) {
+    double r = a->r[top + k], under = a->radius - depth;
+    if (indenter > 0) under += r < indenter ? indenter - sqrt(indenter * indenter - r * r) : a->radius;
+    a->q[k] = under - a->z[top + k];
+  }
   double tol = 1e-12 * a->radius;
   for (int it = 0; it < 20 * nc + 20; it++) {
     if (!active_solve(a)) break;

@@ -1,6 +1,6 @@
 // Internal: the organ-hemisphere check's converged continuum reference. The
-// hemisphere with a fixed base pressed by a rigid frictionless flat at its
-// pole is axisymmetric, so the continuum (small-strain linear elasticity, the
+// hemisphere with a fixed base pressed at its pole by a rigid frictionless
+// flat or sphere is axisymmetric, so the continuum (small-strain linear elasticity, the
 // model the organs' FEM discretises) is solved here in the (r, z) half plane
 // with biquadratic (9-node) elements, which neither lock at nu = 0.45 nor
 // need many elements across the contact, a banded Cholesky factorisation, and
@@ -10,7 +10,7 @@
 //
 //   tx_axisym* a = tx_axisym_create(0.02, 5e3, 0.45, 32, 2);  // R, E, nu, elements per side, grading
 //   double f;
-//   tx_axisym_indent(a, 0.002, &f);                           // N at d = 2 mm
+//   tx_axisym_indent(a, 0.002, 0, &f);                        // N at d = 2 mm under a flat
 //   tx_axisym_destroy(a);
 #ifndef TX_STUDIES_EXPERIMENTS_ORGAN_AXISYM_H
 #define TX_STUDIES_EXPERIMENTS_ORGAN_AXISYM_H
@@ -29,11 +29,12 @@ typedef struct tx_axisym tx_axisym;
 // the flat (r <= 0.6 R). NULL and tx_error() on bad arguments or memory.
 tx_axisym* tx_axisym_create(double radius, double young, double nu, int n, double grade);
 void tx_axisym_destroy(tx_axisym* a);
-// the flat lowered a depth d below the pole: the force it takes (N), the
-// complementarity problem (gap >= 0, pressure >= 0, one of them zero at every
+// the indenter lowered a depth d below the pole: a rigid frictionless flat
+// (indenter 0) or a sphere of that radius (m, a tool's tip) on the axis; the
+// force it takes (N), the complementarity problem (gap >= 0, pressure >= 0, one of them zero at every
 // node) solved by Murty's least-index principal pivoting; false and
 // tx_error() if it does not end or the contact reaches past the nodes kept
-bool tx_axisym_indent(tx_axisym* a, double depth, double* force);
+bool tx_axisym_indent(tx_axisym* a, double depth, double indenter, double* force);
 // after tx_axisym_indent: the nodes in contact, and the outer surface's
 // vertical displacement (m) at the point phi radians from the pole (0 to pi/2,
 // linear between the surface's nodes)

@@ -46,6 +46,8 @@ typedef struct tx_fem_def {
   double volume_stiffness;  // links: Bullet's kVC (volume conservation), >= 0
   double gravity[3];   // m/s^2
   double max_speed;    // m/s: a faster node is a blow-up (tx_fem_step returns false); 0: only NaN and Inf
+  bool nodal_pressure; // FEM models: the volume term from each node's J over all its tetrahedra (average nodal
+                       // pressure), which keeps linear tetrahedra from locking near nu = 0.5; false: each its own
 } tx_fem_def;
 
 tx_fem_def tx_fem_def_default(void);
@@ -60,6 +62,11 @@ void tx_fem_fix(tx_fem* b, int node);
 // a rigid frictionless plate whose underside is the plane y = Y: nodes are
 // kept at or below it, and what it takes to keep them is its force
 void tx_fem_set_plate(tx_fem* b, double y);
+// in place of the plate, a rigid frictionless ball (centre c, radius r, m):
+// nodes are kept outside it, and tx_fem_plate_force is the upward part of
+// what that takes (a node-wise contact, as the plate's; the tool below is
+// face-wise). r <= 0: neither ball nor plate.
+void tx_fem_set_ball(tx_fem* b, const double c[3], double r);
 // false when a position or velocity stopped being finite
 bool tx_fem_step(tx_fem* b, int steps);
 
@@ -126,9 +133,9 @@ void tx_fem_restore(tx_fem* b);
 int tx_fem_node_count(const tx_fem* b);
 double tx_fem_added_mass(const tx_fem* b);  // mass scaling's added mass over the true mass (0 without)
 double tx_fem_dt(const tx_fem* b);          // s, the step in use
-double tx_fem_plate_force(const tx_fem* b); // N, upward, averaged over the last tx_fem_step's steps
+double tx_fem_plate_force(const tx_fem* b); // N, upward on the plate or ball, averaged over the last tx_fem_step's steps
 double tx_fem_kinetic(const tx_fem* b);     // J
-int tx_fem_plate_contacts(const tx_fem* b); // nodes on the plate
+int tx_fem_plate_contacts(const tx_fem* b); // nodes on the plate or ball
 void tx_fem_positions(const tx_fem* b, double* out);  // (nv x 3), m
 
 #ifdef __cplusplus

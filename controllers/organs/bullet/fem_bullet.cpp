@@ -38,12 +38,15 @@ struct tx_fem {
   btDeformableMultiBodyDynamicsWorld* world;
   btDeformableLagrangianForce* force;
   btAlignedObjectArray<btVector3> elastic;  // (nv) N, the elastic force of the explicit step
+  double volume_modulus;     // Pa, the force's lambda: the volume term the nodal pressure averages; 0: per element
+  std::vector<double> node_rest, node_now;  // (nv) m^3, a quarter of each live tetrahedron's volume, at rest and now
   btSoftBodyWorldInfo info;  // the links body's world
   btSoftBody* body;
   std::vector<double> mass;  // (nv) kg, lumped
   std::vector<double> weight;  // (nv) true mass over mass (1 without mass scaling)
   bool has_plate;
-  double plate;              // m, the plate's underside
+  double plate;              // m, the plate's underside; with ball_r > 0, the ball's centre height
+  double ball_x, ball_z, ball_r;  // m, a ball in place of the plate (tx_fem_set_ball); r 0: the plate
   double plate_force;        // N, upward, averaged over the last tx_fem_step
   int contacts;              // nodes on the plate after the last step
   double added_mass;         // mass scaling's, over the true mass
@@ -93,6 +96,7 @@ extern "C" tx_fem_def tx_fem_def_default(void) {
   d.volume_stiffness = 0;
   d.gravity[0] = d.gravity[1] = d.gravity[2] = 0;
   d.max_speed = 0;
+  d.nodal_pressure = true;
   return d;
 }
 
@@ -320,11 +324,16 @@ extern "C" tx_fem* tx_fem_create(const tx_fem_def* d, const double* nodes, int n
       b->world->addSoftBody(s);
       if (d->model == TX_FEM_COROTATED) {
         b->force = new btDeformableCorotatedForce((btScalar)mu, (btScalar)lambda);
+        b->volume_modulus = lambda;
       } else {
         // Smith et al.'s stable Neo-Hookean matches linear elasticity at rest
         // with mu' = 4/3 mu and lambda' = lambda + 5/6 mu
         b->force = new btDeformableNeoHookeanForce((btScalar)(4.0 / 3.0 * mu), (btScalar)(lambda + 5.0 / 6.0 * mu), 0);
+        b->volume_modulus = lambda + 5.0 / 6.0 * mu;
       }
+      if (!d->nodal_pressure) b->volume_modulus = 0;
+      b->node_rest.resize((size_t)nv);
+      b->node_now.resize((size_t)nv);
       b->world->addForce(s, b->force);
       // the force reads the nodes by index; the world, which is never stepped (fem_step), would number them so
       for (int i = 0; i < nv; i++) s->m_nodes[i].index = i;
@@ -427,6 +436,7 @@ static void place_kinematic(tx_fem* b, int k, int steps) {
 extern "C" void tx_fem_set_plate(tx_fem* b, double y) {
   b->has_plate = true;
   b->plate = y;
+  b->ball_r = 0;
 }
 
 // one step of the links body: Bullet's own order, without collisions
@@ -435,6 +445,49 @@ static void links_step(tx_fem* b) {
   s->predictMotion((btScalar)b->dt);
   s->solveConstraints();
   s->integrateMotion();
+}
+
+// The average nodal pressure tetrahedron (Bonet and Burton, Commun. Numer.
+// Meth. Engng 14, 1998): linear tetrahedra lock when nearly incompressible,
+// as every element's own volume change is penalised. Here each node's
+// volume ratio J is taken over all the tetrahedra around it, and each
+// tetrahedron's volume term uses the mean of its nodes' J in place of its
+// own. Both models' volume terms are lambda (J - c) cof(F), so the change is
+// lambda (Jbar - J) cof(F), added to the force Bullet computed.
+static void nodal_pressure(tx_fem* b) {
+  btSoftBody* s = b->body;
+  std::fill(b->node_rest.begin(), b->node_rest.end(), 0.0);
+  std::fill(b->node_now.begin(), b->node_now.end(), 0.0);
+  btSoftBody::Node* first = &s->m_nodes[0];
+  for (int t = 0; t < s->m_tetras.size(); t++) {
+    const btSoftBody::Tetra& e = s->m_tetras[t];
+    double v = e.m_element_measure / 4, j = s->m_tetraScratches[t].m_J;
+    for (int k = 0; k < 4; k++) {
+      size_t n = (size_t)(e.m_n[k] - first);
+      b->node_rest[n] += v, b->node_now[n] += v * j;
+    }
+  }
+  for (int t = 0; t < s->m_tetras.size(); t++) {
+    const btSoftBody::Tetra& e = s->m_tetras[t];
+    const btSoftBody::TetraScratch& sc = s->m_tetraScratches[t];
+    double jbar = 0;
+    for (int k = 0; k < 4; k++) {
+      size_t n = (size_t)(e.m_n[k] - first);
+      jbar += b->node_now[n] / b->node_rest[n] / 4;
+    }
+    // the change in first Piola stress, lambda (Jbar - J) cof(F), gives node
+    // k the force -V (that) Dm^-T grad N_k, which is -(lambda (Jbar - J) / 6)
+    // times column k of cof(Ds): the area vector of the face opposite it
+    const btVector3 c1 = e.m_n[1]->m_x - e.m_n[0]->m_x, c2 = e.m_n[2]->m_x - e.m_n[0]->m_x,
+                    c3 = e.m_n[3]->m_x - e.m_n[0]->m_x;
+    const btScalar k = (btScalar)(-b->volume_modulus * (jbar - sc.m_J) / 6);
+    const btVector3 f1 = c2.cross(c3) * k, f2 = c3.cross(c1) * k, f3 = c1.cross(c2) * k;
+    b->elastic[(int)(e.m_n[1] - first)] += f1;
+    b->elastic[(int)(e.m_n[2] - first)] += f2;
+    b->elastic[(int)(e.m_n[3] - first)] += f3;
+    const btVector3 f0 = -(f1 + f2 + f3);
+    b->elastic[(int)(e.m_n[0] - first)] += f0;
+  }
 }
 
 // One explicit step of the FEM body: Bullet's elastic force (the model's, on
@@ -462,6 +515,7 @@ static void fem_step(tx_fem* b) {
   }
   for (int i = 0; i < b->nv; i++) b->elastic[i].setZero();
   b->force->addScaledExplicitForce(1, b->elastic);
+  if (b->volume_modulus > 0) nodal_pressure(b);
   const btScalar dt = (btScalar)b->dt;
   for (int i = 0; i < b->nv; i++) {
     btSoftBody::Node& n = s->m_nodes[i];
@@ -604,7 +658,20 @@ extern "C" bool tx_fem_step(tx_fem* b, int steps) {
       btSoftBody::Node& n = nodes[i];
       if (n.m_im <= 0) continue;
       n.m_v *= (btScalar)keep;
-      if (b->has_plate && n.m_x.getY() > b->plate) {
+      if (b->has_plate && b->ball_r > 0) {
+        // the ball: a node inside goes out along the ball's normal; the ball's
+        // upward force is the normal momentum this takes, projected on y
+        btVector3 c((btScalar)b->ball_x, (btScalar)b->plate, (btScalar)b->ball_z), r = n.m_x - c;
+        double len = r.length();
+        if (len < b->ball_r && len > 0) {
+          btVector3 nn = r / (btScalar)len;
+          double moved = (b->ball_r - len) / b->dt, vin = -(double)n.m_v.dot(nn);
+          impulse += b->mass[(size_t)i] * std::max(vin, moved) * -(double)nn.getY();
+          n.m_x = c + nn * (btScalar)b->ball_r;
+          if (vin > 0) n.m_v += nn * (btScalar)vin;
+          on++;
+        }
+      } else if (b->has_plate && n.m_x.getY() > b->plate) {
         // frictionless: only the normal motion is stopped; the momentum the
         // plate takes is its force times the step
         double moved = (n.m_x.getY() - b->plate) / b->dt;
@@ -679,6 +746,11 @@ extern "C" int tx_fem_node_count(const tx_fem* b) { return b->nv; }
 extern "C" double tx_fem_added_mass(const tx_fem* b) { return b->added_mass; }
 
 extern "C" double tx_fem_dt(const tx_fem* b) { return b->dt; }
+extern "C" void tx_fem_set_ball(tx_fem* b, const double c[3], double r) {
+  b->has_plate = r > 0;
+  b->ball_x = c[0], b->plate = c[1], b->ball_z = c[2], b->ball_r = r;
+}
+
 extern "C" double tx_fem_plate_force(const tx_fem* b) { return b->plate_force; }
 extern "C" int tx_fem_plate_contacts(const tx_fem* b) { return b->contacts; }
 
