@@ -7,8 +7,10 @@
 // missed deadline; that next tick then runs at once, late, unless its whole
 // period is already over: such ticks are skipped, each counted as missed. Threads ask for
 // SCHED_FIFO, haptics highest, the others by rate (faster = higher priority),
-// and a CPU each, round-robin, haptics then the fastest on the last CPU; where either is refused they run without it and
-// the result says so.
+// and a CPU each, round-robin, haptics then the fastest on the last CPU (a
+// process with no haptics thread starts on the CPU before it, leaving the last
+// to a haptics thread in another process of the session); where either is
+// refused they run without it and the result says so.
 #include "system_internal.h"
 
 #include <errno.h>
@@ -255,12 +257,16 @@ int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r) {
     if (pthread_create(&spinners[nspin].thread, NULL, spinner_main, &spinners[nspin]) == 0) nspin++;
   }
 
+  // the last CPU is the haptics thread's: a process without one (a
+  // session's sim, on the device's host) starts on the CPU before it
+  int skip = 1;
+  for (int g = 0; g < ng; g++) skip &= !s->threads[g].own;
   int rc = 0, started = 0;
   for (int g = 0; g < ng; g++) {
     // leave the top for the kernel's own threads; haptics just below, alone
     int prio = s->threads[g].own ? prio_max - 10 : prio_max - 12 - 2 * s->threads[g].rank;
     w[g] = (worker){.sys = s, .group = g, .gate = &gt, .stop = &stop,
-                    .cpu = ncpu > 0 ? cpus[(ncpu - 1) - (g % ncpu)] : -1,
+                    .cpu = ncpu > 0 ? cpus[(ncpu - 1) - ((g + skip) % ncpu)] : -1,
                     .priority = o->realtime_priority ? (prio < prio_min ? prio_min : prio) : 0};
     if (pthread_create(&th[g], NULL, worker_main, &w[g]) != 0) {
       rc = -1;
