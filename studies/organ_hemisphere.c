@@ -1,7 +1,8 @@
 // tactus study organ-hemisphere: the LAGB paper's check of its soft bodies
 // (its Figure 14). A hemisphere (R = 2 cm, E = 5 kPa, nu = 0.45) with its
 // base fixed is indented at its pole by a tool's tip (a rigid frictionless
-// sphere of 5 mm; or a flat plate), on
+// ball of 5 mm, on tetrahedra graded toward the pole, assets/hemisphere) or
+// by a rigid frictionless plate (on structured meshes), on
 // Bullet's FEM deformables (corotated) at three refinements and on Bullet's
 // classic soft body (links) at several iteration counts. The force against
 // Hertz, F = (4/3) E / (1 - nu^2) sqrt(R) d^(3/2) ((16/9) E sqrt(R) d^(3/2)
@@ -18,6 +19,7 @@
 #include "../views/plot.h"
 #include "../views/report.h"
 #include "../model/error.h"
+#include "../tools/lagb/mesh.h"
 
 #include <tactus/config.h>
 #include <tactus/model.h>
@@ -40,12 +42,14 @@ enum { DEPTHS = 5, LEVELS = 3, LINK_RUNS = 4 };
 
 static const double RADIUS = 0.02, YOUNG = 5e3;
 
-// what presses the pole: a sphere of radius `indenter` (m; 0: a flat plate);
-// Hertz's radius for the two curvatures; the 3-D meshes' grading toward the
-// pole (stronger under a tip, whose contact is smaller)
+// what presses the pole: a ball of radius `radius` (m; 0: a flat plate), and
+// Hertz's radius for the two curvatures. A ball's contact is small, so its
+// meshes are tetgen's, graded toward the pole (assets/hemisphere/graded-L,
+// tools/hemisphere_assets.c); the plate's are the structured ones, graded 1.5.
 typedef struct indenter {
-  double radius, hertz_radius, grade;
+  double radius, hertz_radius;
 } indenter;
+static const double GRADE = 1.5;
 // the continuum's elements per side (quick: the coarser three) and grading toward the pole
 static const int AXI_FULL[LEVELS] = {16, 32, 64}, AXI_QUICK[LEVELS] = {8, 16, 32};
 static const double AXI_GRADE = 2;
@@ -55,7 +59,9 @@ typedef struct run_result {
   double dt;             // s
   double cpu;            // s
   double force[DEPTHS];  // N, at d / R = 0.02 .. 0.10
-  double* profile;       // (meridian nodes) vertical displacement at d / R = 0.1, m
+  int np;                // surface nodes of the cap (the base's left out)
+  double* phi;           // (np) their angle from the pole at rest, rad
+  double* uy;            // (np) their vertical displacement at the deepest depth, m
   bool finite;
 } run_result;
 
@@ -65,21 +71,31 @@ static double cpu_now(void) {
   return t.tv_sec + 1e-9 * t.tv_nsec;
 }
 
-// the meridian in the plane z = 0 from the pole to the base rim: the top
-// face's nodes i = n..2n (j = n), then the side's j = n-1..0 (i = 2n); at
-// refinement n its node s is the coarse mesh's node s / 2 (the grids nest)
-static int meridian(const tx_hemisphere_mesh* m, int* ids) {
-  int n = m->n, nx = 2 * n + 1, ny = n + 1, c = 0;
-  for (int i = n; i <= 2 * n; i++) ids[c++] = (n * ny + n) * nx + i;
-  for (int j = n - 1; j >= 0; j--) ids[c++] = (n * ny + j) * nx + 2 * n;
-  return c;
+// the mesh at refinement `level`: the structured hemisphere at that many
+// cells per radius under a plate, tetgen's graded level under a ball
+static bool hemisphere_mesh(const indenter* in, int level, tx_hemisphere_mesh* m) {
+  if (in->radius <= 0) return tx_hemisphere_build_graded(RADIUS, level, GRADE, m);
+  *m = (tx_hemisphere_mesh){0};
+  char node[4300], ele[4300];
+  snprintf(node, sizeof node, "%s/hemisphere/graded-%d.node", TX_ASSET_DIR, level);
+  snprintf(ele, sizeof ele, "%s/hemisphere/graded-%d.ele", TX_ASSET_DIR, level);
+  tx_tetmesh t;
+  if (!tx_tetmesh_read(node, ele, &t)) return false;
+  m->n = level, m->nv = t.nv, m->ne = t.ne, m->v = t.v, m->e = t.e;
+  m->base = calloc((size_t)t.nv, sizeof(bool));
+  if (!m->base) return tx_hemisphere_free(m), tx_set_error("organ-hemisphere: out of memory"), false;
+  for (int i = 0; i < t.nv; i++) {
+    m->base[i] = fabs(t.v[3 * i + 1]) < 1e-12;
+    if (t.v[3 * i + 1] > t.v[3 * m->pole + 1]) m->pole = i;
+  }
+  return true;
 }
 
 // indent to each depth in turn, each ramped over half a settling time and
 // then held for one, the force averaged over the last quarter
 static bool indent(const tx_fem_def* d, const indenter* in, int n, run_result* r) {
   tx_hemisphere_mesh m;
-  if (!tx_hemisphere_build_graded(RADIUS, n, in->grade, &m)) return false;
+  if (!hemisphere_mesh(in, n, &m)) return false;
   tx_fem* b = tx_fem_create(d, m.v, m.nv, m.e, m.ne);
   if (!b) {
     tx_hemisphere_free(&m);
@@ -107,53 +123,73 @@ static bool indent(const tx_fem_def* d, const indenter* in, int n, run_result* r
     r->force[l] = tx_fem_plate_force(b);
   }
   r->cpu = cpu_now() - t0;
-  int ids[200];
-  int c = meridian(&m, ids);
+  // the cap's surface nodes: the boundary's, off the base
+  int faces = 0;
+  const int* hull = tx_fem_hull(b, &faces);
+  bool* cap = calloc((size_t)m.nv, sizeof(bool));
   double* x = malloc((size_t)m.nv * 3 * sizeof(double));
-  r->profile = malloc((size_t)c * sizeof(double));
-  if (x && r->profile) {
+  r->np = 0;
+  for (int k = 0; cap && k < 3 * faces; k++)
+    if (!m.base[hull[k]] && !cap[hull[k]]) cap[hull[k]] = true, r->np++;
+  r->phi = malloc((size_t)(r->np + 1) * sizeof(double));
+  r->uy = malloc((size_t)(r->np + 1) * sizeof(double));
+  bool ok = cap && x && r->phi && r->uy;
+  if (ok) {
     tx_fem_positions(b, x);
-    for (int s = 0; s < c; s++) r->profile[s] = x[3 * ids[s] + 1] - m.v[3 * ids[s] + 1];
+    for (int i = 0, k = 0; i < m.nv; i++) {
+      if (!cap[i]) continue;
+      const double* p = m.v + 3 * i;
+      r->phi[k] = atan2(sqrt(p[0] * p[0] + p[2] * p[2]), p[1]);
+      r->uy[k++] = x[3 * i + 1] - p[1];
+    }
   }
-  free(x);
+  free(cap), free(x);
   tx_fem_destroy(b);
   tx_hemisphere_free(&m);
-  if (!r->profile) tx_set_error("organ-hemisphere: out of memory");
-  return r->profile != NULL;
+  if (!ok) tx_set_error("organ-hemisphere: out of memory");
+  return ok;
 }
 
-// RMS over the coarse mesh's meridian nodes of the difference to a finer
-// mesh's (at refinement ratio `step`), over the indentation depth
-static double profile_error(const double* coarse, int n_coarse, const double* fine, int step, double depth) {
-  int c = 2 * n_coarse + 1;
-  double s = 0;
-  for (int k = 0; k < c; k++) s += pow(coarse[k] - fine[k * step], 2);
-  return sqrt(s / c) / depth;
-}
+static void free_run(run_result* r) { free(r->phi), free(r->uy); }
 
-enum { CONT_SAMPLES = 181 };  // the continuum's surface displacement at 0, 0.5, .. 90 degrees from the pole
+enum { PROFILE_BINS = 721 };  // a profile sampled from the pole (0) to the base rim (pi / 2), every 0.125 degrees
 
-// RMS over a run's meridian nodes, pole to base rim, of the difference to the
-// continuum's surface displacement (linear between its samples), over d
-static double continuum_profile_error(const run_result* r, const indenter* in, int n, const double* uc, double depth) {
-  tx_hemisphere_mesh m;
-  if (!tx_hemisphere_build_graded(RADIUS, n, in->grade, &m)) return NAN;
-  int ids[200], c = meridian(&m, ids);
-  double s = 0;
-  for (int i = 0; i < c; i++) {
-    const double* p = m.v + 3 * ids[i];
-    double x = atan2(p[0], p[1]) / (M_PI / 2) * (CONT_SAMPLES - 1);
-    int j = (int)x < CONT_SAMPLES - 2 ? (int)x : CONT_SAMPLES - 2;
-    s += pow(r->profile[i] - (uc[j] + (uc[j + 1] - uc[j]) * (x - j)), 2);
+// a run's profile in bins of its nodes' angle (their mean; an empty bin
+// linear between its neighbours), so that meshes that do not nest compare
+static void binned_profile(const run_result* r, double* out) {
+  int count[PROFILE_BINS] = {0};
+  for (int k = 0; k < PROFILE_BINS; k++) out[k] = 0;
+  for (int i = 0; i < r->np; i++) {
+    int k = (int)lround(r->phi[i] / (M_PI / 2) * (PROFILE_BINS - 1));
+    k = k < 0 ? 0 : k >= PROFILE_BINS ? PROFILE_BINS - 1 : k;
+    out[k] += r->uy[i], count[k]++;
   }
-  tx_hemisphere_free(&m);
-  return sqrt(s / c) / depth;
+  int last = -1;
+  for (int k = 0; k < PROFILE_BINS; k++) {
+    if (!count[k]) continue;
+    out[k] /= count[k];
+    for (int j = last + 1; j < k; j++) out[j] = last < 0 ? out[k] : out[last] + (out[k] - out[last]) * (j - last) / (k - last);
+    last = k;
+  }
+  for (int j = last + 1; j < PROFILE_BINS; j++) out[j] = last < 0 ? 0 : out[last];
+}
+
+// RMS over a run's cap nodes of the difference to a reference profile (bins,
+// linear between them), over the depth
+static double profile_error(const run_result* r, const double* ref, double depth) {
+  double s = 0;
+  for (int i = 0; i < r->np; i++) {
+    double x = r->phi[i] / (M_PI / 2) * (PROFILE_BINS - 1);
+    int j = (int)x < PROFILE_BINS - 2 ? (int)x : PROFILE_BINS - 2;
+    s += pow(r->uy[i] - (ref[j] + (ref[j + 1] - ref[j]) * (x - j)), 2);
+  }
+  return r->np ? sqrt(s / r->np) / depth : NAN;
 }
 #endif
 
 int tx_study_organ_hemisphere(const tx_study_args* a) {
   bool quick = false;
-  double nu = 0.45, tip_mm = 0;
+  double nu = 0.45, tip_mm = 5;
   for (int i = 0; i < a->nsets; i++) {
     const char* eq = strchr(a->sets[i], '=');
     double v;
@@ -174,13 +210,14 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
   (void)num, (void)quick, (void)nu, (void)tip_mm;
   return tx_bad_input("study organ-hemisphere: this build has no Bullet (configured with TX_WITH_BULLET=OFF)");
 #else
-  // refinements at ratio 2 (cells per radius); quick: the coarsest three
-  const int full_levels[LEVELS] = {2, 4, 8}, quick_levels[LEVELS] = {1, 2, 4};
-  const int* levels = quick ? quick_levels : full_levels;
+  // refinements at ratio 2: cells per radius under a plate, tetgen's graded
+  // levels under a ball; quick: the coarsest three
+  const int plate_levels[2][LEVELS] = {{2, 4, 8}, {1, 2, 4}}, ball_levels[2][LEVELS] = {{1, 2, 3}, {0, 1, 2}};
+  const int* levels = (tip_mm > 0 ? ball_levels : plate_levels)[quick];
   const int link_iterations[LINK_RUNS] = {2, 5, 10, 20};
   const int link_n = levels[1];
-  indenter in = {tip_mm * 1e-3, RADIUS, 1.5};
-  if (in.radius > 0) in.hertz_radius = in.radius * RADIUS / (in.radius + RADIUS), in.grade = 2.5;
+  indenter in = {tip_mm * 1e-3, RADIUS};
+  if (in.radius > 0) in.hertz_radius = in.radius * RADIUS / (in.radius + RADIUS);
   const double RH = in.hertz_radius;  // Hertz's R: d/R below is over it
   if (in.radius > 0)
     printf("study organ-hemisphere: R = %g cm, E = %g kPa, nu = %g, base fixed, a tool's tip (a rigid frictionless sphere of"
@@ -195,7 +232,7 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
   snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
   FILE* csv = fopen(tmp, "w");
   if (!csv) return tx_bad_input("--out %s: cannot write organ-hemisphere.csv", a->out_dir);
-  fprintf(csv, "model,cells_per_radius,tetrahedra,iterations,dt_s,cpu_s,d_over_r,force_n,hertz_n,force_error,profile_error,"
+  fprintf(csv, "model,refinement,tetrahedra,iterations,dt_s,cpu_s,d_over_r,force_n,hertz_n,force_error,profile_error,"
                "continuum_n,continuum_force_error,continuum_profile_error\n");
 
   run_result fem[LEVELS] = {{0}}, links[LINK_RUNS] = {{0}};
@@ -205,7 +242,8 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
   bool ok = true;
   for (int l = 0; l < LEVELS && ok; l++) {
     ok = indent(&d, &in, levels[l], &fem[l]);
-    if (ok) printf("  FEM corotated, %2d cells per radius, %6d tetrahedra: %.2f s of CPU\n", levels[l], fem[l].tets, fem[l].cpu);
+    if (ok) printf("  FEM corotated, %s %d, %6d tetrahedra: %.2f s of CPU\n", in.radius > 0 ? "graded level" : "cells per radius",
+                   levels[l], fem[l].tets, fem[l].cpu);
     fflush(stdout);
   }
   tx_fem_def dl = d;
@@ -216,8 +254,8 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
   }
   if (!ok) {
     fclose(csv), remove(tmp);
-    for (int l = 0; l < LEVELS; l++) free(fem[l].profile);
-    for (int k = 0; k < LINK_RUNS; k++) free(links[k].profile);
+    for (int l = 0; l < LEVELS; l++) free_run(&fem[l]);
+    for (int k = 0; k < LINK_RUNS; k++) free_run(&links[k]);
     return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   }
 
@@ -226,7 +264,7 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
   enum { SHALLOW = 3, ALL = SHALLOW + DEPTHS };
   const double shallow[SHALLOW] = {0.001, 0.003, 0.01};
   const int* axl = quick ? AXI_QUICK : AXI_FULL;
-  double axi[LEVELS][ALL], axi_cpu[LEVELS], cont[ALL], cont_spread[ALL], uc[CONT_SAMPLES];
+  double axi[LEVELS][ALL], axi_cpu[LEVELS], cont[ALL], cont_spread[ALL], uc[PROFILE_BINS];
   int axi_dofs[LEVELS];
   for (int l = 0; l < LEVELS; l++) {
     double t0 = cpu_now();
@@ -236,13 +274,13 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
       good = tx_axisym_indent(c, (i < SHALLOW ? shallow[i] : 0.02 * (i - SHALLOW + 1)) * RH, in.radius, &axi[l][i]);
     axi_dofs[l] = c ? tx_axisym_dofs(c) : 0;
     if (good && l == LEVELS - 1)  // the finest at d / R = 0.1, the last depth
-      for (int k = 0; k < CONT_SAMPLES; k++) uc[k] = tx_axisym_surface_uz(c, M_PI / 2 * k / (CONT_SAMPLES - 1));
+      for (int k = 0; k < PROFILE_BINS; k++) uc[k] = tx_axisym_surface_uz(c, M_PI / 2 * k / (PROFILE_BINS - 1));
     tx_axisym_destroy(c);
     axi_cpu[l] = cpu_now() - t0;
     if (!good) {
       fclose(csv), remove(tmp);
-      for (int k = 0; k < LEVELS; k++) free(fem[k].profile);
-      for (int k = 0; k < LINK_RUNS; k++) free(links[k].profile);
+      for (int k = 0; k < LEVELS; k++) free_run(&fem[k]);
+      for (int k = 0; k < LINK_RUNS; k++) free_run(&links[k]);
       return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
     }
   }
@@ -273,7 +311,7 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
   double depth_max = 0.1 * RH;
   printf("\n  force (N) against Hertz; FEM by refinement, and Richardson's limit from the three\n  %6s %10s", "d/R",
          "Hertz");
-  for (int l = 0; l < LEVELS; l++) printf("   n=%-2d %6s", levels[l], "error");
+  for (int l = 0; l < LEVELS; l++) printf("   %s=%-2d %6s", in.radius > 0 ? "L" : "n", levels[l], "error");
   printf(" %6s %9s %6s\n", "order", "limit", "error");
   bool limits_within = true;
   bool all_finite = true;
@@ -327,7 +365,9 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
 
   // profiles against the finest FEM mesh, and error against CPU time
   double cpu_x[LEVELS + LINK_RUNS], err_y[LEVELS + LINK_RUNS];
-  printf("\n  error against run time (profile: RMS over the meridian against the finest FEM mesh and against\n"
+  double finest[PROFILE_BINS];
+  binned_profile(&fem[top], finest);
+  printf("\n  error against run time (profile: RMS over the cap's surface against the finest FEM mesh and against\n"
          "  the continuum, over d; force: against Hertz and against the continuum, at d/R = 0.1)\n"
          "  %-10s %6s %10s %8s %10s %12s %10s %10s %10s\n",
          "model", "tets", "iterations", "dt us", "CPU s", "force error", "profile", "continuum", "profile");
@@ -335,8 +375,8 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
   int np = 0;
   for (int l = 0; l < LEVELS; l++) {
     double fe = fem[l].force[DEPTHS - 1] / hertz_max - 1;
-    double pe = l < top ? profile_error(fem[l].profile, levels[l], fem[top].profile, levels[top] / levels[l], depth_max) : 0;
-    double ce = fem[l].force[DEPTHS - 1] / cont[ALL - 1] - 1, cpe = continuum_profile_error(&fem[l], &in, levels[l], uc, depth_max);
+    double pe = l < top ? profile_error(&fem[l], finest, depth_max) : 0;
+    double ce = fem[l].force[DEPTHS - 1] / cont[ALL - 1] - 1, cpe = profile_error(&fem[l], uc, depth_max);
     printf("  %-10s %6d %10s %8.1f %10.3f %11.1f%% %9.2f%% %+9.1f%% %9.2f%%\n", "FEM", fem[l].tets, "-", fem[l].dt * 1e6,
            fem[l].cpu, 100 * fe, 100 * pe, 100 * ce, 100 * cpe);
     char pe_text[32] = "";  // the finest is the reference: no error of its own
@@ -347,7 +387,7 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
               dd / RH, fem[l].force[i], h, fem[l].force[i] / h - 1, pe_text, cont[SHALLOW + i],
               fem[l].force[i] / cont[SHALLOW + i] - 1, cpe);
     }
-    json_array_append_new(jruns, json_pack("{s:s,s:i,s:i,s:f,s:f,s:o,s:o}", "model", "fem_corotated", "cells_per_radius",
+    json_array_append_new(jruns, json_pack("{s:s,s:i,s:i,s:f,s:f,s:o,s:o}", "model", "fem_corotated", "refinement",
                                            levels[l], "tetrahedra", fem[l].tets, "dt_s", fem[l].dt, "cpu_s", fem[l].cpu,
                                            "force_error_at_0_1", num(fe), "profile_error", l < top ? num(pe) : json_null()));
     json_object_update_new(json_array_get(jruns, json_array_size(jruns) - 1),
@@ -357,9 +397,9 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
   int nfem = np;
   for (int k = 0; k < LINK_RUNS; k++) {
     double fe = links[k].force[DEPTHS - 1] / hertz_max - 1;
-    double pe = profile_error(links[k].profile, link_n, fem[top].profile, levels[top] / link_n, depth_max);
+    double pe = profile_error(&links[k], finest, depth_max);
     all_finite &= links[k].finite;
-    double ce = links[k].force[DEPTHS - 1] / cont[ALL - 1] - 1, cpe = continuum_profile_error(&links[k], &in, link_n, uc, depth_max);
+    double ce = links[k].force[DEPTHS - 1] / cont[ALL - 1] - 1, cpe = profile_error(&links[k], uc, depth_max);
     printf("  %-10s %6d %10d %8.1f %10.3f %11.1f%% %9.2f%% %+9.1f%% %9.2f%%\n", "links", links[k].tets, link_iterations[k],
            links[k].dt * 1e6, links[k].cpu, 100 * fe, 100 * pe, 100 * ce, 100 * cpe);
     for (int i = 0; i < DEPTHS; i++) {
@@ -368,7 +408,7 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
               link_iterations[k], links[k].dt, links[k].cpu, dd / RH, links[k].force[i], h, links[k].force[i] / h - 1, pe,
               cont[SHALLOW + i], links[k].force[i] / cont[SHALLOW + i] - 1, cpe);
     }
-    json_array_append_new(jruns, json_pack("{s:s,s:i,s:i,s:i,s:f,s:f,s:o,s:o}", "model", "links", "cells_per_radius",
+    json_array_append_new(jruns, json_pack("{s:s,s:i,s:i,s:i,s:f,s:f,s:o,s:o}", "model", "links", "refinement",
                                            link_n, "tetrahedra", links[k].tets, "iterations", link_iterations[k], "dt_s",
                                            links[k].dt, "cpu_s", links[k].cpu, "force_error_at_0_1", num(fe),
                                            "profile_error", num(pe), "continuum_force_error_at_0_1", num(ce),
@@ -379,15 +419,15 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
   bool falls = fabs(f2 / hertz_max - 1) < fabs(f1 / hertz_max - 1) && fabs(f3 / hertz_max - 1) < fabs(f2 / hertz_max - 1);
   printf("  FEM force error falls with refinement: %s; never a NaN: %s\n", falls ? "yes" : "NO", all_finite ? "yes" : "NO");
 
-  for (int l = 0; l < LEVELS; l++) free(fem[l].profile);
-  for (int k = 0; k < LINK_RUNS; k++) free(links[k].profile);
+  for (int l = 0; l < LEVELS; l++) free_run(&fem[l]);
+  for (int k = 0; k < LINK_RUNS; k++) free_run(&links[k]);
   if (fclose(csv) != 0 || rename(tmp, csv_path) != 0) {
     remove(tmp), json_decref(jdepths), json_decref(jruns), json_decref(jcont), json_decref(jparts);
     return fprintf(stderr, "tactus: %s: cannot write\n", csv_path), 1;
   }
-  json_t* doc = json_pack("{s:s,s:b,s:{s:f,s:f,s:f,s:f,s:s},s:o,s:o,s:{s:o,s:o,s:o,s:f},s:b,s:b,s:b,s:b}", "study",
+  json_t* doc = json_pack("{s:s,s:b,s:{s:f,s:f,s:f,s:o,s:s},s:o,s:o,s:{s:o,s:o,s:o,s:f},s:b,s:b,s:b,s:b}", "study",
                           "organ-hemisphere", "quick", quick, "case", "radius_m", RADIUS, "young_pa", YOUNG, "poisson",
-                          nu, "grading", in.grade, "hertz", "F = 4/3 E / (1 - nu^2) sqrt(R) d^(3/2)", "depths", jdepths,
+                          nu, "grading", num(in.radius > 0 ? NAN : GRADE), "hertz", "F = 4/3 E / (1 - nu^2) sqrt(R) d^(3/2)", "depths", jdepths,
                           "runs", jruns, "richardson_at_0_1", "observed_order", num(order), "limit_n", num(limit),
                           "limit_error", num(limit_error), "finest_error", finest_error, "fem_error_falls", falls,
                           "hertz_within_10_percent", within, "finite", all_finite,

@@ -98,6 +98,21 @@ static void remove_work(const char* dir) {
 }
 
 bool tx_lagb_tetgen(const tx_trimesh* s, const char* prefix, const char* switches, const char* tetgen, int* tets) {
+  return tx_lagb_tetgen_sized(s, NULL, prefix, switches, tetgen, tets);
+}
+
+// surf.mtr: one size a vertex, which tetgen -m reads beside surf.off
+static bool write_sizes(const char* path, const double* sizes, int n) {
+  FILE* f = fopen(path, "w");
+  if (!f) return tx_set_error("%s: cannot write: %s", path, strerror(errno)), false;
+  fprintf(f, "%d 1\n", n);
+  for (int i = 0; i < n; i++) fprintf(f, "%.9g\n", sizes[i]);
+  if (fclose(f) != 0) return tx_set_error("%s: cannot write", path), false;
+  return true;
+}
+
+bool tx_lagb_tetgen_sized(const tx_trimesh* s, const double* sizes, const char* prefix, const char* switches,
+                          const char* tetgen, int* tets) {
   *tets = 0;
   if (!tetgen || access(tetgen, X_OK) != 0) {
     tx_set_error("the tetgen program was not found (%s): install the tetgen package",
@@ -112,7 +127,9 @@ bool tx_lagb_tetgen(const tx_trimesh* s, const char* prefix, const char* switche
   snprintf(off, sizeof off, "%s/surf.off", dir);
   snprintf(log, sizeof log, "%s/log", dir);
   snprintf(ele, sizeof ele, "%s/surf.1.ele", dir);
-  if (!tx_trimesh_write_off(s, off)) {
+  char mtr[4300];
+  snprintf(mtr, sizeof mtr, "%s/surf.mtr", dir);
+  if (!tx_trimesh_write_off(s, off) || (sizes && !write_sizes(mtr, sizes, s->nv))) {
     remove_work(dir);
     return false;
   }

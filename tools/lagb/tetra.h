@@ -10,5 +10,9 @@
 // must hold -z (zero-based numbering, as Bullet reads it). A run that takes
 // over a minute is stopped.
 bool tx_lagb_tetgen(const tx_trimesh* s, const char* prefix, const char* switches, const char* tetgen, int* tets);
+// the same with a size for each vertex of S (m), which switches with -m make
+// tetgen grade the tetrahedra by (its .mtr file)
+bool tx_lagb_tetgen_sized(const tx_trimesh* s, const double* sizes, const char* prefix, const char* switches,
+                          const char* tetgen, int* tets);
 
 #endif
