@@ -7,7 +7,10 @@
 # skipped (not scripted yet); the scorecard's JSON has the shape other tools
 # read: eight steps A to H in order, "wound_gap_m" with "before" and "after"
 # (a spacing, 2.5 mm, before: the skin is not pre-tensioned), each other
-# measure with its value, unit and rule. Release only (about 7 s).
+# measure with its value, unit and rule. The run's recordings of both hands
+# (device0.bin, device1.bin) replayed in lockstep give the same scorecard,
+# byte for byte, and hand 1 replayed from hand 0's recording scores
+# otherwise. Release only (about 25 s).
 #
 #   test_suturing.sh TACTUS
 set -eu
@@ -15,7 +18,7 @@ TACTUS=$1
 command -v python3 >/dev/null || { echo "no python3: skipped"; exit 77; }
 d=$(mktemp -d)
 trap 'rm -rf "$d"' EXIT
-"$TACTUS" run suturing --lockstep --no-record --quiet --out "$d/o"
+"$TACTUS" run suturing --lockstep --quiet --out "$d/o"
 python3 - "$d/o" <<'PY'
 import json, math, sys
 out = sys.argv[1]
@@ -50,4 +53,12 @@ check(s["punctures"]["value"] == 2, "punctures %r" % s["punctures"])
 check(0 < s["tissue_force_max_n"]["value"] <= 3.3, "tissue force %r" % s["tissue_force_max_n"])
 PY
 test -s "$d/o/scorecard.png"
-echo "suturing: ok"
+# the session replayed from its recordings scores the same
+"$TACTUS" run suturing --lockstep --no-record --quiet --device "replay:$d/o/device0.bin" --device "replay:$d/o/device1.bin" \
+  --out "$d/r"
+cmp "$d/o/scorecard.json" "$d/r/scorecard.json"
+# and the replay is what drives the hands: hand 1 given hand 0's recording scores otherwise
+"$TACTUS" run suturing --lockstep --no-record --quiet --device "replay:$d/o/device0.bin" --device "replay:$d/o/device0.bin" \
+  --out "$d/x"
+! cmp -s "$d/o/scorecard.json" "$d/x/scorecard.json"
+echo "suturing: ok (the replay's scorecard is the same, byte for byte)"
