@@ -680,11 +680,15 @@ tx_scenario* tx_scenario_load(const char* path, const tx_load_options* o) {
   json_error_t e;
   json_t* root = json_load_file(path, JSON_REJECT_DUPLICATES, &e);
   if (!root) return format_parse_error(path, &e), NULL;
-  char copy[PATH_MAX];
-  snprintf(copy, sizeof copy, "%s", path);
-  tx_scenario* s = load_root(path, dirname(copy), root, o);
+  tx_scenario* s = tx_scenario_load_json(path, root, o);
   json_decref(root);
   return s;
+}
+
+tx_scenario* tx_scenario_load_json(const char* path, json_t* root, const tx_load_options* o) {
+  char copy[PATH_MAX];
+  snprintf(copy, sizeof copy, "%s", path);
+  return load_root(path, dirname(copy), root, o);
 }
 
 tx_scenario* tx_scenario_load_text(const char* label, const char* text, size_t len, const tx_load_options* o) {

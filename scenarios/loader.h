@@ -37,6 +37,9 @@ int tx_scenario_locate(const char* name_or_path, char* path, size_t size);
 // NULL with the one-line message in tx_error()
 tx_scenario* tx_scenario_load(const char* path, const tx_load_options* o);
 tx_scenario* tx_scenario_load_text(const char* label, const char* text, size_t len, const tx_load_options* o);
+// a document already parsed (a bench's changed copy of a scenario file), as
+// if it were the file at path: its relative names are found beside it
+tx_scenario* tx_scenario_load_json(const char* path, json_t* root, const tx_load_options* o);
 void tx_scenario_free(tx_scenario* s);
 
 // a file a scenario or study names (assets/needle/x.csv): as given when it is

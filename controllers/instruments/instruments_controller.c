@@ -59,6 +59,7 @@ typedef struct instruments {
   double pin_bary[TX_NEEDLE_PINS_MAX][3];   // and their weights
   bool at_hole[TX_NEEDLE_PINS_MAX]; // the row is at the hole: where the arc crossed the patch's sheet
   int32_t* hole_scratch; // 2 x HOLE_PARTICLES_MAX: the skin's components (tx_puncture_hole)
+  tx_sheet_grid sheet;   // the skin's particles by x and z, for the clearance (up to 4 HOLE_PARTICLES_MAX)
   tx_result clearance, hand_clearance[HANDS];
   double clearance_min; // m: the lowest any held instrument's collision shapes came above the skin's sheet
   double hand_clearance_min[HANDS]; // m: the same for each hand's instruments
@@ -254,7 +255,7 @@ static int configure(tx_setup* s, void** self) {
     snprintf(name, sizeof name, "%s.contact", skin);
     m->skin_contact = TX_READ_OF(s, name, tx_skin_contact);
     m->hole_scratch = calloc(2 * HOLE_PARTICLES_MAX, sizeof *m->hole_scratch);
-    if (!m->hole_scratch) return -1;
+    if (!m->hole_scratch || !tx_sheet_grid_init(&m->sheet, 4 * HOLE_PARTICLES_MAX)) return -1;
     tx_puncture_tracker_init(&m->tracker, tx_table_num(s, "puncture_separation_m"), tx_table_num(s, "puncture_min_force_n"), 0);
   }
   for (int h = 0; h < HANDS; h++) {
@@ -522,6 +523,9 @@ static void rotate(const double q[4], const double v[3], double o[3]) {
 static void clearance(instruments* m, const float* xs, int nx) {
   double top = -INFINITY;
   for (int i = 0; i < nx; i++) top = fmax(top, xs[3 * i + 1]);
+  // the particles bucketed once for all the points below (a larger skin: each point scans them)
+  bool grid = nx <= m->sheet.cap;
+  if (grid) tx_sheet_grid_build(&m->sheet, xs, nx);
   for (int h = 0; h < m->nhands; h++) {
     int i = m->slot[h][m->cur[h]];
     const tx_urdf* u = m->desc[i]->urdf;
@@ -556,7 +560,9 @@ static void clearance(instruments* m, const float* xs, int nx) {
           memcpy(pts[n], c, sizeof c), pts[n][1] -= sh->size[0], n++;
         }
         for (int j = 0; j < n; j++)
-          if (pts[j][1] < top + 0.01) m->hand_clearance_min[h] = fmin(m->hand_clearance_min[h], tx_height_above_sheet(xs, nx, pts[j]));
+          if (pts[j][1] < top + 0.01)
+            m->hand_clearance_min[h] = fmin(m->hand_clearance_min[h], grid ? tx_sheet_height(&m->sheet, xs, pts[j])
+                                                                           : tx_height_above_sheet(xs, nx, pts[j]));
       }
     }
     m->clearance_min = fmin(m->clearance_min, m->hand_clearance_min[h]);
@@ -736,6 +742,7 @@ static void fini(void* self) {
   tx_instrument_world_destroy(m->world);
   for (int i = 0; i < TX_INSTRUMENTS_MAX; i++) tx_instrument_desc_free(m->desc[i]);
   free(m->hole_scratch);
+  tx_sheet_grid_free(&m->sheet);
   free(m);
 }
 

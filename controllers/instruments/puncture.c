@@ -2,6 +2,7 @@
 #include "puncture.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 static double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -45,14 +46,35 @@ static void corner(const float* x, int32_t i, double o[3]) {
 
 // the nearest point of the triangles whose first particle is in component
 // `patch` of `root` (all of them when root is NULL)
+static bool valid(const int32_t* v, int nx) {
+  return v[0] >= 0 && v[1] >= 0 && v[2] >= 0 && v[0] < nx && v[1] < nx && v[2] < nx;
+}
+
 static int nearest_of(const float* x, int nx, const int32_t* tri, int ntri, const int32_t* root, int32_t patch,
                       const double p[3], double bary[3], double point[3]) {
+  // no point of a triangle is farther from its first corner than its longest
+  // edge from there, so a triangle whose first corner is farther from p than
+  // that plus the best distance so far cannot be nearer: it is skipped
+  // before its closest point is sought (the answer is the same)
+  double reach2 = 0;
+  for (int t = 0; t < ntri; t++) {
+    const int32_t* v = tri + 3 * t;
+    if (!valid(v, nx)) continue;
+    const float *a = x + 3 * v[0], *b = x + 3 * v[1], *c = x + 3 * v[2];
+    double ab = 0, ac = 0;
+    for (int k = 0; k < 3; k++) ab += (double)(b[k] - a[k]) * (b[k] - a[k]), ac += (double)(c[k] - a[k]) * (c[k] - a[k]);
+    reach2 = fmax(reach2, fmax(ab, ac));
+  }
+  double reach = sqrt(reach2), bound2 = INFINITY;
   int best = -1;
   double best_d2 = INFINITY;
   for (int t = 0; t < ntri; t++) {
     const int32_t* v = tri + 3 * t;
-    if (v[0] < 0 || v[1] < 0 || v[2] < 0 || v[0] >= nx || v[1] >= nx || v[2] >= nx) continue;
+    if (!valid(v, nx)) continue;
     if (root && root[v[0]] != patch) continue;
+    const float* f = x + 3 * v[0];
+    double e0 = f[0] - p[0], e1 = f[1] - p[1], e2 = f[2] - p[2];
+    if (e0 * e0 + e1 * e1 + e2 * e2 > bound2) continue;
     double a[3], b[3], c[3], w[3], q[3], d2 = 0;
     corner(x, v[0], a), corner(x, v[1], b), corner(x, v[2], c);
     closest_bary(a, b, c, p, w);
@@ -61,6 +83,7 @@ static int nearest_of(const float* x, int nx, const int32_t* tri, int ntri, cons
       best_d2 = d2, best = t;
       memcpy(bary, w, sizeof w);
       memcpy(point, q, sizeof q);
+      bound2 = (sqrt(d2) + reach) * (sqrt(d2) + reach) * (1 + 1e-9);
     }
   }
   return best;
@@ -249,5 +272,85 @@ double tx_height_above_sheet(const float* x, int nx, const double p[3]) {
     if (d2 < best) best = d2, y = q[1];
   }
   if (!(p[0] >= lo[0] && p[0] <= hi[0] && p[2] >= lo[1] && p[2] <= hi[1])) return INFINITY;
+  return p[1] - y;
+}
+
+bool tx_sheet_grid_init(tx_sheet_grid* g, int cap) {
+  *g = (tx_sheet_grid){.cap = cap > 0 ? cap : 0};
+  g->start = malloc(sizeof(int32_t) * (size_t)(g->cap + 1));
+  g->cursor = malloc(sizeof(int32_t) * (size_t)(g->cap + 1));
+  g->order = malloc(sizeof(int32_t) * (size_t)(g->cap + 1));
+  if (!g->start || !g->cursor || !g->order) return tx_sheet_grid_free(g), false;
+  return true;
+}
+
+void tx_sheet_grid_free(tx_sheet_grid* g) {
+  free(g->start), free(g->cursor), free(g->order);
+  *g = (tx_sheet_grid){0};
+}
+
+static int cell_of(const tx_sheet_grid* g, double x, double z) {
+  int i = (int)((x - g->lo[0]) / g->cell), j = (int)((z - g->lo[1]) / g->cell);
+  i = i < 0 ? 0 : i >= g->cols ? g->cols - 1 : i;
+  j = j < 0 ? 0 : j >= g->rows ? g->rows - 1 : j;
+  return j * g->cols + i;
+}
+
+void tx_sheet_grid_build(tx_sheet_grid* g, const float* x, int nx) {
+  g->n = 0;
+  if (nx > g->cap) return;
+  g->lo[0] = g->lo[1] = INFINITY, g->hi[0] = g->hi[1] = -INFINITY;
+  for (int i = 0; i < nx; i++) {
+    const float* q = x + 3 * i;
+    if (!isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2])) continue;
+    g->lo[0] = fmin(g->lo[0], q[0]), g->hi[0] = fmax(g->hi[0], q[0]);
+    g->lo[1] = fmin(g->lo[1], q[2]), g->hi[1] = fmax(g->hi[1], q[2]);
+    g->n++;
+  }
+  if (g->n == 0) return;
+  // about two particles a cell, and never more cells than room
+  double w = g->hi[0] - g->lo[0], h = g->hi[1] - g->lo[1];
+  g->cell = fmax(sqrt(w * h * 2 / g->n), fmax(w, h) / g->cap + 1e-9);
+  for (;;) {
+    g->cols = (int)(w / g->cell) + 1, g->rows = (int)(h / g->cell) + 1;
+    if ((long)g->cols * g->rows <= g->cap) break;
+    g->cell *= 1.25;
+  }
+  int cells = g->cols * g->rows;
+  for (int c = 0; c <= cells; c++) g->start[c] = 0;
+  for (int i = 0; i < nx; i++) {
+    const float* q = x + 3 * i;
+    if (isfinite(q[0]) && isfinite(q[1]) && isfinite(q[2])) g->start[cell_of(g, q[0], q[2]) + 1]++;
+  }
+  for (int c = 0; c < cells; c++) g->start[c + 1] += g->start[c], g->cursor[c] = g->start[c];
+  for (int i = 0; i < nx; i++) {
+    const float* q = x + 3 * i;
+    if (isfinite(q[0]) && isfinite(q[1]) && isfinite(q[2])) g->order[g->cursor[cell_of(g, q[0], q[2])]++] = i;
+  }
+}
+
+double tx_sheet_height(const tx_sheet_grid* g, const float* x, const double p[3]) {
+  if (g->n == 0 || !(p[0] >= g->lo[0] && p[0] <= g->hi[0] && p[2] >= g->lo[1] && p[2] <= g->hi[1])) return INFINITY;
+  int home = cell_of(g, p[0], p[2]), ci = home % g->cols, cj = home / g->cols;
+  double best = INFINITY, y = 0;
+  int best_i = -1;
+  // rings of cells about p's: a particle in ring r + 1 is at least r cells away
+  for (int r = 0; r <= g->cols + g->rows; r++) {
+    for (int j = cj - r; j <= cj + r; j++) {
+      if (j < 0 || j >= g->rows) continue;
+      int step = (j == cj - r || j == cj + r) ? 1 : 2 * r;  // the ring's edge cells only
+      for (int i = ci - r; i <= ci + r; i += step > 0 ? step : 1) {
+        if (i < 0 || i >= g->cols) continue;
+        int c = j * g->cols + i;
+        for (int k = g->start[c]; k < g->start[c + 1]; k++) {
+          int32_t n = g->order[k];
+          const float* q = x + 3 * n;
+          double dx = p[0] - q[0], dz = p[2] - q[2], d2 = dx * dx + dz * dz;
+          if (d2 < best || (d2 == best && n < best_i)) best = d2, y = q[1], best_i = n;  // ties: the lowest number, as the scan
+        }
+      }
+    }
+    if (best_i >= 0 && best < (r * g->cell) * (r * g->cell)) break;
+  }
   return p[1] - y;
 }

@@ -83,4 +83,25 @@ bool tx_puncture_attached(int nx, const int32_t* tri, int ntri, int32_t* scratch
 // p is not over the patch (outside its particles' x-z bounds)
 double tx_height_above_sheet(const float* x, int nx, const double p[3]);
 
+// The same for many points against one publish of the sheet: its particles
+// bucketed by x and z once (tx_sheet_grid_build, O(n)), then each point's
+// nearest particle across found in the cells around it. Sized once by
+// tx_sheet_grid_init (particles), no allocation after; a build with more
+// particles than that keeps none (every height INFINITY).
+typedef struct tx_sheet_grid {
+  int cap;             // particles it has room for (and cells: as many)
+  int n;               // particles bucketed by the last build (the finite ones)
+  int cols, rows;      // cells
+  double lo[2], hi[2]; // m, the particles' x-z bounds
+  double cell;         // m, a cell's side
+  int32_t* start;      // (cap + 1) where each cell's particles begin in order
+  int32_t* cursor;     // (cap) the build's scratch
+  int32_t* order;      // (cap) particle numbers, cell by cell
+} tx_sheet_grid;
+bool tx_sheet_grid_init(tx_sheet_grid* g, int cap);
+void tx_sheet_grid_free(tx_sheet_grid* g);
+void tx_sheet_grid_build(tx_sheet_grid* g, const float* x, int nx);
+// tx_height_above_sheet of p against the particles of the last build
+double tx_sheet_height(const tx_sheet_grid* g, const float* x, const double p[3]);
+
 #endif

@@ -307,8 +307,44 @@ static void test_height_above_sheet(void** state) {
   assert_true(fabs(tx_height_above_sheet(x, N * N, (double[3]){0.001, 0.01, -0.002}) - 0.01) < 1e-7);
 }
 
+// the sheet's grid gives the scan's heights exactly: a wrinkled, sheared
+// patch of 60 x 40 particles with a few not finite, at points over it, on
+// its edges, on particles and beyond it; a build past its room keeps none
+static void test_sheet_grid_matches_the_scan(void** state) {
+  (void)state;
+  enum { W = 60, H = 40, NP = W * H };
+  static float x[3 * NP];
+  for (int j = 0; j < H; j++)
+    for (int i = 0; i < W; i++) {
+      float* q = x + 3 * (j * W + i);
+      q[0] = 0.001f * i + 0.0003f * j + 0.0002f * sinf(0.7f * j);
+      q[1] = 0.002f * sinf(0.3f * i) * cosf(0.2f * j);
+      q[2] = 0.0012f * j + 0.0004f * cosf(0.5f * i);
+    }
+  x[3 * 77 + 1] = NAN, x[3 * 1500] = INFINITY;
+  tx_sheet_grid g;
+  assert_true(tx_sheet_grid_init(&g, NP));
+  tx_sheet_grid_build(&g, x, NP);
+  assert_int_equal(g.n, NP - 2);
+  unsigned seed = 7;
+  for (int k = 0; k < 2000; k++) {
+    seed = seed * 1103515245u + 12345u;
+    double u = (seed >> 8) / 16777216.0;
+    seed = seed * 1103515245u + 12345u;
+    double v = (seed >> 8) / 16777216.0;
+    double p[3] = {-0.005 + 0.08 * u, 0.003, -0.005 + 0.06 * v};
+    if (k % 10 == 0) p[0] = x[3 * (k % NP)], p[2] = x[3 * (k % NP) + 2];  // right over a particle
+    double scan = tx_height_above_sheet(x, NP, p), grid = tx_sheet_height(&g, x, p);
+    assert_true(isinf(scan) ? isinf(grid) : grid == scan);
+  }
+  tx_sheet_grid_build(&g, x, NP + 1);  // more than its room
+  assert_true(isinf(tx_sheet_height(&g, x, (double[3]){0.02, 0, 0.02})));
+  tx_sheet_grid_free(&g);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_sheet_grid_matches_the_scan),
       cmocka_unit_test_setup(test_nearest_triangle, patch),
       cmocka_unit_test_setup(test_entry_then_exit, patch),
       cmocka_unit_test_setup(test_hole_at_the_crossing_on_the_patch, patch),
