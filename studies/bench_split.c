@@ -22,7 +22,8 @@ extern char** environ;
 
 void tx_bench_target(const char* what, const char* measured, const char* limit, bool ok);
 
-enum { ROUNDS = 5, SETUPS = 3, MAX_ROLES = 3 };
+#if TX_WITH_DDS
+enum { ROUNDS = 5, SETUPS = 3 };
 
 static const char* const SETUP_NAMES[SETUPS] = {"one process", "sim + device", "sim + device + view"};
 
@@ -129,6 +130,8 @@ static double median(const double* v, int n) {
   qsort(s, (size_t)n, sizeof(double), by_value);
   return n % 2 ? s[n / 2] : (s[n / 2 - 1] + s[n / 2]) / 2;
 }
+
+#endif
 
 int tx_bench_split_session(const char* out, double duration_s) {
 #if !TX_WITH_DDS
