@@ -47,11 +47,13 @@ void tx_bench_target_us(const char* what, double measured_us, double limit_us) {
 static int bench_render(const bench_args* a) { return tx_bench_render(a->out, a->duration_s); }
 static int bench_render_gui(const bench_args* a) { return tx_bench_render_gui(a->out, a->duration_s); }
 
-static json_t* find_controller(json_t* report, const char* name) {
+json_t* tx_report_controller(json_t* report, const char* name) {
   size_t i;
   json_t* c;
-  json_array_foreach(json_object_get(report, "controllers"), i, c)
-    if (strcmp(json_string_value(json_object_get(c, "name")), name) == 0) return c;
+  json_array_foreach(json_object_get(report, "controllers"), i, c) {
+    const char* n = json_string_value(json_object_get(c, "name"));
+    if (n && strcmp(n, name) == 0) return c;
+  }
   return NULL;
 }
 
@@ -112,7 +114,7 @@ static int bench_rates(const bench_args* a) {
     tx_bench_target(what, measured, "<= 1%", error <= 1.0);
     all &= error <= 1.0;
   }
-  json_t* h = find_controller(report, "haptics");
+  json_t* h = tx_report_controller(report, "haptics");
   if (h) {
     double p99 = json_number_value(json_object_get(json_object_get(h, "jitter_us"), "p99"));
     snprintf(measured, sizeof measured, "%.1f us", p99);

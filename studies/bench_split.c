@@ -2,6 +2,7 @@
 // `tactus run` process, started as a user starts a session
 // (docs/distributed.md); the numbers come from each process's report.json.
 #include "bench_split.h"
+#include "studies.h"
 
 #include "../scenarios/command.h"
 
@@ -20,7 +21,6 @@
 
 extern char** environ;
 
-void tx_bench_target(const char* what, const char* measured, const char* limit, bool ok);
 
 #if TX_WITH_DDS
 enum { ROUNDS = 5, SETUPS = 3 };
@@ -60,13 +60,8 @@ static bool finished(pid_t pid) {
 }
 
 static double controller_num(json_t* report, const char* name, const char* key) {
-  size_t i;
-  json_t* c;
-  json_array_foreach(json_object_get(report, "controllers"), i, c) {
-    const char* n = json_string_value(json_object_get(c, "name"));
-    if (n && strcmp(n, name) == 0) return json_number_value(json_object_get(c, key));
-  }
-  return -1;
+  json_t* c = tx_report_controller(report, name);
+  return c ? json_number_value(json_object_get(c, key)) : -1;
 }
 
 // the run's numbers from the device's and the sim's reports (the same

@@ -1,5 +1,6 @@
 // tactus bench suturing (see bench_suturing.h).
 #include "bench_suturing.h"
+#include "studies.h"
 
 #include "../scenarios/command.h"
 #include "../scenarios/loader.h"
@@ -13,7 +14,6 @@
 #include <string.h>
 #include <time.h>
 
-void tx_bench_target(const char* what, const char* measured, const char* limit, bool ok);
 
 static double wall_now(void) {
   struct timespec t;

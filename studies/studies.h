@@ -5,6 +5,7 @@
 #ifndef TX_SCENARIOS_STUDIES_H
 #define TX_SCENARIOS_STUDIES_H
 
+#include <jansson.h>
 #include <stdbool.h>
 
 typedef struct tx_study_args {
@@ -22,6 +23,8 @@ int tx_study_quick_set(const tx_study_args* a, bool* quick);
 // met or MISSED; _us: a time in microseconds against an upper limit
 void tx_bench_target(const char* what, const char* measured, const char* limit, bool ok);
 void tx_bench_target_us(const char* what, double measured_us, double limit_us);
+// a run report's entry for the controller NAME (report.json's "controllers"), or NULL
+json_t* tx_report_controller(json_t* report, const char* name);
 
 int tx_study_haptic_stability(const tx_study_args* a);
 int tx_study_needle_fit(const tx_study_args* a);

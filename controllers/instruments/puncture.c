@@ -50,12 +50,9 @@ static bool valid(const int32_t* v, int nx) {
   return v[0] >= 0 && v[1] >= 0 && v[2] >= 0 && v[0] < nx && v[1] < nx && v[2] < nx;
 }
 
-static int nearest_of(const float* x, int nx, const int32_t* tri, int ntri, const int32_t* root, int32_t patch,
-                      const double p[3], double bary[3], double point[3]) {
-  // no point of a triangle is farther from its first corner than its longest
-  // edge from there, so a triangle whose first corner is farther from p than
-  // that plus the best distance so far cannot be nearer: it is skipped
-  // before its closest point is sought (the answer is the same)
+// the longest edge from a triangle's first corner, over all the triangles:
+// no point of a triangle is farther than that from its first corner
+static double triangles_reach(const float* x, int nx, const int32_t* tri, int ntri) {
   double reach2 = 0;
   for (int t = 0; t < ntri; t++) {
     const int32_t* v = tri + 3 * t;
@@ -65,7 +62,16 @@ static int nearest_of(const float* x, int nx, const int32_t* tri, int ntri, cons
     for (int k = 0; k < 3; k++) ab += (double)(b[k] - a[k]) * (b[k] - a[k]), ac += (double)(c[k] - a[k]) * (c[k] - a[k]);
     reach2 = fmax(reach2, fmax(ab, ac));
   }
-  double reach = sqrt(reach2), bound2 = INFINITY;
+  return sqrt(reach2);
+}
+
+// reach: triangles_reach of these triangles. A triangle whose first corner
+// is farther from p than reach plus the best distance so far cannot be
+// nearer: it is skipped before its closest point is sought (the answer is
+// the same)
+static int nearest_of(const float* x, int nx, const int32_t* tri, int ntri, const int32_t* root, int32_t patch,
+                      double reach, const double p[3], double bary[3], double point[3]) {
+  double bound2 = INFINITY;
   int best = -1;
   double best_d2 = INFINITY;
   for (int t = 0; t < ntri; t++) {
@@ -91,7 +97,7 @@ static int nearest_of(const float* x, int nx, const int32_t* tri, int ntri, cons
 
 int tx_nearest_triangle(const float* x, int nx, const int32_t* tri, int ntri, const double p[3], double bary[3],
                         double point[3]) {
-  return nearest_of(x, nx, tri, ntri, NULL, 0, p, bary, point);
+  return nearest_of(x, nx, tri, ntri, NULL, 0, triangles_reach(x, nx, tri, ntri), p, bary, point);
 }
 
 static int32_t find(int32_t* up, int32_t i) {
@@ -102,9 +108,9 @@ static int32_t find(int32_t* up, int32_t i) {
 // which side of the patch's sheet p is on: the sign of the nearest
 // triangle's normal (by its corners' order) dotted with p - that point
 static int side_of(const float* x, int nx, const int32_t* tri, int ntri, const int32_t* root, int32_t patch,
-                   const double p[3], double* dist) {
+                   double reach, const double p[3], double* dist) {
   double bary[3], q[3], a[3], b[3], c[3], ab[3], ac[3];
-  int t = nearest_of(x, nx, tri, ntri, root, patch, p, bary, q);
+  int t = nearest_of(x, nx, tri, ntri, root, patch, reach, p, bary, q);
   if (t < 0) return 0;
   corner(x, tri[3 * t], a), corner(x, tri[3 * t + 1], b), corner(x, tri[3 * t + 2], c);
   for (int k = 0; k < 3; k++) ab[k] = b[k] - a[k], ac[k] = c[k] - a[k];
@@ -155,7 +161,7 @@ int tx_puncture_hole(const float* x, int nx, const int32_t* tri, int ntri, const
   // the crossings of the sheet along the arc (the side flips between two
   // points, where the signed distance goes through zero): the first from the
   // tip, or the one nearest near_to within `within` of it; none taken
-  double d0 = 0, d1 = 0, best = INFINITY;
+  double d0 = 0, d1 = 0, best = INFINITY, reach = -1;
   int s0 = 0, found = 0;
   for (int k = 0; k < narc; k++) {
     if (near_to) {
@@ -166,7 +172,8 @@ int tx_puncture_hole(const float* x, int nx, const int32_t* tri, int ntri, const
         continue;
       }
     }
-    int s1 = side_of(x, nx, tri, ntri, root, patch, arc[k], &d1);
+    if (reach < 0) reach = triangles_reach(x, nx, tri, ntri);  // once for every search below
+    int s1 = side_of(x, nx, tri, ntri, root, patch, reach, arc[k], &d1);
     if (s0 && s1 && s1 != s0) {
       double u = d0 + d1 > 0 ? d0 / (d0 + d1) : 0.5, c[3], e2 = 0;
       for (int j = 0; j < 3; j++) c[j] = arc[k - 1][j] + u * (arc[k][j] - arc[k - 1][j]);
@@ -184,7 +191,7 @@ int tx_puncture_hole(const float* x, int nx, const int32_t* tri, int ntri, const
     s0 = s1, d0 = d1;
   }
   if (!found) return -1;
-  int t = nearest_of(x, nx, tri, ntri, root, patch, on_arc, bary, point);
+  int t = nearest_of(x, nx, tri, ntri, root, patch, reach, on_arc, bary, point);
   if (t < 0) return -1;
   // the crossing itself, in the rim triangle's plane: its coordinates in
   // that plane (summing to 1, outside [0, 1] off the triangle), so the

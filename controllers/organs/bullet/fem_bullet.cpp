@@ -39,7 +39,7 @@ struct tx_fem {
   btDeformableLagrangianForce* force;
   btAlignedObjectArray<btVector3> elastic;  // (nv) N, the elastic force of the explicit step
   double volume_modulus;     // Pa, the force's lambda: the volume term the nodal pressure averages; 0: per element
-  std::vector<double> node_rest, node_now;  // (nv) m^3, a quarter of each live tetrahedron's volume, at rest and now
+  std::vector<double> node_rest, node_now;  // (nv) m^3, a quarter of each live tetrahedron's volume, at rest and now (then J)
   btSoftBodyWorldInfo info;  // the links body's world
   btSoftBody* body;
   std::vector<double> mass;  // (nv) kg, lumped
@@ -467,14 +467,14 @@ static void nodal_pressure(tx_fem* b) {
       b->node_rest[n] += v, b->node_now[n] += v * j;
     }
   }
+  // each node's J (a node in no live tetrahedron keeps 0: none reads it)
+  for (int i = 0; i < b->nv; i++)
+    if (b->node_rest[(size_t)i] > 0) b->node_now[(size_t)i] /= b->node_rest[(size_t)i];
   for (int t = 0; t < s->m_tetras.size(); t++) {
     const btSoftBody::Tetra& e = s->m_tetras[t];
     const btSoftBody::TetraScratch& sc = s->m_tetraScratches[t];
     double jbar = 0;
-    for (int k = 0; k < 4; k++) {
-      size_t n = (size_t)(e.m_n[k] - first);
-      jbar += b->node_now[n] / b->node_rest[n] / 4;
-    }
+    for (int k = 0; k < 4; k++) jbar += b->node_now[(size_t)(e.m_n[k] - first)] / 4;
     // the change in first Piola stress, lambda (Jbar - J) cof(F), gives node
     // k the force -V (that) Dm^-T grad N_k, which is -(lambda (Jbar - J) / 6)
     // times column k of cof(Ds): the area vector of the face opposite it
