@@ -410,6 +410,45 @@ typedef struct tx_band_state {
 #define tx_band_state_UNITS "1"
 TX_LAYOUT_ASSERT(tx_band_state, double);
 
+// cautery.tissue (one row per organ: the liver, then the stomach), written by
+// physics.cautery: the tissue its heat has damaged and boiled so far
+typedef struct tx_tissue_damage {
+  double damaged_m3; // m^3, the volume where the Arrhenius Omega is over 1
+  double boiled_m3;  // m^3, the volume that reached the vaporisation temperature
+  double peak_k;     // K, the hottest drawn vertex so far
+} tx_tissue_damage;
+#define tx_tissue_damage_TYPE TX_F64
+#define tx_tissue_damage_COLS 3u
+#define tx_tissue_damage_UNITS "m^3, m^3, K"
+TX_LAYOUT_ASSERT(tx_tissue_damage, double);
+
+// band.centre (rows), written by physics.band: the band's centre line as one
+// open loop, from the ring's head (the buckle) round to its tail, then the
+// tube from its head to its tip (each row the middle of a cross-section), m
+// (tx_vertex rows)
+
+// --- gastric banding: a membrane (physics.membrane) --------------------------
+
+// physics.membrane writes a thin membrane (the pars flaccida, the
+// phrenogastric ligament at the angle of His) under its own name MEMBRANE:
+//   MEMBRANE.x (N rows, tx_vertex): its particles, m
+//   MEMBRANE.tri (M rows, tx_triangle): its live triangles (burnt or cut ones gone)
+//   MEMBRANE.temperature (N rows, tx_temperature): each particle's, K
+//   MEMBRANE.state (1 row, tx_membrane_state)
+typedef struct tx_membrane_state {
+  double opening_m;  // m, the largest hole's longest extent across the membrane at rest; 0: intact
+  double removed;    // triangles removed so far (burnt or cut)
+  double burnt;      // of them, removed because a corner boiled
+  double cut;        // of them, cut by the scissors
+  double passes;     // times a tool passed through a hole (crossed the membrane where it is open)
+  double peak_k;     // K, the hottest particle now
+  double damaged_m2; // m^2, the area where the Arrhenius Omega is over 1
+} tx_membrane_state;
+#define tx_membrane_state_TYPE TX_F64
+#define tx_membrane_state_COLS 7u
+#define tx_membrane_state_UNITS "m, 1, K, m^2"
+TX_LAYOUT_ASSERT(tx_membrane_state, double);
+
 // --- the procedure ------------------------------------------------------------
 
 // procedure.step (1 row), written by whatever runs a procedure, read by the
@@ -461,6 +500,34 @@ typedef struct tx_suture_measures {
 #define tx_suture_measures_COLS 12u
 #define tx_suture_measures_UNITS "m, 1, N"
 TX_LAYOUT_ASSERT(tx_suture_measures, double);
+
+// PREFIX.step_paths (one row per step), written by procedure.lagb: how far
+// each hand's tool point travelled while the step was under way
+typedef struct tx_step_path {
+  double path_m[2]; // m, hand 0, hand 1
+} tx_step_path;
+#define tx_step_path_TYPE TX_F64
+#define tx_step_path_COLS 2u
+#define tx_step_path_UNITS "m"
+TX_LAYOUT_ASSERT(tx_step_path, double);
+
+// PREFIX.lagb (1 row), written by procedure.lagb: the measures of its
+// scorecard (docs/lagb.md, "The procedure")
+typedef struct tx_lagb_measures {
+  double path_m[2];           // m, the path of each hand's tool point over the run
+  double liver_force_max_n;   // N, the largest pull of the liver on a grasper holding it
+  double stomach_force_max_n; // N, the same for the stomach
+  double damage_outside_m3;   // m^3, organ tissue (liver, stomach: not the target) with Omega over 1; NaN: no cautery read
+  double locked;              // 1: the band is locked
+  double encircles;           // 1: the band's loop goes round the stomach's axis (linking number +-1)
+  double linking;             // the linking number of the band's loop, closed at the buckle, with the axis
+  double band_from_gej_m;     // m, the band's centre from the gastro-oesophageal junction along the axis (+: toward the stomach)
+  double band_off_axis_m;     // m, the band's centre from the axis
+} tx_lagb_measures;
+#define tx_lagb_measures_TYPE TX_F64
+#define tx_lagb_measures_COLS 10u
+#define tx_lagb_measures_UNITS "m, N, m^3, 1"
+TX_LAYOUT_ASSERT(tx_lagb_measures, double);
 
 #ifdef __cplusplus
 }

@@ -222,6 +222,12 @@ int tx_cloth_faults(const tx_cloth* c);
 // across it, as a tear would take them, but not counted as torn. Returns the
 // links cut (0: the segment crosses none)
 int tx_cloth_cut(tx_cloth* c, const double a[3], const double b[3]);
+// A particle gone (boiled away by a cautery): every stretch, shear and
+// bending link at particle i goes, with the triangles they border, as
+// tx_cloth_cut takes them (not counted as torn), and the particle is frozen
+// where it is as a freed one (tx_cloth_freed; not counted as a piece).
+// Returns the links removed (0: a bad index, or none left)
+int tx_cloth_remove_particle(tx_cloth* c, int i);
 // the pierce: a link torn where the HIP holds the skin is its puncture; from
 // then on the contact ignores the hole's rim (the particles then within the
 // contact distance plus two of the longest links of the HIP) and the skin

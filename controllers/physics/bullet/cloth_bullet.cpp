@@ -1587,6 +1587,31 @@ extern "C" int tx_cloth_cut(tx_cloth* c, const double a[3], const double b[3]) {
   return cut;
 }
 
+extern "C" int tx_cloth_remove_particle(tx_cloth* c, int i) {
+  if (!c || i < 0 || i >= c->n || c->freed[(size_t)i]) return 0;
+  const int before = c->body->m_links.size();
+  const int32_t* ls = &c->node_links[(size_t)i * 12];
+  for (int k = 0; k < 12 && ls[k] >= 0; k++) {
+    if (c->info[(size_t)ls[k]].slot < 0) continue;
+    if (c->info[(size_t)ls[k]].kind == BEND) remove_link(c, ls[k]), c->tension[(size_t)ls[k]] = 0;
+    else sever_link(c, ls[k]); // its triangles and the bending links across it too
+  }
+  const int32_t* ts = &c->node_tris[(size_t)i * 8];
+  for (int k = 0; k < 8 && ts[k] >= 0; k++)
+    if (c->tri_alive[(size_t)ts[k]]) c->tri_alive[(size_t)ts[k]] = 0, c->live_dirty = true;
+  // frozen as a freed particle: nothing holds it any more
+  if (c->pinned[(size_t)i]) tx_cloth_unpin(c, i);
+  btSoftBody::Node& nd = c->body->m_nodes[i];
+  nd.m_im = 0;
+  nd.m_v = btVector3(0, 0, 0);
+  c->freed[(size_t)i] = 1;
+  c->nfreed++;
+  c->rim[(size_t)i] = 0;
+  c->topology_dirty = c->detach_check = true;
+  tx_cloth_save(c); // a fault goes back to the patch without it
+  return before - c->body->m_links.size();
+}
+
 // Pieces cut off from the patch: particles with no path of live links to a
 // fixed or pinned particle. Each is frozen where it is (no mass, no
 // velocity), loses its links and its triangles, and keeps its index: what

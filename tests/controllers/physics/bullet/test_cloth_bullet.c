@@ -921,6 +921,42 @@ static void pinned_particles_follow(void** state) {
   tx_cloth_destroy(c);
 }
 
+// a particle removed (boiled away): its 12 links go (4 stretch, 4 shear, 4
+// bending for an inner one, the bending links across it with them), its 8
+// triangles leave the mesh, nothing counts as torn, it is frozen; the patch
+// steps on, finite, and the removal survives a fault's restore
+static void removed_particle_leaves_a_hole(void** state) {
+  (void)state;
+  tx_cloth* c = make(11, 0, 0);
+  const int i = centre(c), links = tx_cloth_link_count(c), tris = tx_cloth_triangle_count(c);
+  int32_t* tri = malloc(sizeof(int32_t) * 3 * (size_t)tris);
+  int gone = tx_cloth_remove_particle(c, i);
+  // 4 stretch, 4 shear, 4 bending at i, and the bending links through i (2 along x, 2 along z, centred on i)
+  print_message("  removed %d links, %d triangles left of %d\n", gone, tx_cloth_triangles(c, tri), tris);
+  assert_int_equal(gone, 4 + 4 + 4 + 2);
+  assert_int_equal(tx_cloth_link_count(c), links - gone);
+  int m = tx_cloth_triangles(c, tri);
+  assert_int_equal(m, tris - 8); // the 2 x 2 cells around it, two triangles each
+  for (int t = 0; t < 3 * m; t++) assert_true(tri[t] != i);
+  assert_int_equal(tx_cloth_torn(c), 0);
+  assert_true(tx_cloth_freed(c, i));
+  assert_int_equal(tx_cloth_pieces_freed(c), 0);
+  assert_int_equal(tx_cloth_remove_particle(c, i), 0); // once only
+  assert_int_equal(tx_cloth_remove_particle(c, -1), 0);
+  assert_int_equal(tx_cloth_remove_particle(c, 11 * 11), 0);
+  for (int k = 0; k < 30; k++) assert_int_equal(tx_cloth_step(c, 1.0 / 60), TX_CLOTH_OK);
+  assert_true(all_finite(c));
+  assert_int_equal(tx_cloth_triangles(c, tri), tris - 8);
+  // a fault goes back to the patch without it
+  tx_cloth_poke(c, i + 2, (double[3]){NAN, 0, 0}, (double[3]){0, 0, 0});
+  assert_int_equal(tx_cloth_step(c, 1.0 / 60), TX_CLOTH_FAULT);
+  assert_int_equal(tx_cloth_link_count(c), links - gone);
+  assert_int_equal(tx_cloth_triangles(c, tri), tris - 8);
+  assert_true(all_finite(c));
+  free(tri);
+  tx_cloth_destroy(c);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(counts_match_the_papers),
@@ -943,6 +979,7 @@ int main(void) {
       cmocka_unit_test(two_level_preconditioner),
       cmocka_unit_test(pierced_hip_is_not_pushed),
       cmocka_unit_test(detached_piece_is_freed),
+      cmocka_unit_test(removed_particle_leaves_a_hole),
 #if !SANITIZED
       cmocka_unit_test(balance_reads_the_converged_force), // the same code paths as above, but for the links' solve; minutes under the sanitizers
       cmocka_unit_test_setup_teardown(pinned_particles_follow, use_xpbd, use_implicit),
