@@ -5,6 +5,8 @@
 #include "band_controller.h"
 
 #include "band_sim.h"
+#include "../rotation.h"
+#include "../system.h" // tx_param_json, tx_param_point
 
 #include <tactus/components.h>
 #include <tactus/config.h>
@@ -17,11 +19,25 @@
 #include <string.h>
 #include <time.h>
 
+#define HANDS_MAX 4
+enum { GRASPABLE = 2 }; // the bodies a grasper can take: the tube's tip and the buckle
+static const int graspable[GRASPABLE] = {TX_BAND_TUBE_TIP, TX_BAND_BUCKLE};
+
+// a grasper's jaws on the band: closing them near the tube's tip or the
+// buckle takes that body, which then follows the jaws until they open
+typedef struct jaws {
+  tx_port pose;     // read: instrumentN.pose (tx_instrument_pose)
+  bool was_open;    // seen open since the last close
+  int body;         // the body held, -1 none
+  double offset[3]; // m, its position in the jaws' frame when taken
+} jaws;
+
 typedef struct band {
   tx_band* b;
   int nv[TX_BAND_PARTS], nf[TX_BAND_PARTS];
   double* pos;  // (nodes x 3) m, scratch
-  tx_port x, tri, state, pose, events;
+  tx_port x, tri, state, pose, events, centre;
+  int sections; // rows of band.centre: the ring's cross-sections, then the tube's
   bool hold_buckle, release_on_lock, following;
   tx_warning fault, bad_pose;
   tx_result locked_result, error_result, fault_result, substeps_result, p50_result, p99_result;
@@ -29,6 +45,11 @@ typedef struct band {
   long faults;
   bool was_locked;
   tx_hist steps; // ns
+  jaws hand[HANDS_MAX];
+  int hands;
+  double grasp_length, grasp_reach, grasp_closed, grasp_open; // m, m, rad, rad
+  tx_result grasps_result;
+  int grasps;
 } band;
 
 // sources of the values: docs/lagb.md, "The band"
@@ -51,8 +72,58 @@ static const tx_param_def params[] = {
     {"max_speed", TX_PARAM_NUM, "m/s", 0.01, 1e4, 50, NULL, "a faster node is a blow-up"},
     {"pull", TX_PARAM_STR, NULL, 0, 0, 0, "", "the pose the tube's tip follows (tx_pose), a grasper's or a device's; \"\": none"},
     {"hold_buckle", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "the buckle held where it is (the other hand's grasper)"},
-    {"release_on_lock", TX_PARAM_BOOL, NULL, 0, 0, 1, NULL, "the pull lets go of the tip when the band locks"},
+    {"release_on_lock", TX_PARAM_BOOL, NULL, 0, 0, 1, NULL, "the pull (or a grasper) lets go of the tip when the band locks"},
+    {"origin_m", TX_PARAM_JSON, NULL, 0, 0, 0, NULL, "[x, y, z], m: where the assets' origin goes in the scene; [0, 0, 0] by default"},
+    {"rotation_deg", TX_PARAM_JSON, NULL, 0, 0, 0, NULL,
+     "[rx, ry, rz], degrees: the assets turned about x, then y, then z (before origin_m); [0, 0, 0] by default"},
+    {"obstacles", TX_PARAM_JSON, NULL, 0, 0, 0, NULL,
+     "[[ax, ay, az, bx, by, bz, r], ...], m: rigid capsules the band is kept out of (the oesophagus, the cardia); none by default"},
+    {"grasp", TX_PARAM_STRS, NULL, 0, HANDS_MAX, 0, NULL,
+     "graspers (tx_instrument_pose: instrumentN.pose) whose closing jaws take the tube's tip or the buckle; none: no grasping"},
+    {"grasp_length_m", TX_PARAM_NUM, "m", 0.001, 0.1, 0.02, NULL, "the jaws reach this far ahead of the pivot along the pose's x"},
+    {"grasp_reach_m", TX_PARAM_NUM, "m", 0, 0.05, 0.008, NULL,
+     "closing jaws take the tube's tip or the buckle when its body is this close to their line (the end's half width and the jaws')"},
+    {"grasp_closed_rad", TX_PARAM_NUM, "rad", 0, 1, 0.1, NULL, "jaws at or below this angle have closed: a grasp, if they were open since the last"},
+    {"grasp_open_rad", TX_PARAM_NUM, "rad", 0.001, 3.2, 0.2, NULL, "jaws at or above this have opened: what they held is let go"},
 };
+
+// obstacles: a list of capsules, each [a, b, r] flattened, within 10 m
+static int read_obstacles(tx_setup* s, tx_band_def* d) {
+  json_t* j = tx_param_json(s, "obstacles");
+  if (!j || json_is_null(j)) return 0;
+  if (!json_is_array(j) || json_array_size(j) > TX_BAND_OBSTACLES_MAX)
+    return tx_setup_fail(s, "obstacles", "expected a list of at most %d capsules [ax, ay, az, bx, by, bz, r]", TX_BAND_OBSTACLES_MAX);
+  d->obstacles = (int)json_array_size(j);
+  for (int c = 0; c < d->obstacles; c++) {
+    json_t* cap = json_array_get(j, (size_t)c);
+    if (!json_is_array(cap) || json_array_size(cap) != 7)
+      return tx_setup_fail(s, "obstacles", "capsule %d: expected [ax, ay, az, bx, by, bz, r], m", c);
+    for (int k = 0; k < 7; k++) {
+      json_t* v = json_array_get(cap, (size_t)k);
+      double x = json_is_number(v) ? json_number_value(v) : NAN;
+      if (!(fabs(x) <= 10) || (k == 6 && !(x > 0 && x <= 1)))
+        return tx_setup_fail(s, "obstacles", "capsule %d: expected [ax, ay, az, bx, by, bz, r], each within 10 m, r in (0, 1] m", c);
+      d->obstacle[c][k] = x;
+    }
+  }
+  return 0;
+}
+
+// rotation_deg: three angles within a turn, or none
+static int read_rotation(tx_setup* s, double r[3][3]) {
+  double deg[3] = {0, 0, 0};
+  json_t* j = tx_param_json(s, "rotation_deg");
+  if (j && !json_is_null(j)) {
+    if (!json_is_array(j) || json_array_size(j) != 3) return tx_setup_fail(s, "rotation_deg", "expected [rx, ry, rz] in degrees");
+    for (int a = 0; a < 3; a++) {
+      json_t* v = json_array_get(j, (size_t)a);
+      deg[a] = json_is_number(v) ? json_number_value(v) : NAN;
+      if (!(fabs(deg[a]) <= 360)) return tx_setup_fail(s, "rotation_deg", "expected [rx, ry, rz], each a number of degrees in [-360, 360]");
+    }
+  }
+  tx_rotation_from_degrees(deg, r);
+  return 0;
+}
 
 static int configure(tx_setup* s, void** self) {
   band* g = calloc(1, sizeof *g);
@@ -78,6 +149,7 @@ static int configure(tx_setup* s, void** self) {
   d.buckle_offset = tx_table_num(s, "buckle_offset_m");
   d.max_speed = tx_table_num(s, "max_speed");
   if (tx_table_bool(s, "gravity")) d.gravity[1] = -9.81;
+  if (tx_param_point(s, "origin_m", (const double[3]){0, 0, 0}, d.origin) || read_rotation(s, d.rotation) || read_obstacles(s, &d)) return -1;
   g->hold_buckle = tx_table_bool(s, "hold_buckle");
   g->release_on_lock = tx_table_bool(s, "release_on_lock");
   char dir[4096];
@@ -95,6 +167,10 @@ static int configure(tx_setup* s, void** self) {
   g->x = tx_setup_write(s, &TX_COMPONENT_OF("band.x", tx_vertex, (uint32_t)nodes));
   g->tri = tx_setup_write(s, &TX_COMPONENT_OF("band.tri", tx_triangle, (uint32_t)faces));
   g->state = tx_setup_write(s, &TX_COMPONENT_OF("band.state", tx_band_state, 1));
+  g->sections = tx_band_sections(g->b, TX_BAND_RING) + tx_band_sections(g->b, TX_BAND_TUBE);
+  if (tx_band_sections(g->b, TX_BAND_RING) < 2 || tx_band_sections(g->b, TX_BAND_TUBE) < 2)
+    return tx_setup_fail(s, "assets", "%s: the band's nodes do not come cross-section by cross-section (tactus-band-assets)", assets);
+  g->centre = tx_setup_write(s, &TX_COMPONENT_OF("band.centre", tx_vertex, (uint32_t)g->sections));
   g->events = tx_setup_emit(s, "band.events", 16);
   if (pull[0]) g->pose = TX_READ_OF(s, pull, tx_pose);
   g->fault = tx_setup_warning(s, "numerical_fault");
@@ -112,16 +188,107 @@ static int configure(tx_setup* s, void** self) {
     tx_band_drive(g->b, TX_BAND_BUCKLE, p);
   }
   g->following = g->pose.id != 0;
+  const char* grasp[HANDS_MAX];
+  g->hands = tx_table_strs(s, "grasp", grasp, HANDS_MAX);
+  g->grasp_length = tx_table_num(s, "grasp_length_m");
+  g->grasp_reach = tx_table_num(s, "grasp_reach_m");
+  g->grasp_closed = tx_table_num(s, "grasp_closed_rad");
+  g->grasp_open = tx_table_num(s, "grasp_open_rad");
+  if (g->hands > 0 && !(g->grasp_open > g->grasp_closed))
+    return tx_setup_fail(s, "grasp_open_rad", "must be above grasp_closed_rad (%g)", g->grasp_closed);
+  for (int h = 0; h < g->hands; h++) {
+    for (int k = 0; k < h; k++)
+      if (!strcmp(grasp[k], grasp[h])) return tx_setup_fail(s, "grasp", "'%s' named twice", grasp[h]);
+    g->hand[h].pose = TX_READ_OF(s, grasp[h], tx_instrument_pose);
+  }
+  if (g->hands > 0) g->grasps_result = tx_setup_result(s, "grasps");
   return 0;
+}
+
+static double segment_distance(const double p[3], const double a[3], const double b[3]) {
+  double ab[3], ap[3], t = 0, l2 = 0;
+  for (int k = 0; k < 3; k++) ab[k] = b[k] - a[k], ap[k] = p[k] - a[k], t += ab[k] * ap[k], l2 += ab[k] * ab[k];
+  t = l2 > 0 ? fmin(fmax(t / l2, 0), 1) : 0;
+  double d2 = 0;
+  for (int k = 0; k < 3; k++) d2 += (ap[k] - t * ab[k]) * (ap[k] - t * ab[k]);
+  return sqrt(d2);
+}
+
+static void let_go(tx_ctx* c, band* g, int h, bool event) {
+  jaws* j = &g->hand[h];
+  if (j->body < 0) return;
+  bool held_still = (j->body == TX_BAND_BUCKLE && g->hold_buckle) || (j->body == TX_BAND_TUBE_TIP && g->following);
+  if (!held_still) tx_band_free(g->b, j->body);
+  j->body = -1;
+  if (event) tx_emit(c, g->events, &(tx_event){.kind = TX_EVENT_RELEASE, .source = (uint32_t)h});
+}
+
+// each grasper: closing jaws take the nearest graspable body within reach,
+// opening ones let it go; a held body is driven where the jaws carry it
+static void grasp_step(tx_ctx* c, band* g) {
+  for (int h = 0; h < g->hands; h++) {
+    jaws* j = &g->hand[h];
+    tx_snapshot sn = tx_read(c, j->pose);
+    if (!sn.seq) continue;
+    const tx_instrument_pose* p = sn.data;
+    double qn = sqrt(p->quat[0] * p->quat[0] + p->quat[1] * p->quat[1] + p->quat[2] * p->quat[2] + p->quat[3] * p->quat[3]);
+    if (!isfinite(p->pos[0] + p->pos[1] + p->pos[2] + p->jaw) || !(qn > 0.5 && qn < 2)) {
+      tx_warn(c, g->bad_pose);
+      continue;
+    }
+    const double q[4] = {p->quat[0] / qn, p->quat[1] / qn, p->quat[2] / qn, p->quat[3] / qn};
+    if (p->jaw >= g->grasp_open) {
+      j->was_open = true;
+      let_go(c, g, h, true);
+    } else if (p->jaw <= g->grasp_closed && j->was_open && j->body < 0) {
+      j->was_open = false;
+      double ahead[3], end[3], best = g->grasp_reach;
+      tx_quat_rotate(q, false, (const double[3]){g->grasp_length, 0, 0}, ahead);
+      for (int k = 0; k < 3; k++) end[k] = p->pos[k] + ahead[k];
+      for (int i = 0; i < GRASPABLE; i++) {
+        bool taken = false;
+        for (int o = 0; o < g->hands; o++) taken |= g->hand[o].body == graspable[i];
+        double at[3];
+        tx_band_body_position(g->b, graspable[i], at);
+        double d = segment_distance(at, p->pos, end);
+        if (!taken && d <= best) best = d, j->body = graspable[i];
+      }
+      if (j->body >= 0) {
+        double at[3], rel[3];
+        tx_band_body_position(g->b, j->body, at);
+        for (int k = 0; k < 3; k++) rel[k] = at[k] - p->pos[k];
+        tx_quat_rotate(q, true, rel, j->offset);
+        tx_event e = {.kind = TX_EVENT_GRASP, .source = (uint32_t)h};
+        for (int k = 0; k < 3; k++) e.grasp.point[k] = at[k];
+        e.grasp.jaw = p->jaw;
+        tx_emit(c, g->events, &e);
+        g->grasps++;
+      }
+    }
+    if (j->body >= 0) {
+      double at[3];
+      tx_quat_rotate(q, false, j->offset, at);
+      for (int k = 0; k < 3; k++) at[k] += p->pos[k];
+      tx_band_drive(g->b, j->body, at);
+    }
+  }
 }
 
 static void publish(tx_ctx* c, band* g) {
   float* x = ((tx_vertex*)tx_write(c, g->x))->x;
   int32_t* t = ((tx_triangle*)tx_write(c, g->tri))->v;
-  int base = 0;
+  float* centre = ((tx_vertex*)tx_write(c, g->centre))->x;
+  int base = 0, row = 0;
   for (int i = 0; i < TX_BAND_PARTS; i++) {
     tx_band_positions(g->b, i, g->pos);
     for (int k = 0; k < 3 * g->nv[i]; k++) x[3 * base + k] = (float)g->pos[k];
+    // the loop from the buckle: the ring from its head (its last section) back, the tube from its head on
+    int n = tx_band_sections(g->b, i);
+    for (int k = 0; k < n; k++, row++) {
+      double m[3];
+      tx_band_section_centre(g->b, i, i == TX_BAND_RING ? n - 1 - k : k, g->pos, m);
+      for (int a = 0; a < 3; a++) centre[3 * row + a] = (float)m[a];
+    }
     const int32_t* f = tx_band_face_nodes(g->b, i);
     for (int k = 0; k < 3 * g->nf[i]; k++) *t++ = f[k] + base;
     base += g->nv[i];
@@ -138,6 +305,9 @@ static void publish(tx_ctx* c, band* g) {
 }
 
 static int init(tx_ctx* c, void* self) {
+  band* g = self;
+  for (int h = 0; h < g->hands; h++) g->hand[h].body = -1, g->hand[h].was_open = false;
+  g->grasps = 0;
   publish(c, self); // the band at rest, at time 0
   return 0;
 }
@@ -154,6 +324,7 @@ static void step(tx_ctx* c, void* self) {
       else tx_warn(c, g->bad_pose);
     }
   }
+  grasp_step(c, g);
   if (tx_band_step(g->b)) {
     tx_band_save(g->b);
   } else {
@@ -169,6 +340,8 @@ static void step(tx_ctx* c, void* self) {
     for (int a = 0; a < 3; a++) e.value[a] = bc[a];
     tx_emit(c, g->events, &e);
     if (g->release_on_lock && g->following) g->following = false, tx_band_free(g->b, TX_BAND_TUBE_TIP);
+    for (int h = 0; h < g->hands && g->release_on_lock; h++)
+      if (g->hand[h].body == TX_BAND_TUBE_TIP) let_go(c, g, h, true);
   }
   g->was_locked = locked;
   publish(c, g);
@@ -185,6 +358,7 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, g->substeps_result, tx_band_substeps(g->b));
   tx_set_result(c, g->p50_result, p.p50 * 1e-6);
   tx_set_result(c, g->p99_result, p.p99 * 1e-6);
+  if (g->hands > 0) tx_set_result(c, g->grasps_result, g->grasps);
 }
 
 static void fini(void* self) {

@@ -30,6 +30,7 @@ typedef struct band_part {
   double* rest;    // (nv x 3) m
   double* pos;     // (nv x 3) m, scratch
   int32_t* face;   // (nf x 3)
+  int per;         // nodes of a cross-section: those of the first (the sweep's node order); 0 if they do not tile nv
 } band_part;
 
 struct tx_band {
@@ -61,8 +62,31 @@ tx_band_def tx_band_def_default(void) {
                    .gravity = {0, 0, 0},
                    .max_speed = 50,
                    .erp = 0.2,
-                   .cfm = 1e-10};
+                   .cfm = 1e-10,
+                   .rotation = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
   return d;
+}
+
+static bool is_rotation(const double r[3][3]) {
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      double dot = r[i][0] * r[j][0] + r[i][1] * r[j][1] + r[i][2] * r[j][2];
+      if (!(fabs(dot - (i == j)) < 1e-9)) return false;
+    }
+  double det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0]) +
+               r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
+  return det > 0;
+}
+
+// the assets into the scene: x' = origin + R x (a rotation keeps every
+// tetrahedron's orientation, and the buckle and the bodies follow the nodes)
+static void place(const tx_band_def* d, double* x, int n) {
+  for (int i = 0; i < n; i++) {
+    double* p = x + 3 * i;
+    double q[3];
+    for (int a = 0; a < 3; a++) q[a] = d->origin[a] + d->rotation[a][0] * p[0] + d->rotation[a][1] * p[1] + d->rotation[a][2] * p[2];
+    memcpy(p, q, sizeof q);
+  }
 }
 
 static const char* const part_name[TX_BAND_PARTS] = {"band_ring", "band_tube"};
@@ -249,6 +273,8 @@ tx_band* tx_band_create(const tx_band_def* d, const char* dir) {
   }
   if (!(d->body_mass > 0) || !(d->buckle_radius > 0) || !(d->max_substep >= 0) || !(d->step > 0 && d->step <= 1))
     return tx_set_error("the bodies' mass, the buckle's radius and the step (at most 1 s) must be > 0, the substep >= 0"), NULL;
+  if (!is_rotation(d->rotation) || !isfinite(d->origin[0] + d->origin[1] + d->origin[2]))
+    return tx_set_error("the band's placement needs a finite origin and a rotation (orthonormal, determinant 1)"), NULL;
   if (!dInitODE2(0) || !dAllocateODEDataForThread(dAllocateMaskAll)) return tx_set_error("ODE cannot be started"), NULL;
   tx_band* b = calloc(1, sizeof *b);
   if (!b) return dCloseODE(), tx_set_error("out of memory"), NULL;
@@ -266,6 +292,11 @@ tx_band* tx_band_create(const tx_band_def* d, const char* dir) {
   for (int i = 0; i < TX_BAND_PARTS && rc == 0; i++) {
     band_part* p = &b->p[i];
     rc = read_part(dir, i, &p->rest, &mark[i], &p->nv, &tets[i], &ntet[i]);
+    if (rc == 0) {
+      place(d, p->rest, p->nv);
+      for (int k = 0; k < p->nv; k++) p->per += mark[i][k] == 1;
+      if (p->per < 1 || p->nv % p->per != 0) p->per = 0;
+    }
     if (rc == 0) {
       tx_fem_def f = tx_fem_def_default();
       f.model = TX_FEM_NEOHOOKEAN;
@@ -289,10 +320,13 @@ tx_band* tx_band_create(const tx_band_def* d, const char* dir) {
       f.model = TX_FEM_NEOHOOKEAN;
       f.young = d->part[i].young, f.poisson = d->part[i].poisson, f.density = d->part[i].density;
       f.damping = d->part[i].damping, f.dt = h, f.max_speed = d->max_speed;
+      f.nodal_pressure = false; // silicone at nu = 0.3 does not lock; the averaging would double the step's cost
       for (int a = 0; a < 3; a++) f.gravity[a] = d->gravity[a];
       p->fem = tx_fem_create(&f, p->rest, p->nv, tets[i], ntet[i]);
       p->pos = malloc(sizeof(double) * 3 * (size_t)p->nv);
       if (!p->fem) rc = (tx_error_prefix("%s/%s", dir, part_name[i]), -1);
+      else if (!tx_fem_set_capsules(p->fem, d->obstacle[0], d->obstacles))
+        rc = (tx_set_error("an obstacle needs a radius above 0 and finite ends, %d at most", TX_BAND_OBSTACLES_MAX), -1);
       else if (!p->pos) rc = (tx_set_error("out of memory"), -1);
     }
   }
@@ -515,3 +549,15 @@ const int32_t* tx_band_face_nodes(const tx_band* b, int part) {
   return part >= 0 && part < TX_BAND_PARTS ? b->p[part].face : NULL;
 }
 const double* tx_band_rest(const tx_band* b, int part) { return part >= 0 && part < TX_BAND_PARTS ? b->p[part].rest : NULL; }
+
+int tx_band_sections(const tx_band* b, int part) {
+  const band_part* p = &b->p[part];
+  return p->per > 0 ? p->nv / p->per : 0;
+}
+
+void tx_band_section_centre(const tx_band* b, int part, int k, const double* pos, double c[3]) {
+  const band_part* p = &b->p[part];
+  c[0] = c[1] = c[2] = 0;
+  for (int i = k * p->per; i < (k + 1) * p->per; i++)
+    for (int a = 0; a < 3; a++) c[a] += pos[3 * i + a] / p->per;
+}

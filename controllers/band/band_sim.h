@@ -38,6 +38,8 @@ enum {
   TX_BAND_BODIES
 };
 
+#define TX_BAND_OBSTACLES_MAX 8
+
 typedef struct tx_band_material {
   double young;    // Pa
   double poisson;  // 1
@@ -57,6 +59,10 @@ typedef struct tx_band_def {
   double gravity[3];     // m/s^2
   double max_speed;      // m/s, a faster node is a fault
   double erp, cfm;       // ODE's error reduction and constraint force mixing
+  double origin[3];      // m, where the assets' origin goes in the scene; 0
+  double rotation[3][3]; // the assets' axes in the scene (a rotation, rows: x' = R x); identity
+  int obstacles;         // rigid capsules the band's nodes are kept out of (the oesophagus, the cardia); 0
+  double obstacle[TX_BAND_OBSTACLES_MAX][7]; // each: its axis's two ends and its radius, m
 } tx_band_def;
 
 tx_band_def tx_band_def_default(void);
@@ -96,5 +102,10 @@ int tx_band_faces(const tx_band* b, int part);
 void tx_band_positions(const tx_band* b, int part, double* out);  // (nodes x 3) m
 const int32_t* tx_band_face_nodes(const tx_band* b, int part);   // (faces x 3)
 const double* tx_band_rest(const tx_band* b, int part);          // (nodes x 3) m, as loaded
+// the part's cross-sections along its centre line (tactus-band-assets writes
+// the nodes section by section, from the end marked 1); 0 when the nodes do
+// not come so. The middle of section k of the positions pos (nodes x 3)
+int tx_band_sections(const tx_band* b, int part);
+void tx_band_section_centre(const tx_band* b, int part, int k, const double* pos, double c[3]);
 
 #endif

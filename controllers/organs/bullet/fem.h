@@ -67,6 +67,12 @@ void tx_fem_set_plate(tx_fem* b, double y);
 // what that takes (a node-wise contact, as the plate's; the tool below is
 // face-wise). r <= 0: neither ball nor plate.
 void tx_fem_set_ball(tx_fem* b, const double c[3], double r);
+// rigid frictionless capsules (each 7 numbers: one end of its axis, the
+// other, its radius; m) that the nodes are kept out of, node-wise, as the
+// ball does; n = 0 removes them. False (nothing changed) for more than
+// TX_FEM_CAPSULES_MAX, a radius not above 0 or a value not finite
+#define TX_FEM_CAPSULES_MAX 8
+bool tx_fem_set_capsules(tx_fem* b, const double* caps, int n);
 // false when a position or velocity stopped being finite
 bool tx_fem_step(tx_fem* b, int steps);
 

@@ -48,6 +48,9 @@ struct tx_fem {
   double plate;              // m, the plate's underside; with ball_r > 0, the ball's centre height
   double ball_x, ball_z, ball_r;  // m, a ball in place of the plate (tx_fem_set_ball); r 0: the plate
   double plate_force;        // N, upward, averaged over the last tx_fem_step
+  int ncaps;                 // rigid capsules nodes are kept out of (tx_fem_set_capsules)
+  double caps[TX_FEM_CAPSULES_MAX][7];  // each: one end, the other, the radius (m)
+  double cap_box[TX_FEM_CAPSULES_MAX][6];  // each capsule's bounding box (low, high), m: most nodes are outside it
   int contacts;              // nodes on the plate after the last step
   double added_mass;         // mass scaling's, over the true mass
   std::vector<btVector3> before;  // (nv) m, the nodes after the last step in which the tool touched nothing
@@ -628,6 +631,23 @@ static btVector3 tool_contact(tx_fem* b, int& touched) {
   return impulse;
 }
 
+// a node inside the capsule goes out along its normal, and loses the speed
+// it had into it (frictionless, as the ball)
+static void keep_out_of_capsule(btSoftBody::Node& n, const double cap[7]) {
+  const btVector3 a((btScalar)cap[0], (btScalar)cap[1], (btScalar)cap[2]), e((btScalar)cap[3], (btScalar)cap[4], (btScalar)cap[5]);
+  const btVector3 ab = e - a;
+  const double l2 = ab.length2();
+  double t = l2 > 0 ? (double)(n.m_x - a).dot(ab) / l2 : 0;
+  t = std::min(std::max(t, 0.0), 1.0);
+  const btVector3 r = n.m_x - (a + ab * (btScalar)t);
+  const double len = r.length();
+  if (!(len < cap[6] && len > 0)) return;
+  const btVector3 nn = r / (btScalar)len;
+  n.m_x += nn * (btScalar)(cap[6] - len);
+  const double vin = -(double)n.m_v.dot(nn);
+  if (vin > 0) n.m_v += nn * (btScalar)vin;
+}
+
 extern "C" bool tx_fem_step(tx_fem* b, int steps) {
   btAlignedObjectArray<btSoftBody::Node>& nodes = b->body->m_nodes;
   const double keep = std::exp(-b->def.damping * b->dt);
@@ -680,6 +700,13 @@ extern "C" bool tx_fem_step(tx_fem* b, int steps) {
         n.m_x.setY((btScalar)b->plate);
         if (n.m_v.getY() > 0) n.m_v.setY(0);
         on++;
+      }
+      for (int c = 0; c < b->ncaps; c++) {
+        const double* box = b->cap_box[c];
+        const btVector3& x = n.m_x;
+        if (x.getX() < box[0] || x.getY() < box[1] || x.getZ() < box[2] || x.getX() > box[3] || x.getY() > box[4] || x.getZ() > box[5])
+          continue;
+        keep_out_of_capsule(n, b->caps[c]);
       }
       if (!std::isfinite(n.m_x.getX() + n.m_x.getY() + n.m_x.getZ() + n.m_v.getX() + n.m_v.getY() + n.m_v.getZ()))
         return false;
@@ -749,6 +776,23 @@ extern "C" double tx_fem_dt(const tx_fem* b) { return b->dt; }
 extern "C" void tx_fem_set_ball(tx_fem* b, const double c[3], double r) {
   b->has_plate = r > 0;
   b->ball_x = c[0], b->plate = c[1], b->ball_z = c[2], b->ball_r = r;
+}
+
+extern "C" bool tx_fem_set_capsules(tx_fem* b, const double* caps, int n) {
+  if (n < 0 || n > TX_FEM_CAPSULES_MAX) return false;
+  for (int c = 0; c < 7 * n; c++)
+    if (!std::isfinite(caps[c])) return false;
+  for (int c = 0; c < n; c++)
+    if (!(caps[7 * c + 6] > 0)) return false;
+  b->ncaps = n;
+  for (int c = 0; c < n; c++) {
+    for (int k = 0; k < 7; k++) b->caps[c][k] = caps[7 * c + k];
+    for (int a = 0; a < 3; a++) {
+      b->cap_box[c][a] = std::min(caps[7 * c + a], caps[7 * c + 3 + a]) - caps[7 * c + 6];
+      b->cap_box[c][3 + a] = std::max(caps[7 * c + a], caps[7 * c + 3 + a]) + caps[7 * c + 6];
+    }
+  }
+  return true;
 }
 
 extern "C" double tx_fem_plate_force(const tx_fem* b) { return b->plate_force; }

@@ -10,6 +10,7 @@
 #include <cmocka.h>
 
 #include "controllers/band/band_sim.h"
+#include "controllers/rotation.h"
 #include "model/error.h"
 
 #include <math.h>
@@ -187,6 +188,94 @@ static void fault_is_restored(void** state) {
   tx_band_destroy(b);
 }
 
+// placed by an origin and a rotation: every node, the buckle and the joint
+// where the placement carries the unplaced band's, and it still latches;
+// its centre line's first ring section is the ring's tail (the marked end)
+static void placed_in_the_scene(void** state) {
+  (void)state;
+  tx_band* plain = make();
+  tx_band_def d = tx_band_def_default();
+  const double origin[3] = {0.1, -0.05, 0.2};
+  memcpy(d.origin, origin, sizeof origin);
+  tx_rotation_from_degrees((const double[3]){30, -20, 90}, d.rotation);
+  tx_band* b = tx_band_create(&d, TX_ASSETS "/lagb");
+  assert_non_null(b);
+  double worst = 0;
+  for (int part = 0; part < TX_BAND_PARTS; part++) {
+    const double *x0 = tx_band_rest(plain, part), *x1 = tx_band_rest(b, part);
+    for (int i = 0; i < tx_band_nodes(b, part); i++) {
+      double want[3];
+      for (int a = 0; a < 3; a++)
+        want[a] = origin[a] + d.rotation[a][0] * x0[3 * i] + d.rotation[a][1] * x0[3 * i + 1] + d.rotation[a][2] * x0[3 * i + 2];
+      worst = fmax(worst, dist(want, x1 + 3 * i));
+    }
+  }
+  assert_true(worst < 1e-12);
+  double c0[3], a0[3], c1[3], a1[3], want[3], wax[3];
+  tx_band_buckle(plain, c0, a0);
+  tx_band_buckle(b, c1, a1);
+  for (int a = 0; a < 3; a++) {
+    want[a] = origin[a] + d.rotation[a][0] * c0[0] + d.rotation[a][1] * c0[1] + d.rotation[a][2] * c0[2];
+    wax[a] = d.rotation[a][0] * a0[0] + d.rotation[a][1] * a0[1] + d.rotation[a][2] * a0[2];
+  }
+  assert_true(dist(want, c1) < 1e-9 && dist(wax, a1) < 1e-9);
+  assert_true(fabs(tx_band_joint_rest(b) - tx_band_joint_rest(plain)) < 1e-12);
+  assert_int_equal(tx_band_sections(b, TX_BAND_RING), 25);
+  assert_int_equal(tx_band_sections(b, TX_BAND_TUBE), 41);
+  double tail[3], first[3];
+  tx_band_body_position(b, TX_BAND_RING_TAIL, tail);
+  double* pos = malloc(sizeof(double) * 3 * (size_t)tx_band_nodes(b, TX_BAND_RING));
+  tx_band_positions(b, TX_BAND_RING, pos);
+  tx_band_section_centre(b, TX_BAND_RING, 0, pos, first);
+  free(pos);
+  assert_true(dist(tail, first) < 1e-3); // the tail body sits at its end section's middle
+  assert_true(thread_tip(b, 0.002));     // the placed buckle still takes the tip
+  tx_band_destroy(b);
+  tx_band_destroy(plain);
+}
+
+// a capsule beside the tube, and the tube's tip carried across it: no node
+// ever inside it, and the tube does come to rest against it
+static void kept_off_an_obstacle(void** state) {
+  (void)state;
+  tx_band_def d = tx_band_def_default();
+  const double n[3] = {M_SQRT1_2, -M_SQRT1_2, 0}; // across the tube, in its plane
+  const double mid[3] = {0.040, 0.070, 0};        // on the tube's centre line
+  const double r = 0.004, off = 0.008;
+  d.obstacles = 1;
+  for (int a = 0; a < 3; a++) d.obstacle[0][a] = mid[a] + off * n[a], d.obstacle[0][3 + a] = mid[a] + off * n[a];
+  d.obstacle[0][2] = -0.05, d.obstacle[0][5] = 0.05, d.obstacle[0][6] = r;
+  tx_band* b = tx_band_create(&d, TX_ASSETS "/lagb");
+  assert_non_null(b);
+  double tip[3];
+  tx_band_body_position(b, TX_BAND_TUBE_TIP, tip);
+  double inside = INFINITY, nearest = INFINITY;
+  double* pos = malloc(sizeof(double) * 3 * (size_t)tx_band_nodes(b, TX_BAND_TUBE));
+  for (int s = 0; s < 30; s++) {
+    double to[3];
+    for (int a = 0; a < 3; a++) to[a] = tip[a] + fmin(s + 1, 20) * 0.0015 * n[a]; // 30 mm across, in 20 steps
+    tx_band_drive(b, TX_BAND_TUBE_TIP, to);
+    assert_true(tx_band_step(b));
+    tx_band_positions(b, TX_BAND_TUBE, pos);
+    for (int i = 0; i < tx_band_nodes(b, TX_BAND_TUBE); i++) {
+      double dx = pos[3 * i] - d.obstacle[0][0], dy = pos[3 * i + 1] - d.obstacle[0][1];
+      double rr = sqrt(dx * dx + dy * dy);
+      inside = fmin(inside, rr), nearest = fmin(nearest, rr);
+    }
+  }
+  free(pos);
+  printf("obstacle r = %.1f mm: nearest node %.4f mm from its axis\n", r * 1e3, nearest * 1e3);
+  assert_true(inside >= r * (1 - 1e-6)); // never inside
+  assert_true(nearest < r + 0.0005);     // and pressed against it
+  tx_band_destroy(b);
+  // bad obstacles are refused
+  d.obstacle[0][6] = 0;
+  assert_null(tx_band_create(&d, TX_ASSETS "/lagb"));
+  d.obstacle[0][6] = r, d.rotation[0][0] = 2;
+  assert_null(tx_band_create(&d, TX_ASSETS "/lagb"));
+  assert_non_null(strstr(tx_error(), "rotation"));
+}
+
 static void bad_input(void** state) {
   (void)state;
   tx_band_def d = tx_band_def_default();
@@ -202,6 +291,7 @@ int main(void) {
       cmocka_unit_test(joint_holds_at_5n),          cmocka_unit_test(ring_returns_to_rest),
       cmocka_unit_test(latch_through_buckle),       cmocka_unit_test(no_latch_outside_the_opening),
       cmocka_unit_test(fault_is_restored),          cmocka_unit_test(bad_input),
+      cmocka_unit_test(placed_in_the_scene),        cmocka_unit_test(kept_off_an_obstacle),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
