@@ -19,18 +19,27 @@
 typedef struct scorecard {
   char scenario[64];
   char procedure[64];
-  tx_port steps, names, suture;
+  tx_port steps, names, suture, lagb, paths;
+  bool is_lagb;  // the measures are procedure.lagb's (PREFIX.lagb, PREFIX.step_paths), not procedure.suture's
   tx_procedure_step_state step[STEPS_MAX];
   tx_procedure_step name[STEPS_MAX];
-  int nsteps;
+  tx_step_path path[STEPS_MAX];
+  int nsteps, npaths;
   tx_suture_measures m;
+  tx_lagb_measures lm;
   bool have_m;
   double bite_tolerance;  // m
+  double damage_tolerance; // m^3
   tx_result done_r;
 } scorecard;
 
 static const tx_param_def params[] = {
-    {"procedure", TX_PARAM_STR, NULL, 0, 0, 0, "procedure", "the procedure controller's prefix: PREFIX.steps, PREFIX.step_names, PREFIX.suture"},
+    {"procedure", TX_PARAM_STR, NULL, 0, 0, 0, "procedure",
+     "the procedure controller's prefix: PREFIX.steps, PREFIX.step_names, and PREFIX.suture or PREFIX.lagb"},
+    {"measures", TX_PARAM_STR, NULL, 0, 0, 0, "suture",
+     "whose measures: \"suture\" (procedure.suture's PREFIX.suture) or \"lagb\" (procedure.lagb's PREFIX.lagb and PREFIX.step_paths)"},
+    {"damage_tolerance_m3", TX_PARAM_NUM, "m^3", 0, 1e-3, 0, NULL,
+     "lagb: a burn outside the target is thermal damage (Omega > 1) in the organs above this volume"},
     {"scenario", TX_PARAM_STR, NULL, 0, 0, 0, "", "the scenario's name, written into the scorecard"},
     {"bite_tolerance_m", TX_PARAM_NUM, "m", 0, 0.01, 0.001, NULL,
      "the two bites of a stitch are symmetric when their distances from the wound differ by at most this much"},
@@ -43,7 +52,11 @@ static int configure(tx_setup* s, void** self) {
   const char* prefix = tx_table_str(s, "procedure");
   const char* scenario = tx_table_str(s, "scenario");
   v->bite_tolerance = tx_table_num(s, "bite_tolerance_m");
-  if (!prefix || !scenario) return -1;
+  v->damage_tolerance = tx_table_num(s, "damage_tolerance_m3");
+  const char* measures = tx_table_str(s, "measures");
+  if (!prefix || !scenario || !measures) return -1;
+  if (strcmp(measures, "suture") && strcmp(measures, "lagb")) return tx_setup_fail(s, "measures", "expected \"suture\" or \"lagb\", not '%s'", measures);
+  v->is_lagb = !strcmp(measures, "lagb");
   if (!*prefix || strlen(prefix) >= 48) return tx_setup_fail(s, "procedure", "expected a prefix of 1 to 47 characters");
   snprintf(v->procedure, sizeof v->procedure, "%s", prefix);
   snprintf(v->scenario, sizeof v->scenario, "%s", scenario);
@@ -52,8 +65,15 @@ static int configure(tx_setup* s, void** self) {
   v->steps = TX_READ_OF(s, name, tx_procedure_step_state);
   snprintf(name, sizeof name, "%s.step_names", prefix);
   v->names = TX_READ_OF(s, name, tx_procedure_step);
-  snprintf(name, sizeof name, "%s.suture", prefix);
-  v->suture = TX_READ_OF(s, name, tx_suture_measures);
+  if (v->is_lagb) {
+    snprintf(name, sizeof name, "%s.lagb", prefix);
+    v->lagb = TX_READ_OF(s, name, tx_lagb_measures);
+    snprintf(name, sizeof name, "%s.step_paths", prefix);
+    v->paths = TX_READ_OF(s, name, tx_step_path);
+  } else {
+    snprintf(name, sizeof name, "%s.suture", prefix);
+    v->suture = TX_READ_OF(s, name, tx_suture_measures);
+  }
   v->done_r = tx_setup_result(s, "steps_done");
   return 0;
 }
@@ -61,14 +81,24 @@ static int configure(tx_setup* s, void** self) {
 // keep the latest of each, so the scorecard is the last one published
 static void step(tx_ctx* c, void* self) {
   scorecard* v = self;
-  tx_snapshot st = tx_read(c, v->steps), nm = tx_read(c, v->names), ms = tx_read(c, v->suture);
+  tx_snapshot st = tx_read(c, v->steps), nm = tx_read(c, v->names);
   if (st.seq && nm.seq) {
     int n = (int)(st.rows < nm.rows ? st.rows : nm.rows);
     v->nsteps = n < STEPS_MAX ? n : STEPS_MAX;
     memcpy(v->step, st.data, (size_t)v->nsteps * sizeof v->step[0]);
     memcpy(v->name, nm.data, (size_t)v->nsteps * sizeof v->name[0]);
   }
-  if (ms.seq) v->m = *(const tx_suture_measures*)ms.data, v->have_m = true;
+  if (v->is_lagb) {
+    tx_snapshot ms = tx_read(c, v->lagb), ps = tx_read(c, v->paths);
+    if (ms.seq) v->lm = *(const tx_lagb_measures*)ms.data, v->have_m = true;
+    if (ps.seq) {
+      v->npaths = (int)(ps.rows < STEPS_MAX ? ps.rows : STEPS_MAX);
+      memcpy(v->path, ps.data, (size_t)v->npaths * sizeof v->path[0]);
+    }
+  } else {
+    tx_snapshot ms = tx_read(c, v->suture);
+    if (ms.seq) v->m = *(const tx_suture_measures*)ms.data, v->have_m = true;
+  }
 }
 
 static json_t* number_or_null(double x) { return isfinite(x) ? json_real(x) : json_null(); }
@@ -78,6 +108,27 @@ static void measure(json_t* root, const char* key, double value, const char* uni
 }
 
 static const char* const status_names[] = {"not reached", "under way", "done", "skipped"};
+
+// procedure.lagb's measures: the band, the force on each organ, the burns
+static json_t* build_lagb(const scorecard* v, json_t* root) {
+  const tx_lagb_measures* m = &v->lm;
+  json_object_set_new(
+      root, "band",
+      json_pack("{s:b, s:b, s:i, s:o, s:o, s:s}", "locked", m->locked > 0.5, "encircles_stomach", m->encircles > 0.5, "linking_number",
+                (int)m->linking, "from_gej_m", number_or_null(m->band_from_gej_m), "off_axis_m", number_or_null(m->band_off_axis_m), "rule",
+                "locked: the tube's tip latched in the buckle; encircles_stomach: the band's centre line, closed at the buckle, "
+                "winds once round the stomach's axis (linking number +-1); from_gej_m: its centre from the gastro-oesophageal "
+                "junction along the axis, + toward the stomach; off_axis_m: from the axis"));
+  measure(root, "path_hand0_m", m->path_m[0], "m", "the path length of hand 0's tool point: economy of motion (OSATS, time and motion)");
+  measure(root, "path_hand1_m", m->path_m[1], "m", "the path length of hand 1's tool point");
+  measure(root, "liver_force_max_n", m->liver_force_max_n, "N", "the largest pull of the liver on a grasper holding it");
+  measure(root, "stomach_force_max_n", m->stomach_force_max_n, "N", "the largest pull of the stomach on a grasper holding it");
+  measure(root, "damage_outside_target_m3", m->damage_outside_m3, "m^3",
+          "thermal damage outside the membranes the dissection divides: the liver's and the stomach's volume with Arrhenius Omega > 1");
+  json_object_set_new(root, "burn_outside_target",
+                      isfinite(m->damage_outside_m3) ? json_boolean(m->damage_outside_m3 > v->damage_tolerance) : json_null());
+  return root;
+}
 
 static json_t* build(const scorecard* v) {
   json_t* root = json_object();
@@ -94,12 +145,16 @@ static json_t* build(const scorecard* v) {
     if (space) snprintf(nm, sizeof nm, "%.*s", (int)(len - idlen - 1), space + 1);
     int status = (int)v->step[i].status;
     if (status < 0 || status > 3) status = 0;
-    json_array_append_new(steps, json_pack("{s:s, s:s, s:b, s:s, s:o, s:o}", "id", id, "name", nm, "done", status == TX_STEP_DONE,
-                                           "status", status_names[status], "t_start_s", number_or_null(v->step[i].t_start_s),
-                                           "t_end_s", number_or_null(v->step[i].t_end_s)));
+    json_t* entry = json_pack("{s:s, s:s, s:b, s:s, s:o, s:o}", "id", id, "name", nm, "done", status == TX_STEP_DONE, "status",
+                              status_names[status], "t_start_s", number_or_null(v->step[i].t_start_s), "t_end_s",
+                              number_or_null(v->step[i].t_end_s));
+    if (i < v->npaths)
+      json_object_set_new(entry, "path_m", json_pack("[o, o]", number_or_null(v->path[i].path_m[0]), number_or_null(v->path[i].path_m[1])));
+    json_array_append_new(steps, entry);
   }
   json_object_set_new(root, "steps", steps);
   if (!v->have_m) return root;
+  if (v->is_lagb) return build_lagb(v, root);
   const tx_suture_measures* m = &v->m;
   measure(root, "bite_entry_m", m->bite_entry_m, "m",
           "the stitch's entry puncture from the wound line, across the skin; bites are placed 3-5 mm from the edge");

@@ -8,7 +8,9 @@
 // A relative FILE that is not there from the working folder is looked up on
 // the scenario search path ($TACTUS_SCENARIO_PATH, then the source tree's
 // scenarios/), where a scenario keeps its files beside its JSON:
-// "scripted:instruments/hand0.csv" is scenarios/instruments/hand0.csv.
+// "scripted:instruments/hand0.csv" is scenarios/instruments/hand0.csv. Last,
+// the assets' folder, where a procedure's waypoints live:
+// "scripted:procedures/lagb/hand0.csv" is assets/procedures/lagb/hand0.csv.
 // Rows are interpolated linearly (orientation by normalised lerp); after the
 // last row the device holds still. Lines starting with '#' and a first line
 // of column names are skipped. Forces written to it are ignored.
@@ -197,6 +199,9 @@ static tx_device* open_scripted(const char* arg, double period_s) {
 #ifdef TX_SCENARIO_DIR
     if (!f && arg[0] != '/' && snprintf(path, sizeof path, "%s/%s", TX_SCENARIO_DIR, arg) < (int)sizeof path)
       f = fopen(path, "r");
+#endif
+#ifdef TX_ASSET_DIR
+    if (!f && arg[0] != '/' && snprintf(path, sizeof path, "%s/%s", TX_ASSET_DIR, arg) < (int)sizeof path) f = fopen(path, "r");
 #endif
     if (!f) return tx_set_error("%s: %s", arg, strerror(err)), NULL;
     tx_device* d = tx_scripted_read_csv(f, arg);

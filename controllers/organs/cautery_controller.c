@@ -62,7 +62,30 @@ typedef struct cautery {
   double remove_fraction;   // 0: none
   tx_port events;           // TX_EVENT_BURN out
   tx_result removed_r, removed_m3_r;
+  tx_port tissue;           // cautery.tissue out: each organ's damaged and boiled volume
+  long steps_taken;
 } cautery;
+
+// the volume with Omega over 1 and the volume that boiled, of the tissue left
+static void measure_tissue(const organ* o, double* damaged, double* boiled) {
+  const double *om = tx_thermal_damage(o->h), *vol = tx_thermal_volume(o->h);
+  const bool* reached = tx_thermal_reached(o->h);
+  double rest = tx_thermal_damage_rest(o->h);
+  *damaged = *boiled = 0;
+  for (int n = 0; n < tx_thermal_nodes(o->h); n++) {
+    if (om[n] + rest > 1) *damaged += vol[n];
+    if (reached[n]) *boiled += vol[n];
+  }
+}
+
+// cautery.tissue: a pass over every node, so at a tenth of the heat's rate
+static void publish_tissue(tx_ctx* c, cautery* g) {
+  tx_tissue_damage* d = tx_write(c, g->tissue);
+  for (int i = 0; i < SOFT; i++) {
+    measure_tissue(&g->o[i], &d[i].damaged_m3, &d[i].boiled_m3);
+    d[i].peak_k = g->o[i].peak;
+  }
+}
 
 // the defaults: IT'IS tissue properties database (docs/lagb.md), Arrhenius
 // parameters for liver after Jacques et al. (1996), as used by Chang and
@@ -223,6 +246,7 @@ static int configure(tx_setup* s, void** self) {
   else if (g->remove_fraction > 0) return tx_setup_fail(s, "events", "names no stream, but remove_fraction is %g", g->remove_fraction);
   g->removed_r = tx_setup_result(s, "removed_tets");
   g->removed_m3_r = tx_setup_result(s, "removed_m3");
+  g->tissue = tx_setup_write(s, &TX_COMPONENT_OF("cautery.tissue", tx_tissue_damage, SOFT));
   tx_hist_clear(&g->steps);
   return 0;
 }
@@ -370,6 +394,8 @@ static void vaporise(tx_ctx* c, cautery* g, int which) {
 static int init(tx_ctx* c, void* self) {
   cautery* g = self;
   for (int i = 0; i < SOFT; i++) publish(c, &g->o[i], NULL); // at rest, at time 0
+  g->steps_taken = 0;
+  publish_tissue(c, g);
   return 0;
 }
 
@@ -411,6 +437,7 @@ static void step(tx_ctx* c, void* self) {
     publish(c, o, &sf[i]);
   }
   if (hot >= 0) g->active_s += g->dt;
+  if (++g->steps_taken % 10 == 0) publish_tissue(c, g);
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t1);
   tx_hist_add(&g->steps, (int64_t)(t1.tv_sec - t0.tv_sec) * 1000000000 + (t1.tv_nsec - t0.tv_nsec));
 }
@@ -420,13 +447,8 @@ static void finish(tx_ctx* c, void* self) {
   double energy = 0, boiled = 0;
   for (int i = 0; i < SOFT; i++) {
     organ* o = &g->o[i];
-    const double *om = tx_thermal_damage(o->h), *vol = tx_thermal_volume(o->h);
-    const bool* reached = tx_thermal_reached(o->h);
-    double damaged = 0, gone = 0, rest = tx_thermal_damage_rest(o->h);
-    for (int n = 0; n < tx_thermal_nodes(o->h); n++) {
-      if (om[n] + rest > 1) damaged += vol[n];
-      if (reached[n]) gone += vol[n];
-    }
+    double damaged, gone;
+    measure_tissue(o, &damaged, &gone);
     tx_set_result(c, o->peak_r, o->peak);
     tx_set_result(c, o->damaged_r, damaged);
     tx_set_result(c, o->boiled_r, gone);

@@ -32,6 +32,8 @@ static const layout layouts[] = {
     L("instrument1.pose", tx_instrument_pose), L("liver.damage", tx_organ_damage), L("stomach.damage", tx_organ_damage),
     L("band.state", tx_band_state),     L("procedure.step", tx_procedure_step), L("procedure.step_names", tx_procedure_step),
     L("procedure.steps", tx_procedure_step_state), L("procedure.suture", tx_suture_measures),
+    L("cautery.tissue", tx_tissue_damage), L("band.centre", tx_vertex), L("pars_flaccida.state", tx_membrane_state),
+    L("his.state", tx_membrane_state), L("procedure.lagb", tx_lagb_measures), L("procedure.step_paths", tx_step_path),
     L(".temperature", tx_temperature),  L(".links", tx_pose), L(".swage", tx_pose), L(".grip", tx_device_grip),
     L(".force_model", tx_force_model), L(".pose", tx_pose),
     L(".velocity", tx_velocity),        L(".force", tx_force),             L(".energy", tx_device_energy),
