@@ -6,11 +6,18 @@
 // errors never accumulate. A step that ends after the next tick's start is a
 // missed deadline; that next tick then runs at once, late, unless its whole
 // period is already over: such ticks are skipped, each counted as missed. Threads ask for
-// SCHED_FIFO, haptics highest, the others by rate (faster = higher priority),
-// and a CPU each, round-robin, haptics then the fastest on the last CPU (a
+// SCHED_FIFO, haptics highest, then the loops of TX_FIFO_MIN_HZ and more by
+// rate (faster = higher priority), and a CPU each, round-robin, haptics then the fastest on the last CPU (a
 // process with no haptics thread starts on the CPU before it, leaving the last
 // to a haptics thread in another process of the session); where either is
-// refused they run without it and the result says so.
+// refused they run without it and the result says so. Slower threads (the
+// physics, the views) stay SCHED_OTHER: a FIFO thread that overruns takes its
+// whole CPU, and past the kernel's real-time share (sched_rt_runtime_us,
+// 95 % by default) every FIFO thread on that CPU is stopped for the rest of
+// the second, a haptics thread pinned there included (a 60 Hz band that could
+// not keep up cost a hand 50 ms of ticks every second). Under SCHED_OTHER an
+// overrunning physics thread takes the spare time and the haptics thread
+// still preempts it at once.
 #include "system_internal.h"
 
 #include <errno.h>
@@ -22,6 +29,10 @@
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
+
+// threads of this rate and more run SCHED_FIFO (the haptic loop's: collision,
+// the instruments' coupling); slower ones SCHED_OTHER (see above)
+#define TX_FIFO_MIN_HZ 1000.0
 
 // the start line: workers report their init done, then wait for t0
 typedef struct gate {
@@ -210,7 +221,7 @@ static int usable_cpus(int* cpus, int max) {
   return n;
 }
 
-static void describe_scheduling(const worker* w, int n, tx_run_result* r) {
+static void describe_scheduling(const worker* w, int n, bool fifo_wanted, tx_run_result* r) {
   int fifo_err = 0, pin_err = 0, fifo_asked = 0, pin_asked = 0;
   for (int i = 0; i < n; i++) {
     fifo_asked += w[i].priority > 0;
@@ -218,12 +229,13 @@ static void describe_scheduling(const worker* w, int n, tx_run_result* r) {
     if (w[i].priority > 0 && w[i].fifo_error) fifo_err = w[i].fifo_error;
     if (w[i].cpu >= 0 && w[i].pin_error) pin_err = w[i].pin_error;
   }
-  r->fifo = fifo_asked && !fifo_err;
+  r->fifo = fifo_wanted && !fifo_err; // every thread the policy puts on SCHED_FIFO has it
   r->pinned = pin_asked && !pin_err;
-  char fifo[96], pin[96];
-  if (!fifo_asked) snprintf(fifo, sizeof fifo, "SCHED_OTHER (SCHED_FIFO not asked for)");
+  char fifo[128], pin[96];
+  if (!fifo_wanted) snprintf(fifo, sizeof fifo, "SCHED_OTHER (SCHED_FIFO not asked for)");
   else if (fifo_err) snprintf(fifo, sizeof fifo, "SCHED_OTHER (SCHED_FIFO refused: %s)", strerror(fifo_err));
-  else snprintf(fifo, sizeof fifo, "SCHED_FIFO, haptics highest, then by rate");
+  else if (!fifo_asked) snprintf(fifo, sizeof fifo, "SCHED_OTHER (no haptics and no loop of %.0f Hz or more)", TX_FIFO_MIN_HZ);
+  else snprintf(fifo, sizeof fifo, "SCHED_FIFO, haptics highest, then the loops of %.0f Hz and more by rate; slower SCHED_OTHER", TX_FIFO_MIN_HZ);
   if (!pin_asked) snprintf(pin, sizeof pin, "not pinned");
   else if (pin_err) snprintf(pin, sizeof pin, "not pinned (refused: %s)", strerror(pin_err));
   else snprintf(pin, sizeof pin, "pinned round-robin");
@@ -267,7 +279,9 @@ int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r) {
     int prio = s->threads[g].own ? prio_max - 10 : prio_max - 12 - 2 * s->threads[g].rank;
     w[g] = (worker){.sys = s, .group = g, .gate = &gt, .stop = &stop,
                     .cpu = ncpu > 0 ? cpus[(ncpu - 1) - ((g + skip) % ncpu)] : -1,
-                    .priority = o->realtime_priority ? (prio < prio_min ? prio_min : prio) : 0};
+                    .priority = o->realtime_priority && (s->threads[g].own || s->threads[g].rate_hz >= TX_FIFO_MIN_HZ)
+                                    ? (prio < prio_min ? prio_min : prio)
+                                    : 0};
     if (pthread_create(&th[g], NULL, worker_main, &w[g]) != 0) {
       rc = -1;
       tx_set_error("could not start thread %d of %d", g + 1, ng);
@@ -322,7 +336,7 @@ int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r) {
   tx_clock_state cs = tx_clock_read(&s->clock);
   int64_t reached = tx_clock_sim(&cs, finish - gt.t0);
   r->duration_s = (double)(reached < end_sim ? reached : end_sim) * 1e-9; // simulation time reached
-  describe_scheduling(w, started, r);
+  describe_scheduling(w, started, o->realtime_priority, r);
   free(w);
   free(th);
   return rc;
