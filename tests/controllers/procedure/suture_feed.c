@@ -14,6 +14,7 @@ typedef struct feed {
   tx_port ievents, tevents, punctures, nodes, tension, holder, hand0, hand1;
   double scale; // simulation seconds per script second
   double step;  // script seconds per step
+  double last;  // script time of the last step, -1 before the first
 } feed;
 
 static const double entry[3] = {0, 0, 0.004};
@@ -37,8 +38,16 @@ static int feed_configure(tx_setup* s, void** self) {
   return 0;
 }
 
-// the step at script time `when`
-static bool at(const feed* f, double t, double when) { return t >= when - 1e-9 && t < when + f->step - 1e-9; }
+// a run (and a reset) starts before the script's first event
+static int feed_init(tx_ctx* c, void* self) {
+  (void)c;
+  ((feed*)self)->last = -1;
+  return 0;
+}
+
+// the first step at or after script time `when`: in real time a late tick
+// may be skipped, and the event must not go with it
+static bool at(const feed* f, double t, double when) { return t >= when - 1e-9 && f->last < when - 1e-9; }
 
 static void feed_step(tx_ctx* c, void* self) {
   feed* f = self;
@@ -88,6 +97,7 @@ static void feed_step(tx_ctx* c, void* self) {
       e.value[2] = thread[i].fixed;
       tx_emit(c, f->tevents, &e);
     }
+  f->last = t;
 }
 
 static void feed_fini(void* self) { free(self); }
@@ -99,6 +109,7 @@ static const tx_param_def params[] = {
 const tx_controller_class tx_test_suture_feed = {.type = "test.suture_feed",
                                                  .summary = "scripted instruments and thread of a suture",
                                                  .configure = feed_configure,
+                                                 .init = feed_init,
                                                  .step = feed_step,
                                                  .fini = feed_fini,
                                                  .params = params,
