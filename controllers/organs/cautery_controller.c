@@ -9,6 +9,7 @@
 
 #include "thermal.h"
 
+#include "../rotation.h"
 #include "../thread/segment.h" // tx_tri_closest_point
 
 #include <tactus/components.h>
@@ -251,14 +252,6 @@ static int configure(tx_setup* s, void** self) {
   return 0;
 }
 
-// q v q^-1 for a unit quaternion (w, x, y, z)
-static void rotate(const double q[4], const double v[3], double out[3]) {
-  double t[3] = {2 * (q[2] * v[2] - q[3] * v[1]), 2 * (q[3] * v[0] - q[1] * v[2]), 2 * (q[1] * v[1] - q[2] * v[0])};
-  out[0] = v[0] + q[0] * t[0] + (q[2] * t[2] - q[3] * t[1]);
-  out[1] = v[1] + q[0] * t[1] + (q[3] * t[0] - q[1] * t[2]);
-  out[2] = v[2] + q[0] * t[2] + (q[1] * t[1] - q[2] * t[0]);
-}
-
 // the surface the tip is located on: physics.organs' latest publish (the
 // drawn surface, or once cut its live tetrahedra's boundary, each row a
 // node), or the drawn surface at rest
@@ -409,7 +402,7 @@ static void step(tx_ctx* c, void* self) {
   if (p.seq > 0) {
     const tx_pose* pose = p.data;
     double off[3];
-    rotate(pose->quat, g->offset, off);
+    tx_quat_rotate(pose->quat, false, g->offset, off);
     for (int a = 0; a < 3; a++) tip[a] = pose->pos[a] + off[a];
     active = isfinite(tip[0] + tip[1] + tip[2]);
     if (!active) tx_warn(c, g->bad_pose);

@@ -6,6 +6,8 @@
 // and the nodes that carry a picked triangle's vertices are the ones moved.
 #include "picking.h"
 
+#include "../rotation.h"
+
 #include "../../model/error.h"
 
 #include <math.h>
@@ -119,15 +121,6 @@ static double dist2(const double a[3], const double b[3]) {
   return dot(d, d);
 }
 
-// v rotated by the unit quaternion q = (w, x, y, z), or by its inverse
-static void rotate(const double q[4], bool inverse, const double v[3], double out[3]) {
-  const double w = q[0], x = inverse ? -q[1] : q[1], y = inverse ? -q[2] : q[2], z = inverse ? -q[3] : q[3];
-  const double t0 = 2 * (y * v[2] - z * v[1]), t1 = 2 * (z * v[0] - x * v[2]), t2 = 2 * (x * v[1] - y * v[0]);
-  out[0] = v[0] + w * t0 + (y * t2 - z * t1);
-  out[1] = v[1] + w * t1 + (z * t0 - x * t2);
-  out[2] = v[2] + w * t2 + (x * t1 - y * t0);
-}
-
 // the point of triangle abc closest to p (Ericson, Real-Time Collision Detection, 5.1.5)
 static void closest_on_triangle(const double p[3], const double a[3], const double b[3], const double c[3], double out[3]) {
   double ab[3], ac[3], ap[3], bp[3], cp[3];
@@ -237,7 +230,7 @@ static void vertices(const tx_picking* p, const pick_body* b, const double* pos)
 // nearest points' mean), 0 when they carry no free node
 static int grasp(tx_picking* p, int h, const tx_instrument_pose* j, const double* const* pos, double point[3]) {
   double tip[3], ahead[3] = {p->d.length, 0, 0};
-  rotate(j->quat, false, ahead, tip);
+  tx_quat_rotate(j->quat, false, ahead, tip);
   for (int a = 0; a < 3; a++) tip[a] += j->pos[a];
   const double r2 = p->d.reach * p->d.reach;
   int tris = 0;
@@ -265,7 +258,7 @@ static int grasp(tx_picking* p, int h, const tx_instrument_pose* j, const double
           if (!tx_fem_is_kinematic(b->fem, n)) continue;  // fixed: it stays where the anatomy holds it
           double rel[3];
           sub(x, j->pos, rel);
-          rotate(j->quat, true, rel, b->offset + 3 * n);
+          tx_quat_rotate(j->quat, true, rel, b->offset + 3 * n);
           b->holder[n] = (int8_t)h;
           p->list[p->nlist++] = (held){bi, n};
           p->nodes[h]++;
@@ -342,8 +335,8 @@ bool tx_picking_update(tx_picking* p, int h, const tx_instrument_pose* jaws, con
     const int n = p->list[i].node;
     if (b->holder[n] != h) continue;
     double x[3], x0[3];
-    rotate(j.quat, false, b->offset + 3 * n, x);
-    rotate(p->taken[h].quat, false, b->offset + 3 * n, x0);
+    tx_quat_rotate(j.quat, false, b->offset + 3 * n, x);
+    tx_quat_rotate(p->taken[h].quat, false, b->offset + 3 * n, x0);
     for (int a = 0; a < 3; a++) x[a] += j.pos[a], x0[a] += p->taken[h].pos[a];
     tx_fem_set_kinematic(b->fem, n, x);
     p->carried[h] = fmax(p->carried[h], sqrt(dist2(x, x0)));
