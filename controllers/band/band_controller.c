@@ -1,10 +1,12 @@
 // physics.band: the gastric band (band_sim.h) as a controller. Each step
 // advances the band, publishes its surfaces and state, and sends a latch
-// event when the band locks. A numerical fault is counted and the band goes
+// event when the band locks. Graspers take the band's ends (their rigid
+// bodies) or, elsewhere, pick its surface triangles (../organs/picking.h). A numerical fault is counted and the band goes
 // back to its last good state, so the model never holds a NaN.
 #include "band_controller.h"
 
 #include "band_sim.h"
+#include "../organs/picking.h"
 #include "../rotation.h"
 #include "../system.h" // tx_param_json, tx_param_point
 
@@ -24,10 +26,12 @@ enum { GRASPABLE = 2 }; // the bodies a grasper can take: the tube's tip and the
 static const int graspable[GRASPABLE] = {TX_BAND_TUBE_TIP, TX_BAND_BUCKLE};
 
 // a grasper's jaws on the band: closing them near the tube's tip or the
-// buckle takes that body, which then follows the jaws until they open
+// buckle takes that body, which then follows the jaws until they open;
+// closing them anywhere else picks the surface triangles between them
 typedef struct jaws {
   tx_port pose;     // read: instrumentN.pose (tx_instrument_pose)
   bool was_open;    // seen open since the last close
+  bool on_end;      // closed on an end since they last opened (still, after letting it go at the lock)
   int body;         // the body held, -1 none
   double offset[3]; // m, its position in the jaws' frame when taken
 } jaws;
@@ -48,8 +52,13 @@ typedef struct band {
   jaws hand[HANDS_MAX];
   int hands;
   double grasp_length, grasp_reach, grasp_closed, grasp_open; // m, m, rad, rad
-  tx_result grasps_result;
+  tx_result grasps_result, nodes_result, force_result;
   int grasps;
+  tx_picking* pick;                 // the triangles picked, by hand (NULL: no graspers)
+  double* part_pos[TX_BAND_PARTS];  // (nodes x 3) m, each part's nodes before the step, for the picking
+  int32_t* identity;                // (largest part's nodes) a surface vertex is its node
+  int pick_nodes_max;               // the most nodes one hand held
+  double pick_force_max;            // N, the largest pull of the band on a hand's jaws through picked nodes
 } band;
 
 // sources of the values: docs/lagb.md, "The band"
@@ -79,10 +88,12 @@ static const tx_param_def params[] = {
     {"obstacles", TX_PARAM_JSON, NULL, 0, 0, 0, NULL,
      "[[ax, ay, az, bx, by, bz, r], ...], m: rigid capsules the band is kept out of (the oesophagus, the cardia); none by default"},
     {"grasp", TX_PARAM_STRS, NULL, 0, HANDS_MAX, 0, NULL,
-     "graspers (tx_instrument_pose: instrumentN.pose) whose closing jaws take the tube's tip or the buckle; none: no grasping"},
+     "graspers (tx_instrument_pose: instrumentN.pose) whose closing jaws take the tube's tip or the buckle, or else pick the band's surface; none: no grasping"},
     {"grasp_length_m", TX_PARAM_NUM, "m", 0.001, 0.1, 0.02, NULL, "the jaws reach this far ahead of the pivot along the pose's x"},
     {"grasp_reach_m", TX_PARAM_NUM, "m", 0, 0.05, 0.008, NULL,
      "closing jaws take the tube's tip or the buckle when its body is this close to their line (the end's half width and the jaws')"},
+    {"grasp_triangle_reach_m", TX_PARAM_NUM, "m", 0, 0.02, 0.003, NULL,
+     "closing jaws with neither end in reach pick the band's surface triangles this close to their line (the jaws' half width, 2 mm, and 1 mm)"},
     {"grasp_closed_rad", TX_PARAM_NUM, "rad", 0, 1, 0.1, NULL, "jaws at or below this angle have closed: a grasp, if they were open since the last"},
     {"grasp_open_rad", TX_PARAM_NUM, "rad", 0.001, 3.2, 0.2, NULL, "jaws at or above this have opened: what they held is let go"},
 };
@@ -201,7 +212,25 @@ static int configure(tx_setup* s, void** self) {
       if (!strcmp(grasp[k], grasp[h])) return tx_setup_fail(s, "grasp", "'%s' named twice", grasp[h]);
     g->hand[h].pose = TX_READ_OF(s, grasp[h], tx_instrument_pose);
   }
-  if (g->hands > 0) g->grasps_result = tx_setup_result(s, "grasps");
+  if (g->hands > 0) {
+    g->grasps_result = tx_setup_result(s, "grasps");
+    g->nodes_result = tx_setup_result(s, "grasp_nodes_max");
+    g->force_result = tx_setup_result(s, "grasp_force_max_n");
+    // the picking: the jaws' move of a step spread over the band's substeps
+    tx_pick_def pd = {g->grasp_length, tx_table_num(s, "grasp_triangle_reach_m"), g->grasp_closed, g->grasp_open,
+                      tx_band_substeps(g->b)};
+    g->pick = tx_picking_create(&pd, g->hands);
+    int most = g->nv[TX_BAND_RING] > g->nv[TX_BAND_TUBE] ? g->nv[TX_BAND_RING] : g->nv[TX_BAND_TUBE];
+    g->identity = malloc(sizeof(int32_t) * (size_t)most);
+    if (!g->pick || !g->identity) return tx_setup_fail(s, "grasp", "%s", g->pick ? "out of memory" : tx_error());
+    for (int i = 0; i < most; i++) g->identity[i] = i;
+    for (int i = 0; i < TX_BAND_PARTS; i++) {
+      tx_pick_surface surf = {.nv = g->nv[i], .nt = g->nf[i], .tri = tx_band_face_nodes(g->b, i), .per = 1, .node = g->identity};
+      g->part_pos[i] = malloc(sizeof(double) * 3 * (size_t)g->nv[i]);
+      if (!g->part_pos[i] || tx_picking_add(g->pick, tx_band_fem(g->b, i), &surf) < 0)
+        return tx_setup_fail(s, "grasp", "%s", g->part_pos[i] ? tx_error() : "out of memory");
+    }
+  }
   return 0;
 }
 
@@ -226,6 +255,7 @@ static void let_go(tx_ctx* c, band* g, int h, bool event) {
 // each grasper: closing jaws take the nearest graspable body within reach,
 // opening ones let it go; a held body is driven where the jaws carry it
 static void grasp_step(tx_ctx* c, band* g) {
+  for (int i = 0; i < TX_BAND_PARTS && g->pick; i++) tx_band_positions(g->b, i, g->part_pos[i]);
   for (int h = 0; h < g->hands; h++) {
     jaws* j = &g->hand[h];
     tx_snapshot sn = tx_read(c, j->pose);
@@ -239,6 +269,7 @@ static void grasp_step(tx_ctx* c, band* g) {
     const double q[4] = {p->quat[0] / qn, p->quat[1] / qn, p->quat[2] / qn, p->quat[3] / qn};
     if (p->jaw >= g->grasp_open) {
       j->was_open = true;
+      j->on_end = false;
       let_go(c, g, h, true);
     } else if (p->jaw <= g->grasp_closed && j->was_open && j->body < 0) {
       j->was_open = false;
@@ -263,6 +294,7 @@ static void grasp_step(tx_ctx* c, band* g) {
         e.grasp.jaw = p->jaw;
         tx_emit(c, g->events, &e);
         g->grasps++;
+        j->on_end = true;
       }
     }
     if (j->body >= 0) {
@@ -270,7 +302,18 @@ static void grasp_step(tx_ctx* c, band* g) {
       tx_quat_rotate(q, false, j->offset, at);
       for (int k = 0; k < 3; k++) at[k] += p->pos[k];
       tx_band_drive(g->b, j->body, at);
+      continue;
     }
+    if (j->on_end) continue; // they let go of an end at the lock, still closed: nothing else until they open
+    // no end held: the jaws pick the triangles between them, or carry what they picked
+    tx_instrument_pose jw = *p;
+    memcpy(jw.quat, q, sizeof q);
+    tx_event e;
+    if (tx_picking_update(g->pick, h, &jw, (const double* const*)g->part_pos, &e)) {
+      tx_emit(c, g->events, &e);
+      if (e.kind == TX_EVENT_GRASP) g->grasps++;
+    }
+    if (tx_picking_nodes(g->pick, h) > g->pick_nodes_max) g->pick_nodes_max = tx_picking_nodes(g->pick, h);
   }
 }
 
@@ -306,8 +349,10 @@ static void publish(tx_ctx* c, band* g) {
 
 static int init(tx_ctx* c, void* self) {
   band* g = self;
-  for (int h = 0; h < g->hands; h++) g->hand[h].body = -1, g->hand[h].was_open = false;
-  g->grasps = 0;
+  for (int h = 0; h < g->hands; h++) g->hand[h].body = -1, g->hand[h].was_open = g->hand[h].on_end = false;
+  g->grasps = g->pick_nodes_max = 0;
+  g->pick_force_max = 0;
+  if (g->pick) tx_picking_release(g->pick, -1);
   publish(c, self); // the band at rest, at time 0
   return 0;
 }
@@ -327,6 +372,11 @@ static void step(tx_ctx* c, void* self) {
   grasp_step(c, g);
   if (tx_band_step(g->b)) {
     tx_band_save(g->b);
+    for (int h = 0; h < g->hands && g->pick; h++) {
+      double f[3];
+      tx_picking_force(g->pick, h, f);
+      g->pick_force_max = fmax(g->pick_force_max, sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]));
+    }
   } else {
     tx_warn(c, g->fault);
     g->faults++;
@@ -358,13 +408,20 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, g->substeps_result, tx_band_substeps(g->b));
   tx_set_result(c, g->p50_result, p.p50 * 1e-6);
   tx_set_result(c, g->p99_result, p.p99 * 1e-6);
-  if (g->hands > 0) tx_set_result(c, g->grasps_result, g->grasps);
+  if (g->hands > 0) {
+    tx_set_result(c, g->grasps_result, g->grasps);
+    tx_set_result(c, g->nodes_result, g->pick_nodes_max);
+    tx_set_result(c, g->force_result, g->pick_force_max);
+  }
 }
 
 static void fini(void* self) {
   band* g = self;
   if (!g) return;
   tx_band_destroy(g->b);
+  tx_picking_destroy(g->pick);
+  for (int i = 0; i < TX_BAND_PARTS; i++) free(g->part_pos[i]);
+  free(g->identity);
   free(g->pos);
   free(g);
 }

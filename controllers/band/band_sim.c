@@ -531,6 +531,7 @@ double tx_band_joint_length(const tx_band* b) {
 double tx_band_joint_rest(const tx_band* b) { return b->rest; }
 bool tx_band_locked(const tx_band* b) { return b->locked; }
 int tx_band_substeps(const tx_band* b) { return b->substeps; }
+tx_fem* tx_band_fem(tx_band* b, int part) { return b->p[part].fem; }
 double tx_band_substep(const tx_band* b) { return b->h_sub; }
 
 void tx_band_body_position(const tx_band* b, int body, double p[3]) {

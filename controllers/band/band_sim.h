@@ -102,6 +102,10 @@ int tx_band_faces(const tx_band* b, int part);
 void tx_band_positions(const tx_band* b, int part, double* out);  // (nodes x 3) m
 const int32_t* tx_band_face_nodes(const tx_band* b, int part);   // (faces x 3)
 const double* tx_band_rest(const tx_band* b, int part);          // (nodes x 3) m, as loaded
+// the part's soft body, for what holds its nodes besides the band's own
+// bodies (a grasper's picking: tx_fem_set_kinematic_over, spread over
+// tx_band_substeps, since each tx_band_step steps the parts one substep at a time)
+struct tx_fem* tx_band_fem(tx_band* b, int part);
 // the part's cross-sections along its centre line (tactus-band-assets writes
 // the nodes section by section, from the end marked 1); 0 when the nodes do
 // not come so. The middle of section k of the positions pos (nodes x 3)

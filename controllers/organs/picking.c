@@ -253,6 +253,7 @@ static int grasp(tx_picking* p, int h, const tx_instrument_pose* j, const double
           const int n = s->node[s->per * vert + k];
           if (s->w && fabs(s->w[s->per * vert + k]) < TX_PICK_WEIGHT_MIN) continue;
           if (b->holder[n] >= 0) continue;  // held already (this hand's, or the other's)
+          if (tx_fem_is_kinematic(b->fem, n)) continue;  // carried by something else (a rigid body it is bolted to)
           const double* x = pos[bi] + 3 * n;
           tx_fem_set_kinematic(b->fem, n, x);
           if (!tx_fem_is_kinematic(b->fem, n)) continue;  // fixed: it stays where the anatomy holds it
@@ -338,7 +339,7 @@ bool tx_picking_update(tx_picking* p, int h, const tx_instrument_pose* jaws, con
     tx_quat_rotate(j.quat, false, b->offset + 3 * n, x);
     tx_quat_rotate(p->taken[h].quat, false, b->offset + 3 * n, x0);
     for (int a = 0; a < 3; a++) x[a] += j.pos[a], x0[a] += p->taken[h].pos[a];
-    tx_fem_set_kinematic(b->fem, n, x);
+    tx_fem_set_kinematic_over(b->fem, n, x, p->d.substeps);
     p->carried[h] = fmax(p->carried[h], sqrt(dist2(x, x0)));
   }
   return sent;
@@ -386,7 +387,7 @@ int tx_pick_configure(tx_setup* s, const char* prefix, int bodies, tx_fem* const
   const char* names[TX_PICK_HANDS_MAX];
   int hands = tx_table_strs(s, "grasp", names, TX_PICK_HANDS_MAX);
   tx_pick_def d = {tx_table_num(s, "grasp_length_m"), tx_table_num(s, "grasp_reach_m"), tx_table_num(s, "grasp_closed_rad"),
-                   tx_table_num(s, "grasp_open_rad")};
+                   tx_table_num(s, "grasp_open_rad"), 0};
   if (hands < 0) return -1;
   if (!(d.open > d.closed))
     return tx_setup_fail(s, "grasp_open_rad", "%g rad: must be above grasp_closed_rad (%g rad)", d.open, d.closed);

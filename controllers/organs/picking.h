@@ -12,8 +12,9 @@
 //    controller API, so a unit test or the band's controller can use it.
 //  - tx_pick_ctl: the controller's part (parameters TX_PICK_PARAMS, the
 //    jaws' pose reads, the grasp component and the event stream, results),
-//    for a physics controller that owns the bodies (physics.organs; the
-//    band's later) and calls four hooks.
+//    for a physics controller that owns the bodies (physics.organs) and
+//    calls four hooks. physics.band uses the first layer alone, since its
+//    graspers also take the band's rigid ends.
 //
 //   tx_picking* p = tx_picking_create(&def, hands);
 //   tx_picking_add(p, fem, &surface);                  // each body, at configure
@@ -41,6 +42,8 @@ typedef struct tx_pick_def {
   double reach;   // m, a triangle this close to the jaws' line is between or touching them
   double closed;  // rad, jaws at or below this angle have closed (a grasp, once opened)
   double open;    // rad, jaws at or above this have opened (a release); above closed
+  int substeps;   // the jaws' move between updates spread over this many of the bodies' substeps (the band's
+                  // parts, stepped one substep at a time: tx_fem_set_kinematic_over); 0: over the next tx_fem_step
 } tx_pick_def;
 
 // a drawn surface and what carries it; the arrays are kept, not copied
@@ -65,7 +68,8 @@ int tx_picking_add(tx_picking* p, tx_fem* fem, const tx_pick_surface* s);
 // (root frame at the pivot, jaw angle); pos[b] body b's node positions (nodes
 // x 3, m) as they are now. Closing jaws (after they were seen open) pick the
 // triangles within reach of the segment from the pivot `length` along x; the
-// nodes carrying them, not held by another hand and not fixed, become
+// nodes carrying them, not held by another hand, not fixed and not
+// kinematic already (bolted to a rigid body, as the band's ends are), become
 // kinematic at their place; opened jaws release them. Every held node is then
 // set where its offset in the jaws' frame puts it. jaws NULL or not finite:
 // nothing changes and what is held stays where it is. Returns true with *e
@@ -90,7 +94,7 @@ int tx_picking_triangle_holder(const tx_picking* p, int body, int tri);
 
 // --- the controller's part ------------------------------------------------------
 
-// the parameters, for the class's table (physics.organs; the band's later)
+// the parameters, for the class's table (physics.organs)
 #define TX_PICK_PARAMS \
   {"grasp", TX_PARAM_STRS, NULL, 0, TX_PICK_HANDS_MAX, 0, NULL, \
    "the graspers that pick: their poses (tx_instrument_pose: instrumentN.pose), hand h the h-th; none: no picking"}, \

@@ -98,6 +98,10 @@ void tx_fem_tool(const tx_fem* b, tx_fem_tool_info* out);
 // Its neighbours follow through the solver. Out-of-range nodes, nodes fixed
 // by tx_fem_fix and non-finite p are ignored.
 void tx_fem_set_kinematic(tx_fem* b, int node, const double p[3]);
+// the same move spread over the next `substeps` substeps, whichever
+// tx_fem_step calls take them (a body stepped one substep at a time beside
+// another solver: the band's parts); substeps <= 1: tx_fem_set_kinematic
+void tx_fem_set_kinematic_over(tx_fem* b, int node, const double p[3], int substeps);
 void tx_fem_release(tx_fem* b, int node);
 bool tx_fem_is_kinematic(const tx_fem* b, int node);
 // FEM models: the body's elastic force on a kinematic node, N, averaged over

@@ -58,7 +58,8 @@ struct tx_fem {
   std::vector<btVector3> saved_x, saved_v;  // tx_fem_save's state
   // kinematic nodes (tx_fem_set_kinematic)
   std::vector<char> kinematic;          // (nv) 1: moved by its holder
-  std::vector<btVector3> kin_from, kin_to;  // (nv) m, this tx_fem_step's move
+  std::vector<btVector3> kin_from, kin_to;  // (nv) m, this tx_fem_step's move (or this spread move's)
+  std::vector<int> kin_span, kin_done;  // (nv) substeps a move is spread over (0: this tx_fem_step's), taken of it
   std::vector<btVector3> kin_force;     // (nv) N, elastic force summed over the substeps
   int kin_count;                        // kinematic nodes now
   int kin_steps;                        // substeps kin_force sums
@@ -244,6 +245,8 @@ extern "C" tx_fem* tx_fem_create(const tx_fem_def* d, const double* nodes, int n
     b->kinematic.assign((size_t)nv, 0);
     b->kin_from.resize((size_t)nv);
     b->kin_to.resize((size_t)nv);
+    b->kin_span.assign((size_t)nv, 0);
+    b->kin_done.assign((size_t)nv, 0);
     b->kin_force.resize((size_t)nv);
     b->kin_count = b->kin_steps = 0;
     // removal's bookkeeping, sized once
@@ -388,7 +391,7 @@ extern "C" void tx_fem_fix(tx_fem* b, int node) {
   if (node >= 0 && node < b->nv) b->body->setMass(node, 0), b->fixed[(size_t)node] = 1;
 }
 
-extern "C" void tx_fem_set_kinematic(tx_fem* b, int node, const double p[3]) {
+extern "C" void tx_fem_set_kinematic_over(tx_fem* b, int node, const double p[3], int substeps) {
   if (node < 0 || node >= b->nv || !std::isfinite(p[0] + p[1] + p[2]) || b->node_tets[(size_t)node] == 0) return;
   size_t i = (size_t)node;
   btSoftBody::Node& n = b->body->m_nodes[node];
@@ -400,7 +403,11 @@ extern "C" void tx_fem_set_kinematic(tx_fem* b, int node, const double p[3]) {
   }
   b->kin_from[i] = n.m_x;
   b->kin_to[i] = btVector3((btScalar)p[0], (btScalar)p[1], (btScalar)p[2]);
+  b->kin_span[i] = substeps > 1 ? substeps : 0;
+  b->kin_done[i] = 0;
 }
+
+extern "C" void tx_fem_set_kinematic(tx_fem* b, int node, const double p[3]) { tx_fem_set_kinematic_over(b, node, p, 0); }
 
 extern "C" void tx_fem_release(tx_fem* b, int node) {
   if (node < 0 || node >= b->nv || !b->kinematic[(size_t)node]) return;
@@ -421,18 +428,27 @@ extern "C" bool tx_fem_kinematic_force(const tx_fem* b, int node, double f[3]) {
 }
 
 // each kinematic node to its place after substep k of steps (k + 1 parts of
-// its move); links: to its place before the substep, at the move's speed,
-// since Bullet's prediction moves every node, massless or not
+// its move; a spread move: its substeps taken so far + 1 of its span); links:
+// to its place before the substep, at the move's speed, since Bullet's
+// prediction moves every node, massless or not
 static void place_kinematic(tx_fem* b, int k, int steps) {
   const btScalar h = (btScalar)b->dt;
-  const int part = b->world ? k + 1 : k;
   for (int i = 0; i < b->nv && b->kin_count > 0; i++) {
     if (!b->kinematic[(size_t)i]) continue;
     btSoftBody::Node& n = b->body->m_nodes[i];
     const btVector3 move = b->kin_to[(size_t)i] - b->kin_from[(size_t)i];
+    int span = steps, part = b->world ? k + 1 : k;
+    bool moving = true;
+    if (b->kin_span[(size_t)i] > 0) {  // spread: substep `done` of its span, and still at its end after it
+      int& done = b->kin_done[(size_t)i];
+      span = b->kin_span[(size_t)i];
+      moving = done < span;
+      part = std::min(b->world ? done + 1 : done, span);
+      done++;
+    }
     n.m_q = n.m_x;
-    n.m_x = b->kin_from[(size_t)i] + move * ((btScalar)part / (btScalar)steps);
-    n.m_v = move / ((btScalar)steps * h);
+    n.m_x = b->kin_from[(size_t)i] + move * ((btScalar)part / (btScalar)span);
+    n.m_v = moving ? move / ((btScalar)span * h) : btVector3(0, 0, 0);
   }
 }
 
@@ -714,8 +730,9 @@ extern "C" bool tx_fem_step(tx_fem* b, int steps) {
     }
     b->contacts = on;
   }
-  for (int i = 0; i < b->nv && b->kin_count > 0; i++)
-    if (b->kinematic[(size_t)i]) b->kin_from[(size_t)i] = b->kin_to[(size_t)i];  // held there until moved again
+  for (int i = 0; i < b->nv && b->kin_count > 0; i++)  // held there until moved again
+    if (b->kinematic[(size_t)i] && (b->kin_span[(size_t)i] == 0 || b->kin_done[(size_t)i] >= b->kin_span[(size_t)i]))
+      b->kin_from[(size_t)i] = b->kin_to[(size_t)i], b->kin_span[(size_t)i] = 0;
   b->plate_force = steps > 0 ? impulse / (steps * b->dt) : 0;
   // the body's force on the tool is minus the momentum the tool gave it
   double span = steps > 0 ? steps * b->dt : 1;

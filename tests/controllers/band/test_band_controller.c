@@ -1,8 +1,9 @@
 // physics.band through the loader, in lockstep: it publishes band.x/.tri
 // (the two parts' nodes and their boundary faces: closed, outward) and band.state at rest;
 // a substep far past the stable one faults, and the fault is counted and
-// recovered, never published; bad parameters and assets are refused with one
-// line naming the key and the file.
+// recovered, never published; a grasper closing across the tube's middle
+// picks its triangles and lifts it, and opening lets go; bad parameters and
+// assets are refused with one line naming the key and the file.
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -12,6 +13,8 @@
 #include "tests/scenario_support.h"
 
 #include <tactus/components.h>
+#include <tactus/config.h>
+#include <tactus/events.h>
 
 #include <math.h>
 #include <stdio.h>
@@ -89,6 +92,101 @@ static void fault_is_recovered(void** state) {
   tx_scenario_free(s);
 }
 
+// a test class: jaws (jaws.pose, tx_instrument_pose) at jaws_at along
+// jaws_q's x: open until 0.1 s, closed by 0.2 s, lifted LIFT by 0.7 s,
+// held to 1.0 s, open again by 1.1 s. It keeps the band's grasp and release
+// events, and band.centre's rows `row` and `row - 6` as they were at 0.95 s
+#define LIFT 0.01 // m
+typedef struct jaws_probe {
+  tx_port pose, centre, events;
+  int row, grasps, releases;
+  double held[3], near[3]; // m, the centre line's rows at 0.95 s
+} jaws_probe;
+static jaws_probe probe;
+static double jaws_at[3], jaws_q[4];
+static int jaws_configure(tx_setup* s, void** self) {
+  probe.pose = tx_setup_write(s, &TX_COMPONENT_OF("jaws.pose", tx_instrument_pose, 1));
+  probe.centre = tx_setup_read(s, "band.centre");
+  probe.events = tx_setup_listen(s, "band.events");
+  probe.grasps = probe.releases = 0;
+  probe.held[1] = NAN;
+  *self = &probe;
+  return 0;
+}
+static double ramp(double t, double a, double b) { return t <= a ? 0 : t >= b ? 1 : (t - a) / (b - a); }
+static void jaws_step(tx_ctx* c, void* self) {
+  jaws_probe* p = self;
+  double t = (double)tx_sim_ns(c) * 1e-9;
+  tx_instrument_pose* j = tx_write(c, p->pose);
+  memcpy(j->pos, jaws_at, sizeof jaws_at);
+  j->pos[1] += LIFT * ramp(t, 0.2, 0.7);
+  memcpy(j->quat, jaws_q, sizeof jaws_q);
+  j->jaw = 0.6 * (1 - ramp(t, 0.1, 0.2)) + 0.6 * ramp(t, 1.0, 1.1);
+  tx_event e;
+  while (tx_next_event(c, p->events, &e)) p->grasps += e.kind == TX_EVENT_GRASP, p->releases += e.kind == TX_EVENT_RELEASE;
+  tx_snapshot cs = tx_read(c, p->centre);
+  if (cs.seq && t >= 0.95 && isnan(p->held[1]))
+    for (int a = 0; a < 3; a++)
+      p->held[a] = ((const float*)cs.data)[3 * p->row + a], p->near[a] = ((const float*)cs.data)[3 * (p->row - 6) + a];
+}
+static const tx_controller_class jaws_class = {
+    .type = "test.band_jaws", .summary = "jaws across the tube", .configure = jaws_configure, .step = jaws_step};
+
+// the jaws, 20 mm long, closed across the tube's middle (band.centre's row
+// three quarters along) with their middle on it, neither end in reach: they
+// pick the surface triangles within 3 mm of their line; lifted 1 cm, that
+// part of the tube goes up with them (the picked nodes' moves spread over
+// the band's 667 substeps, so none outruns max_speed: no fault); with the
+// buckle held, the band between it and the jaws (band.centre's rows run
+// from the buckle) follows part of the way through its solver; opened, the
+// jaws let go: one grasp, one release
+static void grasper_picks_the_tube(void** state) {
+  (void)state;
+  if (!tx_find_controller(jaws_class.type)) assert_int_equal(tx_register_controller(&jaws_class), 0);
+  tx_scenario* s = load("");
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 0.02);
+  tx_snapshot cs = latest_snapshot(s, "band.centre");
+  const float* cl = cs.data;
+  const int row = (int)cs.rows - (int)cs.rows / 4;
+  double c0[3], t[3], up[3] = {0, 1, 0}, across[3], near0[3];
+  for (int a = 0; a < 3; a++)
+    c0[a] = cl[3 * row + a], t[a] = cl[3 * row + 3 + a] - cl[3 * row - 3 + a], near0[a] = cl[3 * (row - 6) + a];
+  tx_scenario_free(s);
+  // across the tube and level: its tangent times up
+  across[0] = t[1] * up[2] - t[2] * up[1], across[1] = t[2] * up[0] - t[0] * up[2], across[2] = t[0] * up[1] - t[1] * up[0];
+  double n = sqrt(across[0] * across[0] + across[1] * across[1] + across[2] * across[2]);
+  assert_true(n > 0);
+  for (int a = 0; a < 3; a++) across[a] /= n;
+  // the quaternion taking x to across: (1 + x.across, x times across), normalised
+  double q[4] = {1 + across[0], 0, -across[2], across[1]}, qn = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  assert_true(qn > 1e-6);
+  for (int a = 0; a < 4; a++) jaws_q[a] = q[a] / qn;
+  for (int a = 0; a < 3; a++) jaws_at[a] = c0[a] - 0.01 * across[a];
+  probe.row = row;
+
+  const char* text = "{\"name\":\"t\",\"controllers\":["
+                     "{\"name\":\"jaws\",\"type\":\"test.band_jaws\",\"rate_hz\":60},"
+                     "{\"name\":\"band\",\"type\":\"physics.band\",\"rate_hz\":60,\"params\":{\"grasp\":[\"jaws.pose\"],\"hold_buckle\":true}}]}";
+  s = tx_scenario_load_text("test", text, strlen(text), NULL);
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 1.3);
+  const double lifted = probe.held[1] - c0[1], beside = probe.near[1] - near0[1];
+  print_message("  held: the tube's centre there %.2f mm up (the jaws %.0f mm), 6 sections along %.2f mm; "
+                "%g nodes held, pull %.3g N; %d grasp, %d release\n",
+                1e3 * lifted, 1e3 * LIFT, 1e3 * beside, result(s, "band.grasp_nodes_max"),
+                result(s, "band.grasp_force_max_n"), probe.grasps, probe.releases);
+  assert_true(fabs(lifted - LIFT) < 0.1 * LIFT);
+  assert_true(beside > 0.05 * LIFT && beside < lifted - 0.05 * LIFT);
+  assert_int_equal(probe.grasps, 1);
+  assert_int_equal(probe.releases, 1);
+  assert_true(result(s, "band.grasps") == 1);
+  assert_true(result(s, "band.grasp_nodes_max") >= 4);
+  assert_true(result(s, "band.faults") == 0);
+  assert_true(all_finite(latest_snapshot(s, "band.x")));
+  tx_scenario_free(s);
+}
+
 static void expect_refused(const char* params, const char* needle) { assert_refused(load(params), needle); }
 
 static void bad_parameters_and_assets(void** state) {
@@ -97,12 +195,14 @@ static void bad_parameters_and_assets(void** state) {
   expect_refused("\"buckle_radius_m\":0", "buckle_radius_m");
   expect_refused("\"assets\":\"/nonexistent/lagb\"", "/nonexistent/lagb/band_ring.node");
   expect_refused("\"pull\":\"nothing.here\"", "nothing.here");
+  expect_refused("\"grasp\":[\"jaws.pose\"],\"grasp_triangle_reach_m\":-1", "grasp_triangle_reach_m");
 }
 
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(publishes_the_band),
       cmocka_unit_test(fault_is_recovered),
+      cmocka_unit_test(grasper_picks_the_tube),
       cmocka_unit_test(bad_parameters_and_assets),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

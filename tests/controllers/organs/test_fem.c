@@ -326,13 +326,44 @@ static void test_kinematic(void** state) {
   tx_hemisphere_free(&m);
 }
 
+// a move spread over 4 substeps taken one tx_fem_step(b, 1) at a time (as
+// the band steps its parts): the pole is at 1/4, 2/4, 3/4 and all of it
+// after each, with the move's speed, then stays there at rest; a plain
+// tx_fem_set_kinematic over one substep takes it all at once
+static void test_kinematic_spread(void** state) {
+  (void)state;
+  tx_hemisphere_mesh m;
+  tx_fem_def d = quasi_static(TX_FEM_COROTATED);
+  tx_fem* b = hemisphere(&d, &m);
+  double* x = malloc((size_t)m.nv * 3 * sizeof(double));
+  const double drop = 2e-4, y0 = R;
+  tx_fem_positions(b, x);
+  assert_true(fabs(x[3 * m.pole + 1] - y0) < 1e-8);
+  double p[3] = {x[3 * m.pole], y0 - drop, x[3 * m.pole + 2]};
+  tx_fem_set_kinematic_over(b, m.pole, p, 4);
+  for (int k = 1; k <= 6; k++) {
+    assert_true(tx_fem_step(b, 1));
+    tx_fem_positions(b, x);
+    double want = y0 - drop * (k < 4 ? k : 4) / 4;
+    assert_true(fabs(x[3 * m.pole + 1] - want) < 1e-8);  // Bullet's float: 2e-9 a step at 2 cm
+  }
+  p[1] = y0 - 2 * drop;
+  tx_fem_set_kinematic(b, m.pole, p);
+  assert_true(tx_fem_step(b, 1));
+  tx_fem_positions(b, x);
+  assert_true(fabs(x[3 * m.pole + 1] - p[1]) < 1e-8);
+  free(x);
+  tx_fem_destroy(b);
+  tx_hemisphere_free(&m);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_rest_stays),      cmocka_unit_test(test_press_corotated),
       cmocka_unit_test(test_nodal_pressure_lifts_locking), cmocka_unit_test(test_ball),
       cmocka_unit_test(test_press_neohookean), cmocka_unit_test(test_press_links),
       cmocka_unit_test(test_refused),          cmocka_unit_test(test_tool),
-      cmocka_unit_test(test_step_allocations), cmocka_unit_test(test_kinematic),
+      cmocka_unit_test(test_step_allocations), cmocka_unit_test(test_kinematic), cmocka_unit_test(test_kinematic_spread),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
