@@ -116,8 +116,9 @@ static json_t* build_lagb(const scorecard* v, json_t* root) {
       root, "band",
       json_pack("{s:b, s:b, s:i, s:o, s:o, s:s}", "locked", m->locked > 0.5, "encircles_stomach", m->encircles > 0.5, "linking_number",
                 (int)m->linking, "from_gej_m", number_or_null(m->band_from_gej_m), "off_axis_m", number_or_null(m->band_off_axis_m), "rule",
-                "locked: the tube's tip latched in the buckle; encircles_stomach: the band's centre line, closed at the buckle, "
-                "winds once round the stomach's axis (linking number +-1); from_gej_m: its centre from the gastro-oesophageal "
+                "locked: the tube's tip latched in the buckle; encircles_stomach: the tube's tip near the buckle (procedure.lagb's "
+                "around_m) and the band's centre line, closed there, winding once round the stomach's axis (linking number "
+                "+-1); from_gej_m: its centre from the gastro-oesophageal "
                 "junction along the axis, + toward the stomach; off_axis_m: from the axis"));
   measure(root, "path_hand0_m", m->path_m[0], "m", "the path length of hand 0's tool point: economy of motion (OSATS, time and motion)");
   measure(root, "path_hand1_m", m->path_m[1], "m", "the path length of hand 1's tool point");

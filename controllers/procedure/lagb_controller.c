@@ -62,7 +62,7 @@ static const tx_param_def params[] = {
     {"retract_m", TX_PARAM_NUM, "m", 0.001, 0.1, 0.01, NULL, "2a is done once a grasper holding the liver has carried it this far"},
     {"opening_m", TX_PARAM_NUM, "m", 0.001, 0.1, 0.01, NULL, "2b, 2c: a membrane is divided once its largest hole is this long (a 5 mm grasper and the band pass)"},
     {"around_m", TX_PARAM_NUM, "m", 0.001, 0.1, 0.02, NULL,
-     "3b is done once the band's loop goes round the stomach's axis with the tube's tip this near the buckle"},
+     "the band encircles the stomach (and 3b is done) once its loop goes round the stomach's axis with the tube's tip this near the buckle"},
     {"stomach_axis_m", TX_PARAM_JSON, NULL, 0, 0, 0, NULL,
      "[[x, y, z], ...], m: the stomach's axis from above the oesophagus down (2 to 32 points); the phantom's centre line by default"},
     {"gej_m", TX_PARAM_JSON, NULL, 0, 0, 0, NULL, "[x, y, z], m: the gastro-oesophageal junction; the phantom's by default"},
@@ -229,13 +229,16 @@ static void follow_band(tx_ctx* c, lagb* k, double t) {
   const float* loop = ((const tx_vertex*)ce.data)->x;
   int lk = tx_lagb_linking(loop, (int)ce.rows, k->axis, k->naxis);
   k->m.linking = lk;
-  k->m.encircles = abs(lk) == 1;
+  // round it only with the loop closed by the band itself: the chord from a
+  // tip far from the buckle could close it round anything (at the start, the
+  // tube's tip 15 cm off to the left gives +1 already)
+  k->m.encircles = abs(lk) == 1 && b->tip_to_buckle <= k->around;
   k->m.locked = b->locked > 0.5;
   double mid[3] = {0, 0, 0};
   for (uint32_t i = 0; i < ce.rows; i++)
     for (int a = 0; a < 3; a++) mid[a] += loop[3 * i + a] / ce.rows;
   k->m.band_from_gej_m = tx_lagb_along(k->axis, k->naxis, mid, &k->m.band_off_axis_m) - k->gej_along;
-  if (k->m.encircles && b->tip_to_buckle <= k->around) tx_lagb_steps_done_at(&k->steps, TX_LAGB_AROUND, t);
+  if (k->m.encircles) tx_lagb_steps_done_at(&k->steps, TX_LAGB_AROUND, t);
   if (k->m.encircles && k->m.locked) tx_lagb_steps_done_at(&k->steps, TX_LAGB_LOCK, t);
 }
 

@@ -4,7 +4,8 @@
 # done, in order, the band locked round the stomach, nothing burnt outside
 # the membranes, no fault and no warning. Then the two scripts that go
 # wrong, each for hand 1 over the first seconds: a burn on the liver (the
-# scorecard's burn_outside_target true) and the band's tip pushed beside the
+# scorecard's burn_outside_target true; the band, untouched, not round the
+# stomach) and the band's tip pushed beside the
 # buckle (taken, never locked, 3c not done). Bad parameters of
 # procedure.lagb and of the scorecard are refused with status 2 and one line.
 #
@@ -56,6 +57,8 @@ card = json.load(open(sys.argv[1]))
 print("wrong organ: damage outside", card["damage_outside_target_m3"]["value"], "m^3")
 assert card["burn_outside_target"] is True and card["damage_outside_target_m3"]["value"] > 1e-9, card
 assert not any(s["done"] for s in card["steps"] if s["id"] in ("2b", "2c")), card["steps"]
+# the tube's tip still where it was placed, 15 cm from the buckle: its loop is not closed, whatever the chord gives
+assert card["band"]["encircles_stomach"] is False, card["band"]
 PY
 
 # the band not locked: its tip pushed past the buckle, 15 mm off its opening
