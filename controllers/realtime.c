@@ -11,7 +11,11 @@
 // process with no haptics thread starts on the CPU before it, leaving the last
 // to a haptics thread in another process of the session); where either is
 // refused they run without it and the result says so. Slower threads (the
-// physics, the views) stay SCHED_OTHER: a FIFO thread that overruns takes its
+// physics, the views) are not pinned: the kernel puts each where there is
+// room, and the threads they start (a view's renderer) inherit that; pinned
+// round-robin, they left one CPU half idle beside the other's queue (lagb:
+// the renderer, started by the organs' 30 Hz thread, shared its CPU with the
+// organs and the membranes). They stay SCHED_OTHER: a FIFO thread that overruns takes its
 // whole CPU, and past the kernel's real-time share (sched_rt_runtime_us,
 // 95 % by default) every FIFO thread on that CPU is stopped for the rest of
 // the second, a haptics thread pinned there included (a 60 Hz band that could
@@ -238,7 +242,7 @@ static void describe_scheduling(const worker* w, int n, bool fifo_wanted, tx_run
   else snprintf(fifo, sizeof fifo, "SCHED_FIFO, haptics highest, then the loops of %.0f Hz and more by rate; slower SCHED_OTHER", TX_FIFO_MIN_HZ);
   if (!pin_asked) snprintf(pin, sizeof pin, "not pinned");
   else if (pin_err) snprintf(pin, sizeof pin, "not pinned (refused: %s)", strerror(pin_err));
-  else snprintf(pin, sizeof pin, "pinned round-robin");
+  else snprintf(pin, sizeof pin, "those pinned round-robin, slower threads on any CPU");
   size_t len = (size_t)snprintf(r->scheduler, sizeof r->scheduler, "%d threads; %s; %s", n, fifo, pin);
   if (r->awake_cpus && len < sizeof r->scheduler)
     snprintf(r->scheduler + len, sizeof r->scheduler - len, "; %d CPUs kept awake", r->awake_cpus);
@@ -271,17 +275,16 @@ int tx_run_realtime(tx_system* s, const tx_run_options* o, tx_run_result* r) {
 
   // the last CPU is the haptics thread's: a process without one (a
   // session's sim, on the device's host) starts on the CPU before it
-  int skip = 1;
+  int skip = 1, pinned = 0;
   for (int g = 0; g < ng; g++) skip &= !s->threads[g].own;
   int rc = 0, started = 0;
   for (int g = 0; g < ng; g++) {
     // leave the top for the kernel's own threads; haptics just below, alone
     int prio = s->threads[g].own ? prio_max - 10 : prio_max - 12 - 2 * s->threads[g].rank;
+    bool fast = s->threads[g].own || s->threads[g].rate_hz >= TX_FIFO_MIN_HZ; // the haptic loop: FIFO and pinned
     w[g] = (worker){.sys = s, .group = g, .gate = &gt, .stop = &stop,
-                    .cpu = ncpu > 0 ? cpus[(ncpu - 1) - ((g + skip) % ncpu)] : -1,
-                    .priority = o->realtime_priority && (s->threads[g].own || s->threads[g].rate_hz >= TX_FIFO_MIN_HZ)
-                                    ? (prio < prio_min ? prio_min : prio)
-                                    : 0};
+                    .cpu = ncpu > 0 && fast ? cpus[(ncpu - 1) - ((pinned++ + skip) % ncpu)] : -1,
+                    .priority = o->realtime_priority && fast ? (prio < prio_min ? prio_min : prio) : 0};
     if (pthread_create(&th[g], NULL, worker_main, &w[g]) != 0) {
       rc = -1;
       tx_set_error("could not start thread %d of %d", g + 1, ng);
