@@ -6,6 +6,7 @@
 #include "skin_controller.h"
 
 #include "bullet/cloth.h"
+#include "../rotation.h"
 #include "../system.h" // tx_param_json, tx_param_point
 
 #include <tactus/components.h>
@@ -199,16 +200,6 @@ static int configure(tx_setup* s, void** self) {
   return 0;
 }
 
-// v rotated by the unit quaternion q = (w, x, y, z), or by its inverse
-static void rotate(const double q[4], bool inverse, const double v[3], double out[3]) {
-  const double w = q[0], x = inverse ? -q[1] : q[1], y = inverse ? -q[2] : q[2], z = inverse ? -q[3] : q[3];
-  // t = 2 (q.xyz x v); out = v + w t + q.xyz x t
-  const double t0 = 2 * (y * v[2] - z * v[1]), t1 = 2 * (z * v[0] - x * v[2]), t2 = 2 * (x * v[1] - y * v[0]);
-  out[0] = v[0] + w * t0 + (y * t2 - z * t1);
-  out[1] = v[1] + w * t1 + (z * t0 - x * t2);
-  out[2] = v[2] + w * t2 + (x * t1 - y * t0);
-}
-
 // the jaws of hand h now; false when nothing is published yet or not finite
 static bool jaws_of(tx_ctx* c, const skin* k, int h, tx_instrument_pose* out) {
   tx_snapshot p = tx_read(c, k->jaws[h]);
@@ -254,7 +245,7 @@ static void grasp(tx_ctx* c, skin* k, int h, const double point[3]) {
     if (tx_cloth_freed(k->cloth, i)) continue; // a piece cut off is no longer the skin's
     if (tx_cloth_pin(k->cloth, i, x) != TX_CLOTH_OK) continue; // the fixed border stays where it is
     double rel[3] = {x[0] - jp.pos[0], x[1] - jp.pos[1], x[2] - jp.pos[2]};
-    rotate(jp.quat, true, rel, &k->offset[(size_t)i * 3]);
+    tx_quat_rotate(jp.quat, true, rel, &k->offset[(size_t)i * 3]);
     k->holder[i] = (int8_t)h;
     k->held[k->nheld++] = i;
     took++;
@@ -283,7 +274,7 @@ static void follow_jaws(tx_ctx* c, skin* k) {
       const int i = k->held[j];
       if (k->holder[i] != h) continue;
       double x[3];
-      rotate(jp.quat, false, &k->offset[(size_t)i * 3], x);
+      tx_quat_rotate(jp.quat, false, &k->offset[(size_t)i * 3], x);
       for (int a = 0; a < 3; a++) x[a] += jp.pos[a];
       tx_cloth_pin(k->cloth, i, x);
     }

@@ -4,6 +4,7 @@
 #include "needle.h"
 
 #include "../range_check.h"
+#include "../rotation.h"
 
 #include "../../model/error.h"
 
@@ -299,23 +300,14 @@ static void substep(tx_voxel_tissue* t, int s, int ns, double h, void* user) {
       }
 }
 
-// rotate v by the unit quaternion q (w, x, y, z)
-static void rotate(const double q[4], const double v[3], double out[3]) {
-  double w = q[0], x = q[1], y = q[2], z = q[3];
-  double tx = 2 * (y * v[2] - z * v[1]), ty = 2 * (z * v[0] - x * v[2]), tz = 2 * (x * v[1] - y * v[0]);
-  out[0] = v[0] + w * tx + (y * tz - z * ty);
-  out[1] = v[1] + w * ty + (z * tx - x * tz);
-  out[2] = v[2] + w * tz + (x * ty - y * tx);
-}
-
 bool tx_voxel_needle_step(tx_voxel_needle* n, tx_voxel_tissue* t, const double tip[3], const double quat[4], double dt) {
   double qn = sqrt(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3]);
   if (!(isfinite(tip[0] + tip[1] + tip[2]) && isfinite(qn) && qn > 1e-9))
     return tx_set_error("needle: the pose is not finite"), false;
   if (!(isfinite(dt) && dt > 0 && dt <= 1)) return tx_set_error("needle: step dt = %g s, must be in (0, 1]", dt), false;
   double q[4] = {quat[0] / qn, quat[1] / qn, quat[2] / qn, quat[3] / qn};
-  rotate(q, n->def.axis, n->dir);
-  rotate(q, n->def.side, n->side);
+  tx_quat_rotate(q, false, n->def.axis, n->dir);
+  tx_quat_rotate(q, false, n->def.side, n->side);
   if (!n->placed) memcpy(n->tip1, tip, sizeof n->tip1), n->placed = true;
   memcpy(n->tip0, n->tip1, sizeof n->tip0);
   memcpy(n->tip1, tip, sizeof n->tip1);
