@@ -12,10 +12,10 @@
 // to a haptics thread in another process of the session); where either is
 // refused they run without it and the result says so. Slower threads (the
 // physics, the views) are not pinned: the kernel puts each where there is
-// room, and the threads they start (a view's renderer) inherit that; pinned
-// round-robin, they left one CPU half idle beside the other's queue (lagb:
-// the renderer, started by the organs' 30 Hz thread, shared its CPU with the
-// organs and the membranes). They stay SCHED_OTHER: a FIFO thread that overruns takes its
+// room. Pinned round-robin, they left one CPU half idle beside the other's
+// queue (lagb: the view's renderer, which keeps to the CPUs its starter may
+// use but the last, was started by the organs' pinned 30 Hz thread and so
+// shared that CPU with the organs and the membranes). They stay SCHED_OTHER: a FIFO thread that overruns takes its
 // whole CPU, and past the kernel's real-time share (sched_rt_runtime_us,
 // 95 % by default) every FIFO thread on that CPU is stopped for the rest of
 // the second, a haptics thread pinned there included (a 60 Hz band that could

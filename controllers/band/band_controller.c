@@ -1,8 +1,9 @@
 // physics.band: the gastric band (band_sim.h) as a controller. Each step
 // advances the band, publishes its surfaces and state, and sends a latch
 // event when the band locks. Graspers take the band's ends (their rigid
-// bodies) or, elsewhere, pick its surface triangles (../organs/picking.h). A numerical fault is counted and the band goes
-// back to its last good state, so the model never holds a NaN.
+// bodies) or, elsewhere, pick its surface triangles (../organs/picking.h).
+// A numerical fault is counted and the band goes back to its last good
+// state, so the model never holds a NaN.
 #include "band_controller.h"
 
 #include "band_sim.h"
