@@ -10,6 +10,7 @@
 #include "bench_render.h"
 #include "bench_split.h"
 #include "bench_suturing.h"
+#include "bench_lagb.h"
 #include "bench_thread.h"
 #include "bench_voxels.h"
 #include "../scenarios/command.h"
@@ -372,6 +373,7 @@ static int bench_organ_collision(const bench_args* a) { return tx_bench_organ_co
 static int bench_dds(const bench_args* a) { return tx_bench_dds(a->duration_s, 1000, 4000, 0, true); }
 static int bench_split_session(const bench_args* a) { return tx_bench_split_session(a->out, a->duration_s); }
 static int bench_suturing(const bench_args* a) { return tx_bench_suturing(a->out, a->duration_s); }
+static int bench_lagb(const bench_args* a) { return tx_bench_lagb(a->out, a->duration_s); }
 
 static int bench_hip(const bench_args* a) {
   (void)a;
@@ -399,6 +401,7 @@ static const struct {
     {"thread", bench_thread, "suture thread step, ftl and rod, 100 and 1000 nodes with self collision"},
     {"dds", bench_dds, "two processes over loopback (net.dds): pose -> sim -> force round trip, a 10404x3 mesh at 60 Hz"},
     {"suturing", bench_suturing, "the suturing scenario in real time beside an empty 1 kHz controller: rates, missed deadlines; lockstep time"},
+    {"lagb", bench_lagb, "gastric banding in real time with no view, mono and stereo: physics, haptics and frame rates against their targets"},
     {"split-session", bench_split_session, "suturing-skin in one, two and three processes, alternated in 5 rounds: haptics' missed deadlines"},
 };
 
