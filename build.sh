@@ -8,7 +8,7 @@ cd "$(dirname "$0")"
 
 jobs=$(nproc 2>/dev/null || echo 2)
 default_scenario=suturing-skin
-fuzz_seconds=${TX_FUZZ_SECONDS:-20}
+fuzz_seconds=${TX_FUZZ_SECONDS:-15}
 soak_seconds=${TX_SOAK_SECONDS:-600}
 
 say() { printf '\n== %s\n' "$*" >&2; }
