@@ -328,8 +328,8 @@ static void test_kinematic(void** state) {
 
 // a move spread over 4 substeps taken one tx_fem_step(b, 1) at a time (as
 // the band steps its parts): the pole is at 1/4, 2/4, 3/4 and all of it
-// after each, with the move's speed, then stays there at rest; a plain
-// tx_fem_set_kinematic over one substep takes it all at once
+// after each, then stays there; a plain tx_fem_set_kinematic over one
+// substep takes it all at once
 static void test_kinematic_spread(void** state) {
   (void)state;
   tx_hemisphere_mesh m;
