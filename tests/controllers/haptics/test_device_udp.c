@@ -250,8 +250,10 @@ static void lossy_link_is_survived(void** unused) {
               x->forged > 0);
   assert_true(c.states >= ss.states / 2 && fresh >= streaming / 4); // 10% lost, and in-phase ticks as above
   assert_true(c.stale > 0 && c.malformed > 0);
-  assert_true(fresh_after_stop <= 2); // what was in flight, then silence
-  assert_true(last_fresh >= streaming - 20 && last_fresh <= streaming + 2);
+  // what was in flight, then silence: counted, not timed, since a loaded machine may hold the relay's
+  // thread back for several ticks before it hands on the last states sent
+  assert_true(fresh_after_stop <= 2);
+  assert_true(last_fresh >= streaming - 20); // the stream was used up to its stop
   assert_true(zero_at > last_fresh && zero_at - last_fresh <= 10);
 }
 
