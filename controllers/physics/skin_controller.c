@@ -43,6 +43,22 @@ typedef struct skin {
   tx_result grasp_result;
   int wound_links;                      // links the wound cut (wound_a_m to wound_b_m), 0: none
   tx_result wound_result;
+  // the thread's pull at its punctures (thread_loads): each row's force spread
+  // over the particles near its point (thread_load_radius_m) on its side of the
+  // wound, or shared by its triangle's particles by their barycentric weights
+  tx_port loads_in;                     // read: tx_puncture_load rows (0: none)
+  double load_tau;                      // s, each row's force followed through a first-order lag of this time constant
+  double* row_f;                        // (rows x 3) N, each row's force as the skin takes it (the lagged one)
+  uint32_t nrows;
+  double load_radius;                   // m, each row's force spread over the particles this near its point; 0: its triangle's
+  bool has_wound;                       // a load stays on its side of the wound line
+  double wound[2][3];                   // m, the wound's ends
+  double* load;                         // (n x 3) N, the load on each particle now
+  int32_t* loaded;                      // (3 n) the particles with a load, nloaded of them
+  int nloaded;
+  tx_warning bad_load;
+  double load_max;                      // N, the largest row's force so far
+  tx_result load_result;
 } skin;
 
 // the wound's ends (wound_a_m, wound_b_m, both or neither): 1 with them, 0 for none, -1 refused
@@ -97,6 +113,12 @@ static const tx_param_def params[] = {
     {"wound_a_m", TX_PARAM_JSON, NULL, 0, 0, 0, NULL,
      "[x, y, z], m: one end of a straight wound cut through the skin (in x-z) before the run; with wound_b_m; none by default"},
     {"wound_b_m", TX_PARAM_JSON, NULL, 0, 0, 0, NULL, "[x, y, z], m: the wound's other end"},
+    {"thread_loads", TX_PARAM_STR, NULL, 0, 0, 0, "",
+     "the thread's pull at its punctures (tx_puncture_load rows, e.g. thread.puncture_loads) on the skin: a tight stitch closes the wound; \"\": none"},
+    {"thread_load_tau_s", TX_PARAM_NUM, "s", 0, 1, 0.05, NULL,
+     "each puncture's load follows the thread's through a first-order lag of this time constant: the thread is stiff and kinematic, the skin light, and their pull and give would otherwise chase each other from step to step; 0: none"},
+    {"thread_load_radius_m", TX_PARAM_NUM, "m", 0, 0.02, 0.004, NULL,
+     "a puncture's load is spread over the particles this near it on its side of the wound, weights falling linearly to 0 at this distance (the thread bears on the tissue along its bite); 0: on its triangle's three particles"},
 };
 
 static int configure(tx_setup* s, void** self) {
@@ -158,6 +180,8 @@ static int configure(tx_setup* s, void** self) {
   double wound[2][3];
   int has_wound = read_wound(s, wound);
   if (has_wound < 0) return -1;
+  k->has_wound = has_wound > 0;
+  memcpy(k->wound, wound, sizeof wound);
   if (has_wound && !(k->wound_links = tx_cloth_cut(k->cloth, wound[0], wound[1])))
     return tx_setup_fail(s, "wound_a_m", "the wound to wound_b_m crosses no link of the patch");
   k->wound_result = tx_setup_result(s, "wound_links_cut");
@@ -197,6 +221,18 @@ static int configure(tx_setup* s, void** self) {
     memset(k->holder, -1, (size_t)n * sizeof *k->holder);
   }
   k->grasp_result = tx_setup_result(s, "grasps");
+  const char* loads = tx_table_str(s, "thread_loads");
+  if (!loads) return -1;
+  if (*loads) {
+    k->loads_in = TX_READ_EXPECT(s, loads, tx_puncture_load);
+    k->load = calloc((size_t)n * 3, sizeof *k->load);
+    k->loaded = malloc((size_t)n * 3 * sizeof *k->loaded); // a particle whose loads cancel may be listed again
+    if (!k->load || !k->loaded) return tx_setup_fail(s, NULL, "out of memory");
+  }
+  k->load_radius = tx_table_num(s, "thread_load_radius_m");
+  k->load_tau = tx_table_num(s, "thread_load_tau_s");
+  k->bad_load = tx_setup_warning(s, "bad_load");
+  k->load_result = tx_setup_result(s, "thread_load_max_n");
   return 0;
 }
 
@@ -281,6 +317,79 @@ static void follow_jaws(tx_ctx* c, skin* k) {
   }
 }
 
+// which side of the wound line a point lies on, in x-z (+1 or -1; 1 without a wound)
+static int wound_side(const skin* k, const double p[3]) {
+  if (!k->has_wound) return 1;
+  const double *a = k->wound[0], *b = k->wound[1];
+  return (b[0] - a[0]) * (p[2] - a[2]) - (b[2] - a[2]) * (p[0] - a[0]) >= 0 ? 1 : -1;
+}
+
+static void add_load(skin* k, int i, double w, const double f[3]) {
+  double* l = &k->load[3 * (size_t)i];
+  if (l[0] == 0 && l[1] == 0 && l[2] == 0) k->loaded[k->nloaded++] = i;
+  for (int e = 0; e < 3; e++) l[e] += w * f[e];
+}
+
+// one row's force on the particles: by their distance from its point, weights
+// 1 - d / R summing to 1, over the free particles within R on its side of the
+// wound; on its triangle by the barycentric weights when R is 0 or none is in reach
+static void spread(skin* k, const tx_puncture_load* q) {
+  double p[3] = {0, 0, 0}, x[3];
+  for (int a = 0; a < 3; a++) {
+    tx_cloth_particle(k->cloth, (int)q->v[a], x);
+    for (int e = 0; e < 3; e++) p[e] += q->bary[a] * x[e];
+  }
+  const double R = k->load_radius;
+  double total = 0;
+  const int side = wound_side(k, p);
+  for (int pass = 0; pass < 2 && R > 0; pass++) // the weights' sum, then the loads
+    for (int i = 0; i < k->n; i++) {
+      if (tx_cloth_freed(k->cloth, i)) continue;
+      tx_cloth_particle(k->cloth, i, x);
+      double d = sqrt((x[0] - p[0]) * (x[0] - p[0]) + (x[1] - p[1]) * (x[1] - p[1]) + (x[2] - p[2]) * (x[2] - p[2]));
+      if (!(d < R) || wound_side(k, x) != side) continue;
+      if (pass == 0) total += 1 - d / R;
+      else add_load(k, i, (1 - d / R) / total, q->f);
+    }
+  if (total > 0) return;
+  for (int a = 0; a < 3; a++) add_load(k, (int)q->v[a], q->bary[a], q->f);
+}
+
+// the thread's latest pull at its punctures on their particles, in place of
+// the last: a row that is not a triangle of this skin with weights summing to
+// 1 and a finite force is counted (bad_load) and left out
+static void take_loads(tx_ctx* c, skin* k) {
+  tx_snapshot sl = tx_read(c, k->loads_in);
+  if (sl.seq == 0) return;
+  static const double zero[3] = {0, 0, 0};
+  for (int j = 0; j < k->nloaded; j++) {
+    memset(&k->load[3 * (size_t)k->loaded[j]], 0, sizeof(double) * 3);
+    tx_cloth_set_load(k->cloth, k->loaded[j], zero);
+  }
+  k->nloaded = 0;
+  const tx_puncture_load* rows = sl.data;
+  if (!k->row_f && (k->row_f = calloc((size_t)sl.rows * 3, sizeof *k->row_f))) k->nrows = sl.rows;
+  for (uint32_t r = 0; r < sl.rows && rows[r].v[0] != -1; r++) {
+    const tx_puncture_load* q = &rows[r];
+    double sum = q->bary[0] + q->bary[1] + q->bary[2];
+    bool ok = isfinite(sum) && fabs(sum - 1) <= 1e-6 && isfinite(q->f[0]) && isfinite(q->f[1]) && isfinite(q->f[2]);
+    for (int a = 0; ok && a < 3; a++) ok = q->v[a] >= 0 && q->v[a] < k->n && q->v[a] == floor(q->v[a]);
+    if (!ok) {
+      tx_warn(c, k->bad_load);
+      continue;
+    }
+    k->load_max = fmax(k->load_max, sqrt(q->f[0] * q->f[0] + q->f[1] * q->f[1] + q->f[2] * q->f[2]));
+    tx_puncture_load lagged = *q;
+    if (r < k->nrows) {
+      double a = k->dt / (k->load_tau + k->dt); // 1 without a lag
+      for (int e = 0; e < 3; e++) lagged.f[e] = k->row_f[3 * r + e] += a * (q->f[e] - k->row_f[3 * r + e]);
+    }
+    spread(k, &lagged);
+  }
+  for (int j = 0; j < k->nloaded; j++)
+    if (tx_cloth_set_load(k->cloth, k->loaded[j], &k->load[3 * (size_t)k->loaded[j]]) != TX_CLOTH_OK) tx_warn(c, k->bad_load);
+}
+
 // The skin's reaction on the HIP and its tangent stiffness k = d|f|/dw. A
 // membrane under a point load pushes back as |f| ~ w^p, p from 1 (held by its
 // pre-tension: w = |f| ln(a/r0) / (2 pi T)) to 3 (stretched by the load alone,
@@ -350,6 +459,7 @@ static void step(tx_ctx* c, void* self) {
     }
   }
   if (k->grasp_in.id) follow_jaws(c, k);
+  if (k->loads_in.id) take_loads(c, k);
   if (tx_cloth_step(k->cloth, k->dt) == TX_CLOTH_FAULT) tx_warn(c, k->fault);
   publish(c, k);
 }
@@ -360,6 +470,7 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, k->wound_result, k->wound_links);
   tx_set_result(c, k->fault_result, tx_cloth_faults(k->cloth));
   tx_set_result(c, k->grasp_result, k->grasps);
+  tx_set_result(c, k->load_result, k->load_max);
   tx_set_result(c, k->pierce_result, tx_cloth_pierces(k->cloth));
   tx_set_result(c, k->freed_result, tx_cloth_freed_count(k->cloth));
   tx_set_result(c, k->pieces_result, tx_cloth_pieces_freed(k->cloth));
@@ -372,6 +483,9 @@ static void fini(void* self) {
   free(k->holder);
   free(k->offset);
   free(k->held);
+  free(k->load);
+  free(k->loaded);
+  free(k->row_f);
   free(k);
 }
 

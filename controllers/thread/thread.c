@@ -105,6 +105,7 @@ struct tx_thread {
   double probe;              // m, the nearest triangle found by a query
   tx_thread_contacts last;
   double head_force[3];      // N, the rod's constraints on the head in the last substep
+  double inv_h2;             // 1/s^2, the last rod substep's: a multiplier times it is a force
   int faults;
   // the rod's bends near crossings (rod_solve, limit_energy)
   double* dxb;               // (n x 3) the bends' move of each node in one solve, m
@@ -367,28 +368,37 @@ const uint8_t* tx_thread_colliding(const tx_thread* t) { return t->colliding; }
 int tx_thread_faults(const tx_thread* t) { return t->faults; }
 void tx_thread_last_contacts(const tx_thread* t, tx_thread_contacts* out) { *out = t->last; }
 void tx_thread_head_force(const tx_thread* t, double out[3]) { memcpy(out, t->head_force, sizeof t->head_force); }
-void tx_thread_tension(const tx_thread* t, double stiffness, double max_force, double f[3], double K[9]) {
-  int n = t->n, end = t->first_cut; // the head's piece: nodes 0..end
+// ftl: how far the head's piece (nodes 0..first_cut) is longer than at rest,
+// the length running on from the tail to its pin when the tail is pinned and
+// the thread uncut (m; <= 0: not taut), and the sum of its segments from the
+// head towards its end
+static double ftl_excess(const tx_thread* t, double sum[3]) {
+  int n = t->n, end = t->first_cut;
   const double* h = t->x;
   const double* tail = t->x + 3 * end;
-  double sum[3], len = 0, rest = t->l0 * end;
+  double len = 0, rest = t->l0 * end;
   for (int i = 0; i < end; i++) len += dist3(t->x + 3 * i, t->x + 3 * i + 3);
-  memset(K, 0, sizeof(double) * 9);
-  for (int a = 0; a < 3; a++) {
-    f[a] = 0;
-    sum[a] = tail[a] - h[a];
-  }
-  if (end == n - 1 && t->pinned[n - 1]) { // the length runs on to the tail's pin
+  for (int a = 0; a < 3; a++) sum[a] = tail[a] - h[a];
+  if (end == n - 1 && t->pinned[n - 1]) {
     const double* pin = t->pin + 3 * (n - 1);
     len += dist3(pin, tail);
     for (int a = 0; a < 3; a++) sum[a] = pin[a] - h[a];
   }
+  return len - rest;
+}
+
+void tx_thread_tension(const tx_thread* t, double stiffness, double max_force, double f[3], double K[9]) {
+  const double* h = t->x;
+  double sum[3];
+  double excess = ftl_excess(t, sum);
   double ls = sqrt(dot3(sum, sum));
+  memset(K, 0, sizeof(double) * 9);
+  for (int a = 0; a < 3; a++) f[a] = 0;
   if (t->def.model == TX_THREAD_ROD) {
     memcpy(f, t->head_force, sizeof t->head_force);
   } else {
-    if (ls > 0 && len > rest) {
-      double mag = stiffness * (len - rest);
+    if (ls > 0 && excess > 0) {
+      double mag = stiffness * excess;
       for (int a = 0; a < 3; a++) {
         f[a] = mag * sum[a] / ls;
         for (int b = 0; b < 3; b++) K[3 * a + b] = -stiffness * sum[a] * sum[b] / (ls * ls);
@@ -1165,6 +1175,48 @@ static void arc_link(const tx_thread* t, double arc, int* i, double* u) {
   *u = fmin(1, fmax(0, f - k));
 }
 
+// the unit vector from p along the thread to the first node at least half a
+// link from p, walking from node i by step (-1: towards the head, +1: towards
+// the tail) without crossing a cut; false when there is none
+static bool direction_away(const tx_thread* t, const double p[3], int i, int step, double u[3]) {
+  for (;;) {
+    double d = dist3(t->x + 3 * i, p);
+    if (d >= 0.5 * t->l0) {
+      for (int a = 0; a < 3; a++) u[a] = (t->x[3 * i + a] - p[a]) / d;
+      return true;
+    }
+    int link = step < 0 ? i - 1 : i; // the link crossed to the next node
+    if (i + step < 0 || i + step >= t->n || t->severed[link]) return false;
+    i += step;
+  }
+}
+
+int tx_thread_puncture_loads(const tx_thread* t, double stiffness, double max_force, double* f) {
+  const bool rod = t->def.model == TX_THREAD_ROD;
+  double sum[3], ftl_tension = 0;
+  if (!rod) ftl_tension = fmin(max_force, fmax(0, stiffness * ftl_excess(t, sum)));
+  for (int k = 0; k < t->passed; k++) {
+    double* fk = f + 3 * k;
+    const double* p = t->punct + 3 * k;
+    fk[0] = fk[1] = fk[2] = 0;
+    int i;
+    double u, head_side[3], tail_side[3];
+    arc_link(t, t->arc[k], &i, &u);
+    if (t->severed[i] || (!rod && i >= t->first_cut)) continue; // a piece that nothing pulls
+    // rod: the tension of the link that holds the point (its multiplier, negative when stretched)
+    double tension = rod ? fmin(max_force, fmax(0, -t->lam[i] * t->inv_h2)) : ftl_tension;
+    bool to_head = direction_away(t, p, i, -1, head_side), to_tail = direction_away(t, p, i + 1, +1, tail_side);
+    for (int a = 0; a < 3; a++) fk[a] = tension * ((to_head ? head_side[a] : 0) + (to_tail ? tail_side[a] : 0));
+    // ftl slides whatever the pull: a puncture it slid through in the last
+    // step is dragged towards the head by its friction
+    if (!rod && to_head && t->arc[k] > t->arc_step[k] + 1e-9 * t->l0)
+      for (int a = 0; a < 3; a++) fk[a] += t->def.puncture_friction * head_side[a];
+    for (int a = 0; a < 3; a++)
+      if (!isfinite(fk[a])) fk[0] = fk[1] = fk[2] = 0;
+  }
+  return t->passed;
+}
+
 // the material coordinate of the thread's point nearest p among the whole
 // links within a few of guess (a sliding thread moves less than a link a substep)
 static double nearest_arc(const tx_thread* t, const double p[3], double guess) {
@@ -1714,6 +1766,7 @@ static void rod_substep(tx_thread* t, double h, double margin) {
   if (t->thrown) limit_energy(t);
   // the force the constraints put on the (pinned) head: gradient x lambda /
   // h^2 of the first distance and of the bend at node 1 (its coefficient at node 0 is 1)
+  t->inv_h2 = 1 / (h * h);
   for (int a = 0; a < 3; a++) {
     t->head_force[a] = t->dir[a] * t->lam[0] / (h * h);
     if (n > 2) t->head_force[a] += t->lam[nseg + a] / (h * h);

@@ -11,7 +11,8 @@
 // it takes the TX_EVENT_CUT events of that stream: the link they name (or the
 // one nearest their point) is severed, PREFIX.cut_links marks it and the pieces,
 // and the cut is sent again on PREFIX.events. With punctures (tx_puncture
-// rows: points on triangles of the skin's particles) the thread passes through them in order.
+// rows: points on triangles of the skin's particles) the thread passes through them in order
+// and writes its pull on the skin at each passed one, PREFIX.puncture_loads (tx_puncture_load).
 // With grasp_events, a TX_EVENT_GRASP from hand h whose point is on the
 // thread holds the nearest node in the jaws' frame (instrument<h>.pose)
 // until a TX_EVENT_RELEASE from h. With start_shape the thread starts on
@@ -68,6 +69,9 @@ typedef struct thread_ctl {
   tx_result grasps_result;
   tx_port punct_in;          // the puncture list (punct_in.id 0: none)
   double* punct;             // (max_punctures x 3) where they are this step, m
+  tx_puncture* punct_rows;   // (max_punctures) their rows as read: the triangles the loads go on
+  double* load_f;            // (max_punctures x 3) N, the thread's pull on the skin at each passed one
+  tx_port loads;             // written with punctures: PREFIX.puncture_loads (tx_puncture_load)
   int max_punct;
   tx_warning bad_puncture, too_many_punctures;
   tx_result passed_result;
@@ -253,7 +257,13 @@ static int configure(tx_setup* s, void** self) {
   }
   k->max_punct = d.max_punctures;
   k->punct = malloc(sizeof(double) * 3 * (size_t)(d.max_punctures + 1));
-  if (!k->punct) return tx_setup_fail(s, NULL, "out of memory");
+  k->punct_rows = malloc(sizeof(tx_puncture) * (size_t)(d.max_punctures + 1));
+  k->load_f = malloc(sizeof(double) * 3 * (size_t)(d.max_punctures + 1));
+  if (!k->punct || !k->punct_rows || !k->load_f) return tx_setup_fail(s, NULL, "out of memory");
+  if (k->punct_in.id) {
+    snprintf(name, sizeof name, "%s.puncture_loads", prefix);
+    k->loads = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_puncture_load, (uint32_t)d.max_punctures + 1));
+  }
   k->bad_puncture = tx_setup_warning(s, "bad_puncture");
   k->too_many_punctures = tx_setup_warning(s, "too_many_punctures");
   k->passed_result = tx_setup_result(s, "punctures_passed");
@@ -338,6 +348,17 @@ static void publish(tx_ctx* c, thread_ctl* k) {
   memset(m, 0, sizeof *m);
   memcpy(m->x0, tx_thread_position(t, 0), sizeof m->x0);
   tx_thread_tension(t, k->tension_k, k->max_force, m->f0, m->k);
+  if (k->loads.id) { // the pull on the skin at each passed puncture, on its triangle
+    int passed = tx_thread_puncture_loads(t, k->tension_k, k->max_force, k->load_f);
+    tx_puncture_load* ld = tx_write(c, k->loads);
+    for (int j = 0; j < passed; j++) {
+      memcpy(ld[j].v, k->punct_rows[j].v, sizeof ld[j].v);
+      memcpy(ld[j].bary, k->punct_rows[j].bary, sizeof ld[j].bary);
+      memcpy(ld[j].f, k->load_f + 3 * j, sizeof ld[j].f);
+    }
+    memset(&ld[passed], 0, sizeof ld[passed] * (size_t)(k->max_punct + 1 - passed));
+    for (int j = passed; j <= k->max_punct; j++) ld[j].v[0] = -1;
+  }
 }
 
 static void emit_knot(tx_ctx* c, thread_ctl* k, const tx_knot_papers* p, bool fixed) {
@@ -526,7 +547,7 @@ static void take_punctures(tx_ctx* c, thread_ctl* k, tx_snapshot sx) {
       for (int j = 0; j < 3; j++) p += q->bary[j] * vx[v[j]].x[a];
       k->punct[3 * n + a] = p;
     }
-    n++;
+    k->punct_rows[n++] = *q;
   }
   if (tx_thread_set_punctures(k->t, k->punct, n) != TX_THREAD_OK) tx_warn(c, k->bad_puncture);
 }
@@ -650,6 +671,8 @@ static void fini(void* self) {
   free(k->start);
   free(k->shapes);
   free(k->punct);
+  free(k->punct_rows);
+  free(k->load_f);
   free(k);
 }
 

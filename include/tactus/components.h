@@ -305,6 +305,21 @@ typedef struct tx_puncture {
 #define tx_puncture_UNITS "1"
 TX_LAYOUT_ASSERT(tx_puncture, double);
 
+// THREAD.puncture_loads (max_punctures + 1 rows), written by physics.thread,
+// read by physics.skin (thread_loads): the force of the thread on the skin
+// at each puncture it runs through, in the puncture list's order, on the
+// same triangle point; rows past the last have v[0] = -1. A tight stitch
+// pulls its two punctures towards each other: the wound's edges close.
+typedef struct tx_puncture_load {
+  double v[3];    // rows of skin.x, as tx_puncture's (integers); v[0] = -1: none in this row
+  double bary[3]; // barycentric coordinates of the point, in the order of v
+  double f[3];    // N: the thread's pull on the skin there
+} tx_puncture_load;
+#define tx_puncture_load_TYPE TX_F64
+#define tx_puncture_load_COLS 9u
+#define tx_puncture_load_UNITS "1, 1, N"
+TX_LAYOUT_ASSERT(tx_puncture_load, double);
+
 // physics.instruments writes, for instrument N (held by deviceN):
 //   INSTRUMENT.pose (1 row, tx_instrument_pose): the root link frame (the
 //     pivot of the jaws) and the angle between the jaws, rad
