@@ -30,6 +30,7 @@
 //   clamp      the border ring (fixed_border) and, with clamp_radius > 0,
 //              every particle at or beyond that distance from the centre
 //   load       an external force per particle (tx_cloth_set_load)
+//   spring     a zero-length spring per particle to an anchor (tx_cloth_set_spring)
 //   pin        grasped particles (tx_cloth_pin): kinematic, moved where the
 //              jaws put them across a step, until unpinned
 //   rupture    the membrane tension, the largest principal value of the
@@ -184,6 +185,13 @@ double tx_cloth_max_strain(const tx_cloth* c);
 // an external force (N) on particle i from the next step on, until set
 // again (zero removes it); TX_CLOTH_BAD for a bad index or a non-finite force
 tx_cloth_status tx_cloth_set_load(tx_cloth* c, int i, const double f[3]);
+// a zero-length spring of k N/m from particle i to anchor (m) from the next
+// step on, until set again (k = 0 removes it): the force k (anchor - x)
+// follows the particle within the step, so the implicit solver takes a
+// stiff pull stably where a constant load, fixed for the whole step, would
+// overshoot; the HIP's balance reading counts it as an external force.
+// TX_CLOTH_BAD for a bad index, k outside [0, 1e9] or a point not finite
+tx_cloth_status tx_cloth_set_spring(tx_cloth* c, int i, const double anchor[3], double k);
 // grasped particles (the forceps' jaws hold them): a pinned particle is
 // kinematic, moved in a straight line from where it is to x (m) across the
 // next step's substeps and held there until pinned again elsewhere or

@@ -56,6 +56,9 @@ struct tx_cloth {
   std::vector<int32_t> node_links; // (n x 12) link ids at each particle, -1 padded
   std::vector<btVector3> load;     // (n) N, external force on each particle
   int loaded;                      // particles with a non-zero load
+  std::vector<double> spring_k;    // (n) N/m, a zero-length spring from each particle to its anchor (0: none)
+  std::vector<double> spring_a;    // (n x 3) m, the anchors
+  int sprung;                      // particles with a spring
   double peak_tension;             // N/m, largest averaged tension of the last step's checks
   double sub_peak;                 // N/m, the same over the current substep's checks
   double prev_peak;                // N/m, the same over the last substep's (the step before, across steps)
@@ -74,7 +77,7 @@ struct tx_cloth {
   std::vector<uint8_t> hold;       // (n) held along hold_n in the solve (the contact moved it)
   std::vector<uint8_t> held_solve; // (n) held at the end of the last solve (its active set)
   std::vector<uint8_t> state;      // (n) in the solve: 0 fixed, 1 free, 2 held (hold and the mass, packed)
-  std::vector<double> mh2;         // (n) N/m, m / h^2 of each particle, 0 when fixed
+  std::vector<double> mh2;         // (n) N/m, m / h^2 of each particle plus its spring's k, 0 when fixed
   std::vector<double> hold_n;      // (n x 3) 1, the contact's push on a held particle, summed
   // the two-level preconditioner (coarse_block > 0): blocks of coarse_block x coarse_block particles,
   // each one coarse particle; the Galerkin product P^T S A S P, banded, factored each Newton step
@@ -438,6 +441,8 @@ static bool build(tx_cloth* c) {
   c->hanging.assign((size_t)c->nlink, 0);
   c->local.assign((size_t)c->n, 0);
   c->load.assign((size_t)c->n, btVector3(0, 0, 0));
+  c->spring_k.assign((size_t)c->n, 0.0);
+  c->spring_a.assign((size_t)c->n * 3, 0.0);
   c->reach_factor = 2;
   c->breaking.resize((size_t)c->nlink);
   c->tri_stamp.assign((size_t)c->ntri, 0);
@@ -599,6 +604,9 @@ static void predict(tx_cloth* c, double h) {
     if (nd.m_im > 0) {
       nd.m_v += g;
       if (c->loaded > 0) nd.m_v += c->load[(size_t)i] * (nd.m_im * hs);
+      const double ks = c->sprung > 0 && !implicit ? c->spring_k[(size_t)i] : 0; // the implicit solve takes it whole
+      for (int a = 0; a < 3 && ks > 0; a++)
+        nd.m_v[a] += (btScalar)(ks * (c->spring_a[(size_t)i * 3 + a] - nd.m_x[a]) * nd.m_im * hs);
     }
     nd.m_x += nd.m_v * hs;
     if (implicit) {
@@ -695,11 +703,13 @@ static void assemble(tx_cloth* c, double h) {
   double* pi = c->pinv.data(); // the diagonal blocks first, inverted below
   for (int i = 0; i < n; i++) {
     const double m = base[i].m_im > 0 ? 1 / (double)base[i].m_im : 0, w = m * ih2;
-    c->mh2[(size_t)i] = w;
     c->state[(size_t)i] = m > 0 ? (c->hold[(size_t)i] ? 2 : 1) : 0;
     for (int a = 0; a < 3; a++) g[i * 3 + a] = w * ((double)base[i].m_x[a] - c->y[(size_t)i * 3 + a]);
+    const double kp = m > 0 && c->sprung > 0 ? c->spring_k[(size_t)i] : 0; // its spring: k (x - anchor), Hessian k I
+    for (int a = 0; a < 3 && kp > 0; a++) g[i * 3 + a] += kp * ((double)base[i].m_x[a] - c->spring_a[(size_t)i * 3 + a]);
+    c->mh2[(size_t)i] = w + kp;
     double* b = &pi[i * 6];
-    b[0] = b[1] = b[2] = w;
+    b[0] = b[1] = b[2] = w + kp;
     b[3] = b[4] = b[5] = 0;
   }
   for (int s = 0; s < nl; s++) {
@@ -799,6 +809,11 @@ static double energy(const tx_cloth* c, double h) {
       s += d * d;
     }
     e += 0.5 * ih2 / (double)base[i].m_im * s;
+    const double ks = c->sprung > 0 ? c->spring_k[(size_t)i] : 0;
+    for (int a = 0; a < 3 && ks > 0; a++) {
+      const double d = (double)base[i].m_x[a] - c->spring_a[(size_t)i * 3 + a];
+      e += 0.5 * ks * d * d;
+    }
   }
   const btAlignedObjectArray<btSoftBody::Link>& links = c->body->m_links;
   for (int i = 0, nl = links.size(); i < nl; i++) {
@@ -1773,8 +1788,11 @@ static int link_reaction(const tx_cloth* c, double dt, double h, double out[3]) 
     const bool in = c->in_contact[(size_t)i] != 0;
     held += in;
     double m = 1.0 / nd.m_im;
-    if (balance)
+    if (balance) {
       for (int e = 0; e < 3; e++) out[e] -= m * ((double)nd.m_x[e] - c->y[(size_t)i * 3 + e]) * ih2;
+      const double ks = c->sprung > 0 ? c->spring_k[(size_t)i] : 0; // a spring is an external force too, as a load in y
+      for (int e = 0; e < 3 && ks > 0; e++) out[e] += ks * (c->spring_a[(size_t)i * 3 + e] - (double)nd.m_x[e]);
+    }
     else if (in)
       for (int e = 0; e < 3; e++)
         out[e] += m * (c->world.m_gravity[e] - (nd.m_v[e] - c->good_v[(size_t)i * 3 + e]) / dt);
@@ -2030,6 +2048,25 @@ extern "C" tx_cloth_status tx_cloth_set_load(tx_cloth* c, int i, const double f[
   c->loaded -= l.length2() > 0;
   l = btVector3((btScalar)f[0], (btScalar)f[1], (btScalar)f[2]);
   c->loaded += l.length2() > 0;
+  return TX_CLOTH_OK;
+}
+
+extern "C" tx_cloth_status tx_cloth_set_spring(tx_cloth* c, int i, const double anchor[3], double k) {
+  if (i < 0 || i >= c->n) {
+    tx_set_error("skin: spring on particle %d, there are %d", i, c->n);
+    return TX_CLOTH_BAD;
+  }
+  bool finite = std::isfinite(anchor[0]) && std::isfinite(anchor[1]) && std::isfinite(anchor[2]);
+  if (!(k >= 0 && k <= 1e9) || !finite) {
+    tx_set_error("skin: spring of %g N/m to (%g, %g, %g) on particle %d, must be in [0, 1e9] N/m to a finite point", k,
+                 anchor[0], anchor[1], anchor[2], i);
+    return TX_CLOTH_BAD;
+  }
+  double& ks = c->spring_k[(size_t)i];
+  c->sprung -= ks > 0;
+  ks = k;
+  c->sprung += ks > 0;
+  for (int a = 0; a < 3; a++) c->spring_a[(size_t)i * 3 + a] = anchor[a];
   return TX_CLOTH_OK;
 }
 

@@ -460,6 +460,43 @@ static void loads_and_the_circular_clamp(void** state) {
   tx_cloth_destroy(c);
 }
 
+// a spring settles where the load it stands for does: a load F pushes the
+// centre down to x_l; a zero-length spring of k to x_l + F / k pulls with F
+// exactly there, so its equilibrium (the implicit solve with the spring's
+// energy and Hessian) is the same point. Bad springs are refused.
+static void a_spring_settles_where_its_load_does(void** state) {
+  (void)state;
+  tx_cloth_def d = tx_cloth_def_default();
+  d.res[0] = d.res[1] = 21;
+  d.rupture_tension = 0;
+  const int mid = 10 * 21 + 10;
+  const double f[3] = {0, -0.05, 0}, k = 50;
+  tx_cloth* c = tx_cloth_create(&d);
+  assert_non_null(c);
+  assert_int_equal(tx_cloth_set_load(c, mid, f), TX_CLOTH_OK);
+  for (int s = 0; s < 180; s++) assert_int_equal(tx_cloth_step(c, 1.0 / 60), TX_CLOTH_OK);
+  double xl[3], xs[3], a[3];
+  tx_cloth_particle(c, mid, xl);
+  tx_cloth_destroy(c);
+  c = tx_cloth_create(&d);
+  for (int e = 0; e < 3; e++) a[e] = xl[e] + f[e] / k;
+  assert_int_equal(tx_cloth_set_spring(c, mid, a, k), TX_CLOTH_OK);
+  for (int s = 0; s < 180; s++) assert_int_equal(tx_cloth_step(c, 1.0 / 60), TX_CLOTH_OK);
+  tx_cloth_particle(c, mid, xs);
+  print_message("the centre under a 0.05 N load: %.4f mm; under the spring standing for it: %.4f mm\n", xl[1] * 1e3,
+                xs[1] * 1e3);
+  assert_true(xl[1] < -0.001);
+  assert_float_equal(xs[1], xl[1], 0.01 * fabs(xl[1]));
+  const double nan3[3] = {NAN, 0, 0};
+  assert_int_equal(tx_cloth_set_spring(c, -1, a, k), TX_CLOTH_BAD);
+  assert_int_equal(tx_cloth_set_spring(c, 21 * 21, a, k), TX_CLOTH_BAD);
+  assert_int_equal(tx_cloth_set_spring(c, mid, a, -1), TX_CLOTH_BAD);
+  assert_int_equal(tx_cloth_set_spring(c, mid, a, 2e9), TX_CLOTH_BAD);
+  assert_int_equal(tx_cloth_set_spring(c, mid, nan3, k), TX_CLOTH_BAD);
+  assert_non_null(strstr(tx_error(), "spring"));
+  tx_cloth_destroy(c);
+}
+
 // stepping, with contact, rupture and a recovered fault, allocates nothing
 static void steps_never_allocate(void** state) {
   (void)state;
@@ -970,6 +1007,7 @@ int main(void) {
       cmocka_unit_test(bad_definitions_are_refused),
       cmocka_unit_test(pretension_is_the_membrane_tension),
       cmocka_unit_test(loads_and_the_circular_clamp),
+      cmocka_unit_test(a_spring_settles_where_its_load_does),
       cmocka_unit_test(steps_never_allocate),
       cmocka_unit_test(implicit_is_stable_when_stiff),
       cmocka_unit_test(untorn_skin_holds_to_3cm),
