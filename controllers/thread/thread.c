@@ -71,6 +71,7 @@ struct tx_thread {
   double* hold_to;           // (n x 3) and at its end
   int nheld;                 // nodes held
   int last_pin;              // the highest pinned node (0: the head alone)
+  double taut_excess;        // m, ftl drawn taut through its punctures (ftl_taut): the path's length over the thread's; -1: not
   double head_from[3], head_to[3];
   // the self-contact broadphase: sort and sweep of the cylinders' boxes
   // along one axis, the order kept from substep to substep
@@ -105,7 +106,6 @@ struct tx_thread {
   double probe;              // m, the nearest triangle found by a query
   tx_thread_contacts last;
   double head_force[3];      // N, the rod's constraints on the head in the last substep
-  double inv_h2;             // 1/s^2, the last rod substep's: a multiplier times it is a force
   int faults;
   // the rod's bends near crossings (rod_solve, limit_energy)
   double* dxb;               // (n x 3) the bends' move of each node in one solve, m
@@ -205,6 +205,7 @@ int tx_thread_def_check(const tx_thread_def* d) {
 static void update_last_pin(tx_thread* t) {
   for (int i = 0; i < t->n; i++) t->w[i] = t->pinned[i] ? 0 : t->wf[i];
   t->last_pin = 0;
+  t->taut_excess = -1;
   for (int i = t->n - 1; i > 0; i--)
     if (t->pinned[i]) {
       t->last_pin = i;
@@ -384,6 +385,9 @@ static double ftl_excess(const tx_thread* t, double sum[3]) {
     len += dist3(pin, tail);
     for (int a = 0; a < 3; a++) sum[a] = pin[a] - h[a];
   }
+  // drawn taut through punctures, its links lie along the path (chords across
+  // the bends): the stretch is the path's length over the thread's
+  if (t->def.model == TX_THREAD_FTL && t->taut_excess >= 0) return t->taut_excess;
   return len - rest;
 }
 
@@ -1175,44 +1179,64 @@ static void arc_link(const tx_thread* t, double arc, int* i, double* u) {
   *u = fmin(1, fmax(0, f - k));
 }
 
-// the unit vector from p along the thread to the first node at least half a
-// link from p, walking from node i by step (-1: towards the head, +1: towards
-// the tail) without crossing a cut; false when there is none
-static bool direction_away(const tx_thread* t, const double p[3], int i, int step, double u[3]) {
-  for (;;) {
-    double d = dist3(t->x + 3 * i, p);
-    if (d >= 0.5 * t->l0) {
-      for (int a = 0; a < 3; a++) u[a] = (t->x[3 * i + a] - p[a]) / d;
-      return true;
+// the thread's direction from passed puncture k towards its head (step -1)
+// or its tail (+1): to the next passed puncture that way when the thread
+// reaches it first (the strand between two is straight), else to its first
+// node at least STRAND_REACH and three links from the point (past the kink,
+// which the routing puts at a node up to a link beyond it, and the bend the
+// kinematic thread keeps next to it), else its last node that way before an
+// end or a cut; false when there is none
+#define STRAND_REACH 0.005 // m
+static bool strand_direction(const tx_thread* t, int k, int step, double u[3]) {
+  const double* p = t->punct + 3 * k;
+  int i;
+  double frac;
+  arc_link(t, t->arc[k], &i, &frac);
+  int next = k - step; // arcs fall from the first passed to the last
+  bool has_next = next >= 0 && next < t->passed;
+  const double* to = NULL;
+  for (int j = step < 0 ? i : i + 1;; j += step) {
+    if (has_next && (step < 0 ? j * t->l0 <= t->arc[next] : j * t->l0 >= t->arc[next])) {
+      to = t->punct + 3 * next;
+      break;
     }
-    int link = step < 0 ? i - 1 : i; // the link crossed to the next node
-    if (i + step < 0 || i + step >= t->n || t->severed[link]) return false;
-    i += step;
+    to = t->x + 3 * j;
+    if (dist3(to, p) >= fmax(3 * t->l0, STRAND_REACH)) break;
+    int link = step < 0 ? j - 1 : j;
+    if (j + step < 0 || j + step >= t->n || t->severed[link]) break;
   }
+  double d = dist3(to, p);
+  if (!(d > 1e-9 * t->l0)) return false;
+  for (int a = 0; a < 3; a++) u[a] = (to[a] - p[a]) / d;
+  return true;
 }
 
-int tx_thread_puncture_loads(const tx_thread* t, double stiffness, double max_force, double* f) {
+int tx_thread_puncture_loads(const tx_thread* t, double stiffness, double max_force, double* f, double* k_out) {
   const bool rod = t->def.model == TX_THREAD_ROD;
-  double sum[3], ftl_tension = 0;
-  if (!rod) ftl_tension = fmin(max_force, fmax(0, stiffness * ftl_excess(t, sum)));
+  // the tension the hand feels (the force model's, or the rod's force on its
+  // head), the same all along through frictionless punctures, and the
+  // strand's stiffness: ftl, its force model's; rod, E A over the head's piece
+  double f0[3], K[9];
+  tx_thread_tension(t, stiffness, max_force, f0, K);
+  const double tension = sqrt(dot3(f0, f0));
+  const double strand = rod ? t->l0 / t->alpha_d / (t->first_cut * t->l0) : stiffness;
   for (int k = 0; k < t->passed; k++) {
     double* fk = f + 3 * k;
-    const double* p = t->punct + 3 * k;
     fk[0] = fk[1] = fk[2] = 0;
+    k_out[k] = 0;
     int i;
-    double u, head_side[3], tail_side[3];
+    double u, head_side[3] = {0, 0, 0}, tail_side[3] = {0, 0, 0};
     arc_link(t, t->arc[k], &i, &u);
-    if (t->severed[i] || (!rod && i >= t->first_cut)) continue; // a piece that nothing pulls
-    // rod: the tension of the link that holds the point (its multiplier, negative when stretched)
-    double tension = rod ? fmin(max_force, fmax(0, -t->lam[i] * t->inv_h2)) : ftl_tension;
-    bool to_head = direction_away(t, p, i, -1, head_side), to_tail = direction_away(t, p, i + 1, +1, tail_side);
-    for (int a = 0; a < 3; a++) fk[a] = tension * ((to_head ? head_side[a] : 0) + (to_tail ? tail_side[a] : 0));
-    // ftl slides whatever the pull: a puncture it slid through in the last
-    // step is dragged towards the head by its friction
-    if (!rod && to_head && t->arc[k] > t->arc_step[k] + 1e-9 * t->l0)
-      for (int a = 0; a < 3; a++) fk[a] += t->def.puncture_friction * head_side[a];
-    for (int a = 0; a < 3; a++)
-      if (!isfinite(fk[a])) fk[0] = fk[1] = fk[2] = 0;
+    if (t->severed[i] || i >= t->first_cut || !(tension > 0)) continue; // a piece the head no longer pulls
+    bool to_head = strand_direction(t, k, -1, head_side), to_tail = strand_direction(t, k, +1, tail_side);
+    if (!to_tail) continue; // the thread's end at the point: it has slid out
+    double dir[3];
+    for (int a = 0; a < 3; a++) dir[a] = (to_head ? head_side[a] : 0) + tail_side[a];
+    for (int a = 0; a < 3; a++) fk[a] = tension * dir[a];
+    // the pull falls by the strand's stiffness times the path it shortens,
+    // |dir| for a move along dir: k |dir|^2 along the pull
+    k_out[k] = strand * dot3(dir, dir);
+    if (!(isfinite(fk[0]) && isfinite(fk[1]) && isfinite(fk[2]) && isfinite(k_out[k]))) fk[0] = fk[1] = fk[2] = k_out[k] = 0;
   }
   return t->passed;
 }
@@ -1399,17 +1423,98 @@ static void ftl_forward(tx_thread* t) {
   }
 }
 
+// The pass back from the last pin towards the head, routed through the
+// punctures as the forward pass is, from the tail's side: the link that holds
+// a puncture's point puts its head-side node on the line from its tail-side
+// node through the point; out of reach, the point held moves on towards the
+// head (the pin draws the thread back through it). Without this, a pass that
+// simply followed the pin would pull the thread off its punctures, and the
+// next forward pass would slide it on through them: step by step a thread
+// whose tail is pinned slid out of its stitch.
+static void ftl_backward(tx_thread* t) {
+  int k = 0; // the first passed lies the furthest along the thread: met first from the tail
+  while (k < t->passed && t->arc[k] > t->last_pin * t->l0) k++;
+  for (int i = t->last_pin; i > 0; i--) {
+    if (t->pinned[i]) {
+      memcpy(t->x + 3 * i, t->pin + 3 * i, sizeof(double) * 3);
+      while (k < t->passed && t->arc[k] >= i * t->l0 * (1 - 1e-12)) k++; // on the pinned node's far side
+      continue;
+    }
+    if (t->severed[i]) continue;
+    if (k < t->passed && t->arc[k] >= i * t->l0 * (1 - 1e-12)) {
+      const double *l = t->x + 3 * (i + 1), *p = t->punct + 3 * k;
+      double d = dist3(l, p);
+      if (d > 1e-9 * t->l0) {
+        for (int c = 0; c < 3; c++) t->x[3 * i + c] = l[c] + (p[c] - l[c]) / d * t->l0;
+      } else {
+        place_after(t, i, i + 1, t->l0);
+      }
+      if (d <= t->l0) {
+        t->arc[k++] = (i + 1) * t->l0 - d;
+      } else {
+        t->arc[k] = i * t->l0;
+      }
+    } else {
+      follow(t, i, i + 1);
+    }
+  }
+}
+
+// A thread whose tail is pinned, drawn through its punctures until it is
+// taut, lies straight from the head through each puncture to the pin; the
+// kinematic passes cannot find that state (an inextensible chain between two
+// fixed ends over a longer path: each pass slides it through the punctures
+// its own way, and the slack it keeps lands where they leave it). So the
+// straight path head -> punctures -> pin decides: at least the thread's
+// length, the nodes are laid along it a link apart from the head, and its
+// excess over the length is the stretch of the force model (tension (length
+// - rest) x stiffness, the same all along, as through frictionless
+// punctures); shorter, the thread is slack (no stretch) and the passes place
+// it. Not with held nodes or a cut (other paths): taut_excess -1.
+#define TX_THREAD_TAUT_POINTS 1026 // the head, max_punctures (at most 1024) and the pin
+static bool ftl_taut(tx_thread* t) {
+  if (t->last_pin != t->n - 1 || t->nheld > 0 || t->first_cut < t->nseg || t->passed == 0) return false;
+  for (int i = 1; i < t->n - 1; i++)
+    if (t->pinned[i]) return false;
+  const double* way[TX_THREAD_TAUT_POINTS];
+  int m = 0;
+  way[m++] = t->x; // the head, then the punctures from the last passed (nearest the head) to the first, then the pin
+  for (int k = t->passed - 1; k >= 0 && m < TX_THREAD_TAUT_POINTS - 1; k--) way[m++] = t->punct + 3 * k;
+  if (m != t->passed + 1) return false;
+  way[m++] = t->pin + 3 * (t->n - 1);
+  double total = 0;
+  for (int j = 0; j + 1 < m; j++) total += dist3(way[j], way[j + 1]);
+  if (total < t->nseg * t->l0) { // slack, as its straight path is shorter: the passes place it, unstretched
+    t->taut_excess = 0;
+    return false;
+  }
+  // the nodes a link apart along the path (a link across a bend is a chord)
+  double start = 0; // the path's length up to way[j]
+  int j = 0;
+  for (int i = 1; i < t->n; i++) {
+    double s = i * t->l0, len = dist3(way[j], way[j + 1]);
+    while (j + 2 < m && s > start + len) start += len, j++, len = dist3(way[j], way[j + 1]);
+    double f = len > 0 ? (s - start) / len : 0;
+    for (int a = 0; a < 3; a++) t->x[3 * i + a] = way[j][a] + f * (way[j + 1][a] - way[j][a]);
+  }
+  t->taut_excess = total - t->nseg * t->l0;
+  // each puncture's point held: its distance from the head along the path
+  double d = 0;
+  for (int k = t->passed - 1, q = 0; k >= 0; k--, q++) {
+    d += dist3(way[q], way[q + 1]);
+    t->arc[k] = fmin(d, t->nseg * t->l0);
+  }
+  return true;
+}
+
 // FABRIK towards the pins behind the head, the last pass from the head
 static void ftl_solve(tx_thread* t) {
+  t->taut_excess = -1;
+  if (ftl_taut(t)) return;
   ftl_forward(t);
   if (t->last_pin == 0) return;
   for (int it = 0; it < t->def.iterations; it++) {
-    for (int i = t->last_pin; i > 0; i--) {
-      if (t->pinned[i])
-        memcpy(t->x + 3 * i, t->pin + 3 * i, sizeof(double) * 3);
-      else if (!t->severed[i])
-        follow(t, i, i + 1);
-    }
+    ftl_backward(t);
     ftl_forward(t);
   }
 }
@@ -1766,7 +1871,6 @@ static void rod_substep(tx_thread* t, double h, double margin) {
   if (t->thrown) limit_energy(t);
   // the force the constraints put on the (pinned) head: gradient x lambda /
   // h^2 of the first distance and of the bend at node 1 (its coefficient at node 0 is 1)
-  t->inv_h2 = 1 / (h * h);
   for (int a = 0; a < 3; a++) {
     t->head_force[a] = t->dir[a] * t->lam[0] / (h * h);
     if (n > 2) t->head_force[a] += t->lam[nseg + a] / (h * h);

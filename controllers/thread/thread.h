@@ -263,15 +263,17 @@ void tx_thread_head_force(const tx_thread* t, double out[3]);
 // clamped to max_force (N) and never NaN.
 void tx_thread_tension(const tx_thread* t, double stiffness, double max_force, double f[3], double K[9]);
 // the force (N) of the thread on the skin at each passed puncture k, into
-// f[3k..3k+2]: its tension pulls the point along the thread both ways,
-// T (u_head + u_tail), u the unit vectors from the point to the thread's
-// first nodes at least half a link away on either side. T: ftl, the same
-// (length - rest length) x stiffness as tx_thread_tension, plus
-// puncture_friction towards the head at a puncture it slid through in the
-// last step; rod, the tension of the link that holds the point. T is
-// clamped to max_force; a piece that no longer pulls (past a cut) loads
-// nothing. Returns the number of passed punctures.
-int tx_thread_puncture_loads(const tx_thread* t, double stiffness, double max_force, double* f);
+// f[3k..3k+2], and its stiffness (N/m) into k_out[k]: the thread's tension T
+// pulls the point along it both ways, T (u_head + u_tail), u the unit
+// vectors from the point to the thread's first nodes at least one and a half
+// links away on either side. T is the tension the hand feels (the magnitude
+// of tx_thread_tension's force with the same stiffness and clamp), the same
+// all along as through frictionless punctures. The pull falls as the point
+// moves along it by the strand's stiffness (ftl: stiffness; rod: E A over the
+// head's piece) times |u_head + u_tail|^2. A puncture on a piece the head no
+// longer pulls (past a cut), or with no thread beyond it towards the tail
+// (its end has slid out), loads nothing. Returns the number of passed punctures.
+int tx_thread_puncture_loads(const tx_thread* t, double stiffness, double max_force, double* f, double* k_out);
 // where node i is pinned: false when it is free
 bool tx_thread_pin_of(const tx_thread* t, int i, double out[3]);
 // steps that faulted and were put back

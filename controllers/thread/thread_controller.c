@@ -71,6 +71,7 @@ typedef struct thread_ctl {
   double* punct;             // (max_punctures x 3) where they are this step, m
   tx_puncture* punct_rows;   // (max_punctures) their rows as read: the triangles the loads go on
   double* load_f;            // (max_punctures x 3) N, the thread's pull on the skin at each passed one
+  double* load_k;            // (max_punctures) N/m, and its stiffness
   tx_port loads;             // written with punctures: PREFIX.puncture_loads (tx_puncture_load)
   int max_punct;
   tx_warning bad_puncture, too_many_punctures;
@@ -259,7 +260,8 @@ static int configure(tx_setup* s, void** self) {
   k->punct = malloc(sizeof(double) * 3 * (size_t)(d.max_punctures + 1));
   k->punct_rows = malloc(sizeof(tx_puncture) * (size_t)(d.max_punctures + 1));
   k->load_f = malloc(sizeof(double) * 3 * (size_t)(d.max_punctures + 1));
-  if (!k->punct || !k->punct_rows || !k->load_f) return tx_setup_fail(s, NULL, "out of memory");
+  k->load_k = malloc(sizeof(double) * (size_t)(d.max_punctures + 1));
+  if (!k->punct || !k->punct_rows || !k->load_f || !k->load_k) return tx_setup_fail(s, NULL, "out of memory");
   if (k->punct_in.id) {
     snprintf(name, sizeof name, "%s.puncture_loads", prefix);
     k->loads = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_puncture_load, (uint32_t)d.max_punctures + 1));
@@ -349,12 +351,13 @@ static void publish(tx_ctx* c, thread_ctl* k) {
   memcpy(m->x0, tx_thread_position(t, 0), sizeof m->x0);
   tx_thread_tension(t, k->tension_k, k->max_force, m->f0, m->k);
   if (k->loads.id) { // the pull on the skin at each passed puncture, on its triangle
-    int passed = tx_thread_puncture_loads(t, k->tension_k, k->max_force, k->load_f);
+    int passed = tx_thread_puncture_loads(t, k->tension_k, k->max_force, k->load_f, k->load_k);
     tx_puncture_load* ld = tx_write(c, k->loads);
     for (int j = 0; j < passed; j++) {
       memcpy(ld[j].v, k->punct_rows[j].v, sizeof ld[j].v);
       memcpy(ld[j].bary, k->punct_rows[j].bary, sizeof ld[j].bary);
       memcpy(ld[j].f, k->load_f + 3 * j, sizeof ld[j].f);
+      ld[j].k = k->load_k[j];
     }
     memset(&ld[passed], 0, sizeof ld[passed] * (size_t)(k->max_punct + 1 - passed));
     for (int j = passed; j <= k->max_punct; j++) ld[j].v[0] = -1;
@@ -673,6 +676,7 @@ static void fini(void* self) {
   free(k->punct);
   free(k->punct_rows);
   free(k->load_f);
+  free(k->load_k);
   free(k);
 }
 

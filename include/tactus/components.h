@@ -314,10 +314,11 @@ typedef struct tx_puncture_load {
   double v[3];    // rows of skin.x, as tx_puncture's (integers); v[0] = -1: none in this row
   double bary[3]; // barycentric coordinates of the point, in the order of v
   double f[3];    // N: the thread's pull on the skin there
+  double k;       // N/m: how fast the pull falls as the skin there moves along it (the thread gives)
 } tx_puncture_load;
 #define tx_puncture_load_TYPE TX_F64
-#define tx_puncture_load_COLS 9u
-#define tx_puncture_load_UNITS "1, 1, N"
+#define tx_puncture_load_COLS 10u
+#define tx_puncture_load_UNITS "1, 1, N, N/m"
 TX_LAYOUT_ASSERT(tx_puncture_load, double);
 
 // physics.instruments writes, for instrument N (held by deviceN):

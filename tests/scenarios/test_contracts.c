@@ -42,6 +42,7 @@ static const layout layouts[] = {
     L(".torn", tx_torn),                L(".damage", tx_damage),           L(".nodes", tx_thread_node),
     L(".pointer", tx_pointer),          L(".contact", tx_skin_contact),    L(".rupture", tx_skin_rupture),
     L(".tip", tx_pose),                 L(".punctures", tx_puncture),      L(".cut_links", tx_thread_link),
+    L(".puncture_loads", tx_puncture_load),
     L(".held", tx_instrument_held),     L(".grasp", tx_organ_grasp),     L(".surface_node", tx_surface_node),
 };
 #undef L

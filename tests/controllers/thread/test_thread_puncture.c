@@ -122,6 +122,63 @@ static void test_slides_through_two_moving_punctures(void** state) {
 #endif
 }
 
+// A taut thread bent through one puncture loads it as a rope loads a
+// pulley: T (u_A + u_H), u the unit vectors from the point to the pinned tail
+// A and to the head H, and T = k (|AP| + |PH| - L), the follow-the-leader
+// tension of a thread of length L drawn over that path (frictionless: the
+// same all along), with stiffness k |u_A + u_H|^2 along the pull. The tail is
+// pinned 40 mm behind the head; the head goes through P, 30.41 mm from A, on
+// 9 mm along -y (slack: 39.41 mm of path) or to 12 mm (2.41 mm over 40), and
+// holds. Slack, the thread pulls nothing. Taut, it is laid straight along the
+// path (ftl_taut), so this checks the chain from the puncture's passing to
+// the load to rounding; before that, the kinematic passes slid this thread
+// out of P step by step and pulled with what they left at the pin.
+static void pull_through(tx_thread* t, const double P[3], double depth, int steps) {
+  for (int s = 1; s <= steps; s++) {
+    double time = s * 1e-3, h[3];
+    double a = fmin(1, time / 0.1), b = fmin(1, fmax(0, (time - 0.1) / 0.1));
+    for (int c = 0; c < 3; c++) h[c] = a * P[c];
+    h[1] -= b * depth;
+    assert_int_equal(tx_thread_set_punctures(t, P, 1), TX_THREAD_OK);
+    assert_int_equal(tx_thread_set_head(t, h), TX_THREAD_OK);
+    assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
+  }
+}
+
+static void test_taut_thread_loads_its_puncture_as_a_pulley(void** state) {
+  (void)state;
+  tx_thread_def d = tx_thread_def_default();
+  d.nodes = 81;
+  d.length = 0.04;
+  d.direction[0] = -1;
+  d.pin_tail = true;
+  const double A[3] = {-0.04, 0, 0}, P[3] = {-0.01, -0.005, 0}, H[3] = {-0.01, -0.017, 0}, k = 200;
+  double load[3], k_load, la = 0, lh = 0, want[3], err = 0, w2 = 0;
+  tx_thread* t = tx_thread_create(&d); // slack
+  assert_non_null(t);
+  pull_through(t, P, 0.009, 300);
+  assert_int_equal(tx_thread_puncture_loads(t, k, 10, load, &k_load), 1);
+  print_message("slack: load (%g, %g) N\n", load[0], load[1]);
+  assert_true(load[0] == 0 && load[1] == 0 && k_load == 0);
+  tx_thread_destroy(t);
+  t = tx_thread_create(&d); // taut
+  pull_through(t, P, 0.012, 300);
+  assert_int_equal(tx_thread_punctures_passed(t), 1);
+  assert_int_equal(tx_thread_puncture_loads(t, k, 10, load, &k_load), 1);
+  for (int c = 0; c < 3; c++) la += pow(A[c] - P[c], 2), lh += pow(H[c] - P[c], 2);
+  la = sqrt(la), lh = sqrt(lh);
+  const double T = k * (la + lh - d.length);
+  for (int c = 0; c < 3; c++) want[c] = T * ((A[c] - P[c]) / la + (H[c] - P[c]) / lh);
+  for (int c = 0; c < 3; c++) err += pow(load[c] - want[c], 2), w2 += want[c] * want[c];
+  print_message("taut: puncture load (%.4f, %.4f) N, as a pulley (%.4f, %.4f) N (T = %.4f N): off by %.2g; "
+                "stiffness %.1f N/m (k |u_A + u_H|^2: %.1f); its point %.3f mm from the head\n", load[0], load[1],
+                want[0], want[1], T, sqrt(err / w2), k_load, k * w2 / (T * T), tx_thread_puncture_arc(t, 0) * 1e3);
+  assert_true(sqrt(err / w2) < 1e-9);
+  assert_float_equal(k_load, k * w2 / (T * T), 1e-9 * k_load);
+  assert_float_equal(tx_thread_puncture_arc(t, 0), lh, 1e-12); // still through P, 12 mm from the head
+  tx_thread_destroy(t);
+}
+
 // friction through the punctures: the head feels more force while the
 // thread is pulled through (rod: through the constraints; ftl: the friction
 // of each puncture it slid through, added to the tension)
@@ -169,6 +226,7 @@ static void test_bad_puncture_lists(void** state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_slides_through_two_moving_punctures),
+      cmocka_unit_test(test_taut_thread_loads_its_puncture_as_a_pulley),
       cmocka_unit_test(test_friction_raises_the_head_force),
       cmocka_unit_test(test_bad_puncture_lists),
   };
