@@ -47,14 +47,13 @@ typedef struct skin {
   // over the particles near its point (thread_load_radius_m) on its side of the
   // wound, or shared by its triangle's particles by their barycentric weights
   tx_port loads_in;                     // read: tx_puncture_load rows (0: none)
-  double load_tau;                      // s, each row's force followed through a first-order lag of this time constant
-  double* row_f;                        // (rows x 3) N, each row's force as the skin takes it (the lagged one)
-  uint32_t nrows;
   double load_radius;                   // m, each row's force spread over the particles this near its point; 0: its triangle's
   bool has_wound;                       // a load stays on its side of the wound line
   double wound[2][3];                   // m, the wound's ends
   double* load;                         // (n x 3) N, the load on each particle now
-  int32_t* loaded;                      // (3 n) the particles with a load, nloaded of them
+  double* load_k;                       // (n) N/m, the stiffness it comes with (its share of its rows')
+  uint8_t* listed;                      // (n) 1: in loaded
+  int32_t* loaded;                      // (n) the particles with a load, nloaded of them
   int nloaded;
   tx_warning bad_load;
   double load_max;                      // N, the largest row's force so far
@@ -115,8 +114,6 @@ static const tx_param_def params[] = {
     {"wound_b_m", TX_PARAM_JSON, NULL, 0, 0, 0, NULL, "[x, y, z], m: the wound's other end"},
     {"thread_loads", TX_PARAM_STR, NULL, 0, 0, 0, "",
      "the thread's pull at its punctures (tx_puncture_load rows, e.g. thread.puncture_loads) on the skin: a tight stitch closes the wound; \"\": none"},
-    {"thread_load_tau_s", TX_PARAM_NUM, "s", 0, 1, 0.05, NULL,
-     "each puncture's load follows the thread's through a first-order lag of this time constant: the thread is stiff and kinematic, the skin light, and their pull and give would otherwise chase each other from step to step; 0: none"},
     {"thread_load_radius_m", TX_PARAM_NUM, "m", 0, 0.02, 0.004, NULL,
      "a puncture's load is spread over the particles this near it on its side of the wound, weights falling linearly to 0 at this distance (the thread bears on the tissue along its bite); 0: on its triangle's three particles"},
 };
@@ -226,11 +223,13 @@ static int configure(tx_setup* s, void** self) {
   if (*loads) {
     k->loads_in = TX_READ_EXPECT(s, loads, tx_puncture_load);
     k->load = calloc((size_t)n * 3, sizeof *k->load);
-    k->loaded = malloc((size_t)n * 3 * sizeof *k->loaded); // a particle whose loads cancel may be listed again
-    if (!k->load || !k->loaded) return tx_setup_fail(s, NULL, "out of memory");
+    k->load_k = calloc((size_t)n, sizeof *k->load_k);
+    k->listed = calloc((size_t)n, 1);
+    k->loaded = malloc((size_t)n * sizeof *k->loaded);
+    if (!k->load || !k->load_k || !k->listed || !k->loaded) return tx_setup_fail(s, NULL, "out of memory");
   }
   k->load_radius = tx_table_num(s, "thread_load_radius_m");
-  k->load_tau = tx_table_num(s, "thread_load_tau_s");
+
   k->bad_load = tx_setup_warning(s, "bad_load");
   k->load_result = tx_setup_result(s, "thread_load_max_n");
   return 0;
@@ -324,10 +323,11 @@ static int wound_side(const skin* k, const double p[3]) {
   return (b[0] - a[0]) * (p[2] - a[2]) - (b[2] - a[2]) * (p[0] - a[0]) >= 0 ? 1 : -1;
 }
 
-static void add_load(skin* k, int i, double w, const double f[3]) {
+static void add_load(skin* k, int i, double w, const tx_puncture_load* q) {
   double* l = &k->load[3 * (size_t)i];
-  if (l[0] == 0 && l[1] == 0 && l[2] == 0) k->loaded[k->nloaded++] = i;
-  for (int e = 0; e < 3; e++) l[e] += w * f[e];
+  if (!k->listed[i]) k->listed[i] = 1, k->loaded[k->nloaded++] = i;
+  for (int e = 0; e < 3; e++) l[e] += w * q->f[e];
+  k->load_k[i] += w * q->k;
 }
 
 // one row's force on the particles: by their distance from its point, weights
@@ -349,45 +349,58 @@ static void spread(skin* k, const tx_puncture_load* q) {
       double d = sqrt((x[0] - p[0]) * (x[0] - p[0]) + (x[1] - p[1]) * (x[1] - p[1]) + (x[2] - p[2]) * (x[2] - p[2]));
       if (!(d < R) || wound_side(k, x) != side) continue;
       if (pass == 0) total += 1 - d / R;
-      else add_load(k, i, (1 - d / R) / total, q->f);
+      else add_load(k, i, (1 - d / R) / total, q);
     }
   if (total > 0) return;
-  for (int a = 0; a < 3; a++) add_load(k, (int)q->v[a], q->bary[a], q->f);
+  for (int a = 0; a < 3; a++) add_load(k, (int)q->v[a], q->bary[a], q);
 }
 
 // the thread's latest pull at its punctures on their particles, in place of
 // the last: a row that is not a triangle of this skin with weights summing to
-// 1 and a finite force is counted (bad_load) and left out
+// 1, a finite force and a stiffness in [0, 1e9] N/m is counted (bad_load) and
+// left out
 static void take_loads(tx_ctx* c, skin* k) {
   tx_snapshot sl = tx_read(c, k->loads_in);
   if (sl.seq == 0) return;
   static const double zero[3] = {0, 0, 0};
   for (int j = 0; j < k->nloaded; j++) {
     memset(&k->load[3 * (size_t)k->loaded[j]], 0, sizeof(double) * 3);
+    k->load_k[k->loaded[j]] = 0;
+    k->listed[k->loaded[j]] = 0;
+    tx_cloth_set_spring(k->cloth, k->loaded[j], zero, 0);
     tx_cloth_set_load(k->cloth, k->loaded[j], zero);
   }
   k->nloaded = 0;
   const tx_puncture_load* rows = sl.data;
-  if (!k->row_f && (k->row_f = calloc((size_t)sl.rows * 3, sizeof *k->row_f))) k->nrows = sl.rows;
   for (uint32_t r = 0; r < sl.rows && rows[r].v[0] != -1; r++) {
     const tx_puncture_load* q = &rows[r];
     double sum = q->bary[0] + q->bary[1] + q->bary[2];
-    bool ok = isfinite(sum) && fabs(sum - 1) <= 1e-6 && isfinite(q->f[0]) && isfinite(q->f[1]) && isfinite(q->f[2]);
+    bool ok = isfinite(sum) && fabs(sum - 1) <= 1e-6 && isfinite(q->f[0]) && isfinite(q->f[1]) && isfinite(q->f[2]) &&
+              q->k >= 0 && q->k <= 1e9;
     for (int a = 0; ok && a < 3; a++) ok = q->v[a] >= 0 && q->v[a] < k->n && q->v[a] == floor(q->v[a]);
     if (!ok) {
       tx_warn(c, k->bad_load);
       continue;
     }
     k->load_max = fmax(k->load_max, sqrt(q->f[0] * q->f[0] + q->f[1] * q->f[1] + q->f[2] * q->f[2]));
-    tx_puncture_load lagged = *q;
-    if (r < k->nrows) {
-      double a = k->dt / (k->load_tau + k->dt); // 1 without a lag
-      for (int e = 0; e < 3; e++) lagged.f[e] = k->row_f[3 * r + e] += a * (q->f[e] - k->row_f[3 * r + e]);
-    }
-    spread(k, &lagged);
+    spread(k, q);
   }
-  for (int j = 0; j < k->nloaded; j++)
-    if (tx_cloth_set_load(k->cloth, k->loaded[j], &k->load[3 * (size_t)k->loaded[j]]) != TX_CLOTH_OK) tx_warn(c, k->bad_load);
+  // each particle's pull as a spring that gives as it moves (anchored load / k
+  // beyond it now), which the implicit step takes whole; without a stiffness, a load
+  for (int j = 0; j < k->nloaded; j++) {
+    const int i = k->loaded[j];
+    const double* l = &k->load[3 * (size_t)i];
+    double x[3], anchor[3];
+    tx_cloth_particle(k->cloth, i, x);
+    tx_cloth_status st;
+    if (k->load_k[i] > 0) {
+      for (int e = 0; e < 3; e++) anchor[e] = x[e] + l[e] / k->load_k[i];
+      st = tx_cloth_set_spring(k->cloth, i, anchor, k->load_k[i]);
+    } else {
+      st = tx_cloth_set_load(k->cloth, i, l);
+    }
+    if (st != TX_CLOTH_OK) tx_warn(c, k->bad_load);
+  }
 }
 
 // The skin's reaction on the HIP and its tangent stiffness k = d|f|/dw. A
@@ -485,7 +498,8 @@ static void fini(void* self) {
   free(k->held);
   free(k->load);
   free(k->loaded);
-  free(k->row_f);
+  free(k->load_k);
+  free(k->listed);
   free(k);
 }
 
