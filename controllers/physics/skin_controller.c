@@ -229,7 +229,6 @@ static int configure(tx_setup* s, void** self) {
     if (!k->load || !k->load_k || !k->listed || !k->loaded) return tx_setup_fail(s, NULL, "out of memory");
   }
   k->load_radius = tx_table_num(s, "thread_load_radius_m");
-
   k->bad_load = tx_setup_warning(s, "bad_load");
   k->load_result = tx_setup_result(s, "thread_load_max_n");
   return 0;
@@ -355,6 +354,20 @@ static void spread(skin* k, const tx_puncture_load* q) {
   for (int a = 0; a < 3; a++) add_load(k, (int)q->v[a], q->bary[a], q);
 }
 
+// no particle loaded any more
+static void clear_loads(skin* k) {
+  static const double zero[3] = {0, 0, 0};
+  for (int j = 0; j < k->nloaded; j++) {
+    const int i = k->loaded[j];
+    memset(&k->load[3 * (size_t)i], 0, sizeof(double) * 3);
+    k->load_k[i] = 0;
+    k->listed[i] = 0;
+    tx_cloth_set_spring(k->cloth, i, zero, 0);
+    tx_cloth_set_load(k->cloth, i, zero);
+  }
+  k->nloaded = 0;
+}
+
 // the thread's latest pull at its punctures on their particles, in place of
 // the last: a row that is not a triangle of this skin with weights summing to
 // 1, a finite force and a stiffness in [0, 1e9] N/m is counted (bad_load) and
@@ -362,15 +375,7 @@ static void spread(skin* k, const tx_puncture_load* q) {
 static void take_loads(tx_ctx* c, skin* k) {
   tx_snapshot sl = tx_read(c, k->loads_in);
   if (sl.seq == 0) return;
-  static const double zero[3] = {0, 0, 0};
-  for (int j = 0; j < k->nloaded; j++) {
-    memset(&k->load[3 * (size_t)k->loaded[j]], 0, sizeof(double) * 3);
-    k->load_k[k->loaded[j]] = 0;
-    k->listed[k->loaded[j]] = 0;
-    tx_cloth_set_spring(k->cloth, k->loaded[j], zero, 0);
-    tx_cloth_set_load(k->cloth, k->loaded[j], zero);
-  }
-  k->nloaded = 0;
+  clear_loads(k);
   const tx_puncture_load* rows = sl.data;
   for (uint32_t r = 0; r < sl.rows && rows[r].v[0] != -1; r++) {
     const tx_puncture_load* q = &rows[r];
@@ -458,6 +463,8 @@ static int init(tx_ctx* c, void* self) {
   skin* k = self;
   for (int h = 0; h < k->hands && k->grasp_in.id; h++) release(k, h); // a run starts with open jaws
   k->grasps = 0;
+  if (k->loads_in.id) clear_loads(k); // a run starts with no pull
+  k->load_max = 0;
   publish(c, self); // the patch at rest, at time 0
   return 0;
 }
