@@ -13,11 +13,12 @@ soak_seconds=${TX_SOAK_SECONDS:-600}
 
 say() { printf '\n== %s\n' "$*" >&2; }
 
-# configure and build one variant: build_variant DIR [cmake args...]
+# configure and build one variant: build_variant DIR [cmake args...]; with
+# targets set, only those (and what they need)
 build_variant() {
   local dir=$1; shift
   cmake -S . -B "$dir" -DTX_WERROR=ON "$@" >/dev/null
-  cmake --build "$dir" -j"$jobs" >/dev/null
+  cmake --build "$dir" -j"$jobs" ${targets:+--target $targets} >/dev/null
 }
 
 # run a variant's tests: test_variant DIR [ctest args...]
@@ -62,7 +63,7 @@ case "$target" in
       test_variant build-asan
 
     say "ThreadSanitizer: the model and scheduler tests"
-    build_variant build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTX_SANITIZE=thread
+    targets=tsan_checks build_variant build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTX_SANITIZE=thread
     TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$PWD/tests/tsan.supp" tsan ctest --test-dir build-tsan --output-on-failure -L tsan
 
     say "core only: every optional part off"
@@ -72,7 +73,7 @@ case "$target" in
     test_variant build-core
 
     say "libFuzzer: the scenario loader, the device packet decoder, the recording and waypoint readers and the sim spec, ${fuzz_seconds} s each"
-    CC=clang build_variant build-fuzz -DCMAKE_BUILD_TYPE=Debug -DTX_FUZZ=ON -DTX_SANITIZE=address,undefined \
+    CC=clang targets=fuzzers build_variant build-fuzz -DCMAKE_BUILD_TYPE=Debug -DTX_FUZZ=ON -DTX_SANITIZE=address,undefined \
       -DTX_FUZZ_SECONDS="$fuzz_seconds"
     test_variant build-fuzz -R fuzz
 
