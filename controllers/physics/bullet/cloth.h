@@ -189,7 +189,9 @@ tx_cloth_status tx_cloth_set_load(tx_cloth* c, int i, const double f[3]);
 // step on, until set again (k = 0 removes it): the force k (anchor - x)
 // follows the particle within the step, so the implicit solver takes a
 // stiff pull stably where a constant load, fixed for the whole step, would
-// overshoot; the HIP's balance reading counts it as an external force.
+// overshoot (XPBD adds it as a force at each substep's start, stable only
+// while k h^2 / m is small); the HIP's balance reading counts it as an
+// external force.
 // TX_CLOTH_BAD for a bad index, k outside [0, 1e9] or a point not finite
 tx_cloth_status tx_cloth_set_spring(tx_cloth* c, int i, const double anchor[3], double k);
 // grasped particles (the forceps' jaws hold them): a pinned particle is
