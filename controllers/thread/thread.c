@@ -377,17 +377,15 @@ static double ftl_excess(const tx_thread* t, double sum[3]) {
   int n = t->n, end = t->first_cut;
   const double* h = t->x;
   const double* tail = t->x + 3 * end;
-  double len = 0, rest = t->l0 * end;
-  for (int i = 0; i < end; i++) len += dist3(t->x + 3 * i, t->x + 3 * i + 3);
-  for (int a = 0; a < 3; a++) sum[a] = tail[a] - h[a];
-  if (end == n - 1 && t->pinned[n - 1]) {
-    const double* pin = t->pin + 3 * (n - 1);
-    len += dist3(pin, tail);
-    for (int a = 0; a < 3; a++) sum[a] = pin[a] - h[a];
-  }
+  const bool to_pin = end == n - 1 && t->pinned[n - 1];
+  const double* far = to_pin ? t->pin + 3 * (n - 1) : tail;
+  for (int a = 0; a < 3; a++) sum[a] = far[a] - h[a];
   // drawn taut through punctures, its links lie along the path (chords across
   // the bends): the stretch is the path's length over the thread's
   if (t->def.model == TX_THREAD_FTL && t->taut_excess >= 0) return t->taut_excess;
+  double len = 0, rest = t->l0 * end;
+  for (int i = 0; i < end; i++) len += dist3(t->x + 3 * i, t->x + 3 * i + 3);
+  if (to_pin) len += dist3(far, tail);
   return len - rest;
 }
 
@@ -1386,6 +1384,20 @@ static void follow(tx_thread* t, int i, int from) {
 // straight towards it and the point held moves on to the next link. So the
 // thread passes through every passed puncture exactly, keeps its length and
 // slides through as the head pulls it.
+// node i a link from node `from` on the line from it through p (a puncture's
+// point), or after it as the thread runs when `from` is on p; returns their
+// distance |x_from - p| (beyond a link: p is out of the link's reach)
+static double place_through(tx_thread* t, int i, int from, const double p[3]) {
+  const double* l = t->x + 3 * from;
+  double d = dist3(l, p);
+  if (d > 1e-9 * t->l0) {
+    for (int c = 0; c < 3; c++) t->x[3 * i + c] = l[c] + (p[c] - l[c]) / d * t->l0;
+  } else {
+    place_after(t, i, from, t->l0);
+  }
+  return d;
+}
+
 static void ftl_forward(tx_thread* t) {
   // the last passed is the nearest the head along the thread: route from it back
   int k = t->passed - 1;
@@ -1398,13 +1410,7 @@ static void ftl_forward(tx_thread* t) {
     }
     if (t->severed[i - 1]) continue;
     if (k >= 0 && t->arc[k] <= i * t->l0 * (1 + 1e-12)) {
-      const double *l = t->x + 3 * (i - 1), *p = t->punct + 3 * k;
-      double d = dist3(l, p);
-      if (d > 1e-9 * t->l0) {
-        for (int c = 0; c < 3; c++) t->x[3 * i + c] = l[c] + (p[c] - l[c]) / d * t->l0;
-      } else {
-        place_after(t, i, i - 1, t->l0);
-      }
+      double d = place_through(t, i, i - 1, t->punct + 3 * k);
       if (d <= t->l0) {
         t->arc[k--] = (i - 1) * t->l0 + d;
       } else {
@@ -1442,13 +1448,7 @@ static void ftl_backward(tx_thread* t) {
     }
     if (t->severed[i]) continue;
     if (k < t->passed && t->arc[k] >= i * t->l0 * (1 - 1e-12)) {
-      const double *l = t->x + 3 * (i + 1), *p = t->punct + 3 * k;
-      double d = dist3(l, p);
-      if (d > 1e-9 * t->l0) {
-        for (int c = 0; c < 3; c++) t->x[3 * i + c] = l[c] + (p[c] - l[c]) / d * t->l0;
-      } else {
-        place_after(t, i, i + 1, t->l0);
-      }
+      double d = place_through(t, i, i + 1, t->punct + 3 * k);
       if (d <= t->l0) {
         t->arc[k++] = (i + 1) * t->l0 - d;
       } else {
