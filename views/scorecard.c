@@ -178,6 +178,9 @@ static json_t* build(const scorecard* v) {
   measure(root, "tissue_force_max_n", m->tissue_force_max_n, "N",
           "the largest force of the skin on the needle's tip; OSATS's respect for tissue asks for no unnecessary force");
   measure(root, "tears", m->tears, "1", "links the skin tore (the punctures' own included), the wound's cut not counted");
+  measure(root, "tears_pulled", m->tears_pulled, "1",
+          "of them, the links a pull tore (the thread's or the jaws'), away from the needle's tip: a stitch pulled too "
+          "hard tears out; OSATS's respect for tissue");
   return root;
 }
 

@@ -28,7 +28,7 @@ typedef struct skin {
   double prev_f, prev_w; // N, m: the reaction along its normal and the indentation of the last step in contact (0: none)
   double k;              // N/m, the last tangent stiffness
   tx_warning fault, bad_pose;
-  tx_result torn_result, fault_result, pierce_result, freed_result, pieces_result;
+  tx_result torn_result, pulled_result, fault_result, pierce_result, freed_result, pieces_result;
   // grasps: the particles between a hand's jaws follow its instrument<h>.pose
   tx_port grasp_in;                     // listened: the grasp stream (0: none)
   tx_port jaws[GRASP_HANDS_MAX];        // read: instrument<h>.pose
@@ -87,7 +87,11 @@ static const tx_param_def params[] = {
     {"pretension_n_per_m", TX_PARAM_NUM, "N/m", 0, 1e9, 0, NULL,
      "isotropic tension of the flat skin at rest against its fixed border; below (3 k + 4 k_bend) / 2"},
     {"rupture_tension_n_per_m", TX_PARAM_NUM, "N/m", 0, 1e7, 80, NULL,
-     "membrane tension, averaged over rupture_length_m, that tears the skin; 0: never"},
+     "membrane tension, averaged over rupture_length_m, that tears the skin within the HIP's reach (the needle's "
+     "tip cuts); 0: the skin never tears"},
+    {"blunt_rupture_tension_n_per_m", TX_PARAM_NUM, "N/m", 0, 1e7, 1000, NULL,
+     "the same beyond the HIP's reach, where a thread or jaws only pull (skin's own strength, docs/skin.md); 0: "
+     "rupture_tension_n_per_m everywhere"},
     {"rupture_length_m", TX_PARAM_NUM, "m", 1e-4, 0.05, 0.002, NULL, "radius over which the tension is averaged"},
     {"solver", TX_PARAM_STR, NULL, 0, 0, 0, "implicit",
      "\"implicit\": backward Euler, Newton and preconditioned CG (real time); \"xpbd\": XPBD, converged only with k w h^2 <= 1/4"},
@@ -139,6 +143,7 @@ static int configure(tx_setup* s, void** self) {
   d.fixed_border = tx_table_bool(s, "fixed_border");
   d.pretension = tx_table_num(s, "pretension_n_per_m");
   d.rupture_tension = tx_table_num(s, "rupture_tension_n_per_m");
+  d.blunt_rupture_tension = tx_table_num(s, "blunt_rupture_tension_n_per_m");
   d.rupture_length = tx_table_num(s, "rupture_length_m");
   const char* solver = tx_table_str(s, "solver");
   if (!solver) return -1;
@@ -194,6 +199,7 @@ static int configure(tx_setup* s, void** self) {
   k->fault = tx_setup_warning(s, "numerical_fault");
   k->bad_pose = tx_setup_warning(s, "bad_pose");
   k->torn_result = tx_setup_result(s, "torn_links");
+  k->pulled_result = tx_setup_result(s, "torn_pulled_links");
   k->fault_result = tx_setup_result(s, "faults");
   k->pierce_result = tx_setup_result(s, "pierces");
   k->freed_result = tx_setup_result(s, "freed_particles");
@@ -452,7 +458,7 @@ static void publish(tx_ctx* c, skin* k) {
   int32_t* tri = ((tx_triangle*)tx_write(c, k->tri))->v; // m x 3 indices: m tx_triangle
   tx_write_rows(c, k->tri, (uint32_t)tx_cloth_triangles(k->cloth, tri));
   ((tx_thickness*)tx_write(c, k->thickness))->m = tx_cloth_get_def(k->cloth)->thickness;
-  ((tx_torn*)tx_write(c, k->torn))->links = tx_cloth_torn(k->cloth);
+  *(tx_torn*)tx_write(c, k->torn) = (tx_torn){tx_cloth_torn(k->cloth), tx_cloth_torn_pulled(k->cloth)};
   publish_contact(c, k);
   tx_skin_rupture* r = tx_write(c, k->rupture);
   r->tension = tx_cloth_peak_tension(k->cloth);
@@ -487,6 +493,7 @@ static void step(tx_ctx* c, void* self) {
 static void finish(tx_ctx* c, void* self) {
   skin* k = self;
   tx_set_result(c, k->torn_result, tx_cloth_torn(k->cloth));
+  tx_set_result(c, k->pulled_result, tx_cloth_torn_pulled(k->cloth));
   tx_set_result(c, k->wound_result, k->wound_links);
   tx_set_result(c, k->fault_result, tx_cloth_faults(k->cloth));
   tx_set_result(c, k->grasp_result, k->grasps);

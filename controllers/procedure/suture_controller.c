@@ -41,8 +41,8 @@ typedef struct suture {
   bool hand_seen[HANDS];
   uint32_t holding;        // bit h: hand h's jaws hold something
   bool cut;
-  // the skin (skin: SKIN.x and SKIN.contact), for the wound gap, the force on the tissue and the tears
-  tx_port skin_x, skin_contact;
+  // the skin (skin: SKIN.x, SKIN.contact and SKIN.torn), for the wound gap, the force on the tissue and the tears
+  tx_port skin_x, skin_contact, skin_torn;
   float* rest;             // (SKIN_PARTICLES_MAX x 3) m, SKIN.x as the run found it
   uint32_t nrest;          // its particles, 0 until the first publish
   tx_warning skin_too_large;
@@ -64,7 +64,7 @@ static const tx_param_def params[] = {
     {"wrap_reach_m", TX_PARAM_NUM, "m", 0.001, 0.1, 0.008, NULL, "thread nodes within this distance of the jaws' axis count for the wrap"},
     {"wrap_length_m", TX_PARAM_NUM, "m", 0.005, 0.3, 0.03, NULL, "the jaws' length ahead of the pivot, along which a wrap counts"},
     {"skin", TX_PARAM_STR, NULL, 0, 0, 0, "",
-     "the skin's prefix: SKIN.x for the wound gap at the stitch, SKIN.contact for the force on the tissue and the tears; empty: none"},
+     "the skin's prefix: SKIN.x for the wound gap at the stitch, SKIN.contact for the force on the tissue and the tears, SKIN.torn for those a pull tore; empty: none"},
 };
 
 // a read that the scenario may leave out with an empty name
@@ -129,6 +129,8 @@ static int configure(tx_setup* s, void** self) {
     k->skin_x = TX_READ_OF(s, name, tx_vertex);
     snprintf(name, sizeof name, "%s.contact", skin);
     k->skin_contact = TX_READ_OF(s, name, tx_skin_contact);
+    snprintf(name, sizeof name, "%s.torn", skin);
+    k->skin_torn = TX_READ_OF(s, name, tx_torn);
     k->rest = malloc(sizeof(float) * 3 * SKIN_PARTICLES_MAX);
     if (!k->rest) return tx_setup_fail(s, NULL, "out of memory");
     k->skin_too_large = tx_setup_warning(s, "skin_too_large");
@@ -347,6 +349,8 @@ static void read_skin(tx_ctx* c, suture* k) {
     k->m.tissue_force_max_n = fmax(k->m.tissue_force_max_n, sqrt(sc->f[0] * sc->f[0] + sc->f[1] * sc->f[1] + sc->f[2] * sc->f[2]));
     k->m.tears = sc->torn;
   }
+  tx_snapshot t = tx_read(c, k->skin_torn);
+  if (t.seq) k->m.tears_pulled = ((const tx_torn*)t.data)->pulled;
 }
 
 static void step(tx_ctx* c, void* self) {

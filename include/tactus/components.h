@@ -163,10 +163,11 @@ TX_LAYOUT_ASSERT(tx_thickness, double);
 
 // SKIN.torn (1 row)
 typedef struct tx_torn {
-  int32_t links; // links torn so far (a count)
+  int32_t links;  // links torn so far (a count)
+  int32_t pulled; // of them, those torn beyond the HIP's reach: by a pull (a thread, jaws), not the tip's cut
 } tx_torn;
 #define tx_torn_TYPE TX_I32
-#define tx_torn_COLS 1u
+#define tx_torn_COLS 2u
 #define tx_torn_UNITS "1"
 TX_LAYOUT_ASSERT(tx_torn, int32_t);
 
@@ -511,9 +512,10 @@ typedef struct tx_suture_measures {
   double wound_gap_after_m;  // m, the same on the latest skin
   double tissue_force_max_n; // N, the largest force of the skin on the needle's tip (SKIN.contact)
   double tears;              // links the skin tore (SKIN.contact's count), the wound's cut not counted
+  double tears_pulled;       // of them, those a pull tore (the thread's, the jaws'), away from the needle's tip (SKIN.torn)
 } tx_suture_measures;
 #define tx_suture_measures_TYPE TX_F64
-#define tx_suture_measures_COLS 12u
+#define tx_suture_measures_COLS 13u
 #define tx_suture_measures_UNITS "m, 1, N"
 TX_LAYOUT_ASSERT(tx_suture_measures, double);
 

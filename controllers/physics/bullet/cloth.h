@@ -38,7 +38,9 @@
 //              (a smooth kernel), breaks the most tensed stretch or shear
 //              link at a particle where it passes rupture_tension (N/m): a
 //              criterion in physical units that does not depend on the
-//              spacing. With gravity the tension each link holds once the
+//              spacing. With blunt_rupture_tension set, that holds only
+//              within the HIP's reach (a needle's tip cuts), and the skin
+//              elsewhere tears at blunt_rupture_tension (a thread's pull). With gravity the tension each link holds once the
 //              patch hangs (settle_time) is not counted: the weight alone
 //              never tears it. A broken link leaves Bullet, the triangles it
 //              bordered (the two of its cell for a diagonal) leave the mesh,
@@ -108,7 +110,10 @@ typedef struct tx_cloth_def {
   double clamp_radius;      // m, particles this far or further from the centre (in the plane) cannot move
                             // either, in [0, 10]; 0: none (a circular membrane inside the square)
   double pretension;        // N/m, isotropic tension of the flat patch at rest, in [0, (3 k + 4 k_bend) / 2]; 0
-  double rupture_tension;   // N/m, membrane tension that tears, in [0, 1e7]; 80; 0: never
+  double rupture_tension;   // N/m, membrane tension that tears, in [0, 1e7]; 80; 0: never, anywhere. With
+                            // blunt_rupture_tension, only within the HIP's reach (the tip cuts)
+  double blunt_rupture_tension; // N/m, the same away from the HIP (a thread or jaws only pull), in [0, 1e7];
+                                // 0: rupture_tension everywhere
   double rupture_length;    // m, radius over which the tension is averaged, in [1e-4, 0.05]; 0.002
   int solver;               // tx_cloth_solver; TX_CLOTH_IMPLICIT
   int iterations;           // XPBD iterations per substep, in [1, 200]; 1
@@ -163,6 +168,8 @@ bool tx_cloth_positions(const tx_cloth* c, float* out);
 int tx_cloth_triangles(tx_cloth* c, int32_t* out);
 // stretch and shear links broken so far
 int tx_cloth_torn(const tx_cloth* c);
+// of them, those torn beyond the HIP's reach: by a pull (a thread, jaws), not the tip
+int tx_cloth_torn_pulled(const tx_cloth* c);
 // force of the skin on the HIP at the end of the last step (N), along the
 // contact's normal, never a pull; zero without contact. TX_CLOTH_HELD: the
 // links' pull (k (l - l0) each) and the weight, less the m a, of the particles

@@ -96,12 +96,14 @@ struct tx_cloth {
   std::vector<link_info> info;     // (nlink)
   std::vector<btSoftBody::Link> original; // (nlink) each link as built, to put broken ones back
   std::vector<int32_t> breaking;   // (nlink) scratch: links to break after a substep
+  std::vector<uint8_t> breaking_far; // (nlink) scratch: 1, judged beyond the HIP's reach (a pull, not the tip)
   std::vector<int32_t> tri_stamp;  // (ntri) scratch: triangles already tested this pass
   int32_t stamp;
   std::vector<int32_t> near_tris;  // (ntri) scratch: candidate triangles of one pass
   std::vector<int32_t> held_tri;   // (ntri) the last substep whose contact touched it
   int32_t substep_id;              // counts substeps, for held_tri
   int torn;
+  int torn_pulled; // of them, torn beyond the HIP's reach
   int faults;
 
   // grasped particles (tx_cloth_pin): kinematic, moved to pin_to across a step
@@ -157,7 +159,7 @@ struct tx_cloth {
   std::vector<uint8_t> good_link;      // (nlink) 1 = present
   std::vector<uint8_t> good_tri;       // (ntri)
   std::vector<float> good_tension;     // (nlink) N, the warm start
-  int good_torn;
+  int good_torn, good_torn_pulled;
   double good_hip[3];
   std::vector<uint8_t> good_rim, good_freed; // (n)
   bool good_pierced;
@@ -184,6 +186,7 @@ extern "C" tx_cloth_def tx_cloth_def_default(void) {
   d.clamp_radius = 0;
   d.pretension = 0;
   d.rupture_tension = 80;
+  d.blunt_rupture_tension = 0;
   d.rupture_length = 0.002;
   d.solver = TX_CLOTH_IMPLICIT;
   d.iterations = 1;
@@ -224,6 +227,7 @@ extern "C" int tx_cloth_def_check(const tx_cloth_def* d) {
             "N/m"))
     return -1;
   if (range("rupture_tension", d->rupture_tension, 0, false, 1e7, false, "N/m")) return -1;
+  if (range("blunt_rupture_tension", d->blunt_rupture_tension, 0, false, 1e7, false, "N/m")) return -1;
   if (range("rupture_length", d->rupture_length, 1e-4, false, 0.05, false, "m")) return -1;
   if (d->solver != TX_CLOTH_IMPLICIT && d->solver != TX_CLOTH_XPBD) {
     tx_set_error("skin: solver = %d, must be %d (implicit) or %d (xpbd)", d->solver, TX_CLOTH_IMPLICIT, TX_CLOTH_XPBD);
@@ -445,6 +449,7 @@ static bool build(tx_cloth* c) {
   c->spring_a.assign((size_t)c->n * 3, 0.0);
   c->reach_factor = 2;
   c->breaking.resize((size_t)c->nlink);
+  c->breaking_far.resize((size_t)c->nlink);
   c->tri_stamp.assign((size_t)c->ntri, 0);
   c->near_tris.resize((size_t)c->ntri);
   c->held_tri.assign((size_t)c->ntri, 0);
@@ -496,12 +501,13 @@ static bool build(tx_cloth* c) {
 // skin hangs about 1 cm before first contact), and the fall from flat, which
 // is no part of any experiment, cannot tear it.
 static void settle(tx_cloth* c) {
-  const double tear = c->def.rupture_tension;
-  c->def.rupture_tension = 0;
+  const double tear = c->def.rupture_tension, blunt = c->def.blunt_rupture_tension;
+  c->def.rupture_tension = c->def.blunt_rupture_tension = 0;
   int steps = c->def.gravity > 0 ? (int)std::ceil(c->def.settle_time * 60) : 0;
   for (int s = 0; s < steps; s++)
     if (tx_cloth_step(c, 1.0 / 60) != TX_CLOTH_OK) break;
   c->def.rupture_tension = tear;
+  c->def.blunt_rupture_tension = blunt;
   if (steps > 0) c->hanging = c->tension; // same size: no allocation beyond create
   for (int a = 0; a < 3; a++) c->contact_force[a] = 0;
   c->peak_tension = 0;
@@ -553,6 +559,7 @@ extern "C" int tx_cloth_particle_count(const tx_cloth* c) { return c->n; }
 extern "C" int tx_cloth_triangle_count(const tx_cloth* c) { return c->ntri; }
 extern "C" int tx_cloth_link_count(const tx_cloth* c) { return c->body->m_links.size(); }
 extern "C" int tx_cloth_torn(const tx_cloth* c) { return c->torn; }
+extern "C" int tx_cloth_torn_pulled(const tx_cloth* c) { return c->torn_pulled; }
 extern "C" int tx_cloth_faults(const tx_cloth* c) { return c->faults; }
 
 extern "C" void tx_cloth_contact_force(const tx_cloth* c, double out[3]) {
@@ -1501,7 +1508,8 @@ static void measure_links(tx_cloth* c, double h) {
   if (c->max_edge > 0) c->reach_factor = std::max(2.0, 2 * (double)longest / c->max_edge);
 }
 
-// Where the membrane tension passes rupture_tension, the most tensed
+// Where the membrane tension passes rupture_tension (within the HIP's reach
+// when blunt_rupture_tension is set, which holds elsewhere), the most tensed
 // stretch or shear link at that particle breaks, with its triangles and the
 // bending links over it. Only particles whose own stretched links could
 // reach it are averaged (the average over a disc is at most about the
@@ -1513,8 +1521,13 @@ static void measure_links(tx_cloth* c, double h) {
 // of it count with their spring's force k (length - rest) where that is
 // larger, and only particles there are checked.
 static void rupture(tx_cloth* c, const btVector3* near) {
-  const double tc = c->def.rupture_tension;
-  if (tc <= 0) return;
+  const double tip = c->def.rupture_tension, blunt = c->def.blunt_rupture_tension > 0 ? c->def.blunt_rupture_tension : tip;
+  if (tip <= 0) return;
+  const double rc = c->hip_radius + 0.5 * c->def.thickness;
+  const btScalar at_hip = (btScalar)(rc + c->reach_factor * c->max_edge);
+  const btVector3 hip((btScalar)c->hip_now[0], (btScalar)c->hip_now[1], (btScalar)c->hip_now[2]);
+  // the tip's criterion holds where its contact moves the skin and the average over rupture_length sees it
+  const btScalar tip_reach = at_hip + (btScalar)c->def.rupture_length, tip_reach2 = tip_reach * tip_reach;
   const btAlignedObjectArray<btSoftBody::Link>& links = c->body->m_links;
   const btSoftBody::Node* base = &c->body->m_nodes[0];
   const btScalar reach = (btScalar)(c->hip_radius + 0.5 * c->def.thickness + 2 * c->max_edge), reach2 = reach * reach;
@@ -1542,7 +1555,7 @@ static void rupture(tx_cloth* c, const btVector3* near) {
   // a margin of 2 below the criterion: in a uniform field a particle's own
   // sum over its area is at least the largest principal tension, and the
   // kernel's average of a peaked field is at most its peak
-  const float bar = (float)(tc * c->area / 2);
+  const float bar = (float)(std::min(tip, blunt) * c->area / 2);
   int nb = 0, most = 0;
   for (int p = 1; p < c->n; p++)
     if (local[p] > local[most]) most = p;
@@ -1552,7 +1565,8 @@ static void rupture(tx_cloth* c, const btVector3* near) {
     const double t = membrane_tension(c, p);
     if (t > c->peak_tension) c->peak_tension = t;
     if (t > c->sub_peak) c->sub_peak = t;
-    if (t < tc) continue;
+    const bool far = !(c->hip_radius > 0 && (base[p].m_x - hip).length2() <= tip_reach2);
+    if (t < (far ? blunt : tip)) continue;
     int best = -1;
     float fbest = 0;
     const int32_t* ls = &c->node_links[(size_t)p * 12];
@@ -1561,11 +1575,8 @@ static void rupture(tx_cloth* c, const btVector3* near) {
       if (li.slot < 0 || li.kind == BEND) continue;
       if (excess(c, ls[k]) > fbest) fbest = excess(c, ls[k]), best = ls[k];
     }
-    if (best >= 0) c->breaking[(size_t)nb++] = best;
+    if (best >= 0) c->breaking_far[(size_t)nb] = far, c->breaking[(size_t)nb++] = best;
   }
-  const double rc = c->hip_radius + 0.5 * c->def.thickness;
-  const btScalar at_hip = (btScalar)(rc + c->reach_factor * c->max_edge);
-  const btVector3 hip((btScalar)c->hip_now[0], (btScalar)c->hip_now[1], (btScalar)c->hip_now[2]);
   bool at_contact = false; // a link torn where the HIP holds the skin: its puncture
   for (int k = 0; k < nb; k++) {
     int id = c->breaking[(size_t)k];
@@ -1575,6 +1586,7 @@ static void rupture(tx_cloth* c, const btVector3* near) {
       for (int e = 0; e < 2; e++) at_contact |= (base[li.end[e]].m_x - hip).length2() <= at_hip * at_hip;
     sever_link(c, id);
     c->torn++;
+    c->torn_pulled += c->breaking_far[(size_t)k];
   }
   if (at_contact) pierce_start(c);
 }
@@ -1706,6 +1718,7 @@ extern "C" void tx_cloth_save(tx_cloth* c) {
     c->pierce_dirty = false;
   }
   c->good_torn = c->torn;
+  c->good_torn_pulled = c->torn_pulled;
   std::memcpy(c->good_tension.data(), c->tension.data(), (size_t)c->nlink * sizeof(float));
   for (int a = 0; a < 3; a++) c->good_hip[a] = c->hip_prev[a];
 }
@@ -1748,6 +1761,7 @@ extern "C" void tx_cloth_restore(tx_cloth* c) {
   }
   c->detach_check = false;
   c->torn = c->good_torn;
+  c->torn_pulled = c->good_torn_pulled;
   std::memcpy(c->tension.data(), c->good_tension.data(), (size_t)c->nlink * sizeof(float));
   for (int a = 0; a < 3; a++) c->hip_prev[a] = c->good_hip[a];
   for (int a = 0; a < 3; a++) c->contact_force[a] = 0;

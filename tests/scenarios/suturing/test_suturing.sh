@@ -47,9 +47,11 @@ print("bites %.2f and %.2f mm, wound gap %.3f -> %.3f mm, tissue force %.3f N, t
 check(0.005 < b0 < 0.02 and 0.005 < b1 < 0.02, "bites %g, %g m" % (b0, b1))
 g = s["wound_gap_m"]
 check(abs(g["before"] - 0.0025) < 1e-4 and math.isfinite(g["after"]) and g["unit"] == "m" and g["rule"], "wound gap %r" % g)
-for k in ("bite_entry_m", "punctures", "peak_tension_n", "path_hand0_m", "tissue_force_max_n", "tears"):
+for k in ("bite_entry_m", "punctures", "peak_tension_n", "path_hand0_m", "tissue_force_max_n", "tears", "tears_pulled"):
     check(set(s[k]) == {"value", "unit", "rule"} and s[k]["rule"], "measure %s: %r" % (k, s[k]))
 check(s["punctures"]["value"] == 2, "punctures %r" % s["punctures"])
+# the needle's tip tore the punctures; nothing pulled hard enough to tear the skin elsewhere
+check(s["tears"]["value"] > 0 and s["tears_pulled"]["value"] == 0, "tears %r, pulled %r" % (s["tears"], s["tears_pulled"]))
 check(0 < s["tissue_force_max_n"]["value"] <= 3.3, "tissue force %r" % s["tissue_force_max_n"])
 PY
 test -s "$d/o/scorecard.png"
