@@ -21,7 +21,8 @@ against the holder's virtual coupling). After changing the drive, write the
 CSVs, run the scenario, read the needle's centre and angle at 10 s (its
 `needle.pose`), and set them; the environment variables CY, HC ("x,y,z"),
 HD, GT and PD override CENTRE_Y, HANDOVER_CENTRE, HANDOVER_DEG,
-GRASP_TIP_RAD and PULL_DEG for such trials (the scenario takes the CSVs
+GRASP_TIP_RAD and PULL_DEG for such trials, and SX sets SHIFT_X (the
+handover centre moves with it) (the scenario takes the CSVs
 with --set hapticsN.device=scripted:FILE).
 """
 import math
@@ -44,6 +45,10 @@ PULL_DEG = 160.0            # the forceps' turn: the swage through both puncture
 # about that centre, the circle through both punctures.
 HANDOVER_CENTRE = (-0.0014, 0.0035, -0.0017)
 HANDOVER_DEG = 172.3
+# The drive's centre across the wound (x): 0 puts it over the wound line, so
+# the two bites match; a shift makes one bite shallow and the other deep (the
+# go-wrong script of assets/procedures/simple-interrupted-suture/shallow-bite)
+SHIFT_X = 0.0
 
 
 def qmul(a, b):
@@ -106,9 +111,9 @@ def hand0():
     rows.append(row(1.4, at(FOAM, 0), q0, 0))
     lifted = (FOAM[0], 0.07, FOAM[2])
     rows.append(row(1.9, at(lifted, 0), q0, 0))
-    over = (0.0, 0.07, 0.0)
+    over = (SHIFT_X, 0.07, 0.0)
     rows.append(row(2.9, at(over, 0), q0, 0))
-    centre = (0.0, CENTRE_Y, 0.0)
+    centre = (SHIFT_X, CENTRE_Y, 0.0)
     rows.append(row(3.9, at(centre, 0), q0, 0))
     # the drive: 6 s about the centre, the grasp point from 0 to HOLDER_END_DEG
     n = 120
@@ -145,7 +150,9 @@ def hand0():
             "# device0, the needle holder (written by hands.py): takes the needle from the foam at (8, 2, 0) cm "
             "from outside its\n# arc, turns it about its centre %.1f mm above the skin by %.0f degrees (in, and the "
             "tip out of the exit) with\n# its shaft never below level, then opens and rises once the forceps "
-            "hold it\n" % (CENTRE_Y * 1e3, HOLDER_END_DEG) + "\n".join(rows) + "\n")
+            "hold it\n" % (CENTRE_Y * 1e3, HOLDER_END_DEG)
+            + ("# (the centre %.1f mm off the wound line along x: one bite shallow, the other deep)\n" % (SHIFT_X * 1e3)
+               if SHIFT_X else "") + "\n".join(rows) + "\n")
 
 
 def hand1(pinch):
@@ -174,9 +181,9 @@ def hand1(pinch):
             "# device1, the thumb forceps (written by hands.py): from 3 s take a pinch of skin 2 cm beside the "
             "needle's plane\n# (the tips, 20 degrees down, 1 mm into it), lift it 8 mm and let go while the holder "
             "drives the needle; then,\n# lying along -z beside the needle's plane, close on its wire %.2f rad "
-            "behind the tip (out of the exit);\n# from 13 s turn it on about its centre (0, %.1f, 0) mm by %.0f "
+            "behind the tip (out of the exit);\n# from 13 s turn it on about its centre (%g, %.1f, 0) mm by %.0f "
             "degrees until the swage has left the skin, and lift it 2 cm\n"
-            % (GRASP_TIP_RAD, CENTRE_Y * 1e3, PULL_DEG) + "\n".join(rows) + "\n")
+            % (GRASP_TIP_RAD, SHIFT_X * 1e3, CENTRE_Y * 1e3, PULL_DEG) + "\n".join(rows) + "\n")
 
 
 # the forceps' pinch of the skin beside the needle's plane and their way back
@@ -198,9 +205,11 @@ PINCH = [
 
 
 def main():
-    global CENTRE_Y, HANDOVER_CENTRE, HANDOVER_DEG, GRASP_TIP_RAD, PULL_DEG
+    global CENTRE_Y, HANDOVER_CENTRE, HANDOVER_DEG, GRASP_TIP_RAD, PULL_DEG, SHIFT_X
     e = os.environ
     CENTRE_Y = float(e.get("CY", CENTRE_Y))
+    SHIFT_X = float(e.get("SX", SHIFT_X))
+    HANDOVER_CENTRE = (HANDOVER_CENTRE[0] + SHIFT_X,) + HANDOVER_CENTRE[1:]
     if "HC" in e:
         HANDOVER_CENTRE = tuple(float(v) for v in e["HC"].split(","))
     HANDOVER_DEG = float(e.get("HD", HANDOVER_DEG))

@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# Sutures that go wrong, each with the scorecard's verdict (docs/suturing.md,
+# "Sutures that go wrong"), headless in lockstep:
+# - the shallow bite (assets/procedures/simple-interrupted-suture/shallow-bite):
+#   the needle turned about a centre 5 mm off the wound line enters near one
+#   edge and comes out far from the other; the needle still passes (A done)
+#   and the scorecard reports the bites asymmetric;
+# - the held tail: the thread's tail pinned on the skin 2 cm from the wound
+#   (thread.pin_tail) while the forceps pull the needle through as usual: the
+#   thread draws tight and pulls the stitch out of the skin, so the scorecard
+#   counts tears by a pull (tears_pulled, beside the needle's own) and the
+#   wound gap opens.
+# Release only (two 17 s runs, about 15 s).
+#
+#   go_wrong.sh TACTUS
+set -eu
+TACTUS=$1
+command -v python3 >/dev/null || { echo "no python3: skipped"; exit 77; }
+d=$(mktemp -d)
+trap 'rm -rf "$d"' EXIT
+p=procedures/simple-interrupted-suture
+"$TACTUS" run suturing --lockstep --quiet --no-record --out "$d/shallow" \
+  --device "scripted:$p/shallow-bite/hand0.csv" --device "scripted:$p/shallow-bite/hand1.csv"
+"$TACTUS" run suturing --lockstep --quiet --no-record --out "$d/held" --set thread.pin_tail=true \
+  --set 'thread.tail_m=[0.02,0,0]'
+python3 - "$d" <<'PY'
+import json, sys
+d = sys.argv[1]
+def card(name):
+    s = json.load(open("%s/%s/scorecard.json" % (d, name)))
+    return s, {e["id"]: e["status"] for e in s["steps"]}
+def check(ok, what):
+    if not ok:
+        sys.exit("go_wrong: " + what)
+
+s, status = card("shallow")
+b0, b1, asym = s["bite_entry_m"]["value"], s["bite_exit_m"]["value"], s["bite_asymmetry_m"]["value"]
+print("shallow bite: bites %.2f and %.2f mm, asymmetry %.2f mm, symmetric %s, steps %s" % (
+    1e3 * b0, 1e3 * b1, 1e3 * asym, s["bite_symmetric"], status))
+check(status["A"] == "done", "the shallow bite's needle did not pass: A %s" % status["A"])
+check(s["bite_symmetric"] is False and asym > 0.001, "the shallow bite is not reported: %r" % s["bite_symmetric"])
+check(b0 < 0.01 < b1 and abs(abs(b1 - b0) - asym) < 1e-9, "bites %g and %g m, asymmetry %g m" % (b0, b1, asym))
+check(s["tears_pulled"]["value"] == 0, "the shallow bite tore by a pull: %r" % s["tears_pulled"])
+
+s, status = card("held")
+g = s["wound_gap_m"]
+print("held tail: tears %d, by a pull %d, peak tension %.2f N, wound gap %.3f -> %.3f mm, steps %s" % (
+    s["tears"]["value"], s["tears_pulled"]["value"], s["peak_tension_n"]["value"], 1e3 * g["before"],
+    1e3 * g["after"], status))
+check(status["A"] == "done", "A %s" % status["A"])
+check(s["tears_pulled"]["value"] > 0, "no tear by a pull counted: %r" % s["tears_pulled"])
+check(s["peak_tension_n"]["value"] > 5, "the thread was not drawn past tying's 5 N: %r" % s["peak_tension_n"])
+check(g["after"] > 2 * g["before"], "the wound did not open: %r" % g)
+PY
