@@ -72,6 +72,7 @@ struct tx_thread {
   int nheld;                 // nodes held
   int last_pin;              // the highest pinned node (0: the head alone)
   double taut_excess;        // m, ftl drawn taut through its punctures (ftl_taut): the path's length over the thread's; -1: not
+  bool taut;                 // ftl_taut laid it along its path last time
   double head_from[3], head_to[3];
   // the self-contact broadphase: sort and sweep of the cylinders' boxes
   // along one axis, the order kept from substep to substep
@@ -1466,43 +1467,58 @@ static void ftl_backward(tx_thread* t) {
 // fixed ends over a longer path: each pass slides it through the punctures
 // its own way, and the slack it keeps lands where they leave it). So the
 // straight path head -> punctures -> pin decides: at least the thread's
-// length, the nodes are laid along it a link apart from the head, and its
-// excess over the length is the stretch of the force model (tension (length
+// length, the nodes are laid evenly along it from the head to the pin, and
+// its excess over the length is the stretch of the force model (tension (length
 // - rest) x stiffness, the same all along, as through frictionless
 // punctures); shorter, the thread is slack (no stretch) and the passes place
 // it. Not with held nodes or a cut (other paths): taut_excess -1.
+//
+// The passes do not settle near that state either: with the path a few per
+// cent short of the thread they leave the slack as one link stretched to the
+// pin, placed anew each substep, and the nodes jumping by more than r made
+// the step take every substep it may (30 ms a step at 1 kHz with the tail held
+// in the suturing scenario). So the nodes are laid along the path once it is
+// within TX_THREAD_TAUT_SLACK of the length (the links that much short: the
+// slack a nearly straight thread has, unstretched), and stay so until it is a
+// diameter shorter than that, so that the skin's give at the boundary does
+// not switch it back and forth.
 #define TX_THREAD_TAUT_POINTS 1026 // the head, max_punctures (at most 1024) and the pin
+#define TX_THREAD_TAUT_SLACK 0.05  // of the length
 static bool ftl_taut(tx_thread* t) {
-  if (t->last_pin != t->n - 1 || t->nheld > 0 || t->first_cut < t->nseg || t->passed == 0) return false;
+  if (t->last_pin != t->n - 1 || t->nheld > 0 || t->first_cut < t->nseg || t->passed == 0) return t->taut = false;
   for (int i = 1; i < t->n - 1; i++)
-    if (t->pinned[i]) return false;
+    if (t->pinned[i]) return t->taut = false;
   const double* way[TX_THREAD_TAUT_POINTS];
   int m = 0;
   way[m++] = t->x; // the head, then the punctures from the last passed (nearest the head) to the first, then the pin
   for (int k = t->passed - 1; k >= 0 && m < TX_THREAD_TAUT_POINTS - 1; k--) way[m++] = t->punct + 3 * k;
-  if (m != t->passed + 1) return false;
+  if (m != t->passed + 1) return t->taut = false;
   way[m++] = t->pin + 3 * (t->n - 1);
   double total = 0;
   for (int j = 0; j + 1 < m; j++) total += dist3(way[j], way[j + 1]);
-  if (total < t->nseg * t->l0) { // slack, as its straight path is shorter: the passes place it, unstretched
+  const double length = t->nseg * t->l0;
+  const double lay = (1 - TX_THREAD_TAUT_SLACK) * length;
+  if (total < (t->taut ? lay - 2 * t->def.radius : lay)) { // slack: the passes place it, unstretched
     t->taut_excess = 0;
-    return false;
+    return t->taut = false;
   }
-  // the nodes a link apart along the path (a link across a bend is a chord)
+  t->taut = true;
+  // the nodes evenly along the path, the links alike (a link across a bend
+  // is a chord), the last at the pin
   double start = 0; // the path's length up to way[j]
   int j = 0;
   for (int i = 1; i < t->n; i++) {
-    double s = i * t->l0, len = dist3(way[j], way[j + 1]);
+    double s = i * total / t->nseg, len = dist3(way[j], way[j + 1]);
     while (j + 2 < m && s > start + len) start += len, j++, len = dist3(way[j], way[j + 1]);
     double f = len > 0 ? (s - start) / len : 0;
     for (int a = 0; a < 3; a++) t->x[3 * i + a] = way[j][a] + f * (way[j + 1][a] - way[j][a]);
   }
-  t->taut_excess = total - t->nseg * t->l0;
+  t->taut_excess = fmax(0, total - length);
   // each puncture's point held: its distance from the head along the path
   double d = 0;
   for (int k = t->passed - 1, q = 0; k >= 0; k--, q++) {
     d += dist3(way[q], way[q + 1]);
-    t->arc[k] = fmin(d, t->nseg * t->l0);
+    t->arc[k] = fmin(d * length / total, length); // along the thread, as its nodes are laid
   }
   return true;
 }

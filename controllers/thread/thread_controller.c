@@ -43,6 +43,10 @@ typedef struct thread_ctl {
   bool knotted, fixed;
   int knots;
   int classify_every;   // steps between two runs of the classifier; 0: never
+  bool knot_confirm;    // the papers' rule's knot counts only while the classifier finds one
+  bool unconfirmed_now; // the rule finds a knot the classifier does not, now
+  int unconfirmed;      // times that began
+  tx_result unconfirmed_result;
   tx_knot_work* work;
   int classified;       // times the classifier went from the unknot to a knot
   tx_knot_class cls;    // its last answer
@@ -133,6 +137,8 @@ static const tx_param_def params[] = {
     {"draw", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL, "also write PREFIX.segments and PREFIX.spheres: the thread as a tube for the graphics view"},
     {"rod_after_s", TX_PARAM_NUM, "s", 0, 1e6, 0, NULL, "ftl: from this time on the thread is a rod (XPBD, self contacts), e.g. to pull a knot tight; 0: never"},
     {"classify_every", TX_PARAM_INT, "1", 0, 100000, 0, NULL, "steps between two runs of the knot classifier (Gauss code, 32 projections); 0: never"},
+    {"knot_confirm", TX_PARAM_BOOL, NULL, 0, 0, 0, NULL,
+     "a knot the papers' rule finds counts (its event, its fixing) only while the classifier finds the thread knotted: the rule alone takes strands lying side by side for a knot; needs classify_every > 0"},
     {"fix_distance_m", TX_PARAM_NUM, "m", 0, 1, 0.002, NULL, "a knot this near the skin is fixed"},
     {"punctures", TX_PARAM_STR, NULL, 0, 0, 0, "", "a puncture list (tx_puncture rows: points on triangles of SKIN.x particles, e.g. needle.punctures) the thread passes through in order; needs skin; empty: none"},
     {"max_punctures", TX_PARAM_INT, "1", 0, 1024, 16, NULL, "room for the puncture list's rows"},
@@ -181,6 +187,9 @@ static int configure(tx_setup* s, void** self) {
   k->knot_every = (int)tx_table_int(s, "knot_every");
   k->fix_distance = tx_table_num(s, "fix_distance_m");
   k->classify_every = (int)tx_table_int(s, "classify_every");
+  k->knot_confirm = tx_table_bool(s, "knot_confirm");
+  if (k->knot_confirm && k->classify_every == 0)
+    return tx_setup_fail(s, "knot_confirm", "needs the classifier: set classify_every > 0");
   k->rod_after_s = tx_table_num(s, "rod_after_s");
   double tail[3];
   if (tx_param_point(s, "tail_m", (const double[3]){0.2, 0, 0}, tail)) return -1;
@@ -314,6 +323,7 @@ static int configure(tx_setup* s, void** self) {
   k->classified_result = tx_setup_result(s, "classifier_knots");
   k->classified_s_result = tx_setup_result(s, "classifier_knot_s");
   k->class_result = tx_setup_result(s, "knot_class");
+  k->unconfirmed_result = tx_setup_result(s, "knots_unconfirmed");
   k->classified_s = -1;
   return 0;
 }
@@ -382,6 +392,12 @@ static void check_knot(tx_ctx* c, thread_ctl* k) {
     if (cut[i]) k->marks[i] = 0; // a cut link is no cylinder
   tx_knot_papers p;
   bool knot = tx_knot_papers_rule(k->marks, n - 1, &rule, &p);
+  if (k->knot_confirm) { // the rule's knot only if the thread is knotted at all
+    const bool unconfirmed = knot && k->cls == TX_KNOT_UNKNOT;
+    if (unconfirmed && !k->unconfirmed_now) k->unconfirmed++;
+    k->unconfirmed_now = unconfirmed;
+    knot = knot && !unconfirmed;
+  }
   // a knot on cylinders that overlap the last one counted is that knot again:
   // held at exactly 2 r, a tight knot's contacts flicker across the 1 % margin
   bool same = k->knot_first >= 0 && p.first <= k->knot_last && p.last >= k->knot_first;
@@ -638,8 +654,9 @@ static void step(tx_ctx* c, void* self) {
   if (tx_thread_step(k->t, k->dt) == TX_THREAD_FAULT) tx_warn(c, k->fault);
   double strain = tx_thread_max_strain(k->t);
   if (strain > k->max_strain) k->max_strain = strain;
-  if (k->steps % k->knot_every == 0) check_knot(c, k);
+  // the classifier first: a knot to confirm is confirmed by this step's answer
   if (k->classify_every > 0 && k->steps % k->classify_every == 0) classify(c, k);
+  if (k->steps % k->knot_every == 0) check_knot(c, k);
   k->steps++;
   publish(c, k);
 }
@@ -663,6 +680,7 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, k->classified_result, k->classified);
   tx_set_result(c, k->classified_s_result, k->classified_s);
   tx_set_result(c, k->class_result, (double)k->cls);
+  tx_set_result(c, k->unconfirmed_result, k->unconfirmed);
 }
 
 static void fini(void* self) {

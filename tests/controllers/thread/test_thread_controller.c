@@ -774,6 +774,55 @@ static void knot_near_the_skin_is_fixed(void** state) {
   free_shapes(set, nset);
 }
 
+// knot_confirm: the papers' rule takes two strands lying side by side for a
+// knot, and one 1 mm over the skin is fixed there; with the classifier's
+// confirmation it is no knot (counted as knots_unconfirmed), while the tight
+// overhand still is, found and fixed.
+static int confirm_run(int which, bool confirm, double* unconfirmed) {
+  shape set[16];
+  int nset = knot_shapes(set);
+  knot_shape = set[which];
+  int n = knot_shape.n;
+  knot_ymin = 1;
+  for (int i = 0; i < n; i++) knot_ymin = fmin(knot_ymin, knot_shape.x[3 * i + 1]);
+  knot_gap = 0.001;
+  ks_rod_step = ks_end_step = -1;
+  ks_heard[0] = ks_heard[1] = 0;
+  char text[2048];
+  snprintf(text, sizeof text,
+           "{\"name\":\"t\",\"controllers\":["
+           "{\"name\":\"fixture\",\"type\":\"test.knot_skin\",\"rate_hz\":1000},"
+           "{\"name\":\"thread\",\"type\":\"physics.thread\",\"rate_hz\":1000,\"params\":{\"head\":\"knot.hand\","
+           "\"start_shape\":\"knot.shape\",\"nodes\":%d,\"length_m\":%.17g,\"radius_m\":%.17g,\"skin\":\"skin\","
+           "\"self_collision\":false,\"slack\":true,\"knot_every\":5,\"classify_every\":5,\"knot_confirm\":%s}}]}",
+           n, SHAPE_SPACING * (n - 1), SHAPE_RADIUS, confirm ? "true" : "false");
+  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 0.03);
+  *unconfirmed = result(s, "thread.knots_unconfirmed");
+  assert_int_equal(warnings(s, "thread.classify_failed"), 0);
+  tx_scenario_free(s);
+  free_shapes(set, nset);
+  return ks_heard[0] + 2 * ks_heard[1];
+}
+
+static void a_knot_the_classifier_denies_does_not_count(void** state) {
+  (void)state;
+  if (!tx_find_controller(knot_skin_class.type)) assert_int_equal(tx_register_controller(&knot_skin_class), 0);
+  double u[4];
+  const int strands = 7, overhand = 0; // the reference set's "parallel strands touching" and "overhand, tight"
+  int got[4] = {confirm_run(strands, false, &u[0]), confirm_run(strands, true, &u[1]),
+                  confirm_run(overhand, false, &u[2]), confirm_run(overhand, true, &u[3])};
+  print_message("  strands side by side: events found+2 fixed %d, confirmed %d (unconfirmed %g); the tight overhand: "
+                "%d, confirmed %d (unconfirmed %g)\n", got[0], got[1], u[1], got[2], got[3], u[3]);
+  assert_int_equal(got[0], 3); // the rule alone: found and fixed
+  assert_int_equal(got[1], 0);
+  assert_true(u[0] == 0 && u[1] == 1);
+  assert_int_equal(got[2], 3);
+  assert_int_equal(got[3], 3);
+  assert_true(u[3] == 0);
+}
+
 static void bad_input_is_named(void** state) {
   (void)state;
   struct {
@@ -797,6 +846,7 @@ static void bad_input_is_named(void** state) {
       {"\"grasp_events\":\"nobody.events\"", "instrument0.pose"}, // no jaws' frame
       {"\"grasp_hands\":9", "params.grasp_hands"},
       {"\"grasp_capture_m\":-1", "params.grasp_capture_m"},
+      {"\"knot_confirm\":true", "params.knot_confirm"}, // without the classifier
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
     tx_scenario* s = load(cases[i].params, "slide-x-over");
@@ -820,6 +870,7 @@ int main(void) {
       cmocka_unit_test(puncture_survives_renumbering),
       cmocka_unit_test(ftl_held_by_grasping_jaws),
       cmocka_unit_test(knot_near_the_skin_is_fixed),
+      cmocka_unit_test(a_knot_the_classifier_denies_does_not_count),
       cmocka_unit_test(bad_input_is_named),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

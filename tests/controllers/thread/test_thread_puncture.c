@@ -175,7 +175,8 @@ static void test_taut_thread_loads_its_puncture_as_a_pulley(void** state) {
                 want[0], want[1], T, sqrt(err / w2), k_load, k * w2 / (T * T), tx_thread_puncture_arc(t, 0) * 1e3);
   assert_true(sqrt(err / w2) < 1e-9);
   assert_float_equal(k_load, k * w2 / (T * T), 1e-9 * k_load);
-  assert_float_equal(tx_thread_puncture_arc(t, 0), lh, 1e-12); // still through P, 12 mm from the head
+  // still through P, 12 mm from the head along the path: along the thread, stretched alike, lh L / (la + lh)
+  assert_float_equal(tx_thread_puncture_arc(t, 0), lh * d.length / (la + lh), 1e-12);
   tx_thread_destroy(t);
 }
 

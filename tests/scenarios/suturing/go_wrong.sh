@@ -7,9 +7,10 @@
 #   and the scorecard reports the bites asymmetric;
 # - the held tail: the thread's tail pinned on the skin 2 cm from the wound
 #   (thread.pin_tail) while the forceps pull the needle through as usual: the
-#   thread draws tight and pulls the stitch out of the skin, so the scorecard
-#   counts tears by a pull (tears_pulled, beside the needle's own) and the
-#   wound gap opens.
+#   thread cannot be drawn through, so B is never done; the thread bunches
+#   where it is held, which the papers' knot rule takes for a knot, and the
+#   classifier does not confirm it (thread.knots_unconfirmed), so no throw is
+#   scored (D and E not reached) and no knot is fixed on the skin.
 # Release only (two 17 s runs, about 15 s).
 #
 #   go_wrong.sh TACTUS
@@ -43,12 +44,11 @@ check(b0 < 0.01 < b1 and abs(abs(b1 - b0) - asym) < 1e-9, "bites %g and %g m, as
 check(s["tears_pulled"]["value"] == 0, "the shallow bite tore by a pull: %r" % s["tears_pulled"])
 
 s, status = card("held")
-g = s["wound_gap_m"]
-print("held tail: tears %d, by a pull %d, peak tension %.2f N, wound gap %.3f -> %.3f mm, steps %s" % (
-    s["tears"]["value"], s["tears_pulled"]["value"], s["peak_tension_n"]["value"], 1e3 * g["before"],
-    1e3 * g["after"], status))
-check(status["A"] == "done", "A %s" % status["A"])
-check(s["tears_pulled"]["value"] > 0, "no tear by a pull counted: %r" % s["tears_pulled"])
-check(s["peak_tension_n"]["value"] > 5, "the thread was not drawn past tying's 5 N: %r" % s["peak_tension_n"])
-check(g["after"] > 2 * g["before"], "the wound did not open: %r" % g)
+r = json.load(open(d + "/held/report.json"))["results"]
+print("held tail: steps %s, knots %d, unconfirmed %d, peak tension %.2f N, tears by a pull %d" % (
+    status, s["knots"]["value"], r["thread.knots_unconfirmed"], s["peak_tension_n"]["value"], s["tears_pulled"]["value"]))
+check(status["A"] == "done" and status["B"] == "under way", "A %s, B %s" % (status["A"], status["B"]))
+check(status["D"] == "not reached" and status["E"] == "not reached", "a throw scored: D %s, E %s" % (status["D"], status["E"]))
+check(s["knots"]["value"] == 0 and s["knots_fixed"]["value"] == 0 and r["thread.knots_unconfirmed"] >= 1,
+      "knots %r, unconfirmed %r" % (s["knots"], r["thread.knots_unconfirmed"]))
 PY
