@@ -692,6 +692,20 @@ static void ks_step(tx_ctx* c, void* self) {
 static const tx_controller_class knot_skin_class = {
     .type = "test.knot_skin", .summary = "a knot over a skin patch", .configure = ks_configure, .step = ks_step};
 
+// the thread on knot_shape over the fixture's skin (ftl, no self contacts: it
+// keeps the shape), with the papers' rule every 5 steps, and more params
+static tx_scenario* load_knot_skin(const char* more) {
+  char text[2048];
+  snprintf(text, sizeof text,
+           "{\"name\":\"t\",\"controllers\":["
+           "{\"name\":\"fixture\",\"type\":\"test.knot_skin\",\"rate_hz\":1000},"
+           "{\"name\":\"thread\",\"type\":\"physics.thread\",\"rate_hz\":1000,\"params\":{\"head\":\"knot.hand\","
+           "\"start_shape\":\"knot.shape\",\"nodes\":%d,\"length_m\":%.17g,\"radius_m\":%.17g,\"skin\":\"skin\","
+           "\"self_collision\":false,\"slack\":true,\"knot_every\":5,%s}}]}",
+           knot_shape.n, SHAPE_SPACING * (knot_shape.n - 1), SHAPE_RADIUS, more);
+  return tx_scenario_load_text("test", text, strlen(text), NULL);
+}
+
 // the tight overhand, 1 mm over the skin (ftl, no self contacts: the thread
 // keeps the shape): the papers' rule finds it at its first check and, the
 // knot within fix_distance_m (2 mm) of the skin, fixes it: a knot event
@@ -716,15 +730,7 @@ static void knot_near_the_skin_is_fixed(void** state) {
     knot_gap = near ? 0.001 : 0.01;
     ks_heard[0] = ks_heard[1] = 0;
     ks_fixed_first = ks_fixed_last = -1;
-    char text[2048];
-    snprintf(text, sizeof text,
-             "{\"name\":\"t\",\"controllers\":["
-             "{\"name\":\"fixture\",\"type\":\"test.knot_skin\",\"rate_hz\":1000},"
-             "{\"name\":\"thread\",\"type\":\"physics.thread\",\"rate_hz\":1000,\"params\":{\"head\":\"knot.hand\","
-             "\"start_shape\":\"knot.shape\",\"nodes\":%d,\"length_m\":%.17g,\"radius_m\":%.17g,\"skin\":\"skin\","
-             "\"self_collision\":false,\"slack\":true,\"knot_every\":5,\"rod_after_s\":0.02,\"damping\":0}}]}",
-             n, SHAPE_SPACING * (n - 1), SHAPE_RADIUS);
-    tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+    tx_scenario* s = load_knot_skin("\"rod_after_s\":0.02,\"damping\":0");
     if (!s) fail_msg("%s", tx_error());
     run(s, (ks_end_step + 2) * 1e-3);
     int first = (int)ks_fixed_first, lastc = (int)ks_fixed_last;
@@ -788,15 +794,7 @@ static int confirm_run(int which, bool confirm, double* unconfirmed) {
   knot_gap = 0.001;
   ks_rod_step = ks_end_step = -1;
   ks_heard[0] = ks_heard[1] = 0;
-  char text[2048];
-  snprintf(text, sizeof text,
-           "{\"name\":\"t\",\"controllers\":["
-           "{\"name\":\"fixture\",\"type\":\"test.knot_skin\",\"rate_hz\":1000},"
-           "{\"name\":\"thread\",\"type\":\"physics.thread\",\"rate_hz\":1000,\"params\":{\"head\":\"knot.hand\","
-           "\"start_shape\":\"knot.shape\",\"nodes\":%d,\"length_m\":%.17g,\"radius_m\":%.17g,\"skin\":\"skin\","
-           "\"self_collision\":false,\"slack\":true,\"knot_every\":5,\"classify_every\":5,\"knot_confirm\":%s}}]}",
-           n, SHAPE_SPACING * (n - 1), SHAPE_RADIUS, confirm ? "true" : "false");
-  tx_scenario* s = tx_scenario_load_text("test", text, strlen(text), NULL);
+  tx_scenario* s = load_knot_skin(confirm ? "\"classify_every\":5,\"knot_confirm\":true" : "\"classify_every\":5");
   if (!s) fail_msg("%s", tx_error());
   run(s, 0.03);
   *unconfirmed = result(s, "thread.knots_unconfirmed");
