@@ -117,11 +117,16 @@ static void panel(const tx_plot* p, double label_gap) {
   range(p, false, p->log_y, &y0, &y1);
   pladv(0);
   plschr(0, 0.8);
-  // the legend goes under the x label: all series in one row when their labels are short, else two columns
-  int nlabels = p->nseries < TX_PLOT_SERIES_MAX ? p->nseries : TX_PLOT_SERIES_MAX, chars = 0;
-  for (int s = 0; s < nlabels; s++) chars += (int)strlen(p->series[s].label) + 6;
-  int ncol = chars <= 60 ? nlabels : 2, nrow = nlabels ? (nlabels + ncol - 1) / ncol : 0;
-  double bottom = 0.12 + label_gap * 0.5 + 0.05 * nrow, top = label_gap > 0.12 ? 0.86 : 0.90;
+  // the legend goes under the x label: all series in one row when their labels are short, else two
+  // columns, or one when two of the longest would not fit across the page
+  int nlabels = p->nseries < TX_PLOT_SERIES_MAX ? p->nseries : TX_PLOT_SERIES_MAX, chars = 0, longest = 0;
+  for (int s = 0; s < nlabels; s++) {
+    int len = (int)strlen(p->series[s].label);
+    chars += len + 6;
+    if (len > longest) longest = len;
+  }
+  int ncol = chars <= 60 ? nlabels : longest > 34 ? 1 : 2, nrow = nlabels ? (nlabels + ncol - 1) / ncol : 0;
+  double bottom = 0.12 + label_gap * 0.5 + (ncol == 1 ? 0.035 : 0.05) * nrow, top = label_gap > 0.12 ? 0.86 : 0.90;
   plvpor(0.17, 0.95, bottom, top);
   plwind(x0, x1, y0, y1);
   // a light grid under everything, then the frame and the numbers in black

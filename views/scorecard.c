@@ -196,7 +196,9 @@ static int plot(const scorecard* v, const char* path) {
     ys[n][0] = ys[n][1] = v->nsteps - i;
     bool done = v->step[i].status == TX_STEP_DONE;
     snprintf(labels[n], sizeof labels[n], "%.*s (%s)", 60, v->name[i].text, done ? "done" : "skipped");
-    s[n] = (tx_plot_series){labels[n], xs[n], ys[n], 2, false, done ? 1 + n % 14 : 15};
+    // a step that began and ended at once (skipped by a later step's event) is a marker, not an empty bar
+    bool instant = xs[n][1] <= xs[n][0];
+    s[n] = (tx_plot_series){labels[n], xs[n], ys[n], instant ? 1 : 2, instant, done ? 1 + n % 14 : 15};
     n++;
   }
   if (n == 0) return 0;

@@ -10,7 +10,8 @@
 # measure with its value, unit and rule. The run's recordings of both hands
 # (device0.bin, device1.bin) replayed in lockstep give the same scorecard,
 # byte for byte, and hand 1 replayed from hand 0's recording scores
-# otherwise. Release only (about 25 s).
+# otherwise. With OSMesa the run also writes its stereo frames (side by side)
+# and a contact sheet. Release only (about 30 s).
 #
 #   test_suturing.sh TACTUS
 set -eu
@@ -18,7 +19,9 @@ TACTUS=$1
 command -v python3 >/dev/null || { echo "no python3: skipped"; exit 77; }
 d=$(mktemp -d)
 trap 'rm -rf "$d"' EXIT
-"$TACTUS" run suturing --lockstep --quiet --out "$d/o"
+view=()
+[ "${TX_OSMESA:-1}" = 1 ] && view=(--view png --stereo sbs)
+"$TACTUS" run suturing --lockstep --quiet --out "$d/o" "${view[@]}"
 python3 - "$d/o" <<'PY'
 import json, math, sys
 out = sys.argv[1]
@@ -55,6 +58,13 @@ check(s["tears"]["value"] > 0 and s["tears_pulled"]["value"] == 0, "tears %r, pu
 check(0 < s["tissue_force_max_n"]["value"] <= 3.3, "tissue force %r" % s["tissue_force_max_n"])
 PY
 test -s "$d/o/scorecard.png"
+# the procedure's stereo frames (side by side: twice the width) and its contact sheet
+if [ ${#view[@]} -gt 0 ]; then
+  frames=("$d"/o/frames/frame_*.png)
+  size=$(python3 -c 'import struct, sys; print("%d x %d" % struct.unpack(">II", open(sys.argv[1], "rb").read()[16:24]))' "${frames[-1]}")
+  echo "frames: ${#frames[@]}, $size"
+  [ "${#frames[@]}" -ge 30 ] && [ "$size" = "1280 x 480" ] && test -s "$d/o/frames/contact_sheet.png"
+fi
 # the session replayed from its recordings scores the same
 "$TACTUS" run suturing --lockstep --no-record --quiet --device "replay:$d/o/device0.bin" --device "replay:$d/o/device1.bin" \
   --out "$d/r"
