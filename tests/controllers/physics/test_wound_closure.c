@@ -282,18 +282,19 @@ static void a_pair_of_loads_closes_the_wound_in_proportion(void** state) {
   assert_refused(s, "nobody.loads");
 }
 
-// the pull at which the skin first tears: the pair ramped up at 5 N/s; with
-// a HIP (the needle's tip) held hip_y above the stitch's entry, or none (0);
-// whether the first tear was counted as a pull's (beyond the tip's reach)
-static double pull_out(double blunt, double hip_y, bool* pulled) {
-  pair_n = 30, pair_k = 0, pair_ramp_s = 6;
+// the pull at which the skin first tears (-1: not by up_to N): the pair
+// ramped up at 5 N/s; with a HIP (the needle's tip) held hip_y above the
+// stitch's entry, or none (0); whether the first tear was counted as a pull's
+// (beyond the tip's reach)
+static double pull_out(double blunt, double hip_y, double up_to, bool* pulled) {
+  pair_n = up_to, pair_k = 0, pair_ramp_s = up_to / 5;
   pair_hip_r = hip_y > 0 ? 0.0005 : 0;
   pair_hip_at[0] = head_x[0], pair_hip_at[1] = hip_y, pair_hip_at[2] = row_z;
   char params[128];
   snprintf(params, sizeof params, ",\"blunt_rupture_tension_n_per_m\":%g", blunt);
   tx_scenario* s = load_pair(params);
   if (!s) fail_msg("%s", tx_error());
-  run(s, 6);
+  run(s, pair_ramp_s);
   tx_scenario_free(s);
   pair_ramp_s = 0.2, pair_hip_r = 0;
   *pulled = pair_first_torn.pulled == pair_first_torn.links;
@@ -316,8 +317,8 @@ static double pull_out(double blunt, double hip_y, bool* pulled) {
 static void a_stitch_holds_the_tying_pull_and_tears_out_past_it(void** state) {
   (void)state;
   bool pulled[4];
-  const double out = pull_out(1000, 0, &pulled[0]), out_tip = pull_out(80, 0, &pulled[1]),
-               tip_near = pull_out(1000, 0.003, &pulled[2]), tip_far = pull_out(1000, 0.03, &pulled[3]);
+  const double out = pull_out(1000, 0, 19, &pulled[0]), out_tip = pull_out(80, 0, 5, &pulled[1]),
+               tip_near = pull_out(1000, 0.003, 5, &pulled[2]), tip_far = pull_out(1000, 0.03, 19, &pulled[3]);
   stitch hard = run_stitch("thread.puncture_loads", -0.065, "");
   print_message("  the pair tears the skin at %.2f N (at %.2f N with the tip's 80 N/m everywhere); with the tip 3 mm "
                 "above the entry at %.2f N, 3 cm above at %.2f N\n", out, out_tip, tip_near, tip_far);
