@@ -43,5 +43,6 @@ int tx_study_thread_accuracy(const tx_study_args* a);
 int tx_study_thread_stability(const tx_study_args* a);
 int tx_study_cautery_heat(const tx_study_args* a);
 int tx_study_band_joint(const tx_study_args* a);
+int tx_study_suturing_accuracy(const tx_study_args* a);
 
 #endif

@@ -58,6 +58,8 @@ static const struct {
      "the thread at 10 m/s, a 10 cm teleport, coincident nodes, stiffness x1e6, steps 1e-5..1e-2 s, a knot at 20 N"},
     {"cautery-heat", tx_study_cautery_heat,
      "the organs' bioheat solver against the erfc and perfused closed forms: error vs CPU time, mesh and step, order"},
+    {"suturing-accuracy", tx_study_suturing_accuracy,
+     "the scripted suture with the skin and the thread refined together: the scorecard's quantities vs the finest, error vs CPU time"},
     {"band-joint", tx_study_band_joint,
      "the gastric band's distance joint (ODE double-ball) with its two parts pulled apart at 1-20 N: length error vs time"},
 };

@@ -174,7 +174,8 @@ static json_t* build(const scorecard* v) {
                       json_pack("{s:o, s:o, s:s, s:s}", "before", number_or_null(m->wound_gap_before_m), "after",
                                 number_or_null(m->wound_gap_after_m), "unit", "m", "rule",
                                 "the distance across the wound where the stitch crosses it, between its two edges' skin "
-                                "nearest there: as the run found the skin, and at its end; a stitch draws the edges together"));
+                                "nearest there: as the run found the skin, and at its end; a stitch draws the edges together "
+                                "(at rest the edges are a particle spacing apart: compare after with before)"));
   measure(root, "tissue_force_max_n", m->tissue_force_max_n, "N",
           "the largest force of the skin on the needle's tip; OSATS's respect for tissue asks for no unnecessary force");
   measure(root, "tears", m->tears, "1", "links the skin tore (the punctures' own included), the wound's cut not counted");
