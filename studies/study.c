@@ -3,6 +3,8 @@
 
 #include "studies.h"
 
+#include "../model/error.h"
+
 #include <tactus/config.h>
 
 #include <getopt.h>
@@ -21,6 +23,23 @@ int tx_study_quick_set(const tx_study_args* a, bool* quick) {
     *quick = v == 1;
   }
   return 0;
+}
+
+int tx_study_steps_done(const char* scorecard_path, char done[9]) {
+  json_error_t e;
+  json_t* card = json_load_file(scorecard_path, 0, &e);
+  done[0] = 0;
+  if (!card) return tx_set_error("%s:%d: %s", scorecard_path, e.line, e.text), -1;
+  int n = 0;
+  size_t i;
+  json_t* s;
+  json_array_foreach(json_object_get(card, "steps"), i, s) {
+    const char* id = json_string_value(json_object_get(s, "id"));
+    if (json_is_true(json_object_get(s, "done")) && id && n < 8) done[n++] = id[0];
+  }
+  done[n] = 0;
+  json_decref(card);
+  return n;
 }
 
 static const struct {
@@ -60,6 +79,8 @@ static const struct {
      "the organs' bioheat solver against the erfc and perfused closed forms: error vs CPU time, mesh and step, order"},
     {"suturing-accuracy", tx_study_suturing_accuracy,
      "the scripted suture with the skin and the thread refined together: the scorecard's quantities vs the finest, error vs CPU time"},
+    {"suturing-stability", tx_study_suturing_stability,
+     "the scripted suture with the hands jittered, the steps varied, stiffness x0.01..x100: completes, no NaN, within the clamp"},
     {"band-joint", tx_study_band_joint,
      "the gastric band's distance joint (ODE double-ball) with its two parts pulled apart at 1-20 N: length error vs time"},
 };

@@ -80,6 +80,10 @@ static void range(const tx_plot* p, bool x, bool log_axis, double* lo, double* h
       if (isfinite(v)) *lo = fmin(*lo, v), *hi = fmax(*hi, v);
     }
   if (!(*lo <= *hi)) *lo = 0, *hi = 1;
+  // values equal but for rounding (3.3 and 3.2999999999) are one value: on a
+  // span a millionth of their size PLplot's ticks no longer advance, and it
+  // drew grid lines for ever
+  if (!log_axis && *hi - *lo <= 1e-6 * fmax(fabs(*hi), fabs(*lo))) *lo = *hi = 0.5 * (*lo + *hi);
   double pad = (*hi - *lo) * 0.05 + (log_axis ? 0.1 : (*hi == *lo ? fmax(fabs(*hi) * 0.1, 1e-9) : 0));
   *lo -= pad, *hi += pad;
 }

@@ -110,10 +110,26 @@ static void draws_log_axes_and_markers(void** state) {
   remove(path);
 }
 
+// values equal but for rounding (3.3 and the next double, a clamped force
+// and its clamp): the axis spans them as one value (it used to
+// make PLplot draw grid lines for ever: the test's timeout catches a hang)
+static void draws_values_equal_but_for_rounding(void** state) {
+  (void)state;
+  double x[2] = {1, 2}, y[2] = {nextafter(3.3, 4), 3.3}, y2[2] = {3.3, 3.3};
+  tx_plot_series s[] = {{"largest force", x, y, 2, true, 1}, {"clamp", x, y2, 2, false, 15}};
+  tx_plot p = {"nearly equal", "case", "force (N)", false, false, s, 2};
+  char path[] = "/tmp/tx_plot_XXXXXX";
+  close(mkstemp(path));
+  int rc = tx_plot_png(path, &p);
+  assert_int_equal(rc, TX_WITH_PLPLOT ? 0 : -1);
+  remove(path);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {cmocka_unit_test(lengths_in_one_unit), cmocka_unit_test(palette_reads_on_white),
                                      cmocka_unit_test(log_axes_have_enough_labels), cmocka_unit_test(markers_differ),
                                      cmocka_unit_test(coinciding_series_are_found),
-                                     cmocka_unit_test(draws_log_axes_and_markers)};
+                                     cmocka_unit_test(draws_log_axes_and_markers),
+                                     cmocka_unit_test(draws_values_equal_but_for_rounding)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
