@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # tactus study suturing-stability, quick (the hands jittered 2 mm, the
-# instruments and the thread at 500 Hz, the tissue x100 stiffer): exit 0 only
+# instruments and the thread at 500 Hz, the tissue x100 stiffer; each run
+# through the needle's pass, 12.5 s): exit 0 only
 # when every case passes (completed, no NaN or Inf to or from a hand, no force
 # over the device's clamp); three cases in the JSON, each passing, with the
 # largest force within the clamp read back; CSV (and the PNG with PLplot); a
-# bad --set is refused with 2 and one line. About 20 s.
+# bad --set is refused with 2 and one line. About 15 s.
 #
 #   suturing_stability.sh TACTUS PLPLOT(0|1)
 set -eu
