@@ -9,7 +9,7 @@ cd "$(dirname "$0")"
 jobs=$(nproc 2>/dev/null || echo 2)
 default_scenario=suturing-skin
 fuzz_seconds=${TX_FUZZ_SECONDS:-15}
-soak_seconds=${TX_SOAK_SECONDS:-600}
+soak_seconds=${TX_SOAK_SECONDS:-540}
 
 say() { printf '\n== %s\n' "$*" >&2; }
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Soak: suturing-skin in real time with the sim device for SECONDS (CI: 600).
+# Soak: suturing-skin in real time with the sim device for SECONDS (CI: 540).
 # Samples the process's resident memory every second into OUT/rss.csv and
 # fails when it grows by more than SLACK_KB between WARMUP seconds in and the
 # end: every buffer of a run is allocated and touched before its first tick,
