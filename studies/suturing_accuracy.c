@@ -52,9 +52,9 @@ static double cpu_now(void) {
 
 // a measure's value in the scorecard: {"value": v} or, for the wound gap, "after"
 static double measure(json_t* card, int q) {
-  if (q == 0) return json_number_value(json_object_get(json_object_get(card, "wound_gap_m"), "after"));
-  json_t* v = json_object_get(json_object_get(card, key[q]), "value");
-  return json_is_number(v) ? json_number_value(v) : NAN;
+  json_t* v = q == 0 ? json_object_get(json_object_get(card, "wound_gap_m"), "after")
+                     : json_object_get(json_object_get(card, key[q]), "value");
+  return json_is_number(v) ? json_number_value(v) : NAN; // null: not measured
 }
 
 static int run_level(const char* path, const char* dir, int k, level_run* r) {

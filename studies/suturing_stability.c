@@ -128,7 +128,7 @@ static double device_clamp(const char* spec) {
   tx_device_info info = {0};
   h.backend->info(h.device, &info);
   tx_device_close(&h);
-  return info.max_force;
+  return info.max_force > 0 ? info.max_force : NAN;
 }
 
 static int run_case(const char* scenario, const char* dir, int k, double duration_s, outcome* o) {
@@ -171,6 +171,7 @@ static int run_case(const char* scenario, const char* dir, int k, double duratio
     snprintf(spec, sizeof spec, "scripted:instruments/hand%d.csv", h);
     o->clamp = fmin(o->clamp, device_clamp(ndevices ? specs[h] : spec));
   }
+  if (!(o->clamp < INFINITY)) return fprintf(stderr, "tactus: study suturing-stability: no device clamp: %s\n", tx_error()), 1;
   char card_path[4300];
   snprintf(card_path, sizeof card_path, "%s/scorecard.json", sub);
   o->steps_done = tx_study_steps_done(card_path, o->done); // -1: a run stopped before its scorecard
