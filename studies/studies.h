@@ -19,10 +19,9 @@ typedef struct tx_study_args {
 // after one line naming the --set
 int tx_study_quick_set(const tx_study_args* a, bool* quick);
 
-// the steps a run's scorecard (OUT/scorecard.json) marks done: their ids'
-// first letters in done (at most 8 and a NUL) and how many; -1 with the
-// message in tx_error() when it cannot be read
-int tx_study_steps_done(const char* scorecard_path, char done[9]);
+// the steps a run's scorecard (OUT/scorecard.json, as read) marks done: their
+// ids' first letters in done (at most 8 and a NUL) and how many
+int tx_study_steps_done(json_t* card, char done[9]);
 
 // one target line of a bench's table: what, the measured value, the limit,
 // met or MISSED; _us: a time in microseconds against an upper limit

@@ -3,8 +3,6 @@
 
 #include "studies.h"
 
-#include "../model/error.h"
-
 #include <tactus/config.h>
 
 #include <getopt.h>
@@ -25,11 +23,7 @@ int tx_study_quick_set(const tx_study_args* a, bool* quick) {
   return 0;
 }
 
-int tx_study_steps_done(const char* scorecard_path, char done[9]) {
-  json_error_t e;
-  json_t* card = json_load_file(scorecard_path, 0, &e);
-  done[0] = 0;
-  if (!card) return tx_set_error("%s:%d: %s", scorecard_path, e.line, e.text), -1;
+int tx_study_steps_done(json_t* card, char done[9]) {
   int n = 0;
   size_t i;
   json_t* s;
@@ -38,7 +32,6 @@ int tx_study_steps_done(const char* scorecard_path, char done[9]) {
     if (json_is_true(json_object_get(s, "done")) && id && n < 8) done[n++] = id[0];
   }
   done[n] = 0;
-  json_decref(card);
   return n;
 }
 

@@ -174,8 +174,9 @@ static int run_case(const char* scenario, const char* dir, int k, double duratio
   if (!(o->clamp < INFINITY)) return fprintf(stderr, "tactus: study suturing-stability: no device clamp: %s\n", tx_error()), 1;
   char card_path[4300];
   snprintf(card_path, sizeof card_path, "%s/scorecard.json", sub);
-  o->steps_done = tx_study_steps_done(card_path, o->done); // -1: a run stopped before its scorecard
-  if (o->steps_done < 0) o->steps_done = 0;
+  json_t* card = json_load_file(card_path, 0, NULL); // NULL: a run stopped before its scorecard, no step done
+  o->steps_done = tx_study_steps_done(card, o->done);
+  json_decref(card);
   o->pass = o->rc == 0 && o->non_finite == 0 && o->force_max <= o->clamp * (1 + 1e-9);
   return 0;
 }
