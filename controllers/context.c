@@ -57,6 +57,11 @@ void tx_write_rows(tx_ctx* c, tx_port p, uint32_t rows) {
   tx_model_set_rows(c->sys->model, pt->comp, rows); // still clamped, so no reader looks past the buffer
 }
 
+const tx_component_def* tx_port_schema(tx_ctx* c, tx_port p) {
+  if (p.id < 1 || p.id > c->in->nports || c->in->ports[p.id - 1].kind != PORT_COMPONENT) return NULL;
+  return tx_model_def(c->sys->model, c->in->ports[p.id - 1].comp);
+}
+
 int64_t tx_sim_ns(const tx_ctx* c) { return c->sim_ns; }
 const char* tx_record_dir(const tx_ctx* c) { return c->sys->record_dir; }
 const char* tx_output_dir(const tx_ctx* c) { return c->sys->out_dir; }

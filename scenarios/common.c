@@ -182,7 +182,7 @@ tx_scenario* tx_load_for_command_view(const char* name, const char* const* sets,
                                       int ndevices, const char* view, const char* stereo, bool lockstep) {
   char path[PATH_MAX];
   if (tx_scenario_locate(name, path, sizeof path)) return tx_bad_input("%s", tx_error()), NULL;
-  tx_load_options o = {sets, nsets, true, devices, ndevices, view, stereo, lockstep, NULL};
+  tx_load_options o = {sets, nsets, true, devices, ndevices, view, stereo, lockstep, NULL, NULL};
   tx_scenario* s = tx_scenario_load(path, &o);
   if (!s) tx_bad_input("%s", tx_error());
   return s;

@@ -11,6 +11,7 @@
 #include <dlfcn.h>
 #include <errno.h>
 #include <libgen.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -320,6 +321,34 @@ static int add_view(const char* file, tx_system* sys, json_t* view, const tx_loa
 }
 
 
+#define PROBE_INSTANCE "probe" // --probe's view.probe in the report
+
+// --probe: a view.probe of the components named, every EVERY_S (0.1 s by default)
+static int add_probe(tx_system* sys, const tx_load_options* o) {
+  if (!o || !o->probe) return 0;
+  char spec[1024];
+  if (snprintf(spec, sizeof spec, "%s", o->probe) >= (int)sizeof spec) return fail("--probe: longer than %zu characters", sizeof spec - 1);
+  double every = 0.1;
+  char* at = strchr(spec, '@');
+  if (at) {
+    char* end;
+    *at = 0;
+    every = strtod(at + 1, &end);
+    if (end == at + 1 || *end || !isfinite(every) || every < 0)
+      return fail("--probe %s: expected @ a time in seconds, 0 or more, after the components", o->probe);
+  }
+  json_t* params = json_object();
+  json_t* list = json_array();
+  if (!params || !list) return json_decref(params), json_decref(list), fail("--probe: out of memory");
+  for (char* save = NULL, *c = strtok_r(spec, ",", &save); c; c = strtok_r(NULL, ",", &save)) json_array_append_new(list, json_string(c));
+  json_object_set_new(params, "components", list);
+  json_object_set_new(params, "every_s", json_real(every));
+  int rc = tx_system_add(sys, PROBE_INSTANCE, "view.probe", every > 0 && every < 0.01 ? 1000 : 100, params);
+  json_decref(params);
+  if (rc) return fail("--probe %s: %s%s%s", o->probe, tx_error_key(), *tx_error_key() ? ": " : "", tx_error());
+  return 0;
+}
+
 // ---- roles and the net section: one scenario split over processes (docs/distributed.md)
 
 #define ROLES_MAX 16
@@ -544,6 +573,7 @@ static int finalize(const char* file, tx_system* sys, json_t* root, const tx_loa
   bool is_view = index < 0 && o && o->view && strcmp(o->view, "none") != 0 && strcmp(key, VIEW_INSTANCE) == 0;
   if (is_view) return fail("%s: view.draw: %s", file, tx_error());
   if (index < 0 && strcmp(key, NET_INSTANCE) == 0) return fail("%s: net: %s", file, tx_error());
+  if (index < 0 && o && o->probe && strcmp(key, PROBE_INSTANCE) == 0) return fail("--probe %s: %s", o->probe, tx_error());
   if (index >= 0) return fail("%s: controllers[%d]: %s", file, index, tx_error());
   return fail("%s: %s", file, tx_error());
 }
@@ -659,6 +689,7 @@ static tx_scenario* load_root(const char* file, const char* dir, json_t* root, c
     else if ((rc = tx_system_set_thread(s->system, tx_system_count(s->system) - 1, NET_INSTANCE))) fail("%s: net: %s", file, tx_error());
   }
   if (!rc) rc = add_view(file, s->system, json_object_get(root, "view"), o);
+  if (!rc) rc = add_probe(s->system, o);
   if (!rc) rc = finalize(file, s->system, root, o);
   if (!rc && role < 0) rc = check_net_names(file, net, s->system);
   json_decref(bp);

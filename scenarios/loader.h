@@ -27,6 +27,7 @@ typedef struct tx_load_options {
   const char* stereo;       // the view's stereo mode (mono, sbs, tb, anaglyph, lr), NULL for mono
   bool view_wait;           // lockstep: the view renders every tick instead of dropping frames
   const char* role;         // run only this role's controllers, and the bridge (docs/distributed.md); NULL: all
+  const char* probe;        // "COMPONENT[,COMPONENT...][@EVERY_S]": add a view.probe of them (OUT/probe.csv); NULL: none
 } tx_load_options;
 
 // register the built-in controller classes (idempotent)

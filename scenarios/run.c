@@ -37,6 +37,8 @@ static const char run_usage[] =
     "  --quiet             no summary table\n"
     "  --role NAME         only the controllers of this role, and the bridge to the other roles' processes\n"
     "                      (a session: one process per role, docs/distributed.md)\n"
+    "  --probe C,...@S     record components C of any type (thread.nodes, needle.pose) every S seconds\n"
+    "                      (@S left out: 0.1) into OUT/probe.csv, one line per row (docs/views.md)\n"
     "\n"
     "Writes OUT/report.json: per controller achieved rate, missed deadlines, period jitter and step time,\n"
     "and OUT/device0.png (force and position traces) when a haptics device was recorded.\n"
@@ -200,7 +202,7 @@ int tx_cmd_run(int argc, char** argv) {
       {"device", required_argument, 0, 'D'},   {"view", required_argument, 0, 'v'}, {"stereo", required_argument, 0, 'S'},
       {"out", required_argument, 0, 'o'},      {"quiet", no_argument, 0, 'q'},   {"help", no_argument, 0, 'h'},
       {"no-record", no_argument, 0, 'R'},      {"role", required_argument, 0, 'r'},      {"force", no_argument, 0, 'F'},
-      {0, 0, 0, 0}};
+      {"probe", required_argument, 0, 'p'},    {0, 0, 0, 0}};
   static const char* const views[] = {"none", "png", "window", NULL};
   static const char* const stereo[] = {"mono", "sbs", "tb", "anaglyph", "lr", NULL};
   tx_run_config cfg = {0};
@@ -211,6 +213,7 @@ int tx_cmd_run(int argc, char** argv) {
   const char* stereo_mode = "mono";
   bool force = false;
   const char* role = NULL;
+  const char* probe = NULL;
   optind = 1;
   opterr = 0;
   // GNU getopt moves operands behind the options, so SCENARIO may stand anywhere
@@ -242,6 +245,7 @@ int tx_cmd_run(int argc, char** argv) {
     case 'R': cfg.no_record = true; break;
     case 'F': force = true; break;
     case 'r': role = optarg; break;
+    case 'p': probe = optarg; break;
     case 'h': return fputs(run_usage, stdout), 0;
     default:
       // inside a group of short options argv[optind - 1] is not the option; optopt is
@@ -276,16 +280,11 @@ int tx_cmd_run(int argc, char** argv) {
   if (role && cfg.lockstep) return tx_bad_input("--role %s: a session runs in real time; leave out --lockstep", role);
   if (tx_out_check(cfg.out, force)) return TX_EXIT_BAD_INPUT;
 
-  tx_scenario* sc = NULL;
-  if (role) { // the common loader, with the role
-    char path[PATH_MAX];
-    if (tx_scenario_locate(cfg.scenario, path, sizeof path)) return tx_bad_input("%s", tx_error());
-    tx_load_options o = {sets, nsets, true, devices, ndevices, view, stereo_mode, cfg.lockstep, role};
-    if (!(sc = tx_scenario_load(path, &o))) return tx_bad_input("%s", tx_error());
-  } else {
-    sc = tx_load_for_command_view(cfg.scenario, sets, nsets, devices, ndevices, view, stereo_mode, cfg.lockstep);
-  }
-  if (!sc) return TX_EXIT_BAD_INPUT;
+  char path[PATH_MAX];
+  if (tx_scenario_locate(cfg.scenario, path, sizeof path)) return tx_bad_input("%s", tx_error());
+  tx_load_options o = {sets, nsets, true, devices, ndevices, view, stereo_mode, cfg.lockstep, role, probe};
+  tx_scenario* sc = tx_scenario_load(path, &o);
+  if (!sc) return tx_bad_input("%s", tx_error());
   tx_replay_warn(sc->system);
   int rc = tx_run_scenario(sc, &cfg, NULL);
   tx_scenario_free(sc);

@@ -194,6 +194,10 @@ tx_snapshot tx_read(tx_ctx* c, tx_port p);           // latest publish; held unt
 void* tx_write(tx_ctx* c, tx_port p);                // back buffer, published after step
 void* tx_write_copy(tx_ctx* c, tx_port p);           // same, starting from the latest publish
 void tx_write_rows(tx_ctx* c, tx_port p, uint32_t rows); // rows in use for this publish
+// the schema (name, element type, rows, cols, units) of a component this
+// instance declared, a read or a write, for one that reads any type (a
+// probe); NULL for a port it did not declare
+const tx_component_def* tx_port_schema(tx_ctx* c, tx_port p);
 int64_t tx_sim_ns(const tx_ctx* c);                  // simulation time of this step, ns
 uint64_t tx_step_index(const tx_ctx* c);             // 0 for the first step
 double tx_rate(const tx_ctx* c);                     // Hz

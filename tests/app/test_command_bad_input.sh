@@ -166,6 +166,10 @@ expect_bad "--stereo without a view" "--stereo sbs" "--view png" -- run haptics-
 expect_bad "--device mouse without a window" "--device mouse" "--view window" -- run haptics-wall --lockstep --device mouse
 expect_bad "--device mouse with options" "--device mouse:fast" -- run haptics-wall --lockstep --device mouse:fast
 DISPLAY= expect_bad "--view window without a display (or GLFW)" "--view window" -- run haptics-wall --view window
+# --probe (view.probe): components nobody writes, a bad interval, nothing named
+expect_bad "--probe of a component nobody writes" "--probe device0.pose,nobody.x" "nobody.x" -- run haptics-wall --lockstep --probe device0.pose,nobody.x
+expect_bad "--probe with a bad interval" "--probe device0.pose@soon" "seconds" -- run haptics-wall --lockstep --probe device0.pose@soon
+expect_bad "--probe of nothing" "--probe @0.1" "at least one component" -- run haptics-wall --lockstep --probe @0.1
 view_scenario() { # FILE VIEW_JSON: the wall scenario with this "view"
   printf '{"name": "t", "controllers": [{"name": "wall", "type": "collision.wall", "rate_hz": 60},
   {"name": "haptics", "type": "haptics", "rate_hz": 1000, "params": {"force_model": "tool0.force_model"}}],
