@@ -21,9 +21,9 @@ against the holder's virtual coupling). After changing the drive, write the
 CSVs, run the scenario, read the needle's centre and angle at 10 s (its
 `needle.pose`), and set them; the environment variables CY, HC ("x,y,z"),
 HD, GT and PD override CENTRE_Y, HANDOVER_CENTRE, HANDOVER_DEG,
-GRASP_TIP_RAD and PULL_DEG for such trials, and SX sets SHIFT_X (the
-handover centre moves with it) (the scenario takes the CSVs
-with --set hapticsN.device=scripted:FILE).
+GRASP_TIP_RAD and PULL_DEG for such trials, SX sets SHIFT_X (the
+handover centre moves with it) and PH sets PULL_HARD_M (the scenario takes
+the CSVs with --set hapticsN.device=scripted:FILE).
 """
 import math
 import os
@@ -49,6 +49,16 @@ HANDOVER_DEG = 172.3
 # the two bites match; a shift makes one bite shallow and the other deep (the
 # go-wrong script of assets/procedures/simple-interrupted-suture/shallow-bite)
 SHIFT_X = 0.0
+# Pulling too hard (assets/procedures/simple-interrupted-suture/pull-too-hard):
+# instead of taking the scissors the holder takes the thread's tail by its
+# node two links beyond the entry, where the run has it once the forceps have
+# pulled the needle through (measured with `tactus run suturing --lockstep
+# --probe thread.nodes@0.5`: node 24 at 15.5 s), coming in low from -x under
+# the needle's arc, and the forceps pull the needle on PULL_HARD_M further
+# than the thread reaches. 0: the scissors cut, as scripted by default.
+PULL_HARD_M = 0.0
+TAIL_HOLD = (-0.0110, 0.0043, -0.0001)
+TAIL_JAW_M = 0.028  # the hold, ahead of the holder's pivot (its jaws: 4 to 35 mm)
 
 
 def qmul(a, b):
@@ -125,6 +135,8 @@ def hand0():
     rows.append(row(12.3, end[0], end[1], 0.4))
     up = (end[0][0], end[0][1] + 0.03, end[0][2])
     rows.append(row(12.6, up, end[1], 0.4))
+    if PULL_HARD_M:
+        return hand0_tail(rows, up, end[1])
     rows.append(("# then it puts the holder down for the Metzenbaum scissors (button 0, the 10th column) and waits "
                  "beside the\n# patch (z = 7 cm) while the forceps pull the needle through; then, blades along -z, "
                  "it opens them across the\n# thread between the exit and the lifted needle, 12 mm above the skin, "
@@ -155,6 +167,23 @@ def hand0():
                if SHIFT_X else "") + "\n".join(rows) + "\n")
 
 
+def hand0_tail(rows, up, q):
+    """The holder, open and risen from the needle at 12.6 s, takes the tail near the entry."""
+    # level, jaws along +x (opening along z, across the thread), low under the needle's arc
+    qj = (1.0, 0.0, 0.0, 0.0)
+    h = TAIL_HOLD
+    at = lambda back: (h[0] - TAIL_JAW_M - back, h[1], h[2])
+    rows.append(row(13.2, (at(0.04)[0], 0.03, h[2]), qj, 0.4))
+    rows.append(row(15.6, at(0.04), qj, 0.4))
+    rows.append(row(16.0, at(0), qj, 0.4))
+    rows.append(row(16.3, at(0), qj, 0))
+    rows.append(row(20.0, at(0), qj, 0))
+    return ("t_s,x_m,y_m,z_m,qw,qx,qy,qz,grip_rad\n"
+            "# device0, the needle holder (written by hands.py with PULL_HARD_M): takes the needle from the foam and "
+            "drives it\n# as the default script does; then, open and risen, comes in level from -x and takes the "
+            "thread's tail at (%.1f, %.1f, %.1f) mm, and holds it\n" % tuple(v * 1e3 for v in h) + "\n".join(rows) + "\n")
+
+
 def hand1(pinch):
     centre = HANDOVER_CENTRE
     psi = math.radians(HANDOVER_DEG + 180.0) - GRASP_TIP_RAD
@@ -177,13 +206,21 @@ def hand1(pinch):
         rows.append(row(13.0 + 2.0 * k / n, p, qq, 0))
     p, qq = about(centre, PULL_DEG, at(0), q)
     rows.append(row(15.5, (p[0], p[1] + 0.02, p[2]), qq, 0))
+    pulled = ""
+    if PULL_HARD_M:  # once the holder holds the tail: on, up and out along the stitch's line, too far
+        rows.append(row(16.5, (p[0], p[1] + 0.02, p[2]), qq, 0))
+        far = (p[0] + PULL_HARD_M * 0.6, p[1] + 0.02 + PULL_HARD_M * 0.8, p[2])
+        rows.append(row(18.5, far, qq, 0))
+        rows.append(row(20.0, far, qq, 0))
+        pulled = ("# from 16.5 s, the tail held in the holder, pull the needle on %.0f mm up and out: too hard\n"
+                  % (PULL_HARD_M * 1e3))
     return ("t_s,x_m,y_m,z_m,qw,qx,qy,qz,grip_rad\n"
             "# device1, the thumb forceps (written by hands.py): from 3 s take a pinch of skin 2 cm beside the "
             "needle's plane\n# (the tips, 20 degrees down, 1 mm into it), lift it 8 mm and let go while the holder "
             "drives the needle; then,\n# lying along -z beside the needle's plane, close on its wire %.2f rad "
             "behind the tip (out of the exit);\n# from 13 s turn it on about its centre (%g, %.1f, 0) mm by %.0f "
             "degrees until the swage has left the skin, and lift it 2 cm\n"
-            % (GRASP_TIP_RAD, SHIFT_X * 1e3, CENTRE_Y * 1e3, PULL_DEG) + "\n".join(rows) + "\n")
+            % (GRASP_TIP_RAD, SHIFT_X * 1e3, CENTRE_Y * 1e3, PULL_DEG) + pulled + "\n".join(rows) + "\n")
 
 
 # the forceps' pinch of the skin beside the needle's plane and their way back
@@ -205,7 +242,7 @@ PINCH = [
 
 
 def main():
-    global CENTRE_Y, HANDOVER_CENTRE, HANDOVER_DEG, GRASP_TIP_RAD, PULL_DEG, SHIFT_X
+    global CENTRE_Y, HANDOVER_CENTRE, HANDOVER_DEG, GRASP_TIP_RAD, PULL_DEG, SHIFT_X, PULL_HARD_M
     e = os.environ
     CENTRE_Y = float(e.get("CY", CENTRE_Y))
     SHIFT_X = float(e.get("SX", SHIFT_X))
@@ -215,6 +252,7 @@ def main():
     HANDOVER_DEG = float(e.get("HD", HANDOVER_DEG))
     GRASP_TIP_RAD = float(e.get("GT", GRASP_TIP_RAD))
     PULL_DEG = float(e.get("PD", PULL_DEG))
+    PULL_HARD_M = float(e.get("PH", PULL_HARD_M))
     out = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.abspath(__file__))
     pinch = [row(t, p, q, g) for t, p, q, g in PINCH]
     for name, text in (("hand0.csv", hand0()), ("hand1.csv", hand1(pinch))):

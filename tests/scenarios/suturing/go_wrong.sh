@@ -11,7 +11,12 @@
 #   where it is held, which the papers' knot rule takes for a knot, and the
 #   classifier does not confirm it (thread.knots_unconfirmed), so no throw is
 #   scored (D and E not reached) and no knot is fixed on the skin.
-# Release only (two 17 s runs, about 15 s).
+# - pulling too hard (assets/procedures/simple-interrupted-suture/pull-too-hard):
+#   the holder takes the thread's tail once it is pulled through and the
+#   forceps pull the needle on 5 cm further than the thread reaches: the
+#   stitch tears out of the skin, and the scorecard counts the tears a pull
+#   made (tears_pulled), apart from the needle tip's.
+# Release only (two 17 s runs and one of 20 s, about 20 s).
 #
 #   go_wrong.sh TACTUS
 set -eu
@@ -24,6 +29,8 @@ p=procedures/simple-interrupted-suture
   --device "scripted:$p/shallow-bite/hand0.csv" --device "scripted:$p/shallow-bite/hand1.csv"
 "$TACTUS" run suturing --lockstep --quiet --no-record --out "$d/held" --set thread.pin_tail=true \
   --set 'thread.tail_m=[0.02,0,0]'
+"$TACTUS" run suturing --lockstep --quiet --no-record --out "$d/hard" --duration 20 \
+  --device "scripted:$p/pull-too-hard/hand0.csv" --device "scripted:$p/pull-too-hard/hand1.csv"
 python3 - "$d" <<'PY'
 import json, sys
 d = sys.argv[1]
@@ -51,4 +58,14 @@ check(status["A"] == "done" and status["B"] == "under way", "A %s, B %s" % (stat
 check(status["D"] == "not reached" and status["E"] == "not reached", "a throw scored: D %s, E %s" % (status["D"], status["E"]))
 check(s["knots"]["value"] == 0 and s["knots_fixed"]["value"] == 0 and r["thread.knots_unconfirmed"] >= 1,
       "knots %r, unconfirmed %r" % (s["knots"], r["thread.knots_unconfirmed"]))
+
+s, status = card("hard")
+r = json.load(open(d + "/hard/report.json"))["results"]
+print("pulled too hard: steps %s, tears %d, by a pull %d, peak tension %.2f N, wound gap %.2f -> %.2f mm" % (
+    status, s["tears"]["value"], s["tears_pulled"]["value"], s["peak_tension_n"]["value"],
+    1e3 * s["wound_gap_m"]["before"], 1e3 * s["wound_gap_m"]["after"]))
+check(status["A"] == "done" and status["B"] == "done", "A %s, B %s" % (status["A"], status["B"]))
+check(r["thread.grasps"] == 1, "the holder did not take the tail: thread.grasps %r" % r["thread.grasps"])
+check(s["tears_pulled"]["value"] >= 1, "no tear by a pull counted: %r" % s["tears_pulled"])
+check(s["wound_gap_m"]["after"] > s["wound_gap_m"]["before"] + 0.001, "the stitch did not tear out: %r" % s["wound_gap_m"])
 PY
