@@ -84,6 +84,7 @@ static void step(tx_ctx* c, void* self) {
   p->next = fmax(p->next + p->every, t);
   for (int k = 0; k < p->n; k++) {
     tx_snapshot s = tx_read(c, p->port[k]);
+    if (s.seq == 0) continue; // never published yet: nothing to keep
     const tx_component_def* d = tx_port_schema(c, p->port[k]);
     uint64_t need = HEAD + (uint64_t)s.rows * s.cols;
     if (p->used + need > p->cap) { // nothing half kept: the sample ends here

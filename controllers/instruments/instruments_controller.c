@@ -41,7 +41,8 @@ typedef struct instruments {
   int nswitches;
   tx_port dev_pose[HANDS], dev_vel[HANDS], dev_grip[HANDS];
   tx_port pose[HANDS], links[HANDS], model[HANDS], held[HANDS];
-  int link_rows[HANDS];
+  tx_port capsules[HANDS]; // the held instrument's jaws as capsules, for the thread
+  int link_rows[HANDS], capsule_rows[HANDS];
   tx_warning bad_input, reset;
   tx_result contacts_max, force_max, grasps, releases;
   tx_port needle_pose, needle_swage, needle_segments, events;
@@ -165,6 +166,59 @@ static void blades_of(instruments* m, int i) {
   }
 }
 
+static void rotate(const double q[4], const double v[3], double o[3]) {
+  double t[3] = {2 * (q[2] * v[2] - q[3] * v[1]), 2 * (q[3] * v[0] - q[1] * v[2]), 2 * (q[1] * v[1] - q[2] * v[0])};
+  o[0] = v[0] + q[0] * t[0] + q[2] * t[2] - q[3] * t[1];
+  o[1] = v[1] + q[0] * t[1] + q[3] * t[0] - q[1] * t[2];
+  o[2] = v[2] + q[0] * t[2] + q[1] * t[1] - q[2] * t[0];
+}
+
+// a shape's centre c and orientation q in the world, from its link's pose (lp, lq)
+static void shape_frame(const double lp[3], const double lq[4], const tx_urdf_shape* sh, double c[3], double q[4]) {
+  rotate(lq, sh->pose.p, c);
+  for (int j = 0; j < 3; j++) c[j] += lp[j];
+  q[0] = lq[0] * sh->pose.q[0] - lq[1] * sh->pose.q[1] - lq[2] * sh->pose.q[2] - lq[3] * sh->pose.q[3];
+  q[1] = lq[0] * sh->pose.q[1] + lq[1] * sh->pose.q[0] + lq[2] * sh->pose.q[3] - lq[3] * sh->pose.q[2];
+  q[2] = lq[0] * sh->pose.q[2] - lq[1] * sh->pose.q[3] + lq[2] * sh->pose.q[0] + lq[3] * sh->pose.q[1];
+  q[3] = lq[0] * sh->pose.q[3] + lq[1] * sh->pose.q[2] - lq[2] * sh->pose.q[1] + lq[3] * sh->pose.q[0];
+}
+
+// The parts that grasp and cut, for the thread to keep out of: each box of
+// a jaw link ahead of its pivot (as blades_of takes them) as a capsule along
+// the box's longest side, as thick as its thinnest, so that two closing jaws
+// leave the thread room between them until they are nearly shut (a holder's
+// jaws 0.5 mm apart 20 mm out at 0.0125 rad, well after the grasp at 0.03
+// rad). Fills out (NULL: only counts) at the instrument's current link poses;
+// returns how many.
+static int jaw_capsules(const instruments* m, int i, tx_capsule* out) {
+  const tx_urdf* u = m->desc[i]->urdf;
+  int n = 0;
+  for (int j = 0; j < u->njoints; j++) {
+    if (u->joints[j].fixed) continue;
+    int l = u->joints[j].child;
+    for (int k = 0; k < u->links[l].nshapes; k++) {
+      const tx_urdf_shape* sh = &u->links[l].shapes[k];
+      if (sh->kind != TX_URDF_BOX || sh->pose.p[0] <= 0) continue;
+      if (out) {
+        int along = 0, thin = 0;
+        for (int a = 1; a < 3; a++) {
+          if (sh->size[a] > sh->size[along]) along = a;
+          if (sh->size[a] < sh->size[thin]) thin = a;
+        }
+        double lp[3], lq[4], c[3], q[4], half[3] = {0, 0, 0}, d[3];
+        tx_instrument_world_link(m->world, i, l, lp, lq);
+        shape_frame(lp, lq, sh, c, q);
+        out[n].radius = sh->size[thin] / 2;
+        half[along] = fmax(sh->size[along] / 2 - out[n].radius, 0);
+        rotate(q, half, d);
+        for (int a = 0; a < 3; a++) out[n].a[a] = c[a] - d[a], out[n].b[a] = c[a] + d[a];
+      }
+      n++;
+    }
+  }
+  return n;
+}
+
 // scissors closing on the thread cut it between their blades; other jaws
 // closing on it grasp it, or else grasp the skin between them (until they
 // open again)
@@ -281,6 +335,8 @@ static int configure(tx_setup* s, void** self) {
       m->slot[h][m->nslot[h]++] = i;
       m->n = i + 1;
       if (m->desc[i]->urdf->nlinks > m->link_rows[h]) m->link_rows[h] = m->desc[i]->urdf->nlinks;
+      int jaws = jaw_capsules(m, i, NULL);
+      if (jaws > m->capsule_rows[h]) m->capsule_rows[h] = jaws;
     }
     if (!m->nslot[h]) continue;
     m->nhands = h + 1;
@@ -298,6 +354,10 @@ static int configure(tx_setup* s, void** self) {
     m->model[h] = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_force_model, 1));
     snprintf(name, sizeof name, "instrument%d.held", h);
     m->held[h] = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_instrument_held, 1));
+    if (m->capsule_rows[h] > 0) {
+      snprintf(name, sizeof name, "instrument%d.capsules", h);
+      m->capsules[h] = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_capsule, (uint32_t)m->capsule_rows[h]));
+    }
   }
   if (m->n == 0) return tx_setup_fail(s, "instrument0", "no instrument: give instrument0");
   if (nd->held_by >= m->nhands) return tx_setup_fail(s, "needle_in_jaws", "there is no instrument%d", nd->held_by);
@@ -508,12 +568,6 @@ static void hole_row(instruments* m, int i, const float* xs, int nx, const int32
   m->at_hole[i] = true;
 }
 
-static void rotate(const double q[4], const double v[3], double o[3]) {
-  double t[3] = {2 * (q[2] * v[2] - q[3] * v[1]), 2 * (q[3] * v[0] - q[1] * v[2]), 2 * (q[1] * v[1] - q[2] * v[0])};
-  o[0] = v[0] + q[0] * t[0] + q[2] * t[2] - q[3] * t[1];
-  o[1] = v[1] + q[0] * t[1] + q[3] * t[0] - q[1] * t[2];
-  o[2] = v[2] + q[0] * t[2] + q[1] * t[1] - q[2] * t[0];
-}
 
 // The lowest the held instruments come above the skin: every corner of
 // their collision boxes, the lowest point of each cylinder's rim and of each
@@ -536,12 +590,7 @@ static void clearance(instruments* m, const float* xs, int nx) {
         const tx_urdf_shape* sh = &u->links[l].shapes[k];
         double c[3], q[4], pts[8][3];
         int n = 0;
-        rotate(lq, sh->pose.p, c);
-        for (int j = 0; j < 3; j++) c[j] += lp[j];
-        q[0] = lq[0] * sh->pose.q[0] - lq[1] * sh->pose.q[1] - lq[2] * sh->pose.q[2] - lq[3] * sh->pose.q[3];
-        q[1] = lq[0] * sh->pose.q[1] + lq[1] * sh->pose.q[0] + lq[2] * sh->pose.q[3] - lq[3] * sh->pose.q[2];
-        q[2] = lq[0] * sh->pose.q[2] - lq[1] * sh->pose.q[3] + lq[2] * sh->pose.q[0] + lq[3] * sh->pose.q[1];
-        q[3] = lq[0] * sh->pose.q[3] + lq[1] * sh->pose.q[2] - lq[2] * sh->pose.q[1] + lq[3] * sh->pose.q[0];
+        shape_frame(lp, lq, sh, c, q);
         if (sh->kind == TX_URDF_BOX) {
           for (int corner = 0; corner < 8; corner++, n++) {
             double v[3] = {(corner & 1 ? 0.5 : -0.5) * sh->size[0], (corner & 2 ? 0.5 : -0.5) * sh->size[1],
@@ -690,6 +739,7 @@ static void step(tx_ctx* c, void* self) {
     for (int l = 0; l < m->link_rows[h]; l++) // rows past its links repeat its root
       tx_instrument_world_link(m->world, i, l < u->nlinks ? l : 0, links[l].pos, links[l].quat);
     ((tx_instrument_held*)tx_write(c, m->held[h]))->index = m->cur[h];
+    if (m->capsules[h].id) tx_write_rows(c, m->capsules[h], (uint32_t)jaw_capsules(m, i, tx_write(c, m->capsules[h])));
     tx_instrument_pose* ip = tx_write(c, m->pose[h]);
     memcpy(ip->pos, links[0].pos, sizeof ip->pos);
     memcpy(ip->quat, links[0].quat, sizeof ip->quat);

@@ -99,6 +99,8 @@ typedef struct thread_ctl {
   double max_strain;         // the largest segment strain seen
   int knot_lost;             // times the papers' rule lost a knot it had found
   tx_result held_result, lost_result;
+  int shape_steps;            // steps in which the thread touched a capsule
+  tx_result shape_steps_result;
   tx_result strain_result;
 } thread_ctl;
 
@@ -309,6 +311,7 @@ static int configure(tx_setup* s, void** self) {
   k->shapes = malloc(sizeof(tx_thread_capsule) * (size_t)(d.max_shapes + 1));
   if (!k->shapes) return tx_setup_fail(s, NULL, "out of memory");
   k->too_many = tx_setup_warning(s, "too_many_capsules");
+  if (k->ncaps) k->shape_steps_result = tx_setup_result(s, "capsule_contact_steps");
   k->fault = tx_setup_warning(s, "numerical_fault");
   k->bad_head = tx_setup_warning(s, "bad_head");
   k->bad_skin = tx_setup_warning(s, "bad_skin");
@@ -652,6 +655,9 @@ static void step(tx_ctx* c, void* self) {
   if (k->rod_after_s > 0 && tx_thread_get_def(k->t)->model == TX_THREAD_FTL && tx_sim_ns(c) * 1e-9 >= k->rod_after_s)
     tx_thread_set_model(k->t, TX_THREAD_ROD);
   if (tx_thread_step(k->t, k->dt) == TX_THREAD_FAULT) tx_warn(c, k->fault);
+  tx_thread_contacts hit;
+  tx_thread_last_contacts(k->t, &hit);
+  k->shape_steps += hit.shape_hits > 0;
   double strain = tx_thread_max_strain(k->t);
   if (strain > k->max_strain) k->max_strain = strain;
   // the classifier first: a knot to confirm is confirmed by this step's answer
@@ -681,6 +687,7 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, k->classified_s_result, k->classified_s);
   tx_set_result(c, k->class_result, (double)k->cls);
   tx_set_result(c, k->unconfirmed_result, k->unconfirmed);
+  tx_set_result(c, k->shape_steps_result, k->shape_steps);
 }
 
 static void fini(void* self) {

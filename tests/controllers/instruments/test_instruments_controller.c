@@ -71,6 +71,45 @@ static void test_follows_the_hand_and_renders_the_weight(void** state) {
   tx_scenario_free(s);
 }
 
+// the holder's jaws as the thread sees them (instrument0.capsules): one
+// capsule per jaw box (31 x 3.5 x 2.25 mm, its centre 19.5 mm ahead of the
+// pivot and 1.125 mm off the jaws' line), along the box, as thick as its
+// thinnest side; opened to 0.2 rad each, the two capsules 0.4 rad apart, their
+// ends where the boxes' ends turn to
+static void test_jaws_are_published_as_capsules(void** state) {
+  (void)state;
+  tx_scenario* s = load("\"instrument0\":\"needle_holder\"");
+  if (!s) fail_msg("%s", tx_error());
+  run(s, 1.55);
+  tx_snapshot cs = latest_snapshot(s, "instrument0.capsules");
+  const tx_capsule* c = cs.data;
+  const double* ins = latest(s, "instrument0.pose");
+  assert_int_equal(cs.rows, 2);
+  double u[2][3];
+  for (int k = 0; k < 2; k++) {
+    double len = 0, da = 0, db = 0;
+    for (int j = 0; j < 3; j++) {
+      u[k][j] = c[k].b[j] - c[k].a[j];
+      len += u[k][j] * u[k][j];
+      da += (c[k].a[j] - ins[j]) * (c[k].a[j] - ins[j]);
+      db += (c[k].b[j] - ins[j]) * (c[k].b[j] - ins[j]);
+    }
+    len = sqrt(len);
+    for (int j = 0; j < 3; j++) u[k][j] /= len;
+    print_message("  jaw %d: radius %.4f mm, %.4f mm long, its ends %.4f and %.4f mm from the pivot\n", k,
+                  1e3 * c[k].radius, 1e3 * len, 1e3 * sqrt(da), 1e3 * sqrt(db));
+    assert_true(fabs(c[k].radius - 0.001125) < 1e-12);
+    assert_true(fabs(len - (0.031 - 0.00225)) < 1e-9);
+    // the box's axis from 5.125 to 33.875 mm ahead, 1.125 mm off the jaw's line
+    assert_true(fabs(sqrt(da) - hypot(0.005125, 0.001125)) < 1e-6);
+    assert_true(fabs(sqrt(db) - hypot(0.033875, 0.001125)) < 1e-6);
+  }
+  double cosine = u[0][0] * u[1][0] + u[0][1] * u[1][1] + u[0][2] * u[1][2];
+  print_message("  the jaws %.4f rad apart, the capsules %.4f rad\n", ins[7], acos(cosine));
+  assert_true(fabs(acos(cosine) - ins[7]) < 1e-6);
+  tx_scenario_free(s);
+}
+
 static void test_refuses_what_it_cannot_read(void** state) {
   (void)state;
   tx_scenario* s = load("\"instrument0\":\"no_such_instrument\"");
@@ -535,6 +574,7 @@ static void test_tune_switches_instruments(void** state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_follows_the_hand_and_renders_the_weight),
+      cmocka_unit_test(test_jaws_are_published_as_capsules),
       cmocka_unit_test(test_refuses_what_it_cannot_read),
       cmocka_unit_test(test_needle_is_published),
       cmocka_unit_test(test_scissors_cut_the_thread),

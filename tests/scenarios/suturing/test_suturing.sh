@@ -32,6 +32,8 @@ def check(ok, what):
         sys.exit("suturing: " + what)
 check(r["skin.wound_links_cut"] == 38, "the wound cut %s links, not 38" % r["skin.wound_links_cut"])
 check(r["skin.faults"] == 0 and r["thread.faults"] == 0, "a fault")
+# the thread meets the instruments' jaws (instrumentN.capsules): the holder's, with the swage between them
+check(r["thread.capsule_contact_steps"] > 0, "the thread never met a jaw: %r" % r["thread.capsule_contact_steps"])
 check(s["scenario"] == "suturing", "scorecard scenario %r" % s["scenario"])
 ids = [e["id"] for e in s["steps"]]
 check(ids == list("ABCDEFGH"), "steps %r" % ids)
