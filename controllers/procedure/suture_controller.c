@@ -64,7 +64,7 @@ static const tx_param_def params[] = {
     {"wrap_reach_m", TX_PARAM_NUM, "m", 0.001, 0.1, 0.008, NULL, "thread nodes within this distance of the jaws' axis count for the wrap"},
     {"wrap_length_m", TX_PARAM_NUM, "m", 0.005, 0.3, 0.03, NULL, "the jaws' length ahead of the pivot, along which a wrap counts"},
     {"skin", TX_PARAM_STR, NULL, 0, 0, 0, "",
-     "the skin's prefix: SKIN.x for the wound gap at the stitch, SKIN.contact for the force on the tissue and the tears, SKIN.torn for those a pull tore; empty: none"},
+     "the skin's prefix: SKIN.x for the wound gap at the stitch, SKIN.contact for the force on the tissue, SKIN.torn for the tears and those a pull tore; empty: none"},
 };
 
 // a read that the scenario may leave out with an empty name
@@ -347,10 +347,9 @@ static void read_skin(tx_ctx* c, suture* k) {
   if (f.seq) {
     const tx_skin_contact* sc = f.data;
     k->m.tissue_force_max_n = fmax(k->m.tissue_force_max_n, sqrt(sc->f[0] * sc->f[0] + sc->f[1] * sc->f[1] + sc->f[2] * sc->f[2]));
-    k->m.tears = sc->torn;
   }
-  tx_snapshot t = tx_read(c, k->skin_torn);
-  if (t.seq) k->m.tears_pulled = ((const tx_torn*)t.data)->pulled;
+  tx_snapshot t = tx_read(c, k->skin_torn); // both counts from one publish: the pulled ones are some of the torn
+  if (t.seq) k->m.tears = ((const tx_torn*)t.data)->links, k->m.tears_pulled = ((const tx_torn*)t.data)->pulled;
 }
 
 static void step(tx_ctx* c, void* self) {
