@@ -41,7 +41,7 @@ typedef struct instruments {
   int nswitches;
   tx_port dev_pose[HANDS], dev_vel[HANDS], dev_grip[HANDS];
   tx_port pose[HANDS], links[HANDS], model[HANDS], held[HANDS];
-  tx_port capsules[HANDS]; // the held instrument's jaws as capsules, for the thread
+  tx_port capsules[HANDS]; // the held instrument's collision shapes as capsules, for the thread
   int link_rows[HANDS], capsule_rows[HANDS];
   tx_warning bad_input, reset;
   tx_result contacts_max, force_max, grasps, releases;
@@ -183,40 +183,65 @@ static void shape_frame(const double lp[3], const double lq[4], const tx_urdf_sh
   q[3] = lq[0] * sh->pose.q[3] + lq[1] * sh->pose.q[2] - lq[2] * sh->pose.q[1] + lq[3] * sh->pose.q[0];
 }
 
-// The parts that grasp and cut, for the thread to keep out of: each box of
-// a jaw link ahead of its pivot (as blades_of takes them) as a capsule along
-// the box's longest side, as thick as its thinnest, so that two closing jaws
-// leave the thread room between them until they are nearly shut (a holder's
-// jaws 0.5 mm apart 20 mm out at 0.0125 rad, well after the grasp at 0.03
-// rad). Fills out (NULL: only counts) at the instrument's current link poses;
-// returns how many.
-static int jaw_capsules(const instruments* m, int i, tx_capsule* out) {
+// The instrument's collision shapes, for the thread to keep out of: each box
+// ahead of its link's pivot (a jaw, a blade, a tine) as a capsule along its
+// longest side, as thick as its thinnest, so that two closing jaws leave the
+// thread room between them until they are nearly shut (a holder's jaws 0.5
+// mm apart 20 mm out at 0.0125 rad, well after the grasp at 0.03 rad); a
+// cylinder (the pivot's lump) as a capsule along its axis, a sphere as
+// itself. The lump keeps a loop wound round the jaws from sliding off them
+// backwards. The shanks (boxes behind the pivot) are left out: the thread
+// leaves the needle's swage along the holder from the first grasp, and a
+// coarse thread (4 mm links) snagged on them (the suturing-accuracy study's 5
+// mm level never finished B). Fills out (NULL: only counts) at the
+// instrument's current link poses; returns how many.
+static int instrument_capsules(const instruments* m, int i, tx_capsule* out) {
   const tx_urdf* u = m->desc[i]->urdf;
   int n = 0;
-  for (int j = 0; j < u->njoints; j++) {
-    if (u->joints[j].fixed) continue;
-    int l = u->joints[j].child;
+  for (int l = 0; l < u->nlinks; l++) {
+    double lp[3], lq[4];
+    if (out) tx_instrument_world_link(m->world, i, l, lp, lq);
     for (int k = 0; k < u->links[l].nshapes; k++) {
       const tx_urdf_shape* sh = &u->links[l].shapes[k];
-      if (sh->kind != TX_URDF_BOX || sh->pose.p[0] <= 0) continue;
-      if (out) {
+      if (sh->kind == TX_URDF_BOX && sh->pose.p[0] <= 0) continue; // a shank
+      if (!out) { n++; continue; }
+      double c[3], q[4], half[3] = {0, 0, 0}, d[3];
+      shape_frame(lp, lq, sh, c, q);
+      if (sh->kind == TX_URDF_BOX) {
         int along = 0, thin = 0;
         for (int a = 1; a < 3; a++) {
           if (sh->size[a] > sh->size[along]) along = a;
           if (sh->size[a] < sh->size[thin]) thin = a;
         }
-        double lp[3], lq[4], c[3], q[4], half[3] = {0, 0, 0}, d[3];
-        tx_instrument_world_link(m->world, i, l, lp, lq);
-        shape_frame(lp, lq, sh, c, q);
         out[n].radius = sh->size[thin] / 2;
         half[along] = fmax(sh->size[along] / 2 - out[n].radius, 0);
-        rotate(q, half, d);
-        for (int a = 0; a < 3; a++) out[n].a[a] = c[a] - d[a], out[n].b[a] = c[a] + d[a];
+      } else if (sh->kind == TX_URDF_CYLINDER) { // radius, length; its axis along z
+        out[n].radius = sh->size[0];
+        half[2] = sh->size[1] / 2;
+      } else {
+        out[n].radius = sh->size[0];
       }
+      rotate(q, half, d);
+      for (int a = 0; a < 3; a++) out[n].a[a] = c[a] - d[a], out[n].b[a] = c[a] + d[a];
       n++;
     }
   }
   return n;
+}
+
+static void arc_point(const instruments* m, double a, double out[3]);
+
+// the needle's wire between jaws (pivot, dir) closing: those jaws take the
+// needle (ODE's grasp, a few steps later, once they squeeze the wire), not
+// the thread that leaves its swage between them too
+static bool needle_between(const instruments* m, int i, const double pivot[3], const double dir[3]) {
+  tx_thread_node wire[NEEDLE_CHORDS + 1];
+  for (int k = 0; k <= NEEDLE_CHORDS; k++) {
+    arc_point(m, m->p.needle.arc * k / NEEDLE_CHORDS, wire[k].x);
+    wire[k].radius = m->p.needle.wire_diameter / 2;
+  }
+  double at[3];
+  return tx_scissors_cut(pivot, dir, m->blade_length[i], m->blade_reach[i], wire, NEEDLE_CHORDS + 1, at) >= 0;
 }
 
 // scissors closing on the thread cut it between their blades; other jaws
@@ -234,6 +259,7 @@ static void cut(tx_ctx* c, instruments* m, int i, double jaw) {
   tx_instrument_world_link(m->world, i, 0, pivot, q);
   // the root's x axis: the closed blades
   dir[0] = 1 - 2 * (q[2] * q[2] + q[3] * q[3]), dir[1] = 2 * (q[1] * q[2] + q[0] * q[3]), dir[2] = 2 * (q[1] * q[3] - q[0] * q[2]);
+  if (!m->scissors[i] && m->p.needle.enabled && needle_between(m, i, pivot, dir)) return;
   tx_snapshot nodes = m->thread_nodes.id ? tx_read(c, m->thread_nodes) : (tx_snapshot){0};
   int seg = nodes.seq ? tx_scissors_cut(pivot, dir, m->blade_length[i], m->blade_reach[i], nodes.data, (int)nodes.rows, point) : -1;
   if (seg >= 0 && m->scissors[i]) {
@@ -335,8 +361,8 @@ static int configure(tx_setup* s, void** self) {
       m->slot[h][m->nslot[h]++] = i;
       m->n = i + 1;
       if (m->desc[i]->urdf->nlinks > m->link_rows[h]) m->link_rows[h] = m->desc[i]->urdf->nlinks;
-      int jaws = jaw_capsules(m, i, NULL);
-      if (jaws > m->capsule_rows[h]) m->capsule_rows[h] = jaws;
+      int shapes = instrument_capsules(m, i, NULL);
+      if (shapes > m->capsule_rows[h]) m->capsule_rows[h] = shapes;
     }
     if (!m->nslot[h]) continue;
     m->nhands = h + 1;
@@ -739,7 +765,7 @@ static void step(tx_ctx* c, void* self) {
     for (int l = 0; l < m->link_rows[h]; l++) // rows past its links repeat its root
       tx_instrument_world_link(m->world, i, l < u->nlinks ? l : 0, links[l].pos, links[l].quat);
     ((tx_instrument_held*)tx_write(c, m->held[h]))->index = m->cur[h];
-    if (m->capsules[h].id) tx_write_rows(c, m->capsules[h], (uint32_t)jaw_capsules(m, i, tx_write(c, m->capsules[h])));
+    if (m->capsules[h].id) tx_write_rows(c, m->capsules[h], (uint32_t)instrument_capsules(m, i, tx_write(c, m->capsules[h])));
     tx_instrument_pose* ip = tx_write(c, m->pose[h]);
     memcpy(ip->pos, links[0].pos, sizeof ip->pos);
     memcpy(ip->quat, links[0].quat, sizeof ip->quat);

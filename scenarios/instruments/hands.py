@@ -22,8 +22,8 @@ CSVs, run the scenario, read the needle's centre and angle at 10 s (its
 `needle.pose`), and set them; the environment variables CY, HC ("x,y,z"),
 HD, GT and PD override CENTRE_Y, HANDOVER_CENTRE, HANDOVER_DEG,
 GRASP_TIP_RAD and PULL_DEG for such trials, SX sets SHIFT_X (the
-handover centre moves with it) and PH sets PULL_HARD_M (the scenario takes
-the CSVs with --set hapticsN.device=scripted:FILE).
+handover centre moves with it), PH sets PULL_HARD_M and TIE=1 writes the
+instrument tie (the scenario takes the CSVs with --device scripted:FILE).
 """
 import math
 import os
@@ -57,6 +57,21 @@ SHIFT_X = 0.0
 # the needle's arc, and the forceps pull the needle on PULL_HARD_M further
 # than the thread reaches. 0: the scissors cut, as scripted by default.
 PULL_HARD_M = 0.0
+# The instrument tie, so far its wrap (C) (assets/procedures/simple-interrupted-
+# suture/instrument-tie, with a 12 cm thread that is a rod from 17.6 s): the
+# forceps pull the needle TIE_UP further up, so that 3 cm of tail is left; the
+# holder, closed, lies with its jaws along the needle's chord (TIE_CHORD, the
+# swage to the tip at 15.5 s), TIE_R from the swage along +z; the forceps carry
+# the needle TIE_TURNS times round the jaws' line, TIE_R out, in the plane
+# across it (so the 25 mm needle keeps clear of the jaws), TIE_TURN_S a turn.
+TIE = False
+TIE_SWAGE = (0.0081, 0.0152, -0.0003)  # the swage at 15.5 s (--probe needle.swage)
+TIE_CHORD = (-0.883, 0.469, 0.0)
+TIE_UP = 0.055
+TIE_R = 0.02
+TIE_TURNS = 1.5
+TIE_TURN_S = 5.0
+TIE_WRAP_T = 18.5  # s, the wrap starts
 TAIL_HOLD = (-0.0110, 0.0043, -0.0001)
 TAIL_JAW_M = 0.028  # the hold, ahead of the holder's pivot (its jaws: 4 to 35 mm)
 
@@ -135,6 +150,8 @@ def hand0():
     rows.append(row(12.3, end[0], end[1], 0.4))
     up = (end[0][0], end[0][1] + 0.03, end[0][2])
     rows.append(row(12.6, up, end[1], 0.4))
+    if TIE:
+        return hand0_tie(rows)
     if PULL_HARD_M:
         return hand0_tail(rows, up, end[1])
     rows.append(("# then it puts the holder down for the Metzenbaum scissors (button 0, the 10th column) and waits "
@@ -184,6 +201,33 @@ def hand0_tail(rows, up, q):
             "thread's tail at (%.1f, %.1f, %.1f) mm, and holds it\n" % tuple(v * 1e3 for v in h) + "\n".join(rows) + "\n")
 
 
+def tie_frame():
+    """The wrap's geometry: the swage lifted, the jaws' line through P along
+    the chord, the direction across it in the x-y plane, the holder's pivot."""
+    d, z = TIE_CHORD, (0.0, 0.0, 1.0)
+    n = (d[1] * z[2] - d[2] * z[1], d[2] * z[0] - d[0] * z[2], d[0] * z[1] - d[1] * z[0])
+    lifted = (TIE_SWAGE[0], TIE_SWAGE[1] + TIE_UP, TIE_SWAGE[2])
+    p = tuple(lifted[i] + TIE_R * z[i] for i in range(3))
+    pivot = tuple(p[i] - 0.017 * d[i] for i in range(3))  # the swage's plane 17 mm along the jaws (4-35 mm)
+    return d, z, n, lifted, p, pivot
+
+
+def hand0_tie(rows):
+    """The holder, open and risen from the needle at 12.6 s, goes over and lies closed along the needle's chord."""
+    d, z, n, lifted, p, pivot = tie_frame()
+    q = rz(math.degrees(math.atan2(d[1], d[0])))
+    rows.append(row(13.2, (-0.0427, 0.09, 0.0), q, 0.4))
+    rows.append(row(14.5, (pivot[0] + 0.03, 0.09, pivot[2] + 0.03), q, 0.4))
+    rows.append(row(16.0, (pivot[0] + 0.03, pivot[1], pivot[2] + 0.03), q, 0))
+    rows.append(row(TIE_WRAP_T - 0.3, pivot, q, 0))
+    rows.append(row(TIE_WRAP_T + TIE_TURNS * TIE_TURN_S + 6, pivot, q, 0))
+    return ("t_s,x_m,y_m,z_m,qw,qx,qy,qz,grip_rad\n"
+            "# device0, the needle holder (written by hands.py with TIE): takes the needle from the foam and drives it "
+            "as the\n# default script does; then, open and risen, comes over and lies closed with its jaws along the "
+            "needle's chord,\n# %.0f mm above the lifted swage, for the thread to be wrapped round them\n" % (TIE_R * 1e3)
+            + "\n".join(rows) + "\n")
+
+
 def hand1(pinch):
     centre = HANDOVER_CENTRE
     psi = math.radians(HANDOVER_DEG + 180.0) - GRASP_TIP_RAD
@@ -207,6 +251,21 @@ def hand1(pinch):
     p, qq = about(centre, PULL_DEG, at(0), q)
     rows.append(row(15.5, (p[0], p[1] + 0.02, p[2]), qq, 0))
     pulled = ""
+    if TIE:  # on up until 3 cm of tail is left, then round the holder's jaws
+        d, z, n, lifted, centre, pivot = tie_frame()
+        q0 = qq
+        p1 = (p[0], p[1] + 0.02 + TIE_UP, p[2])
+        rows.append(row(17.5, p1, q0, 0))
+        rows.append(row(TIE_WRAP_T, p1, q0, 0))
+        k = int(round(48 * TIE_TURNS))
+        for j in range(1, k + 1):
+            th = 2 * math.pi * TIE_TURNS * j / k
+            sw = tuple(centre[i] - TIE_R * (math.cos(th) * z[i] + math.sin(th) * n[i]) for i in range(3))
+            rows.append(row(TIE_WRAP_T + TIE_TURN_S * TIE_TURNS * j / k, tuple(p1[i] + sw[i] - lifted[i] for i in range(3)), q0, 0))
+        last = rows[-1].split(",")
+        rows.append(row(TIE_WRAP_T + TIE_TURNS * TIE_TURN_S + 6, tuple(float(v) for v in last[1:4]), q0, 0))
+        pulled = ("# then on up %.0f mm, and %.1f times round the holder's jaws, %.0f mm out (the wrap)\n"
+                  % (TIE_UP * 1e3, TIE_TURNS, TIE_R * 1e3))
     if PULL_HARD_M:  # once the holder holds the tail: on, up and out along the stitch's line, too far
         rows.append(row(16.5, (p[0], p[1] + 0.02, p[2]), qq, 0))
         far = (p[0] + PULL_HARD_M * 0.6, p[1] + 0.02 + PULL_HARD_M * 0.8, p[2])
@@ -242,7 +301,7 @@ PINCH = [
 
 
 def main():
-    global CENTRE_Y, HANDOVER_CENTRE, HANDOVER_DEG, GRASP_TIP_RAD, PULL_DEG, SHIFT_X, PULL_HARD_M
+    global CENTRE_Y, HANDOVER_CENTRE, HANDOVER_DEG, GRASP_TIP_RAD, PULL_DEG, SHIFT_X, PULL_HARD_M, TIE
     e = os.environ
     CENTRE_Y = float(e.get("CY", CENTRE_Y))
     SHIFT_X = float(e.get("SX", SHIFT_X))
@@ -253,6 +312,7 @@ def main():
     GRASP_TIP_RAD = float(e.get("GT", GRASP_TIP_RAD))
     PULL_DEG = float(e.get("PD", PULL_DEG))
     PULL_HARD_M = float(e.get("PH", PULL_HARD_M))
+    TIE = e.get("TIE", "") == "1"
     out = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.abspath(__file__))
     pinch = [row(t, p, q, g) for t, p, q, g in PINCH]
     for name, text in (("hand0.csv", hand0()), ("hand1.csv", hand1(pinch))):

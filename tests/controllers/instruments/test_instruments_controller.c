@@ -71,10 +71,12 @@ static void test_follows_the_hand_and_renders_the_weight(void** state) {
   tx_scenario_free(s);
 }
 
-// the holder's jaws as the thread sees them (instrument0.capsules): one
-// capsule per jaw box (31 x 3.5 x 2.25 mm, its centre 19.5 mm ahead of the
-// pivot and 1.125 mm off the jaws' line), along the box, as thick as its
-// thinnest side; opened to 0.2 rad each, the two capsules 0.4 rad apart, their
+// the holder as the thread sees it (instrument0.capsules), its URDF's
+// collision shapes in order but the shanks: the pivot's lump (a cylinder 4
+// mm in radius, 6 mm long, about the pivot), then each jaw. A jaw box (31 x
+// 3.5 x 2.25 mm, its centre 19.5 mm ahead of the pivot and 1.125 mm off the
+// jaws' line) is a capsule along the box, as thick as its thinnest side;
+// opened to 0.2 rad each, the two jaws' capsules are 0.4 rad apart, their
 // ends where the boxes' ends turn to
 static void test_jaws_are_published_as_capsules(void** state) {
   (void)state;
@@ -84,21 +86,25 @@ static void test_jaws_are_published_as_capsules(void** state) {
   tx_snapshot cs = latest_snapshot(s, "instrument0.capsules");
   const tx_capsule* c = cs.data;
   const double* ins = latest(s, "instrument0.pose");
-  assert_int_equal(cs.rows, 2);
+  assert_int_equal(cs.rows, 3);
+  double lump_a = 0, lump_b = 0;
+  for (int j = 0; j < 3; j++) lump_a += (c[0].a[j] - ins[j]) * (c[0].a[j] - ins[j]), lump_b += (c[0].b[j] - ins[j]) * (c[0].b[j] - ins[j]);
+  assert_true(fabs(c[0].radius - 0.004) < 1e-12 && fabs(sqrt(lump_a) - 0.003) < 1e-6 && fabs(sqrt(lump_b) - 0.003) < 1e-6);
   double u[2][3];
   for (int k = 0; k < 2; k++) {
+    const tx_capsule* jaw = &c[1 + k];
     double len = 0, da = 0, db = 0;
     for (int j = 0; j < 3; j++) {
-      u[k][j] = c[k].b[j] - c[k].a[j];
+      u[k][j] = jaw->b[j] - jaw->a[j];
       len += u[k][j] * u[k][j];
-      da += (c[k].a[j] - ins[j]) * (c[k].a[j] - ins[j]);
-      db += (c[k].b[j] - ins[j]) * (c[k].b[j] - ins[j]);
+      da += (jaw->a[j] - ins[j]) * (jaw->a[j] - ins[j]);
+      db += (jaw->b[j] - ins[j]) * (jaw->b[j] - ins[j]);
     }
     len = sqrt(len);
     for (int j = 0; j < 3; j++) u[k][j] /= len;
     print_message("  jaw %d: radius %.4f mm, %.4f mm long, its ends %.4f and %.4f mm from the pivot\n", k,
-                  1e3 * c[k].radius, 1e3 * len, 1e3 * sqrt(da), 1e3 * sqrt(db));
-    assert_true(fabs(c[k].radius - 0.001125) < 1e-12);
+                  1e3 * jaw->radius, 1e3 * len, 1e3 * sqrt(da), 1e3 * sqrt(db));
+    assert_true(fabs(jaw->radius - 0.001125) < 1e-12);
     assert_true(fabs(len - (0.031 - 0.00225)) < 1e-9);
     // the box's axis from 5.125 to 33.875 mm ahead, 1.125 mm off the jaw's line
     assert_true(fabs(sqrt(da) - hypot(0.005125, 0.001125)) < 1e-6);
