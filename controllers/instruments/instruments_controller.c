@@ -594,7 +594,6 @@ static void hole_row(instruments* m, int i, const float* xs, int nx, const int32
   m->at_hole[i] = true;
 }
 
-
 // The lowest the held instruments come above the skin: every corner of
 // their collision boxes, the lowest point of each cylinder's rim and of each
 // sphere, against the sheet under it (tx_height_above_sheet), at each publish

@@ -44,6 +44,7 @@ static const layout layouts[] = {
     L(".tip", tx_pose),                 L(".punctures", tx_puncture),      L(".cut_links", tx_thread_link),
     L(".puncture_loads", tx_puncture_load),
     L(".held", tx_instrument_held),     L(".grasp", tx_organ_grasp),     L(".surface_node", tx_surface_node),
+    L(".capsules", tx_capsule),
 };
 #undef L
 
