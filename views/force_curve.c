@@ -3,6 +3,7 @@
 // once the run is over.
 #include "force_curve.h"
 
+#include "aside.h"
 #include "plot.h"
 
 #include <tactus/components.h>
@@ -98,26 +99,17 @@ static void finish(tx_ctx* ctx, void* self) {
   tx_set_result(ctx, c->r_samples, (double)c->n);
   const char* dir = tx_record_dir(ctx);
   if (!dir || c->n == 0) return;
-  char path[4200], tmp[4300];
-  snprintf(path, sizeof path, "%s/%s.csv", dir, c->file);
-  snprintf(tmp, sizeof tmp, "%s.tmp", path);
-  FILE* f = fopen(tmp, "w"); // written aside, renamed once whole
-  if (!f) {
-    tx_stop_run(ctx, "%s: cannot be written", path); // the run fails: its data would be lost
-    return;
-  }
-  fprintf(f, "t_s,x_m,y_m,z_m,fx_n,fy_n,fz_n,contacts,pierced,torn,skin_t_s\n");
+  char name[80], path[4200];
+  snprintf(name, sizeof name, "%s.csv", c->file);
+  tx_aside a;
+  if (!tx_aside_open(ctx, &a, dir, name)) return;
+  fprintf(a.f, "t_s,x_m,y_m,z_m,fx_n,fy_n,fz_n,contacts,pierced,torn,skin_t_s\n");
   for (uint64_t i = 0; i < c->n; i++) {
     const double* r = c->rows + COLS * i;
-    fprintf(f, "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.0f,%.0f,%.0f,%.6f\n", r[0], r[1], r[2], r[3], r[4], r[5], r[6],
+    fprintf(a.f, "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.0f,%.0f,%.0f,%.6f\n", r[0], r[1], r[2], r[3], r[4], r[5], r[6],
             r[7], r[8], r[9], r[10]);
   }
-  if (fclose(f) != 0 || rename(tmp, path) != 0) {
-    remove(tmp);
-    tx_stop_run(ctx, "%s: cannot be written", path);
-    return;
-  }
-  if (!c->png) return;
+  if (!tx_aside_commit(ctx, &a) || !c->png) return;
   // the papers' plot: force along the axis (N) against the position along it, in the plots' length unit
   double* xs = malloc(sizeof(double) * c->n);
   double* ys = malloc(sizeof(double) * c->n);

@@ -2,6 +2,8 @@
 // writes them as one CSV once the run is over (probe.h).
 #include "probe.h"
 
+#include "aside.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -105,14 +107,11 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, p->r_samples, (double)p->samples);
   const char* dir = tx_output_dir(c);
   if (!dir) return;
-  char path[4200], tmp[4300];
-  snprintf(path, sizeof path, "%s/%s.csv", dir, p->file);
-  snprintf(tmp, sizeof tmp, "%s.tmp", path);
-  FILE* f = fopen(tmp, "w"); // written aside, renamed once whole
-  if (!f) {
-    tx_stop_run(c, "%s: cannot be written", path);
-    return;
-  }
+  char name[80];
+  snprintf(name, sizeof name, "%s.csv", p->file);
+  tx_aside a;
+  if (!tx_aside_open(c, &a, dir, name)) return;
+  FILE* f = a.f;
   uint32_t most = 0;
   for (int k = 0; k < p->n; k++) {
     const tx_component_def* d = tx_port_schema(c, p->port[k]);
@@ -133,10 +132,7 @@ static void finish(tx_ctx* c, void* self) {
     }
     at += HEAD + (uint64_t)rows * d->cols;
   }
-  if (fclose(f) != 0 || rename(tmp, path) != 0) {
-    remove(tmp);
-    tx_stop_run(c, "%s: cannot be written", path);
-  }
+  tx_aside_commit(c, &a);
 }
 
 static void fini(void* self) {

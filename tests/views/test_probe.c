@@ -1,6 +1,7 @@
 // Tests of view.probe (views/probe.c): what it writes is what was published,
 // at the times asked, whatever the element type; it stops whole samples when
-// its memory is used up; bad parameters fail configure in one line.
+// its memory is used up; a file it cannot write stops the run; bad
+// parameters fail configure in one line.
 #include "controllers/system.h"
 #include "model/error.h"
 #include "scenarios/loader.h"
@@ -151,6 +152,20 @@ static void stops_whole_samples_when_full(void** state) {
   tx_system_destroy(s);
 }
 
+// a folder it cannot write into: the run ends saying so, naming the file, and no .tmp is left
+static void a_file_that_cannot_be_written_stops_the_run(void** state) {
+  (void)state;
+  tx_system* s = make("{\"components\": [\"src.f\"]}");
+  if (!s) fail_msg("%s", tx_error());
+  tx_run_options o = {.duration_s = 0.05, .lockstep = true, .out_dir = "/nonexistent/test_probe"};
+  tx_run_result r;
+  assert_int_equal(tx_system_run(s, &o, &r), 0);
+  print_message("  %s\n", r.halt_reason);
+  assert_true(r.halted);
+  assert_non_null(strstr(r.halt_reason, "/nonexistent/test_probe/probe.csv: cannot be written"));
+  tx_system_destroy(s);
+}
+
 static void bad_parameters_fail_in_one_line(void** state) {
   (void)state;
   const char* cases[][2] = {
@@ -175,6 +190,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(writes_what_was_published_at_the_times_asked),
       cmocka_unit_test(stops_whole_samples_when_full),
+      cmocka_unit_test(a_file_that_cannot_be_written_stops_the_run),
       cmocka_unit_test(bad_parameters_fail_in_one_line),
   };
   return cmocka_run_group_tests(tests, setup, NULL);
