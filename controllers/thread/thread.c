@@ -64,7 +64,7 @@ struct tx_thread {
   uint8_t* near_punct;       // (n) nodes near a passed puncture: no skin contact there
   double* arc_step;          // (max_punctures) arc at the start of the step
   double* arc_sub;           // (max_punctures) and of the substep, for a substep taken again
-  double* plam;              // (max_punctures) rod: the friction's multiplier along the thread in this substep
+  uint8_t* slides;           // (max_punctures) rod: 1 where the thread slides through the puncture this substep
   double* pin;               // (n x 3) where pinned nodes are held, m (a held node: in this substep)
   uint8_t* held;             // (n) grasped: 1 pinned by the grasp, 2 pinned before it (a release keeps that pin)
   double* hold_from;         // (n x 3) a held node's place at the start of the step, m
@@ -253,7 +253,7 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   t->near_punct = calloc((size_t)n, 1);
   t->arc_step = malloc(sizeof(double) * (def->max_punctures + 1));
   t->arc_sub = malloc(sizeof(double) * (def->max_punctures + 1));
-  t->plam = calloc((size_t)def->max_punctures + 1, sizeof(double));
+  t->slides = calloc((size_t)def->max_punctures + 1, 1);
   t->pin = calloc(3 * (size_t)n, sizeof(double));
   t->held = calloc((size_t)n, 1);
   t->hold_from = calloc(3 * (size_t)n, sizeof(double));
@@ -276,7 +276,7 @@ tx_thread* tx_thread_create(const tx_thread_def* def) {
   t->caps = malloc(sizeof(tx_thread_capsule) * (def->max_shapes + 1));
   t->dxb = malloc(sizeof(double) * 3 * n);
   t->bscale = malloc(sizeof(double) * n);
-  if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->v0 || !t->w || !t->wf || !t->lam || !t->band || !t->bend || !t->rhs || !t->dir || !t->pinned || !t->severed || !t->punct || !t->arc || !t->near_punct || !t->arc_step || !t->arc_sub || !t->plam || !t->pin || !t->held || !t->hold_from || !t->hold_to || !t->box ||
+  if (!t->x || !t->x0 || !t->v || !t->xs || !t->vs || !t->v0 || !t->w || !t->wf || !t->lam || !t->band || !t->bend || !t->rhs || !t->dir || !t->pinned || !t->severed || !t->punct || !t->arc || !t->near_punct || !t->arc_step || !t->arc_sub || !t->slides || !t->pin || !t->held || !t->hold_from || !t->hold_to || !t->box ||
       !t->order || !t->order_tmp || !t->key || !t->xb || !t->sbox || !t->sb01 || !t->smove || !t->sorder || !t->skey || !t->pairs || !t->colliding || !t->caps || !t->dxb || !t->bscale)
     goto oom;
   t->nslots = 1 + def->max_meshes;
@@ -335,7 +335,7 @@ void tx_thread_destroy(tx_thread* t) {
   free(t->near_punct);
   free(t->arc_step);
   free(t->arc_sub);
-  free(t->plam);
+  free(t->slides);
   free(t->pin);
   free(t->held);
   free(t->hold_from);
@@ -407,15 +407,16 @@ void tx_thread_tension(const tx_thread* t, double stiffness, double max_force, d
         for (int b = 0; b < 3; b++) K[3 * a + b] = -stiffness * sum[a] * sum[b] / (ls * ls);
       }
     }
-    // the kinematic thread slides through punctures whatever the pull: the
-    // hand feels their friction, towards the first, for each it slid through
-    if (t->slid > 0 && t->passed > 0) {
-      double d[3], dl;
-      for (int a = 0; a < 3; a++) d[a] = t->punct[a] - h[a];
-      dl = sqrt(dot3(d, d));
-      if (dl > 0)
-        for (int a = 0; a < 3; a++) f[a] += t->def.puncture_friction * t->slid * d[a] / dl;
-    }
+  }
+  // the hand feels the friction of each puncture the thread slid through,
+  // towards the first (the rod's constraints carry only what the friction
+  // held before it slid: a light thread drawn through moves on at once)
+  if (t->slid > 0 && t->passed > 0) {
+    double d[3], dl;
+    for (int a = 0; a < 3; a++) d[a] = t->punct[a] - h[a];
+    dl = sqrt(dot3(d, d));
+    if (dl > 0)
+      for (int a = 0; a < 3; a++) f[a] += t->def.puncture_friction * t->slid * d[a] / dl;
   }
   double fm = sqrt(dot3(f, f));
   double scale = fm > max_force ? max_force / fm : 1;
@@ -1285,16 +1286,94 @@ static void punctures_begin_substep(tx_thread* t) {
   }
 }
 
-// each passed puncture holds the thread's point at arc[k] on it. In the
-// iterations (friction true) the offset across the thread is undone, and
-// the drift along it as far as the friction's multiplier allows (XPBD
-// Coulomb friction: the multiplier along the thread, summed over the
-// iterations of the substep, stays within puncture_friction h^2, so the
-// force never exceeds it; within, it sticks); what is left slides, the
-// point held moving on along the thread. At the end of the substep
-// (friction false) the point held is put on the puncture whole: the thread
-// never leaves it.
-static void solve_punctures(tx_thread* t, double h, bool friction) {
+// the thread's point at material coordinate s (m from the head)
+static void point_at(const tx_thread* t, double s, double out[3]) {
+  int i;
+  double u;
+  arc_link(t, s, &i, &u);
+  for (int c = 0; c < 3; c++) out[c] = t->x[3 * i + c] + u * (t->x[3 * i + 3 + c] - t->x[3 * i + c]);
+}
+
+// the mean stretch of the thread between material coordinates s0 < s1
+// (its polyline's length over s1 - s0, less 1); 0 for a strand shorter than a link
+static double strand_stretch(const tx_thread* t, double s0, double s1) {
+  if (s1 - s0 < t->l0) return 0;
+  double p[3], q[3], len = 0;
+  point_at(t, s0, p);
+  for (int j = (int)floor(s0 / t->l0) + 1; j * t->l0 < s1; j++) {
+    if (t->severed[j - 1]) return 0;
+    len += dist3(p, t->x + 3 * j);
+    memcpy(p, t->x + 3 * j, sizeof p);
+  }
+  point_at(t, s1, q);
+  return (len + dist3(p, q)) / (s1 - s0) - 1;
+}
+
+// Coulomb friction at a puncture: it holds the thread while the tensions on
+// its two sides differ by at most puncture_friction. The tensions are the
+// elastic ones: each puncture slides this substep when the strands on
+// either side of it (to the next puncture, the head or the thread's end)
+// are stretched apart by more than the friction holds, puncture_friction /
+// E A, and by more than SLIP_STRETCH of the stretch cap: the rod's links
+// stray from rest by up to a per cent or two (contacts, the cap's passes),
+// which no pull made; a nylon thread's friction of a few tenths of a newton
+// is a stretch of 1e-3, below that. (An XPBD friction whose multiplier is
+// kept within puncture_friction h^2 weighs the drift against the two light
+// nodes' inertia alone: it held any drift, and a needle dragging the thread
+// stretched the link through the puncture to 4.4 times its length.) The
+// arcs fall from the first passed to the last.
+#define SLIP_STRETCH 0.5
+static void decide_slides(tx_thread* t) {
+  const double ea = t->l0 / t->alpha_d; // N, E A
+  const double slip = fmax(t->def.puncture_friction / ea, SLIP_STRETCH * (t->lmax / t->l0 - 1));
+  for (int k = 0; k < t->passed; k++) {
+    double head = k + 1 < t->passed ? t->arc[k + 1] : 0, tail = k > 0 ? t->arc[k - 1] : t->nseg * t->l0;
+    t->slides[k] = fabs(strand_stretch(t, head, t->arc[k]) - strand_stretch(t, t->arc[k], tail)) > slip;
+  }
+}
+
+// whether putting the point at fraction u of link i (weight W) back by C
+// would stretch it or a link beside it past the cap
+static bool overstretches(const tx_thread* t, int i, double u, double W, const double C[3]) {
+  double a[3], b[3], l2 = t->lmax * t->lmax;
+  for (int c = 0; c < 3; c++) {
+    a[c] = t->x[3 * i + c] - t->w[i] * (1 - u) / W * C[c];
+    b[c] = t->x[3 * i + 3 + c] - t->w[i + 1] * u / W * C[c];
+  }
+  return dist3_sq(a, b) > l2 || (i >= 1 && !t->severed[i - 1] && dist3_sq(a, t->x + 3 * i - 3) > l2) ||
+         (i + 2 < t->n && !t->severed[i + 1] && dist3_sq(b, t->x + 3 * i + 6) > l2);
+}
+
+// the point of links i - 1 .. i + 1 (not cut, both ends free) nearest p,
+// for passed puncture k held on link i: moves arc[k] there and returns true
+// when it is elsewhere than arc[k]
+static bool nearest_on_thread(tx_thread* t, int k, const double p[3], int* link, double* frac) {
+  double best = INFINITY, arc = t->arc[k];
+  for (int j = *link - 1; j <= *link + 1; j++) {
+    if (j < 0 || j >= t->nseg || t->severed[j] || t->w[j] == 0 || t->w[j + 1] == 0) continue;
+    const double *a = t->x + 3 * j, *b = a + 3;
+    double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, ee = dot3(e, e), s = 0, d2 = 0;
+    if (ee > 0) s = fmin(1, fmax(0, ((p[0] - a[0]) * e[0] + (p[1] - a[1]) * e[1] + (p[2] - a[2]) * e[2]) / ee));
+    for (int c = 0; c < 3; c++) d2 += (a[c] + s * e[c] - p[c]) * (a[c] + s * e[c] - p[c]);
+    if (d2 < best) best = d2, arc = (j + s) * t->l0;
+  }
+  if (arc == t->arc[k]) return false;
+  t->arc[k] = arc;
+  arc_link(t, arc, link, frac);
+  return true;
+}
+
+// each passed puncture holds the thread's point at arc[k] on it, with
+// stick and slip along the thread (decide_slides, from the stretch the
+// substep starts with). In the iterations (friction true) the offset across
+// the thread is undone, and the drift along it too where the puncture
+// sticks; where it slides the point held moves on along the thread. At the
+// end of the substep (friction false) a stuck point that would stretch its
+// link past the cap by being put back slides instead, a sliding point is
+// first moved to the thread's nearest point (the passes after the
+// iterations draw the thread on), and then every point is put on its
+// puncture whole: the thread never leaves one.
+static void solve_punctures(tx_thread* t, bool friction) {
   for (int k = 0; k < t->passed; k++) {
     const double* p = t->punct + 3 * k;
     int i;
@@ -1325,16 +1404,19 @@ static void solve_punctures(tx_thread* t, double h, bool friction) {
     if (!(W > 0)) continue;
     double ct = dot3(C, tan), corr[3];
     if (!friction) {
+      if (!t->slides[k] && overstretches(t, i, u, W, C)) t->slides[k] = 1; // held, it would stretch past the cap: it slides
+      if (t->slides[k] && nearest_on_thread(t, k, p, &i, &u)) { // held where the thread now is nearest
+        a = t->x + 3 * i, b = a + 3;
+        W = t->w[i] * (1 - u) * (1 - u) + t->w[i + 1] * u * u;
+        if (!(W > 0)) continue;
+        for (int c = 0; c < 3; c++) C[c] = a[c] + u * (b[c] - a[c]) - p[c];
+      }
       memcpy(corr, C, sizeof corr); // the held point onto the puncture, whole
+    } else if (t->slides[k]) { // across only: the point held moves on with the thread
+      for (int c = 0; c < 3; c++) corr[c] = C[c] - ct * tan[c];
+      t->arc[k] = fmin(t->nseg * t->l0, fmax(0, t->arc[k] - ct));
     } else {
-      // the multiplier along the thread that would undo the drift, clamped
-      // to the friction's: the rest slides (the point held moves on)
-      double lim = t->def.puncture_friction * h * h, lt = t->plam[k] - ct / W;
-      if (fabs(lt) > lim) lt = copysign(lim, lt);
-      double dq = (lt - t->plam[k]) * W; // the move along the thread friction makes
-      t->plam[k] = lt;
-      for (int c = 0; c < 3; c++) corr[c] = C[c] - ct * tan[c] - dq * tan[c];
-      t->arc[k] = fmin(t->nseg * t->l0, fmax(0, t->arc[k] - (ct + dq)));
+      memcpy(corr, C, sizeof corr); // stuck
     }
     for (int c = 0; c < 3; c++) {
       a[c] -= t->w[i] * (1 - u) / W * corr[c];
@@ -1848,6 +1930,7 @@ static void rod_substep(tx_thread* t, double h, double margin) {
   t->capped = false;
   t->thrown = false;
   if (d->self_collision && isfinite(t->alpha_b)) t->e_sub = rod_energy(t); // only cap_bends needs it
+  if (t->passed) decide_slides(t); // from the stretch the substep starts with
   for (int i = 0; i < n; i++) {
     if (t->pinned[i]) continue;
     v[3 * i + 1] -= d->gravity * h;
@@ -1860,12 +1943,11 @@ static void rod_substep(tx_thread* t, double h, double margin) {
   bool self = d->self_collision && nseg > t->skip + 1;
   if (self) broadphase(t, margin);
   bend_factor(t, h);
-  if (t->passed) memset(t->plam, 0, sizeof(double) * t->passed);
   for (int it = 0; it < d->iterations; it++) {
     rod_solve(t, h, self);
     solve_capsules(t);
     if (self) solve_self(t);
-    if (t->passed) solve_punctures(t, h, true);
+    if (t->passed) solve_punctures(t, true);
   }
   cap_stretch(t);
   // a node moved by one cylinder's push can go back into its neighbour's
@@ -1880,7 +1962,7 @@ static void rod_substep(tx_thread* t, double h, double margin) {
   cap_stretch(t);
   solve_capsules(t);
   solve_mesh(t);
-  for (int pass = 0; pass < 2 && t->passed; pass++) solve_punctures(t, h, false); // never leaves one
+  for (int pass = 0; pass < 2 && t->passed; pass++) solve_punctures(t, false); // never leaves one
   for (int i = 0; i < n; i++)
     for (int a = 0; a < 3; a++)
       v[3 * i + a] = t->pinned[i] && !t->held[i] ? 0 : (x[3 * i + a] - t->x0[3 * i + a]) / h; // a held node lets go at the jaws' speed

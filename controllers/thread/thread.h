@@ -201,9 +201,10 @@ int tx_thread_head_piece_end(const tx_thread* t);
 // gone through point k (after points 0..k-1: the thread behind the head,
 // not its end, within puncture_capture of it), the thread runs through it:
 // it slides through and never leaves it (ftl: the link that holds it is put
-// through it; rod: a sliding constraint on the polyline, with Coulomb
-// friction puncture_friction along the thread; a link on a pinned node
-// turns about it through the point, without friction). The
+// through it; rod: a sliding constraint on the polyline that sticks until
+// the thread's two sides are stretched apart by more than puncture_friction
+// / E A and half max_stretch, then slides; a link on a pinned node turns
+// about it through the point, without friction). The
 // skin's contacts are left out near a passed puncture. Points move between
 // steps (a skin that moves); a shorter list forgets those past its end.
 tx_thread_status tx_thread_set_punctures(tx_thread* t, const double* p, int n);
@@ -259,7 +260,8 @@ void tx_thread_head_force(const tx_thread* t, double out[3]);
 // tail is pinned and the thread uncut, K = -stiffness d d^T, plus
 // puncture_friction for each puncture it slid through in the last step,
 // towards the first; rod: the
-// constraints' force on the head (tx_thread_head_force), K = 0. f (N) is
+// constraints' force on the head (tx_thread_head_force) plus the same
+// friction, K = 0. f (N) is
 // clamped to max_force (N) and never NaN.
 void tx_thread_tension(const tx_thread* t, double stiffness, double max_force, double f[3], double K[9]);
 // the force (N) of the thread on the skin at each passed puncture k, into

@@ -144,7 +144,7 @@ static const tx_param_def params[] = {
     {"fix_distance_m", TX_PARAM_NUM, "m", 0, 1, 0.002, NULL, "a knot this near the skin is fixed"},
     {"punctures", TX_PARAM_STR, NULL, 0, 0, 0, "", "a puncture list (tx_puncture rows: points on triangles of SKIN.x particles, e.g. needle.punctures) the thread passes through in order; needs skin; empty: none"},
     {"max_punctures", TX_PARAM_INT, "1", 0, 1024, 16, NULL, "room for the puncture list's rows"},
-    {"puncture_friction_n", TX_PARAM_NUM, "N", 0, 100, 0, NULL, "the force along the thread a puncture holds it with before it slides (Coulomb); ftl: felt at the hand only"},
+    {"puncture_friction_n", TX_PARAM_NUM, "N", 0, 100, 0, NULL, "the force along the thread a puncture holds it with before it slides (Coulomb), felt at the hand while it slides; rod: it slides also once holding it would stretch it by half max_stretch"},
     {"puncture_capture_m", TX_PARAM_NUM, "m", 1e-6, 0.1, 0.001, NULL, "the head has gone through a puncture once the thread behind it is this near it"},
     {"cut_events", TX_PARAM_STR, NULL, 0, 0, 0, "", "an event stream (instruments.events) whose TX_EVENT_CUT events cut the thread; empty: none"},
     {"grasp_events", TX_PARAM_STR, NULL, 0, 0, 0, "", "an event stream (instruments.events) whose TX_EVENT_GRASP from hand h holds the thread's nearest node in instrument<h>.pose's frame until h's TX_EVENT_RELEASE; empty: none"},
