@@ -1320,7 +1320,7 @@ static double strand_stretch(const tx_thread* t, double s0, double s1) {
 // is a stretch of 1e-3, below that. (An XPBD friction whose multiplier is
 // kept within puncture_friction h^2 weighs the drift against the two light
 // nodes' inertia alone: it held any drift, and a needle dragging the thread
-// stretched the link through the puncture to 4.4 times its length.) The
+// stretched the link through the puncture by 4.4 times its length.) The
 // arcs fall from the first passed to the last.
 #define SLIP_STRETCH 0.5
 static void decide_slides(tx_thread* t) {
@@ -1470,15 +1470,18 @@ static void follow(tx_thread* t, int i, int from) {
 // node i a link from node `from` on the line from it through p (a puncture's
 // point), or after it as the thread runs when `from` is on p; returns their
 // distance |x_from - p| (beyond a link: p is out of the link's reach)
-static double place_through(tx_thread* t, int i, int from, const double p[3]) {
+static double place_through_at(tx_thread* t, int i, int from, const double p[3], double len) {
   const double* l = t->x + 3 * from;
   double d = dist3(l, p);
   if (d > 1e-9 * t->l0) {
-    for (int c = 0; c < 3; c++) t->x[3 * i + c] = l[c] + (p[c] - l[c]) / d * t->l0;
+    for (int c = 0; c < 3; c++) t->x[3 * i + c] = l[c] + (p[c] - l[c]) / d * len;
   } else {
-    place_after(t, i, from, t->l0);
+    place_after(t, i, from, len);
   }
   return d;
+}
+static double place_through(tx_thread* t, int i, int from, const double p[3]) {
+  return place_through_at(t, i, from, p, t->l0);
 }
 
 static void ftl_forward(tx_thread* t) {
@@ -1635,21 +1638,53 @@ static void ftl_substep(tx_thread* t, double h, double margin) {
   for (int i = 0; i < 3 * t->n; i++) t->v[i] = (t->x[i] - t->x0[i]) / h;
 }
 
-// no segment longer than lmax: from the head along the thread, then back from the last pin
-static void cap_stretch(tx_thread* t) {
-  double l2 = t->lmax * t->lmax; // squared: no root per segment and pass
-  for (int pass = 0; pass < 2; pass++) {
-    for (int i = 1; i < t->n; i++)
-      if (!t->pinned[i] && !t->severed[i - 1] && dist3_sq(t->x + 3 * i, t->x + 3 * i - 3) > l2)
-        place_after(t, i, i - 1, t->lmax);
-    if (t->last_pin == 0) break;
-    for (int i = t->last_pin - 1; i > 0; i--)
-      if (!t->pinned[i] && !t->severed[i] && dist3_sq(t->x + 3 * i, t->x + 3 * i + 3) > l2)
-        place_after(t, i, i + 1, t->lmax);
+// node i at lmax from node `from` (a neighbour), its link over lmax; when the
+// link holds passed puncture k (k >= 0), on the line from `from` through
+// its point, which the link then holds at its distance from `from` (out of
+// the link's reach, the next link on holds it): drawing the node straight
+// towards `from` would cut the corner the thread turns at the puncture, and
+// putting the point back on it would stretch the links again
+static void cap_node(tx_thread* t, int i, int from, int k) {
+  if (k < 0) {
+    place_after(t, i, from, t->lmax);
+    return;
   }
-  for (int i = 1; i < t->n; i++)
+  double d = place_through_at(t, i, from, t->punct + 3 * k, t->lmax);
+  double u = fmin(1, d / t->lmax); // the point's fraction of the link from `from`
+  t->arc[k] = (i > from ? from + u : from - u) * t->l0;
+}
+
+// the cap from the head along the thread
+static void cap_forward(tx_thread* t) {
+  double l2 = t->lmax * t->lmax; // squared: no root per segment and pass
+  int k = t->passed - 1;         // the last passed lies the nearest the head
+  for (int i = 1; i < t->n; i++) {
+    while (k >= 0 && t->arc[k] < (i - 1) * t->l0) k--;
     if (!t->pinned[i] && !t->severed[i - 1] && dist3_sq(t->x + 3 * i, t->x + 3 * i - 3) > l2)
-      place_after(t, i, i - 1, t->lmax);
+      cap_node(t, i, i - 1, k >= 0 && t->arc[k] <= i * t->l0 ? k : -1);
+  }
+}
+
+// and back from the last pin
+static void cap_backward(tx_thread* t) {
+  double l2 = t->lmax * t->lmax;
+  int k = 0; // the first passed lies the furthest along the thread: met first from the tail
+  for (int i = t->last_pin - 1; i > 0; i--) {
+    while (k < t->passed && t->arc[k] > (i + 1) * t->l0) k++;
+    if (!t->pinned[i] && !t->severed[i] && dist3_sq(t->x + 3 * i, t->x + 3 * i + 3) > l2)
+      cap_node(t, i, i + 1, k < t->passed && t->arc[k] >= i * t->l0 ? k : -1);
+  }
+}
+
+// no segment longer than lmax: from the head along the thread, then back
+// from the last pin, through the punctures as they lie
+static void cap_stretch(tx_thread* t) {
+  for (int pass = 0; pass < 2; pass++) {
+    cap_forward(t);
+    if (t->last_pin == 0) break;
+    cap_backward(t);
+  }
+  cap_forward(t);
 }
 
 // LDL^T of the symmetric banded systems in place, written out for the two

@@ -207,13 +207,12 @@ static void test_friction_raises_the_head_force(void** state) {
 
 // A puncture that holds the thread firmly (1 N, against a thread that
 // weighs 0.01 mN) still lets a hand that pulls draw the rod through, as
-// far as with no friction, and stretches it no more than that does. Before,
-// its friction held the light nodes whatever pulled them (the thread stuck).
-// What stretches both: the rod bent sharply at the second point as the
-// head goes up and aside flows through it slowly at 2 iterations, and the
-// stretch cap, drawing each node straight towards the one before, cuts the
-// corner there, which putting the point back on the puncture undoes
-// (docs/thread.md, "Passing through punctures").
+// far as with no friction, and stretches it no more than that does (0.16:
+// the points move 0.4 mm a step, and putting the held point back across the
+// thread stretches a link beside it). Before, its friction held the light
+// nodes whatever pulled them: the thread stuck and stretched by 6.5 times a
+// link; and the stretch cap, drawing each node straight towards the one
+// before, cut the corner the rod turns at the second point (1.77).
 static void test_a_pulled_rod_slides_through_a_firm_puncture(void** state) {
   (void)state;
   drag_result r0 = drag(TX_THREAD_ROD, 0, false, false, 2), r = drag(TX_THREAD_ROD, 1.0, false, false, 2);
@@ -221,7 +220,7 @@ static void test_a_pulled_rod_slides_through_a_firm_puncture(void** state) {
                 "%.4f, %.2f, %.2f mm with 1 N a puncture\n", r0.strain, r0.arc_end[0] * 1e3, r0.arc_end[1] * 1e3,
                 r.strain, r.arc_end[0] * 1e3, r.arc_end[1] * 1e3);
   for (int j = 0; j < 2; j++) assert_float_equal(r.arc_end[j], r0.arc_end[j], 0.001);
-  assert_true(r.strain <= r0.strain + 1e-3);
+  assert_true(r.strain <= r0.strain + 1e-3 && r0.strain < 0.2);
   assert_true(r.worst <= 0.00025);
 }
 
