@@ -60,6 +60,7 @@ struct tx_thread {
   double* arc;               // (max_punctures) the arc length from the head of the thread's point held at each, m
   int npunct;                // points given
   int passed;                // the first this many are passed by the head: the thread runs through them
+  int out;                   // but the first this many of those: the thread was pulled out of them (its end through)
   int slid;                  // punctures the thread slid through in the last step
   uint8_t* near_punct;       // (n) nodes near a passed puncture: no skin contact there
   double* arc_step;          // (max_punctures) arc at the start of the step
@@ -409,11 +410,12 @@ void tx_thread_tension(const tx_thread* t, double stiffness, double max_force, d
     }
   }
   // the hand feels the friction of each puncture the thread slid through,
-  // towards the first (the rod's constraints carry only what the friction
+  // towards the first it runs through (the rod's constraints carry only what the friction
   // held before it slid: a light thread drawn through moves on at once)
   if (t->slid > 0 && t->passed > 0) {
+    const double* p = t->punct + 3 * (t->out < t->passed ? t->out : t->passed - 1); // or the one just left
     double d[3], dl;
-    for (int a = 0; a < 3; a++) d[a] = t->punct[a] - h[a];
+    for (int a = 0; a < 3; a++) d[a] = p[a] - h[a];
     dl = sqrt(dot3(d, d));
     if (dl > 0)
       for (int a = 0; a < 3; a++) f[a] += t->def.puncture_friction * t->slid * d[a] / dl;
@@ -609,12 +611,14 @@ tx_thread_status tx_thread_set_punctures(tx_thread* t, const double* p, int n) {
   if (n) memcpy(t->punct, p, sizeof(double) * 3 * n);
   t->npunct = n;
   if (t->passed > n) t->passed = n; // a list that shrank: those past its end are gone
+  if (t->out > t->passed) t->out = t->passed;
   return TX_THREAD_OK;
 }
 
 int tx_thread_punctures_passed(const tx_thread* t) { return t->passed; }
 int tx_thread_punctures_slid(const tx_thread* t) { return t->slid; }
-double tx_thread_puncture_arc(const tx_thread* t, int k) { return k >= 0 && k < t->passed ? t->arc[k] : -1; }
+double tx_thread_puncture_arc(const tx_thread* t, int k) { return k >= t->out && k < t->passed ? t->arc[k] : -1; }
+int tx_thread_punctures_out(const tx_thread* t) { return t->out; }
 
 static void note_meshes(tx_thread* t) {
   t->mntri = t->meshes[0].ntri;
@@ -1193,7 +1197,7 @@ static bool strand_direction(const tx_thread* t, int k, int step, double u[3]) {
   double frac;
   arc_link(t, t->arc[k], &i, &frac);
   int next = k - step; // arcs fall from the first passed to the last
-  bool has_next = next >= 0 && next < t->passed;
+  bool has_next = next >= t->out && next < t->passed;
   const double* to = NULL;
   for (int j = step < 0 ? i : i + 1;; j += step) {
     if (has_next && (step < 0 ? j * t->l0 <= t->arc[next] : j * t->l0 >= t->arc[next])) {
@@ -1220,7 +1224,8 @@ int tx_thread_puncture_loads(const tx_thread* t, double stiffness, double max_fo
   tx_thread_tension(t, stiffness, max_force, f0, K);
   const double tension = sqrt(dot3(f0, f0));
   const double strand = rod ? t->l0 / t->alpha_d / (t->first_cut * t->l0) : stiffness;
-  for (int k = 0; k < t->passed; k++) {
+  for (int k = 0; k < t->out; k++) f[3 * k] = f[3 * k + 1] = f[3 * k + 2] = k_out[k] = 0; // pulled out of: no load
+  for (int k = t->out; k < t->passed; k++) {
     double* fk = f + 3 * k;
     fk[0] = fk[1] = fk[2] = 0;
     k_out[k] = 0;
@@ -1279,7 +1284,7 @@ static void punctures_begin_substep(tx_thread* t) {
   if (t->mntri == 0) return;
   memset(t->near_punct, 0, (size_t)t->n);
   int m = (int)ceil((t->meshes[0].thickness + 2 * t->def.radius) / t->l0) + 1;
-  for (int k = 0; k < t->passed; k++) {
+  for (int k = t->out; k < t->passed; k++) {
     int c = (int)floor(t->arc[k] / t->l0);
     for (int i = c - m; i <= c + 1 + m; i++)
       if (i >= 0 && i < t->n) t->near_punct[i] = 1;
@@ -1326,8 +1331,8 @@ static double strand_stretch(const tx_thread* t, double s0, double s1) {
 static void decide_slides(tx_thread* t) {
   const double ea = t->l0 / t->alpha_d; // N, E A
   const double slip = fmax(t->def.puncture_friction / ea, SLIP_STRETCH * (t->lmax / t->l0 - 1));
-  for (int k = 0; k < t->passed; k++) {
-    double head = k + 1 < t->passed ? t->arc[k + 1] : 0, tail = k > 0 ? t->arc[k - 1] : t->nseg * t->l0;
+  for (int k = t->out; k < t->passed; k++) {
+    double head = k + 1 < t->passed ? t->arc[k + 1] : 0, tail = k > t->out ? t->arc[k - 1] : t->nseg * t->l0;
     t->slides[k] = fabs(strand_stretch(t, head, t->arc[k]) - strand_stretch(t, t->arc[k], tail)) > slip;
   }
 }
@@ -1374,7 +1379,7 @@ static bool nearest_on_thread(tx_thread* t, int k, const double p[3], int* link,
 // iterations draw the thread on), and then every point is put on its
 // puncture whole: the thread never leaves one.
 static void solve_punctures(tx_thread* t, bool friction) {
-  for (int k = 0; k < t->passed; k++) {
+  for (int k = t->out; k < t->passed; k++) {
     const double* p = t->punct + 3 * k;
     int i;
     double u;
@@ -1423,6 +1428,13 @@ static void solve_punctures(tx_thread* t, bool friction) {
       b[c] -= t->w[i + 1] * u / W * corr[c];
     }
   }
+}
+
+// a free tail drawn through the first puncture it runs through (the point
+// held at its end) has left it: the thread runs through the rest
+static void pull_out(tx_thread* t) {
+  if (t->pinned[t->n - 1]) return;
+  while (t->out < t->passed && t->arc[t->out] >= (t->nseg - 1e-9) * t->l0) t->out++;
 }
 
 // ---------------------------------------------------------------------------
@@ -1491,11 +1503,11 @@ static void ftl_forward(tx_thread* t) {
     if (t->held[i]) { // in the jaws, exactly: the thread behind follows it
       memcpy(t->x + 3 * i, t->pin + 3 * i, sizeof(double) * 3);
       // a puncture on the link into the jaws stays on it: both its ends are placed
-      while (k >= 0 && t->arc[k] <= i * t->l0 * (1 + 1e-12)) k--;
+      while (k >= t->out && t->arc[k] <= i * t->l0 * (1 + 1e-12)) k--;
       continue;
     }
     if (t->severed[i - 1]) continue;
-    if (k >= 0 && t->arc[k] <= i * t->l0 * (1 + 1e-12)) {
+    if (k >= t->out && t->arc[k] <= i * t->l0 * (1 + 1e-12)) {
       double d = place_through(t, i, i - 1, t->punct + 3 * k);
       if (d <= t->l0) {
         t->arc[k--] = (i - 1) * t->l0 + d;
@@ -1524,7 +1536,7 @@ static void ftl_forward(tx_thread* t) {
 // next forward pass would slide it on through them: step by step a thread
 // whose tail is pinned slid out of its stitch.
 static void ftl_backward(tx_thread* t) {
-  int k = 0; // the first passed lies the furthest along the thread: met first from the tail
+  int k = t->out; // the first passed lies the furthest along the thread: met first from the tail
   while (k < t->passed && t->arc[k] > t->last_pin * t->l0) k++;
   for (int i = t->last_pin; i > 0; i--) {
     if (t->pinned[i]) {
@@ -1570,14 +1582,14 @@ static void ftl_backward(tx_thread* t) {
 #define TX_THREAD_TAUT_POINTS 1026 // the head, max_punctures (at most 1024) and the pin
 #define TX_THREAD_TAUT_SLACK 0.05  // of the length
 static bool ftl_taut(tx_thread* t) {
-  if (t->last_pin != t->n - 1 || t->nheld > 0 || t->first_cut < t->nseg || t->passed == 0) return t->taut = false;
+  if (t->last_pin != t->n - 1 || t->nheld > 0 || t->first_cut < t->nseg || t->passed == t->out) return t->taut = false;
   for (int i = 1; i < t->n - 1; i++)
     if (t->pinned[i]) return t->taut = false;
   const double* way[TX_THREAD_TAUT_POINTS];
   int m = 0;
   way[m++] = t->x; // the head, then the punctures from the last passed (nearest the head) to the first, then the pin
-  for (int k = t->passed - 1; k >= 0 && m < TX_THREAD_TAUT_POINTS - 1; k--) way[m++] = t->punct + 3 * k;
-  if (m != t->passed + 1) return t->taut = false;
+  for (int k = t->passed - 1; k >= t->out && m < TX_THREAD_TAUT_POINTS - 1; k--) way[m++] = t->punct + 3 * k;
+  if (m != t->passed - t->out + 1) return t->taut = false;
   way[m++] = t->pin + 3 * (t->n - 1);
   double total = 0;
   for (int j = 0; j + 1 < m; j++) total += dist3(way[j], way[j + 1]);
@@ -1601,7 +1613,7 @@ static bool ftl_taut(tx_thread* t) {
   t->taut_excess = fmax(0, total - length);
   // each puncture's point held: its distance from the head along the path
   double d = 0;
-  for (int k = t->passed - 1, q = 0; k >= 0; k--, q++) {
+  for (int k = t->passed - 1, q = 0; k >= t->out; k--, q++) {
     d += dist3(way[q], way[q + 1]);
     t->arc[k] = fmin(d * length / total, length); // along the thread, as its nodes are laid
   }
@@ -1659,16 +1671,16 @@ static void cap_forward(tx_thread* t) {
   double l2 = t->lmax * t->lmax; // squared: no root per segment and pass
   int k = t->passed - 1;         // the last passed lies the nearest the head
   for (int i = 1; i < t->n; i++) {
-    while (k >= 0 && t->arc[k] < (i - 1) * t->l0) k--;
+    while (k >= t->out && t->arc[k] < (i - 1) * t->l0) k--;
     if (!t->pinned[i] && !t->severed[i - 1] && dist3_sq(t->x + 3 * i, t->x + 3 * i - 3) > l2)
-      cap_node(t, i, i - 1, k >= 0 && t->arc[k] <= i * t->l0 ? k : -1);
+      cap_node(t, i, i - 1, k >= t->out && t->arc[k] <= i * t->l0 ? k : -1);
   }
 }
 
 // and back from the last pin
 static void cap_backward(tx_thread* t) {
   double l2 = t->lmax * t->lmax;
-  int k = 0; // the first passed lies the furthest along the thread: met first from the tail
+  int k = t->out; // the first passed lies the furthest along the thread: met first from the tail
   for (int i = t->last_pin - 1; i > 0; i--) {
     while (k < t->passed && t->arc[k] > (i + 1) * t->l0) k++;
     if (!t->pinned[i] && !t->severed[i] && dist3_sq(t->x + 3 * i, t->x + 3 * i + 3) > l2)
@@ -1997,6 +2009,7 @@ static void rod_substep(tx_thread* t, double h, double margin) {
   cap_stretch(t);
   solve_capsules(t);
   solve_mesh(t);
+  pull_out(t); // a tail drawn through to its end is not held back by the last pass
   for (int pass = 0; pass < 2 && t->passed; pass++) solve_punctures(t, false); // never leaves one
   for (int i = 0; i < n; i++)
     for (int a = 0; a < 3; a++)
@@ -2031,7 +2044,7 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
   memcpy(t->vs, t->v, sizeof(double) * 3 * n);
   memset(t->colliding, 0, (size_t)t->nseg);
   memset(&t->last, 0, sizeof t->last);
-  int passed0 = t->passed;
+  int passed0 = t->passed, out0 = t->out;
   if (passed0) memcpy(t->arc_step, t->arc, sizeof(double) * passed0);
   // substeps: the head and, by their last velocities, the nodes move no
   // more than 3 r / 4 in one
@@ -2070,7 +2083,7 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
     double f = (tau + h) / dt;
     memcpy(t->x0, t->x, sizeof(double) * 3 * n);
     memcpy(t->v0, t->v, sizeof(double) * 3 * n);
-    int passed_sub = t->passed;
+    int passed_sub = t->passed, out_sub = t->out;
     if (passed_sub) memcpy(t->arc_sub, t->arc, sizeof(double) * passed_sub);
     for (int a = 0; a < 3; a++) t->x[a] = t->head_from[a] + f * (t->head_to[a] - t->head_from[a]);
     for (int i = 1; i < n; i++) {
@@ -2084,6 +2097,7 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
       ftl_substep(t, h, margin);
     else
       rod_substep(t, h, margin);
+    pull_out(t);
     ns++;
     bool again = false;
     if (h > hmin * (1 + 1e-9) && ns < 4 * d->max_substeps) {
@@ -2102,7 +2116,7 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
     if (again) {
       memcpy(t->x, t->x0, sizeof(double) * 3 * n);
       memcpy(t->v, t->v0, sizeof(double) * 3 * n);
-      t->passed = passed_sub;
+      t->passed = passed_sub, t->out = out_sub;
       if (passed_sub) memcpy(t->arc, t->arc_sub, sizeof(double) * passed_sub);
       h = fmax(0.5 * h, hmin);
       t->last.retries++;
@@ -2123,12 +2137,13 @@ tx_thread_status tx_thread_step(tx_thread* t, double dt) {
     if (t->held[i]) memcpy(t->hold_from + 3 * i, t->hold_to + 3 * i, sizeof(double) * 3);
   t->last.substeps = ns;
   t->slid = 0; // punctures the thread went on through (pulled, not pushed back)
-  for (int k = 0; k < passed0; k++) t->slid += t->arc[k] > t->arc_step[k] + 1e-9 * t->l0;
+  for (int k = out0; k < passed0 && k < t->out; k++) t->slid++; // pulled out through it
+  for (int k = t->out; k < passed0; k++) t->slid += t->arc[k] > t->arc_step[k] + 1e-9 * t->l0;
   for (int i = 0; i < 3 * n; i++)
     if (!isfinite(t->x[i]) || !isfinite(t->v[i])) {
       memcpy(t->x, t->xs, sizeof(double) * 3 * n);
       memcpy(t->v, t->vs, sizeof(double) * 3 * n);
-      t->passed = passed0;
+      t->passed = passed0, t->out = out0;
       if (passed0) memcpy(t->arc, t->arc_step, sizeof(double) * passed0);
       t->slid = 0;
       t->faults++;

@@ -210,10 +210,15 @@ int tx_thread_head_piece_end(const tx_thread* t);
 tx_thread_status tx_thread_set_punctures(tx_thread* t, const double* p, int n);
 int tx_thread_punctures_passed(const tx_thread* t); // how many the thread runs through
 // the material coordinate (m from the head, at rest) of the thread's point
-// at passed puncture k; -1 when k is not passed. It grows as the thread is pulled through.
+// at passed puncture k; -1 when k is not passed or pulled out of. It grows as the thread is pulled through.
 double tx_thread_puncture_arc(const tx_thread* t, int k);
-// the passed punctures the thread slid on through in the last step
+// the passed punctures the thread slid on through in the last step (a
+// puncture it was pulled out of in it counts)
 int tx_thread_punctures_slid(const tx_thread* t);
+// the first this many passed punctures the thread was pulled out of: its
+// free tail drawn through to its end, it runs through them no more (their
+// arcs -1, no load on the skin there)
+int tx_thread_punctures_out(const tx_thread* t);
 
 // advances by dt (s, in (0, 1])
 // changes the model from the next step on, the nodes where they are and at

@@ -80,6 +80,7 @@ typedef struct thread_ctl {
   int max_punct;
   tx_warning bad_puncture, too_many_punctures;
   tx_result passed_result;
+  tx_result out_result;
   int cuts;
   tx_warning bad_cut;
   tx_result cuts_result;
@@ -280,6 +281,7 @@ static int configure(tx_setup* s, void** self) {
   k->bad_puncture = tx_setup_warning(s, "bad_puncture");
   k->too_many_punctures = tx_setup_warning(s, "too_many_punctures");
   k->passed_result = tx_setup_result(s, "punctures_passed");
+  k->out_result = tx_setup_result(s, "punctures_out");
   k->bad_cut = tx_setup_warning(s, "bad_cut");
   k->cuts_result = tx_setup_result(s, "cuts");
   k->draw = tx_table_bool(s, "draw");
@@ -680,6 +682,7 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, k->held_result, k->knotted ? 1 : 0);
   tx_set_result(c, k->lost_result, k->knot_lost);
   tx_set_result(c, k->passed_result, tx_thread_punctures_passed(k->t));
+  tx_set_result(c, k->out_result, tx_thread_punctures_out(k->t));
   tx_set_result(c, k->first_knot_result, k->first_knot_s);
   tx_set_result(c, k->strain_result, k->max_strain);
   tx_set_result(c, k->faults_result, tx_thread_faults(k->t));

@@ -224,6 +224,51 @@ static void test_a_pulled_rod_slides_through_a_firm_puncture(void** state) {
   assert_true(r.worst <= 0.00025);
 }
 
+// A thread pulled on through a puncture until its free tail goes through
+// leaves it: 20 mm of thread, its head drawn along +x at 0.1 m/s through a
+// point at x = 5 mm, then 15 mm further than the thread reaches. The point
+// is passed at 0.05 s and left at 0.25 s, when the tail's end is at it;
+// after that the thread runs through nothing (its arc -1, no load, no link
+// held back past the cap) and lies beyond the point, behind the head.
+static void test_a_thread_pulled_through_to_its_end_leaves_the_puncture(void** state) {
+  (void)state;
+  for (int model = 0; model < 2; model++) {
+    tx_thread_def d = tx_thread_def_default();
+    d.model = (tx_thread_model)model;
+    d.nodes = 21;
+    d.length = 0.02;
+    d.direction[0] = -1;
+    d.gravity = 0;
+    d.damping = 5;
+    tx_thread* t = tx_thread_create(&d);
+    assert_non_null(t);
+    const double P[3] = {0.005, 0, 0};
+    int passed_at = -1, out_at = -1;
+    double strain = 0;
+    for (int k = 1; k <= 400; k++) {
+      double h[3] = {0.1 * k * 1e-3, 0, 0};
+      assert_int_equal(tx_thread_set_punctures(t, P, 1), TX_THREAD_OK);
+      assert_int_equal(tx_thread_set_head(t, h), TX_THREAD_OK);
+      assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
+      if (passed_at < 0 && tx_thread_punctures_passed(t) == 1) passed_at = k;
+      if (out_at < 0 && tx_thread_punctures_out(t) == 1) out_at = k;
+      strain = fmax(strain, tx_thread_max_strain(t));
+    }
+    double load[3], k_load;
+    int n = tx_thread_puncture_loads(t, 200, 10, load, &k_load);
+    const double* tail = tx_thread_position(t, 20);
+    print_message("%s: passed at step %d, pulled out at %d; the tail's end at x = %.2f mm; largest strain %.4f\n",
+                  model ? "rod" : "ftl", passed_at, out_at, tail[0] * 1e3, strain);
+    assert_true(passed_at >= 50 && passed_at <= 52);
+    assert_true(out_at >= 249 && out_at <= 256);
+    assert_true(tx_thread_puncture_arc(t, 0) == -1);
+    assert_true(n == 1 && load[0] == 0 && load[1] == 0 && load[2] == 0 && k_load == 0);
+    assert_true(tail[0] > 0.0055 && tail[0] < 0.021); // beyond the point, behind the head (at 40 mm)
+    if (model == TX_THREAD_ROD) assert_true(strain <= 0.05 + 1e-6);
+    tx_thread_destroy(t);
+  }
+}
+
 static void test_bad_puncture_lists(void** state) {
   (void)state;
   tx_thread_def d = tx_thread_def_default();
@@ -255,6 +300,7 @@ int main(void) {
       cmocka_unit_test(test_taut_thread_loads_its_puncture_as_a_pulley),
       cmocka_unit_test(test_friction_raises_the_head_force),
       cmocka_unit_test(test_a_pulled_rod_slides_through_a_firm_puncture),
+      cmocka_unit_test(test_a_thread_pulled_through_to_its_end_leaves_the_puncture),
       cmocka_unit_test(test_bad_puncture_lists),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
