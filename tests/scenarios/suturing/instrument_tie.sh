@@ -4,7 +4,7 @@
 # scenarios/instruments/hands.py with TIE=1), a wrap drawn taut: with a 12
 # cm thread that is a rod from 17.6 s, the forceps pull the needle up until
 # 3 cm of tail is left (B), then carry it 1.5 times round the closed needle
-# holder's jaws 20 mm out. The loop has not the thread that takes: the
+# holder's jaws 20 mm out. The loop lacks the thread the wrap takes up: the
 # stitch holds the thread only until it is pulled (thread.md, "Passing
 # through punctures"), so the wrap draws the tail back out through the
 # stitch's entry and the thread never winds round the jaws: C is not
