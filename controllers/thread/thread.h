@@ -200,7 +200,8 @@ int tx_thread_head_piece_end(const tx_thread* t);
 // for the next steps (copied; n in [0, max_punctures]). Once the head has
 // gone through point k (after points 0..k-1: the thread behind the head,
 // not its end, within puncture_capture of it), the thread runs through it:
-// it slides through and never leaves it (ftl: the link that holds it is put
+// it slides through and never leaves it sideways (a free tail can be pulled
+// out through it: tx_thread_punctures_out) (ftl: the link that holds it is put
 // through it; rod: a sliding constraint on the polyline that sticks until
 // the thread's two sides are stretched apart by more than puncture_friction
 // / E A and half max_stretch, then slides; a link on a pinned node turns
@@ -208,7 +209,7 @@ int tx_thread_head_piece_end(const tx_thread* t);
 // skin's contacts are left out near a passed puncture. Points move between
 // steps (a skin that moves); a shorter list forgets those past its end.
 tx_thread_status tx_thread_set_punctures(tx_thread* t, const double* p, int n);
-int tx_thread_punctures_passed(const tx_thread* t); // how many the thread runs through
+int tx_thread_punctures_passed(const tx_thread* t); // how many the head has passed (the thread runs through those after the first tx_thread_punctures_out)
 // the material coordinate (m from the head, at rest) of the thread's point
 // at passed puncture k; -1 when k is not passed or pulled out of. It grows as the thread is pulled through.
 double tx_thread_puncture_arc(const tx_thread* t, int k);
