@@ -584,17 +584,25 @@ const uint8_t* tx_thread_severed(const tx_thread* t) { return t->severed; }
 int tx_thread_cut_count(const tx_thread* t) { return t->cuts; }
 int tx_thread_head_piece_end(const tx_thread* t) { return t->first_cut; }
 
+// the point of link i nearest p: its fraction along the link in u, the point
+// in q; returns its squared distance
+static double link_nearest(const tx_thread* t, int i, const double p[3], double* u, double q[3]) {
+  const double *a = t->x + 3 * i, *b = a + 3;
+  double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, ap[3] = {p[0] - a[0], p[1] - a[1], p[2] - a[2]};
+  double ee = dot3(e, e), s = ee > 0 ? fmin(1, fmax(0, dot3(ap, e) / ee)) : 0;
+  for (int c = 0; c < 3; c++) q[c] = a[c] + s * e[c];
+  *u = s;
+  return dist3_sq(p, q);
+}
+
 int tx_thread_nearest_link(const tx_thread* t, const double p[3], double at[3]) {
   int best = -1;
   double bd = INFINITY;
   for (int i = 0; i < t->nseg; i++) {
     if (t->severed[i]) continue;
-    const double *a = t->x + 3 * i, *b = a + 3;
-    double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, ee = dot3(e, e), s = 0;
-    if (ee > 0) s = fmin(1, fmax(0, (dot3(p, e) - dot3(a, e)) / ee));
-    double q[3] = {a[0] + s * e[0], a[1] + s * e[1], a[2] + s * e[2]}, d = dist3(p, q);
-    if (d < bd) {
-      bd = d, best = i;
+    double u, q[3], d2 = link_nearest(t, i, p, &u, q);
+    if (d2 < bd) {
+      bd = d2, best = i;
       if (at) memcpy(at, q, sizeof q);
     }
   }
@@ -1247,20 +1255,17 @@ int tx_thread_puncture_loads(const tx_thread* t, double stiffness, double max_fo
 }
 
 // the material coordinate of the thread's point nearest p among the whole
-// links within a few of guess (a sliding thread moves less than a link a substep)
-static double nearest_arc(const tx_thread* t, const double p[3], double guess) {
-  int c, lo, hi;
-  double u0, best = guess, bd = INFINITY;
-  arc_link(t, guess, &c, &u0);
-  lo = c - 3 < 0 ? 0 : c - 3;
-  hi = c + 3 > t->nseg - 1 ? t->nseg - 1 : c + 3;
-  for (int i = lo; i <= hi; i++) {
-    if (t->severed[i]) continue;
-    const double *a = t->x + 3 * i, *b = a + 3;
-    double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, ee = dot3(e, e), u = 0;
-    if (ee > 0) u = fmin(1, fmax(0, (dot3(p, e) - dot3(a, e)) / ee));
-    double q[3] = {a[0] + u * e[0], a[1] + u * e[1], a[2] + u * e[2]}, d = dist3(p, q);
-    if (d < bd) bd = d, best = (i + u) * t->l0;
+// links within `window` of the one at guess (a sliding thread moves less than
+// a link a substep), those on a pinned node left out where free_only; guess
+// itself when there is none
+static double nearest_arc(const tx_thread* t, const double p[3], double guess, int window, bool free_only) {
+  int c;
+  double u, q[3], best = guess, bd = INFINITY;
+  arc_link(t, guess, &c, &u);
+  for (int i = c - window; i <= c + window; i++) {
+    if (i < 0 || i >= t->nseg || t->severed[i] || (free_only && (t->w[i] == 0 || t->w[i + 1] == 0))) continue;
+    double d2 = link_nearest(t, i, p, &u, q);
+    if (d2 < bd) bd = d2, best = (i + u) * t->l0;
   }
   return best;
 }
@@ -1273,7 +1278,7 @@ static void punctures_begin_substep(tx_thread* t) {
   while (t->passed < t->npunct) {
     const double* p = t->punct + 3 * t->passed;
     if (dist3(t->x, p) > t->def.puncture_capture + t->l0) break;
-    double arc = nearest_arc(t, p, 0);
+    double arc = nearest_arc(t, p, 0, 3, false);
     int i;
     double u, q[3];
     arc_link(t, arc, &i, &u);
@@ -1349,25 +1354,6 @@ static bool overstretches(const tx_thread* t, int i, double u, double W, const d
          (i + 2 < t->n && !t->severed[i + 1] && dist3_sq(b, t->x + 3 * i + 6) > l2);
 }
 
-// the point of links i - 1 .. i + 1 (not cut, both ends free) nearest p,
-// for passed puncture k held on link i: moves arc[k] there and returns true
-// when it is elsewhere than arc[k]
-static bool nearest_on_thread(tx_thread* t, int k, const double p[3], int* link, double* frac) {
-  double best = INFINITY, arc = t->arc[k];
-  for (int j = *link - 1; j <= *link + 1; j++) {
-    if (j < 0 || j >= t->nseg || t->severed[j] || t->w[j] == 0 || t->w[j + 1] == 0) continue;
-    const double *a = t->x + 3 * j, *b = a + 3;
-    double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, ee = dot3(e, e), s = 0, d2 = 0;
-    if (ee > 0) s = fmin(1, fmax(0, ((p[0] - a[0]) * e[0] + (p[1] - a[1]) * e[1] + (p[2] - a[2]) * e[2]) / ee));
-    for (int c = 0; c < 3; c++) d2 += (a[c] + s * e[c] - p[c]) * (a[c] + s * e[c] - p[c]);
-    if (d2 < best) best = d2, arc = (j + s) * t->l0;
-  }
-  if (arc == t->arc[k]) return false;
-  t->arc[k] = arc;
-  arc_link(t, arc, link, frac);
-  return true;
-}
-
 // each passed puncture holds the thread's point at arc[k] on it, with
 // stick and slip along the thread (decide_slides, from the stretch the
 // substep starts with). In the iterations (friction true) the offset across
@@ -1410,7 +1396,10 @@ static void solve_punctures(tx_thread* t, bool friction) {
     double ct = dot3(C, tan), corr[3];
     if (!friction) {
       if (!t->slides[k] && overstretches(t, i, u, W, C)) t->slides[k] = 1; // held, it would stretch past the cap: it slides
-      if (t->slides[k] && nearest_on_thread(t, k, p, &i, &u)) { // held where the thread now is nearest
+      double moved = t->slides[k] ? nearest_arc(t, p, t->arc[k], 1, true) : t->arc[k];
+      if (moved != t->arc[k]) { // held where the thread now is nearest, on a link with both ends free
+        t->arc[k] = moved;
+        arc_link(t, moved, &i, &u);
         a = t->x + 3 * i, b = a + 3;
         W = t->w[i] * (1 - u) * (1 - u) + t->w[i + 1] * u * u;
         if (!(W > 0)) continue;
