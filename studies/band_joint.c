@@ -10,6 +10,7 @@
 
 #include "../scenarios/command.h"
 #include "../views/plot.h"
+#include "../views/aside.h"
 #include "../views/report.h"
 #include "../model/error.h"
 
@@ -49,11 +50,9 @@ int tx_study_band_joint(const tx_study_args* a) {
          "%.2f s and held to %.2g s%s\n\n",
          assets, d.part[TX_BAND_RING].young * 1e-6, d.part[TX_BAND_TUBE].young * 1e-6, ramp, duration, quick ? ", quick" : "");
 
-  char csv_path[4200], tmp[4300];
-  snprintf(csv_path, sizeof csv_path, "%s/band-joint.csv", a->out_dir);
-  snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
-  FILE* csv = fopen(tmp, "w");
-  if (!csv) return tx_bad_input("--out %s: cannot write band-joint.csv", a->out_dir);
+  tx_aside out;
+  if (!tx_aside_begin(&out, a->out_dir, "band-joint.csv")) return tx_bad_input("--out %s", tx_error());
+  FILE* csv = out.f;
   fprintf(csv, "force_n,t_s,pull_n,joint_length_m,joint_error\n");
 
   const int steps = (int)lround(duration / d.step);
@@ -107,15 +106,15 @@ int tx_study_band_joint(const tx_study_args* a) {
                                           "final_error", err, "tube_head_moved_m", stretch, "cpu_s", cpu));
   }
   if (!ok) {
-    free(px), free(py), json_decref(runs), fclose(csv), remove(tmp);
+    free(px), free(py), json_decref(runs), tx_aside_drop(&out);
     return 1;
   }
   bool met = at5 <= TARGET;
   printf("\n  at 5 N the joint's length stays within %.4f %% of %.3g mm (target 1 %%): %s\n", 100 * at5, rest * 1e3,
          met ? "met" : "MISSED");
-  if (fclose(csv) != 0 || rename(tmp, csv_path) != 0) {
-    free(px), free(py), json_decref(runs), remove(tmp);
-    return fprintf(stderr, "tactus: %s: cannot write\n", csv_path), 1;
+  if (!tx_aside_end(&out)) {
+    free(px), free(py), json_decref(runs);
+    return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   }
   json_t* doc = json_pack("{s:s,s:b,s:s,s:f,s:f,s:f,s:f,s:o,s:f,s:f,s:b}", "study", "band-joint", "quick", quick, "joint",
                           "ODE double-ball (dJointCreateDBall), dWorldStep at the band's substep", "joint_rest_m", rest,

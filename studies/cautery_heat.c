@@ -10,6 +10,7 @@
 
 #include "experiments/cautery_heat.h"
 #include "../scenarios/command.h"
+#include "../views/aside.h"
 #include "../views/plot.h"
 #include "../views/report.h"
 
@@ -42,11 +43,9 @@ int tx_study_cautery_heat(const tx_study_args* a) {
          "liver (IT'IS), a Gaussian source of 0.5 W and radius 1.5 mm at the centre of a block held at T_a%s\n\n",
          quick ? ", quick" : "");
 
-  char csv_path[4200], tmp[4300];
-  snprintf(csv_path, sizeof csv_path, "%s/cautery-heat.csv", a->out_dir);
-  snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
-  FILE* csv = fopen(tmp, "w");
-  if (!csv) return tx_bad_input("--out %s: cannot write cautery-heat.csv", a->out_dir);
+  tx_aside out;
+  if (!tx_aside_begin(&out, a->out_dir, "cautery-heat.csv")) return tx_bad_input("--out %s", tx_error());
+  FILE* csv = out.f;
   fprintf(csv, "check,h_m,nodes,tetrahedra,dt_s,steps,error,max_error,order,reference,cpu_s\n");
 
   bool all = true;
@@ -68,7 +67,7 @@ int tx_study_cautery_heat(const tx_study_args* a) {
       tx_heat_case c = tx_heat_case_default(k == 1);
       c.cells = cells[k][l];
       if (!tx_heat_run(&c, false, &r)) {
-        fclose(csv), remove(tmp), json_decref(checks), json_decref(levels);
+        tx_aside_drop(&out), json_decref(checks), json_decref(levels);
         return fprintf(stderr, "tactus: study cautery-heat: %s\n", tx_error()), 1;
       }
       order = l > 0 ? log(prev / r.error) / log(2.0) : NAN;
@@ -103,16 +102,16 @@ int tx_study_cautery_heat(const tx_study_args* a) {
   {
     double* x;
     int *tet, n, nt;
-    if (!tx_heat_block(c.half_m, c.cells, &x, &n, &tet, &nt)) return fclose(csv), remove(tmp), json_decref(checks), 1;
+    if (!tx_heat_block(c.half_m, c.cells, &x, &n, &tet, &nt)) return tx_aside_drop(&out), json_decref(checks), 1;
     tx_thermal* h = tx_thermal_create(x, n, tet, nt, &c.tissue, NULL, 1);
     free(x), free(tet);
-    if (!h) return fclose(csv), remove(tmp), json_decref(checks), fprintf(stderr, "tactus: %s\n", tx_error()), 1;
+    if (!h) return tx_aside_drop(&out), json_decref(checks), fprintf(stderr, "tactus: %s\n", tx_error()), 1;
     stable = tx_thermal_stable_dt(h);
     tx_thermal_destroy(h);
   }
   int n0 = (int)ceil(c.t_end_s / stable);
   c.dt_s = c.t_end_s / (64.0 * n0);
-  if (!tx_heat_run(&c, true, &ref)) return fclose(csv), remove(tmp), json_decref(checks), fprintf(stderr, "tactus: %s\n", tx_error()), 1;
+  if (!tx_heat_run(&c, true, &ref)) return tx_aside_drop(&out), json_decref(checks), fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   printf("  step: the transient on the 1 mm mesh, the step refined from the stable %.3g s; error against dt / 64 on the "
          "same mesh (converged reference) and against the closed form\n  %9s %7s %12s %6s %12s %9s\n",
          c.t_end_s / n0, "dt s", "steps", "vs dt/64", "order", "vs exact", "CPU s");
@@ -123,7 +122,7 @@ int tx_study_cautery_heat(const tx_study_args* a) {
     c.dt_s = c.t_end_s / (n0 << l);
     tx_heat_result r;
     if (!tx_heat_run(&c, true, &r)) {
-      free(ref.theta), fclose(csv), remove(tmp), json_decref(checks), json_decref(steps);
+      free(ref.theta), tx_aside_drop(&out), json_decref(checks), json_decref(steps);
       return fprintf(stderr, "tactus: study cautery-heat: %s\n", tx_error()), 1;
     }
     double e = tx_heat_difference(&c, r.theta, ref.theta);
@@ -146,9 +145,9 @@ int tx_study_cautery_heat(const tx_study_args* a) {
   printf("  step error falls at every refinement: %s; observed order %.2f within 0.2 of 1 (explicit Euler): %s\n\n",
          sfalls ? "yes" : "NO", sorder, sordered ? "yes" : "NO");
 
-  if (fclose(csv) != 0 || rename(tmp, csv_path) != 0) {
-    remove(tmp), json_decref(checks), json_decref(steps);
-    return fprintf(stderr, "tactus: %s: cannot write\n", csv_path), 1;
+  if (!tx_aside_end(&out)) {
+    json_decref(checks), json_decref(steps);
+    return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   }
   json_t* doc = json_pack("{s:s,s:b,s:s,s:o,s:{s:s,s:o,s:b,s:o,s:b},s:b}", "study", "cautery-heat", "quick", quick, "solver",
                           "Pennes bioheat, linear tetrahedra, lumped mass, explicit Euler at 0.9 x Gershgorin's stable step",

@@ -7,6 +7,7 @@
 #include "studies.h"
 
 #include "experiments/wall_stability.h"
+#include "../views/aside.h"
 #include "../views/plot.h"
 #include "../views/report.h"
 #include "../scenarios/command.h"
@@ -143,11 +144,9 @@ int tx_study_haptic_stability(const tx_study_args* a) {
 
   // JSON and CSV, each whole or absent
   json_t* cases = json_array();
-  char csv_path[4200], tmp[4300];
-  snprintf(csv_path, sizeof csv_path, "%s/haptic-stability.csv", a->out_dir);
-  snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
-  FILE* csv = fopen(tmp, "w");
-  if (!csv) return json_decref(cases), tx_bad_input("--out %s: cannot write haptic-stability.csv", a->out_dir);
+  tx_aside out;
+  if (!tx_aside_begin(&out, a->out_dir, "haptic-stability.csv")) return json_decref(cases), tx_bad_input("--out %s", tx_error());
+  FILE* csv = out.f;
   fprintf(csv, "period_s,k_max_theory_n_m,k_max_exact_n_m,k_max_measured_n_m,k_max_with_passivity_control_n_m,"
                "k_max_with_port_passivity_control_n_m\n");
   for (int i = 0; i < n; i++) {
@@ -167,7 +166,7 @@ int tx_study_haptic_stability(const tx_study_args* a) {
                                            num(r->spring_pc / r->measured), "k_max_with_port_passivity_control",
                                            r->port_pc, "wall_damping", damping));
   }
-  if (fclose(csv) != 0 || rename(tmp, csv_path) != 0) return remove(tmp), fprintf(stderr, "tactus: %s: cannot write\n", csv_path), 1;
+  if (!tx_aside_end(&out)) return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   json_t* doc = json_pack("{s:s,s:{s:f,s:f,s:f,s:f},s:f,s:s,s:s,s:o}", "study", "haptic-stability", "device", "mass_kg",
                           c.device.mass, "damping_n_s_m", c.device.damping, "quantum_m", c.device.quantum,
                           "hand_stiffness_n_m", c.device.hand_stiffness, "wall_damping_n_s_m", c.damping, "units",

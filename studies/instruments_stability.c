@@ -19,6 +19,7 @@
 #include "studies.h"
 
 #include "../scenarios/command.h"
+#include "../views/aside.h"
 #include "../views/plot.h"
 #include "../views/report.h"
 
@@ -237,11 +238,9 @@ int tx_study_instruments_stability(const tx_study_args* a) {
   double clamp = tx_instrument_sim_defaults().max_force;
 
   // outputs, each written aside and renamed when whole
-  char csv_path[4200], tmp[4300];
-  snprintf(csv_path, sizeof csv_path, "%s/instruments-stability.csv", a->out_dir);
-  snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
-  FILE* csv = fopen(tmp, "w");
-  if (!csv) return tx_instrument_desc_free(hook), tx_instrument_desc_free(holder), tx_bad_input("--out %s: cannot write", a->out_dir);
+  tx_aside out;
+  if (!tx_aside_begin(&out, a->out_dir, "instruments-stability.csv")) return tx_instrument_desc_free(hook), tx_instrument_desc_free(holder), tx_bad_input("--out %s", tx_error());
+  FILE* csv = out.f;
   fprintf(csv, "coupling_damping_n_s_m,coupling_stiffness_n_m,oscillation_ratio\n");
   json_t* couplings = json_array();
   for (int i = 0; i < 2; i++) {
@@ -254,8 +253,8 @@ int tx_study_instruments_stability(const tx_study_args* a) {
                                                "k_max_theory", colgate[i], "k_max_exact", exact[i], "k_max_measured",
                                                sw[i].k_max, "measured_over_exact", num(sw[i].k_max / exact[i]), "sweep", pts));
   }
-  if (fclose(csv) != 0 || rename(tmp, csv_path) != 0)
-    return remove(tmp), tx_instrument_desc_free(hook), tx_instrument_desc_free(holder), fprintf(stderr, "tactus: %s: cannot write\n", csv_path), 1;
+  if (!tx_aside_end(&out))
+    return tx_instrument_desc_free(hook), tx_instrument_desc_free(holder), fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   json_t* cases = json_array();
   for (int i = 0; i < nrows; i++)
     json_array_append_new(cases, json_pack("{s:s,s:f,s:f,s:f,s:i,s:i,s:i}", "case", rows[i].name, "dt_s", rows[i].dt,

@@ -6,6 +6,7 @@
 
 #include "experiments/needle_fit.h"
 #include "../model/error.h"
+#include "../views/aside.h"
 #include "../views/plot.h"
 #include "../views/report.h"
 #include "../scenarios/command.h"
@@ -46,23 +47,6 @@ static int apply(const tx_study_args* a, int* evals) {
     *evals = (int)v;
   }
   return 0;
-}
-
-static FILE* open_tmp(const char* dir, const char* name, char* path, char* tmp) {
-  snprintf(path, 4200, "%s/%s", dir, name);
-  snprintf(tmp, 4300, "%s.tmp", path);
-  return fopen(tmp, "w");
-}
-
-static bool close_tmp(FILE* f, const char* path, const char* tmp) {
-  bool ok = !ferror(f);
-  ok = fclose(f) == 0 && ok;
-  if (!ok || rename(tmp, path) != 0) {
-    remove(tmp);
-    fprintf(stderr, "tactus: %s: cannot write\n", path);
-    return false;
-  }
-  return true;
 }
 
 static int write_plots(const char* dir, const tx_recording* rec, const double* model, const trace* tr) {
@@ -128,25 +112,28 @@ int tx_study_needle_fit(const tx_study_args* a) {
     free(model), tx_recording_free(&rec);
     return 1;
   }
-  char path[4200], tmp[4300], rms_text[128];
+  char rms_text[128];
   int status = 0;
-  FILE* f = open_tmp(a->out_dir, "needle-fit.csv", path, tmp);
-  if (!f) status = 1, fprintf(stderr, "tactus: %s: cannot write\n", path);
-  else {
-    fprintf(f, "simulation,run_time_s,best_rms_n,best_rms_percent_of_peak\n");
-    for (int i = 0; i < tr.n; i++) fprintf(f, "%d,%.6f,%.9g,%.6g\n", i + 1, tr.seconds[i], tr.rms[i], 100 * tr.rms[i] / tr.peak);
-    if (!close_tmp(f, path, tmp)) status = 1;
+  tx_aside o;
+  if (!tx_aside_begin(&o, a->out_dir, "needle-fit.csv")) {
+    status = 1;
+  } else {
+    fprintf(o.f, "simulation,run_time_s,best_rms_n,best_rms_percent_of_peak\n");
+    for (int i = 0; i < tr.n; i++) fprintf(o.f, "%d,%.6f,%.9g,%.6g\n", i + 1, tr.seconds[i], tr.rms[i], 100 * tr.rms[i] / tr.peak);
+    if (!tx_aside_end(&o)) status = 1;
   }
-  f = status ? NULL : open_tmp(a->out_dir, "needle-fit-force.csv", path, tmp);
-  if (f) {
-    fprintf(f, "t_s,depth_m,recorded_fx_n,recorded_fy_n,recorded_fz_n,model_fx_n,model_fy_n,model_fz_n\n");
+  if (!status && !tx_aside_begin(&o, a->out_dir, "needle-fit-force.csv")) {
+    status = 1;
+  } else if (!status) {
+    fprintf(o.f, "t_s,depth_m,recorded_fx_n,recorded_fy_n,recorded_fz_n,model_fx_n,model_fy_n,model_fz_n\n");
     for (size_t k = 0; k < rec.count; k++) {
       const tx_recording_row* r = &rec.rows[k];
-      fprintf(f, "%.6f,%.9f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", r->t, r->depth, r->f[0], r->f[1], r->f[2], model[3 * k],
+      fprintf(o.f, "%.6f,%.9f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", r->t, r->depth, r->f[0], r->f[1], r->f[2], model[3 * k],
               model[3 * k + 1], model[3 * k + 2]);
     }
-    if (!close_tmp(f, path, tmp)) status = 1;
-  } else if (!status) status = 1, fprintf(stderr, "tactus: %s: cannot write\n", path);
+    if (!tx_aside_end(&o)) status = 1;
+  }
+  if (status) fprintf(stderr, "tactus: %s\n", tx_error());
   bool met = rms <= 0.1 * tr.peak;
   json_t* doc = json_pack(
       "{s:s,s:s,s:i,s:f,s:f,s:f,s:f,s:i,s:f,s:b,s:{s:f,s:f,s:f,s:f,s:f,s:f,s:f,s:f,s:f,s:f},s:s}", "study", "needle-fit",

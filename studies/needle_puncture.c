@@ -14,6 +14,7 @@
 #include "studies.h"
 
 #include "../scenarios/command.h"
+#include "../views/aside.h"
 #include "../views/plot.h"
 #include "../views/report.h"
 
@@ -180,19 +181,17 @@ int tx_study_needle_puncture(const tx_study_args* a) {
   if (!depth) return free(p->s), fprintf(stderr, "tactus: out of memory\n"), 1;
   double* along = depth + n;
 
-  char csv_path[4200], tmp[4300];
-  snprintf(csv_path, sizeof csv_path, "%s/needle-puncture.csv", a->out_dir);
-  snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
-  FILE* csv = fopen(tmp, "w");
-  if (!csv) return free(depth), free(p->s), tx_bad_input("--out %s: cannot write", a->out_dir);
+  tx_aside out;
+  if (!tx_aside_begin(&out, a->out_dir, "needle-puncture.csv")) return free(depth), free(p->s), tx_bad_input("--out %s", tx_error());
+  FILE* csv = out.f;
   fprintf(csv, "t_s,tip_depth_m,force_along_needle_n,skin_force_n,hand_force_n,torn_after\n");
   for (int i = first; i <= last; i++) {
     const sample* q = &p->s[i];
     fprintf(csv, "%.4f,%.6g,%.6g,%.6g,%.6g,%d\n", q->t, q->depth, q->along, q->force, q->hand, q->t >= p->punct_t);
     depth[i - first] = tx_plot_length(q->depth), along[i - first] = q->along;
   }
-  if (fclose(csv) != 0 || rename(tmp, csv_path) != 0)
-    return remove(tmp), free(depth), free(p->s), fprintf(stderr, "tactus: %s: cannot write\n", csv_path), 1;
+  if (!tx_aside_end(&out))
+    return free(depth), free(p->s), fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   const sample* pk = &p->s[peak];
   json_t* doc = json_pack("{s:s,s:{s:f,s:f,s:f,s:f},s:f,s:f,s:f,s:f,s:f,s:f,s:f,s:i}", "study", "needle-puncture", "needle",
                           "length_m", NEEDLE_LENGTH, "radius_m", radius(), "centre_above_skin_m", CENTRE_Y, "turn_rad_s",

@@ -11,6 +11,7 @@
 #include "studies.h"
 
 #include "experiments/net_wall.h"
+#include "../views/aside.h"
 #include "../views/plot.h"
 #include "../views/report.h"
 #include "../scenarios/command.h"
@@ -257,11 +258,9 @@ int tx_study_network_haptics(const tx_study_args* a) {
   link_close(&k);
 #endif
 
-  char csv_path[4200], tmp[4300];
-  snprintf(csv_path, sizeof csv_path, "%s/network-haptics.csv", a->out_dir);
-  snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
-  FILE* csv = fopen(tmp, "w");
-  if (!csv) return tx_bad_input("--out %s: cannot write network-haptics.csv", a->out_dir);
+  tx_aside out;
+  if (!tx_aside_begin(&out, a->out_dir, "network-haptics.csv")) return tx_bad_input("--out %s", tx_error());
+  FILE* csv = out.f;
   fprintf(csv, "delay_ms,round_trip_periods,k_max_exact_n_m,k_max_measured_n_m,k_max_with_passivity_control_n_m,"
                "k_max_with_port_passivity_control_n_m,dds_cases,dds_same\n");
   json_t* cases = json_array();
@@ -278,10 +277,9 @@ int tx_study_network_haptics(const tx_study_args* a) {
                                            "port_passivity_control_gain", num(r->port.k / r->off.k), "dds_cases",
                                            r->dds_checked, "dds_same", r->dds_same));
   }
-  if (fclose(csv) != 0 || rename(tmp, csv_path) != 0) {
-    remove(tmp);
+  if (!tx_aside_end(&out)) {
     json_decref(cases);
-    return fprintf(stderr, "tactus: %s: cannot write\n", csv_path), 1;
+    return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   }
   json_t* doc = json_pack("{s:s,s:b,s:{s:f,s:f,s:f,s:f},s:f,s:s,s:s,s:o}", "study", "network-haptics", "quick", quick,
                           "device", "mass_kg", c.device.mass, "damping_n_s_m", c.device.damping, "period_s", c.device.period,

@@ -16,6 +16,7 @@
 #include "experiments/organ_axisym.h"
 #include "experiments/organ_hemisphere.h"
 #include "../scenarios/command.h"
+#include "../views/aside.h"
 #include "../views/plot.h"
 #include "../views/report.h"
 #include "../model/error.h"
@@ -227,11 +228,9 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
     printf("study organ-hemisphere: R = %g cm, E = %g kPa, nu = %g, base fixed, a rigid frictionless plate at the pole%s\n\n",
            RADIUS * 1e2, YOUNG * 1e-3, nu, quick ? ", quick" : "");
 
-  char csv_path[4200], tmp[4300];
-  snprintf(csv_path, sizeof csv_path, "%s/organ-hemisphere.csv", a->out_dir);
-  snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
-  FILE* csv = fopen(tmp, "w");
-  if (!csv) return tx_bad_input("--out %s: cannot write organ-hemisphere.csv", a->out_dir);
+  tx_aside out;
+  if (!tx_aside_begin(&out, a->out_dir, "organ-hemisphere.csv")) return tx_bad_input("--out %s", tx_error());
+  FILE* csv = out.f;
   fprintf(csv, "model,refinement,tetrahedra,iterations,dt_s,cpu_s,d_over_r,force_n,hertz_n,force_error,profile_error,"
                "continuum_n,continuum_force_error,continuum_profile_error\n");
 
@@ -253,7 +252,7 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
     ok = indent(&dl, &in, link_n, &links[k]);
   }
   if (!ok) {
-    fclose(csv), remove(tmp);
+    tx_aside_drop(&out);
     for (int l = 0; l < LEVELS; l++) free_run(&fem[l]);
     for (int k = 0; k < LINK_RUNS; k++) free_run(&links[k]);
     return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
@@ -278,7 +277,7 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
     tx_axisym_destroy(c);
     axi_cpu[l] = cpu_now() - t0;
     if (!good) {
-      fclose(csv), remove(tmp);
+      tx_aside_drop(&out);
       for (int k = 0; k < LEVELS; k++) free_run(&fem[k]);
       for (int k = 0; k < LINK_RUNS; k++) free_run(&links[k]);
       return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
@@ -421,9 +420,9 @@ int tx_study_organ_hemisphere(const tx_study_args* a) {
 
   for (int l = 0; l < LEVELS; l++) free_run(&fem[l]);
   for (int k = 0; k < LINK_RUNS; k++) free_run(&links[k]);
-  if (fclose(csv) != 0 || rename(tmp, csv_path) != 0) {
-    remove(tmp), json_decref(jdepths), json_decref(jruns), json_decref(jcont), json_decref(jparts);
-    return fprintf(stderr, "tactus: %s: cannot write\n", csv_path), 1;
+  if (!tx_aside_end(&out)) {
+    json_decref(jdepths), json_decref(jruns), json_decref(jcont), json_decref(jparts);
+    return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   }
   json_t* doc = json_pack("{s:s,s:b,s:{s:f,s:f,s:f,s:o,s:s},s:o,s:o,s:{s:o,s:o,s:o,s:f},s:b,s:b,s:b,s:b}", "study",
                           "organ-hemisphere", "quick", quick, "case", "radius_m", RADIUS, "young_pa", YOUNG, "poisson",

@@ -21,6 +21,7 @@
 #include "studies.h"
 
 #include "../scenarios/command.h"
+#include "../views/aside.h"
 #include "../views/plot.h"
 #include "../views/report.h"
 #include "../model/error.h"
@@ -118,15 +119,13 @@ int tx_study_organ_removal(const tx_study_args* a) {
          nx, ny, nz, CUBE * 1e3, ne, nv, d.young * 1e-3, d.poisson, d.density, d.damping, STEP * 1e3, TOOL_R * 1e3,
          TOOL_DEPTH * 1e3, removals, STEPS_PER_FRAME, quick ? " (quick)" : "");
 
-  char csv_path[4200], tmp[4300];
-  snprintf(csv_path, sizeof csv_path, "%s/organ-removal.csv", a->out_dir);
-  snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
-  FILE* csv = fopen(tmp, "w");
+  tx_aside out;
+  FILE* csv = tx_aside_begin(&out, a->out_dir, "organ-removal.csv") ? out.f : NULL;
   if (!csv) {
     tx_fem_destroy(body);
     free(x0), free(tet), free(row_of), free(node_of), free(seen), free(tri), free(xs), free(pos), free(keys), free(order);
     free(frame_ms), free(plot_x), free(plot_live);
-    return tx_bad_input("--out %s: cannot write organ-removal.csv", a->out_dir);
+    return tx_bad_input("--out %s", tx_error());
   }
   fprintf(csv, "removal,tet,live_tets,live_nodes,surface_rows,surface_triangles,nonmanifold_edges,faults,inverted,"
                "min_volume_ratio,surface_ok,reference_ok,frame_ms\n");
@@ -215,9 +214,8 @@ int tx_study_organ_removal(const tx_study_args* a) {
   tx_fem_destroy(body);
   free(x0), free(tet), free(row_of), free(node_of), free(seen), free(tri), free(xs), free(pos), free(keys), free(order);
   int rc = 0;
-  if (fclose(csv) != 0 || rename(tmp, csv_path) != 0) {
-    remove(tmp);
-    fprintf(stderr, "tactus: %s: cannot write\n", csv_path);
+  if (!tx_aside_end(&out)) {
+    fprintf(stderr, "tactus: %s\n", tx_error());
     rc = 1;
   }
   json_t* doc = rc ? NULL

@@ -17,6 +17,7 @@
 
 #include "experiments/organ_hemisphere.h"
 #include "../scenarios/command.h"
+#include "../views/aside.h"
 #include "../views/plot.h"
 #include "../views/report.h"
 #include "../model/error.h"
@@ -125,11 +126,9 @@ int tx_study_organ_stability(const tx_study_args* a) {
          "step), links 1 ms, 5 iterations, kLST 0.1%s\n\n",
          RADIUS * 1e2, YOUNG * 1e-3, NU, DENSITY, DAMPING, cells, seconds / 2, fem_dt * 1e6, quick ? ", quick" : "");
 
-  char csv_path[4200], tmp[4300];
-  snprintf(csv_path, sizeof csv_path, "%s/organ-stability.csv", a->out_dir);
-  snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
-  FILE* csv = fopen(tmp, "w");
-  if (!csv) return tx_bad_input("--out %s: cannot write organ-stability.csv", a->out_dir);
+  tx_aside out;
+  if (!tx_aside_begin(&out, a->out_dir, "organ-stability.csv")) return tx_bad_input("--out %s", tx_error());
+  FILE* csv = out.f;
   fprintf(csv, "mode,factor,value,frames,faults,numerical_faults,clamp_faults,blew_up,reported_finite,force_over_hertz\n");
 
   const tx_fem_model models[2] = {TX_FEM_COROTATED, TX_FEM_LINKS};
@@ -149,7 +148,7 @@ int tx_study_organ_stability(const tx_study_args* a) {
                c = DAMPING * (f == 3 ? x : 1), k = fmin(1, 0.1 * (f == 1 ? x : 1));
         outcome o;
         if (!run(models[md], s, e, k, rho, c, fem_dt, cells, seconds, &o)) {
-          fclose(csv), remove(tmp), json_decref(jruns);
+          tx_aside_drop(&out), json_decref(jruns);
           return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
         }
         char what[64];
@@ -183,9 +182,9 @@ int tx_study_organ_stability(const tx_study_args* a) {
          "within the clamp: %s\n  FEM (SI units) under scale: force over Hertz the same within 5%% wherever it ran: %s; "
          "links: it varies %.1f-fold over the scales\n",
          blowups, recovered, all_finite ? "yes" : "NO", fem_consistent ? "yes" : "NO", links_spread);
-  if (fclose(csv) != 0 || rename(tmp, csv_path) != 0) {
-    remove(tmp), json_decref(jruns);
-    return fprintf(stderr, "tactus: %s: cannot write\n", csv_path), 1;
+  if (!tx_aside_end(&out)) {
+    json_decref(jruns);
+    return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   }
   json_t* doc = json_pack("{s:s,s:b,s:{s:f,s:f,s:f,s:f,s:f,s:i,s:f,s:f},s:o,s:i,s:i,s:b,s:b,s:o}", "study",
                           "organ-stability", "quick", quick, "nominal", "radius_m", RADIUS, "young_pa", YOUNG, "poisson",

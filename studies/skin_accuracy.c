@@ -46,6 +46,7 @@
 
 #include "../scenarios/command.h"
 #include "../controllers/haptics/device_scripted.h"
+#include "../views/aside.h"
 #include "../views/plot.h"
 #include "../views/report.h"
 
@@ -283,16 +284,15 @@ static int real_time_setting(setting* s) {
 static const tx_hand_motion quick_motion = {
     "accuracy-pierce-down-short", 4, {{0, 0, 0.003, 0}, {0.1, 0, 0.003, 0}, {1.4, 0, -0.010, 0}, {1.5, 0, -0.010, 0}}};
 
-static int write_motion(const char* path, const tx_hand_motion* m, double offset) {
-  char tmp[4300];
-  snprintf(tmp, sizeof tmp, "%s.tmp", path);
-  FILE* f = fopen(tmp, "w");
-  if (!f) return -1;
-  fprintf(f, "# t_s, x_m, y_m, z_m: %s at 1 cm/s, tactus study skin-accuracy\n", m->name);
+// the motion as DIR/NAME, its path into path; -1: tx_error() says why
+static int write_motion(const char* dir, const char* name, const tx_hand_motion* m, double offset, char* path, size_t size) {
+  tx_aside o;
+  if (!tx_aside_begin(&o, dir, name)) return -1;
+  fprintf(o.f, "# t_s, x_m, y_m, z_m: %s at 1 cm/s, tactus study skin-accuracy\n", m->name);
   for (int i = 0; i < m->count; i++)
-    fprintf(f, "%.9g,%.9g,%.9g,%.9g\n", m->t_pos[i][0], m->t_pos[i][1] + offset, m->t_pos[i][2], m->t_pos[i][3] + offset);
-  if (fclose(f) != 0 || rename(tmp, path) != 0) return remove(tmp), -1;
-  return 0;
+    fprintf(o.f, "%.9g,%.9g,%.9g,%.9g\n", m->t_pos[i][0], m->t_pos[i][1] + offset, m->t_pos[i][2], m->t_pos[i][3] + offset);
+  snprintf(path, size, "%s", o.path);
+  return tx_aside_end(&o) ? 0 : -1;
 }
 
 // the pierce's quantities from its ticks. Indentation is measured from the
@@ -517,11 +517,9 @@ static double real_time_error(const row* rows, int nset, int k) {
 
 static int write_outputs(const char* dir, const setting* set, const row* rows, const curve* curves, int nset,
                          const tx_convergence* conv, const options* o, const char* motion) {
-  char path[4200], tmp[4300];
   // one row per setting
-  snprintf(path, sizeof path, "%s/skin-accuracy.csv", dir);
-  snprintf(tmp, sizeof tmp, "%s.tmp", path);
-  FILE* f = fopen(tmp, "w");
+  tx_aside out;
+  FILE* f = tx_aside_begin(&out, dir, "skin-accuracy.csv") ? out.f : NULL;
   if (f) {
     fprintf(f, "setting,spacing_m,edge_m,iterations,rate_hz,time_step_s,cpu_s_per_sim_s,wall_s,contact_y_m,torn_links");
     for (int k = 0; k < NQ; k++) fprintf(f, ",%s,%s_error_rel", q_key[k], q_key[k]);
@@ -534,12 +532,9 @@ static int write_outputs(const char* dir, const setting* set, const row* rows, c
       fprintf(f, "\n");
     }
   }
-  if (!f || fclose(f) != 0 || rename(tmp, path) != 0)
-    return remove(tmp), fprintf(stderr, "tactus: %s: cannot be written\n", path), 1;
+  if (!f || !tx_aside_end(&out)) return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   // every tick of every pierce
-  snprintf(path, sizeof path, "%s/skin-accuracy-curves.csv", dir);
-  snprintf(tmp, sizeof tmp, "%s.tmp", path);
-  f = fopen(tmp, "w");
+  f = tx_aside_begin(&out, dir, "skin-accuracy-curves.csv") ? out.f : NULL;
   if (f) {
     fprintf(f, "setting,spacing_m,iterations,time_step_s,tick,hip_y_m,force_y_n,torn_links\n");
     for (int i = 0; i < nset; i++)
@@ -547,8 +542,7 @@ static int write_outputs(const char* dir, const setting* set, const row* rows, c
         fprintf(f, "%s,%g,%d,%.9g,%d,%.6g,%.6g,%.0f\n", set[i].name, set[i].spacing, set[i].iterations, set[i].substep,
                 t, curves[i].y[t], curves[i].f[t], curves[i].torn[t]);
   }
-  if (!f || fclose(f) != 0 || rename(tmp, path) != 0)
-    return remove(tmp), fprintf(stderr, "tactus: %s: cannot be written\n", path), 1;
+  if (!f || !tx_aside_end(&out)) return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   // JSON: the path, each quantity's order and reference, each setting; NaN is no JSON number: null
   json_t* list = json_array();
   json_t* quantities = json_object();
@@ -606,8 +600,7 @@ int tx_study_skin_accuracy(const tx_study_args* a) {
   if (!motion) return fprintf(stderr, "tactus: skin-accuracy: no hand motion accuracy-pierce-down\n"), 1;
   double duration = motion->t_pos[motion->count - 1][0];
   char path[4200], device[4300];
-  snprintf(path, sizeof path, "%s/motion-pierce-down.csv", a->out_dir);
-  if (write_motion(path, motion, 0)) return tx_bad_input("--out %s: cannot write motion-pierce-down.csv", a->out_dir);
+  if (write_motion(a->out_dir, "motion-pierce-down.csv", motion, 0, path, sizeof path)) return tx_bad_input("--out %s", tx_error());
   snprintf(device, sizeof device, "scripted:%s", path);
   if (!tx_find_controller(pierce_class.type)) tx_register_controller(&pierce_class);
   if (!tx_find_controller(sag_class.type)) tx_register_controller(&sag_class);
@@ -630,9 +623,8 @@ int tx_study_skin_accuracy(const tx_study_args* a) {
   for (int i = nlev; i < nset; i++)
     snprintf(set[i].name, sizeof set[i].name, "real time (%s)", over_particle(&set[i]) ? "particle" : "cell middle");
   char offset_path[4200], offset_device[4300];
-  snprintf(offset_path, sizeof offset_path, "%s/motion-pierce-down-offset.csv", a->out_dir);
-  if (write_motion(offset_path, motion, 0.5 * set[nlev].spacing))
-    return tx_bad_input("--out %s: cannot write motion-pierce-down-offset.csv", a->out_dir);
+  if (write_motion(a->out_dir, "motion-pierce-down-offset.csv", motion, 0.5 * set[nlev].spacing, offset_path, sizeof offset_path))
+    return tx_bad_input("--out %s", tx_error());
   snprintf(offset_device, sizeof offset_device, "scripted:%s", offset_path);
   curve* curves = calloc((size_t)nset, sizeof *curves);
   row rows[LEVELS_MAX + 2];

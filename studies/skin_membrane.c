@@ -8,6 +8,7 @@
 
 #include "experiments/skin_membrane.h"
 #include "../scenarios/command.h"
+#include "../views/aside.h"
 #include "../views/plot.h"
 #include "../views/report.h"
 
@@ -41,11 +42,9 @@ int tx_study_skin_membrane(const tx_study_args* a) {
   printf("study skin-membrane: the cloth against closed-form membranes, converged XPBD (k w h^2 = 1/4, 4 iterations), and the implicit solver on the disc%s\n\n",
          quick ? ", quick" : "");
 
-  char csv_path[4200], tmp[4300];
-  snprintf(csv_path, sizeof csv_path, "%s/skin-membrane.csv", a->out_dir);
-  snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
-  FILE* csv = fopen(tmp, "w");
-  if (!csv) return tx_bad_input("--out %s: cannot write skin-membrane.csv", a->out_dir);
+  tx_aside out;
+  if (!tx_aside_begin(&out, a->out_dir, "skin-membrane.csv")) return tx_bad_input("--out %s", tx_error());
+  FILE* csv = out.f;
   fprintf(csv, "check,spacing_m,particles,substep_s,measured,exact,error,units\n");
 
   bool all = true;
@@ -67,7 +66,7 @@ int tx_study_skin_membrane(const tx_study_args* a) {
     for (int l = 0; l < nlevels; l++) {
       tx_membrane_result r;
       if (!tx_membrane_run(&mc, spacing[l], &r)) {
-        fclose(csv), remove(tmp), json_decref(checks), json_decref(levels);
+        tx_aside_drop(&out), json_decref(checks), json_decref(levels);
         return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
       }
       printf("  %10.3g %9d %10.3g %12.5f %12.5f %7.2f%% %8.2f\n", r.spacing * 1e3, r.particles, r.substep * 1e6,
@@ -100,7 +99,7 @@ int tx_study_skin_membrane(const tx_study_args* a) {
   for (int l = 0; l < nrupture; l++) {
     tx_membrane_rupture r;
     if (!tx_membrane_rupture_run(rspacing[l], &r)) {
-      fclose(csv), remove(tmp), json_decref(checks), json_decref(rup);
+      tx_aside_drop(&out), json_decref(checks), json_decref(rup);
       return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
     }
     change = l > 0 ? fabs(r.force - last) / last : NAN;
@@ -125,7 +124,7 @@ int tx_study_skin_membrane(const tx_study_args* a) {
   for (int l = 0; l < ngrav; l++) {
     tx_membrane_sag r;
     if (!tx_membrane_gravity_run(gres[l], &r)) {
-      fclose(csv), remove(tmp), json_decref(checks), json_decref(rup), json_decref(grav);
+      tx_aside_drop(&out), json_decref(checks), json_decref(rup), json_decref(grav);
       return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
     }
     printf("  %4d x %-3d %14.3f %16.3f\n", r.res, r.res, r.converged * 1e3, r.realtime * 1e3);
@@ -136,9 +135,9 @@ int tx_study_skin_membrane(const tx_study_args* a) {
   }
   printf("  the journal paper: about 10 mm (first contact at y = -1.0 cm with gravity, -0.1 cm without)\n\n");
 
-  if (fclose(csv) != 0 || rename(tmp, csv_path) != 0) {
-    remove(tmp), json_decref(checks), json_decref(rup), json_decref(grav);
-    return fprintf(stderr, "tactus: %s: cannot write\n", csv_path), 1;
+  if (!tx_aside_end(&out)) {
+    json_decref(checks), json_decref(rup), json_decref(grav);
+    return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   }
   json_t* doc = json_pack("{s:s,s:b,s:s,s:o,s:{s:o,s:b},s:o,s:b}", "study", "skin-membrane", "quick", quick, "solver",
                           "XPBD, substep with k w h^2 = 1/4, 4 iterations", "checks", checks, "rupture", "levels", rup,

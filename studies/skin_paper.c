@@ -24,6 +24,7 @@
 #include "../scenarios/command.h"
 #include "../controllers/haptics/device_scripted.h"
 #include "../scenarios/run.h"
+#include "../views/aside.h"
 #include "../views/plot.h"
 #include "../views/report.h"
 
@@ -107,16 +108,15 @@ static const tx_hand_motion* find_motion(const char* name) {
 
 static int write_motions(const char* dir) {
   for (size_t i = 0; i < sizeof motions / sizeof motions[0]; i++) {
-    char path[4300];
-    snprintf(path, sizeof path, "%s/%s.csv", dir, motions[i].name);
-    FILE* f = fopen(path, "w");
-    if (!f) return -1;
     const tx_hand_motion* m = tx_hand_motion_find(motions[i].table);
-    if (!m) return fclose(f), -1;
-    fprintf(f, "t_s,x_m,y_m,z_m\n");
+    char name[96];
+    snprintf(name, sizeof name, "%s.csv", motions[i].name);
+    tx_aside o;
+    if (!m || !tx_aside_begin(&o, dir, name)) return -1;
+    fprintf(o.f, "t_s,x_m,y_m,z_m\n");
     for (int k = 0; k < m->count; k++)
-      fprintf(f, "%g,%g,%g,%g\n", m->t_pos[k][0], m->t_pos[k][1], m->t_pos[k][2], m->t_pos[k][3]);
-    if (fclose(f) != 0) return -1;
+      fprintf(o.f, "%g,%g,%g,%g\n", m->t_pos[k][0], m->t_pos[k][1], m->t_pos[k][2], m->t_pos[k][3]);
+    if (!tx_aside_end(&o)) return -1;
   }
   return 0;
 }
@@ -222,11 +222,11 @@ static void label_in_plot_unit(const char* in, char* out, size_t n) {
 // EXPERIMENT.csv and EXPERIMENT.png from the cases [first, last)
 static int write_experiment(const char* dir, const char* name, run_data* const runs[][NCASES], const char* const* modes,
                             int nmodes, int first, int last) {
-  char path[4300], tmp[4400];
-  snprintf(path, sizeof path, "%s/%s.csv", dir, name);
-  snprintf(tmp, sizeof tmp, "%s.tmp", path);
-  FILE* f = fopen(tmp, "w");
-  if (!f) return tx_set_error("%s: cannot be written", path), -1;
+  char path[4300], file[96];
+  snprintf(file, sizeof file, "%s.csv", name);
+  tx_aside o;
+  if (!tx_aside_begin(&o, dir, file)) return -1;
+  FILE* f = o.f;
   fprintf(f, "mode,case,t_s,x_m,y_m,z_m,fx_n,fy_n,fz_n,contacts,pierced,torn\n");
   for (int m = 0; m < nmodes; m++)
     for (int c = first; c < last; c++) {
@@ -236,7 +236,7 @@ static int write_experiment(const char* dir, const char* name, run_data* const r
                 d->pos[0][i], d->pos[1][i], d->pos[2][i], d->f[0][i], d->f[1][i], d->f[2][i], d->contacts[i],
                 d->pierced[i], d->torn[i]);
     }
-  if (fclose(f) != 0 || rename(tmp, path) != 0) return remove(tmp), tx_set_error("%s: cannot be written", path), -1;
+  if (!tx_aside_end(&o)) return -1;
   // force against position: along y for piercing; for sliding the tangential force along the slide
   // with two modes each case is drawn twice, its label led by the mode
   tx_plot_series s[8];
@@ -502,12 +502,11 @@ int tx_study_skin_paper(const tx_study_args* a) {
     for (int f = 0; f < NFINDINGS; f++) from[f] = holds_from(&findings[f], holds[f], ran, depends);
   }
   if (!rc) { // one row per case and mode: skin-paper.csv and .json; one per finding: skin-paper-findings.csv
-    char path[4300], tmp[4400];
-    snprintf(path, sizeof path, "%s/skin-paper.csv", a->out_dir);
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE* f = fopen(tmp, "w");
+    tx_aside o;
+    FILE* f = tx_aside_begin(&o, a->out_dir, "skin-paper.csv") ? o.f : NULL;
     json_t* list = json_array();
-    if (!f || !list) return fprintf(stderr, "tactus: %s: cannot be written\n", path), 1;
+    if (!f || !list)
+      return tx_aside_drop(&o), json_decref(list), fprintf(stderr, "tactus: %s\n", f ? "out of memory" : tx_error()), 1;
     fprintf(f, "mode,experiment,case,rays,radius_m,thickness_m,spacing_m,gravity,sample_hold,contact_y_m,peak_force_n,"
                "rupture_y_m,r2,slope_n_m,zero_after_rupture_s,max_step_n,roughness,tangent_mean_n,tangent_cv\n");
     for (int k = 0; k < nmodes; k++)
@@ -531,13 +530,13 @@ int tx_study_skin_paper(const tx_study_args* a) {
           if (isfinite(nums[q].v)) json_object_set_new(row, nums[q].k, json_real(nums[q].v));
         json_array_append_new(list, row);
       }
-    if (fclose(f) != 0 || rename(tmp, path) != 0) return remove(tmp), json_decref(list), fprintf(stderr, "tactus: %s: cannot be written\n", path), 1;
+    if (!tx_aside_end(&o)) return json_decref(list), fprintf(stderr, "tactus: %s\n", tx_error()), 1;
     // the findings: one row each, a column per mode
-    snprintf(path, sizeof path, "%s/skin-paper-findings.csv", a->out_dir);
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    f = fopen(tmp, "w");
+    f = tx_aside_begin(&o, a->out_dir, "skin-paper-findings.csv") ? o.f : NULL;
     json_t* flist = json_array();
-    if (!f || !flist) return json_decref(list), fprintf(stderr, "tactus: %s: cannot be written\n", path), 1;
+    if (!f || !flist)
+      return tx_aside_drop(&o), json_decref(list), json_decref(flist),
+             fprintf(stderr, "tactus: %s\n", f ? "out of memory" : tx_error()), 1;
     fprintf(f, "finding,counted,holds_paper,holds_mechanics,holds_from,measured_paper,measured_mechanics\n");
     for (int i = 0; i < NFINDINGS; i++) {
       json_t* holds_o = json_object();
@@ -553,8 +552,7 @@ int tx_study_skin_paper(const tx_study_args* a) {
                                              findings[i].what, "counted", findings[i].counted, "holds", holds_o,
                                              "holds_from", from[i], "measured", meas_o));
     }
-    if (fclose(f) != 0 || rename(tmp, path) != 0)
-      return remove(tmp), json_decref(list), json_decref(flist), fprintf(stderr, "tactus: %s: cannot be written\n", path), 1;
+    if (!tx_aside_end(&o)) return json_decref(list), json_decref(flist), fprintf(stderr, "tactus: %s\n", tx_error()), 1;
     json_t* probe = json_object();
     for (int k = 0; k < nmodes; k++) json_object_set_new(probe, modes[k], isfinite(change[k]) ? json_real(change[k]) : json_null());
     json_t* mlist = json_array();

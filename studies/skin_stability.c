@@ -14,6 +14,7 @@
 
 #include "../model/error.h"
 #include "../scenarios/command.h"
+#include "../views/aside.h"
 #include "../views/report.h"
 
 #include <tactus/components.h>
@@ -150,15 +151,16 @@ static const motion* find_motion(const char* name) {
   return NULL;
 }
 
-static int write_motion(const motion* m, const char* path) {
-  char tmp[4300];
-  snprintf(tmp, sizeof tmp, "%s.tmp", path);
-  FILE* f = fopen(tmp, "w");
-  if (!f) return -1;
-  fprintf(f, "# t_s, x_m, y_m, z_m: the %s motion of tactus study skin-stability\n", m->name);
-  for (int i = 0; i < m->n; i++) fprintf(f, "%.6f,%.6f,%.6f,%.6f\n", m->w[i][0], m->w[i][1], m->w[i][2], m->w[i][3]);
-  if (fclose(f) != 0 || rename(tmp, path) != 0) return remove(tmp), -1;
-  return 0;
+// the motion as DIR/motion-NAME.csv, its path into path; -1: tx_error() says why
+static int write_motion(const motion* m, const char* dir, char* path, size_t size) {
+  char name[96];
+  snprintf(name, sizeof name, "motion-%s.csv", m->name);
+  tx_aside o;
+  if (!tx_aside_begin(&o, dir, name)) return -1;
+  fprintf(o.f, "# t_s, x_m, y_m, z_m: the %s motion of tactus study skin-stability\n", m->name);
+  for (int i = 0; i < m->n; i++) fprintf(o.f, "%.6f,%.6f,%.6f,%.6f\n", m->w[i][0], m->w[i][1], m->w[i][2], m->w[i][3]);
+  snprintf(path, size, "%s", o.path);
+  return tx_aside_end(&o) ? 0 : -1;
 }
 
 static double result(tx_system* s, const char* key) {
@@ -172,8 +174,7 @@ int tx_skin_stability_run(const tx_skin_stability_case* c, const char* dir, tx_s
   const motion* m = find_motion(c->motion);
   if (!m) return tx_set_error("skin-stability: no motion '%s'", c->motion), -1;
   char path[4200];
-  snprintf(path, sizeof path, "%s/motion-%s.csv", dir, m->name);
-  if (write_motion(m, path)) return tx_set_error("%s: cannot be written", path), -1;
+  if (write_motion(m, dir, path, sizeof path)) return -1;
   if (!tx_find_controller(guard_class.type)) tx_register_controller(&guard_class);
 
   // the scenario, built as JSON so that any folder name is quoted right
@@ -245,19 +246,16 @@ int tx_study_skin_stability(const tx_study_args* a) {
   printf("  %-26s %6s %6s %6s %5s %10s %11s %8s  %-9s\n", "case", "steps", "faults", "torn", "NaN", "max |F| N",
          "max |F0| N", "clamped", "outcome");
   json_t* list = json_array();
-  char csv_path[4200], tmp[4300];
-  snprintf(csv_path, sizeof csv_path, "%s/skin-stability.csv", a->out_dir);
-  snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
-  FILE* csv = fopen(tmp, "w");
-  if (!csv) return json_decref(list), tx_bad_input("--out %s: cannot write skin-stability.csv", a->out_dir);
+  tx_aside out;
+  if (!tx_aside_begin(&out, a->out_dir, "skin-stability.csv")) return json_decref(list), tx_bad_input("--out %s", tx_error());
+  FILE* csv = out.f;
   fprintf(csv, "case,motion,stiffness_factor,rate_hz,substep_s,thickness_m,max_speed_m_s,skin_steps,faults,torn_links,nan_values,"
                "max_device_force_n,max_model_force_n,force_clamped,outcome\n");
   int failed = 0;
   for (int i = 0; i < n; i++) {
     tx_skin_stability_row r;
     if (tx_skin_stability_run(&cs[i], a->out_dir, &r)) {
-      fclose(csv);
-      remove(tmp);
+      tx_aside_drop(&out);
       json_decref(list);
       return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
     }
@@ -275,10 +273,9 @@ int tx_study_skin_stability(const tx_study_args* a) {
                         r.max_force, "max_model_force_n", r.max_model_force, "force_clamped", (json_int_t)r.clamped,
                         "outcome", r.outcome, "warnings", r.warnings));
   }
-  if (fclose(csv) != 0 || rename(tmp, csv_path) != 0) {
-    remove(tmp);
+  if (!tx_aside_end(&out)) {
     json_decref(list);
-    return fprintf(stderr, "tactus: %s: cannot be written\n", csv_path), 1;
+    return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   }
   json_t* doc = json_pack("{s:s,s:f,s:s,s:o}", "study", "skin-stability", "clamp_n", TX_SKIN_STABILITY_CLAMP_N,
                           "units", "stiffness as a factor on 2000 N/m stretch and 20 N/m bend; s, m, N", "cases", list);

@@ -16,6 +16,7 @@
 #include "../scenarios/loader.h"
 #include "../scenarios/run.h"
 #include "../model/error.h"
+#include "../views/aside.h"
 #include "../views/plot.h"
 #include "../views/report.h"
 
@@ -88,10 +89,8 @@ static double rel_error(double v, double ref) { return isfinite(v) && isfinite(r
 
 static int write_outputs(const char* dir, const level_run* r, int n, bool quick) {
   const level_run* ref = &r[n - 1];
-  char path[4200], tmp[4300];
-  snprintf(path, sizeof path, "%s/suturing-accuracy.csv", dir);
-  snprintf(tmp, sizeof tmp, "%s.tmp", path);
-  FILE* f = fopen(tmp, "w");
+  tx_aside o;
+  FILE* f = tx_aside_begin(&o, dir, "suturing-accuracy.csv") ? o.f : NULL;
   if (f) {
     fprintf(f, "spacing_m,thread_nodes,cpu_s,steps_done,steps");
     for (int q = 0; q < QUANTITIES; q++) fprintf(f, ",%s,%s_rel_error", key[q], key[q]);
@@ -102,8 +101,7 @@ static int write_outputs(const char* dir, const level_run* r, int n, bool quick)
       fprintf(f, "\n");
     }
   }
-  if (!f || fclose(f) != 0 || rename(tmp, path) != 0)
-    return remove(tmp), fprintf(stderr, "tactus: %s: cannot be written\n", path), 1;
+  if (!f || !tx_aside_end(&o)) return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   json_t* rows = json_array();
   for (int k = 0; k < n && rows; k++) {
     json_t* row = json_pack("{s:f,s:i,s:f,s:i,s:s}", "spacing_m", spacing_m[k], "thread_nodes", thread_nodes[k], "cpu_s",

@@ -17,6 +17,7 @@
 #include "../scenarios/loader.h"
 #include "../scenarios/run.h"
 #include "../model/error.h"
+#include "../views/aside.h"
 #include "../views/plot.h"
 #include "../views/report.h"
 
@@ -182,18 +183,15 @@ static int run_case(const char* scenario, const char* dir, int k, double duratio
 }
 
 static int write_outputs(const char* dir, const outcome* o, const int* which, int n, bool quick) {
-  char path[4200], tmp[4300];
-  snprintf(path, sizeof path, "%s/suturing-stability.csv", dir);
-  snprintf(tmp, sizeof tmp, "%s.tmp", path);
-  FILE* f = fopen(tmp, "w");
+  tx_aside out;
+  FILE* f = tx_aside_begin(&out, dir, "suturing-stability.csv") ? out.f : NULL;
   if (f) {
     fprintf(f, "case,completed,faults_recovered,non_finite,force_max_n,clamp_n,steps_done,steps,pass\n");
     for (int i = 0; i < n; i++)
       fprintf(f, "%s,%d,%d,%d,%.6g,%.6g,%d,%s,%d\n", cases[which[i]].name, o[i].rc == 0, o[i].faults, o[i].non_finite,
               o[i].force_max, o[i].clamp, o[i].steps_done, o[i].done, o[i].pass);
   }
-  if (!f || fclose(f) != 0 || rename(tmp, path) != 0)
-    return remove(tmp), fprintf(stderr, "tactus: %s: cannot be written\n", path), 1;
+  if (!f || !tx_aside_end(&out)) return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   json_t* rows = json_array();
   for (int i = 0; i < n && rows; i++)
     json_array_append_new(rows, json_pack("{s:s,s:b,s:i,s:i,s:f,s:f,s:i,s:s,s:b}", "case", cases[which[i]].name,

@@ -16,6 +16,7 @@
 
 #include "../controllers/thread/thread.h"
 #include "../scenarios/command.h"
+#include "../views/aside.h"
 #include "../views/plot.h"
 #include "../views/report.h"
 
@@ -126,18 +127,15 @@ static double ftl_length_error(void) {
 }
 
 static int write_outputs(const char* dir, const acc_row* rows, int n, double ftl_err, bool quick) {
-  char path[4200], tmp[4300];
-  snprintf(path, sizeof path, "%s/thread-accuracy.csv", dir);
-  snprintf(tmp, sizeof tmp, "%s.tmp", path);
-  FILE* f = fopen(tmp, "w");
+  tx_aside o;
+  FILE* f = tx_aside_begin(&o, dir, "thread-accuracy.csv") ? o.f : NULL;
   if (f) {
     fprintf(f, "sweep,nodes,iterations,time_step_s,error_of_sag,cpu_s_per_sim_s,max_strain\n");
     for (int i = 0; i < n; i++)
       fprintf(f, "%s,%d,%d,%.9g,%.6g,%.6g,%.6g\n", rows[i].sweep, rows[i].nodes, rows[i].iterations, rows[i].dt,
               rows[i].error, rows[i].cpu, rows[i].strain);
   }
-  if (!f || fclose(f) != 0 || rename(tmp, path) != 0)
-    return remove(tmp), fprintf(stderr, "tactus: %s: cannot be written\n", path), 1;
+  if (!f || !tx_aside_end(&o)) return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   json_t* list = json_array();
   for (int i = 0; i < n && list; i++)
     json_array_append_new(list, json_pack("{s:s,s:i,s:i,s:f,s:f,s:f,s:f}", "sweep", rows[i].sweep, "nodes",

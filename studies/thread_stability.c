@@ -18,6 +18,7 @@
 #include "../controllers/thread/knot.h"
 #include "../controllers/thread/thread.h"
 #include "../scenarios/command.h"
+#include "../views/aside.h"
 #include "../views/plot.h"
 #include "../views/report.h"
 
@@ -229,10 +230,9 @@ int tx_study_thread_stability(const tx_study_args* a) {
     }
   printf("\n%s\n", all ? "every case ends stable: no NaN, the force within the clamp, the length kept" : "some case is UNSTABLE");
   // outputs
-  char path[4200], tmp[4300];
-  snprintf(path, sizeof path, "%s/thread-stability.csv", a->out_dir);
-  snprintf(tmp, sizeof tmp, "%s.tmp", path);
-  FILE* f = fopen(tmp, "w");
+  char path[4200];
+  tx_aside o;
+  FILE* f = tx_aside_begin(&o, a->out_dir, "thread-stability.csv") ? o.f : NULL;
   if (f) {
     fprintf(f, "case,model,time_step_s,max_force_n,max_strain,end_strain,faults,retries,finite,stable\n");
     for (int i = 0; i < n; i++)
@@ -240,8 +240,7 @@ int tx_study_thread_stability(const tx_study_args* a) {
               cases[i].max_force, cases[i].max_strain, cases[i].end_strain, cases[i].faults, cases[i].retries,
               cases[i].finite, cases[i].stable);
   }
-  if (!f || fclose(f) != 0 || rename(tmp, path) != 0)
-    return remove(tmp), fprintf(stderr, "tactus: %s: cannot be written\n", path), 1;
+  if (!f || !tx_aside_end(&o)) return fprintf(stderr, "tactus: %s\n", tx_error()), 1;
   json_t* list = json_array();
   for (int i = 0; i < n && list; i++)
     json_array_append_new(list, json_pack("{s:s,s:s,s:f,s:f,s:f,s:f,s:i,s:i,s:b,s:b,s:f,s:f,s:f,s:s}", "case", cases[i].name, "model",
