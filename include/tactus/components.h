@@ -175,7 +175,7 @@ TX_LAYOUT_ASSERT(tx_torn, int32_t);
 // studies that resolve where the skin tore between steps
 typedef struct tx_skin_rupture {
   double tension; // N/m, the largest averaged membrane tension the step's rupture checks found
-  double broke;   // 1 when a link tore in the step, else 0
+  double broke;   // 1 when a link tore in the step within the HIP's reach, else 0 (a pull's tear: skin.torn)
   double at[3];   // m, the HIP centre where the criterion was first met in the step: between the
                   // substep before the tear and the tear's, linear in the tension (0 when broke is 0)
 } tx_skin_rupture;

@@ -227,9 +227,11 @@ double tx_cloth_membrane_tension(const tx_cloth* c, int i);
 // (N/m): at the particle whose own links carry the most in each substep, and
 // at every particle whose links could reach rupture_tension; 0 without rupture
 double tx_cloth_peak_tension(const tx_cloth* c);
-// whether the last step tore a link; if so, at = the HIP centre where the
-// rupture criterion was first met in it: between the substep before the tear
-// and the tear's substep, linear in the peak membrane tension of their checks
+// whether the last step tore a link within the HIP's reach (a tear by a pull
+// elsewhere, tx_cloth_torn_pulled, does not count); if so, at = the HIP
+// centre where the rupture criterion was first met in it: between the
+// substep before the tear and the tear's, linear in the peak membrane
+// tension of their checks
 bool tx_cloth_broke_at(const tx_cloth* c, double at[3]);
 // faults found and recovered so far
 int tx_cloth_faults(const tx_cloth* c);

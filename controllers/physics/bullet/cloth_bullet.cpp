@@ -1929,7 +1929,7 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
   for (int s = 0; s < substeps; s++) {
     btVector3 h0 = start.lerp(end, (btScalar)s / (btScalar)substeps);
     btVector3 h1 = start.lerp(end, (btScalar)(s + 1) / (btScalar)substeps);
-    const int torn0 = c->torn;
+    const int torn0 = c->torn, pulled0 = c->torn_pulled;
     c->sub_peak = 0;
     if (c->detach_check) free_detached(c);
     predict(c, h);
@@ -1973,8 +1973,9 @@ extern "C" tx_cloth_status tx_cloth_step(tx_cloth* c, double dt) {
     }
     measure_links(c, h);
     rupture(c, nullptr);
-    if (c->torn > torn0 && !c->broke) {
-      // the criterion crossed between the last substep's check and this one's: where, linear in the tension
+    if (c->torn - torn0 > c->torn_pulled - pulled0 && !c->broke) {
+      // the HIP tore a link (not a pull beyond its reach, whose place the HIP's path does not tell): the
+      // criterion crossed between the last substep's check and this one's: where, linear in the tension
       const double tc = c->def.rupture_tension, d = c->sub_peak - c->prev_peak;
       double u = d > 0 ? (tc - c->prev_peak) / d : 1;
       u = u < 0 ? 0 : u > 1 ? 1 : u;

@@ -751,11 +751,14 @@ static void detached_piece_is_freed(void** state) {
     }
     assert_int_equal(tx_cloth_step(c, 1.0 / 60), TX_CLOTH_OK);
     assert_int_equal(tx_cloth_freed_count(c), 0); // the jaws hold it: not cut off
+    double at[3];
+    assert_false(tx_cloth_broke_at(c, at)); // torn by the pull, nowhere near a HIP: no HIP place to report
     if (x0[0][1] + 0.001 * (s + 1) > 0.03) break;
   }
   const int torn = tx_cloth_torn(c);
   print_message("  lifted 3 cm: %d links torn\n", torn);
   assert_true(torn > 0);
+  assert_int_equal(tx_cloth_torn_pulled(c), torn);
   for (int k = 0; k < 9; k++) assert_true(tx_cloth_unpin(c, block[k]));
   assert_int_equal(tx_cloth_step(c, 1.0 / 60), TX_CLOTH_OK);
   const int freed = tx_cloth_freed_count(c);
