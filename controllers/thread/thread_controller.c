@@ -74,6 +74,7 @@ typedef struct thread_ctl {
   tx_port punct_in;          // the puncture list (punct_in.id 0: none)
   double* punct;             // (max_punctures x 3) where they are this step, m
   tx_puncture* punct_rows;   // (max_punctures) their rows as read: the triangles the loads go on
+  double* side;              // (max_punctures) +1 entry, -1 exit, 0: each row's side, for the bites
   double* load_f;            // (max_punctures x 3) N, the thread's pull on the skin at each passed one
   double* load_k;            // (max_punctures) N/m, and its stiffness
   tx_port loads;             // written with punctures: PREFIX.puncture_loads (tx_puncture_load)
@@ -271,9 +272,10 @@ static int configure(tx_setup* s, void** self) {
   k->max_punct = d.max_punctures;
   k->punct = malloc(sizeof(double) * 3 * (size_t)(d.max_punctures + 1));
   k->punct_rows = malloc(sizeof(tx_puncture) * (size_t)(d.max_punctures + 1));
+  k->side = malloc(sizeof(double) * (size_t)(d.max_punctures + 1));
   k->load_f = malloc(sizeof(double) * 3 * (size_t)(d.max_punctures + 1));
   k->load_k = malloc(sizeof(double) * (size_t)(d.max_punctures + 1));
-  if (!k->punct || !k->punct_rows || !k->load_f || !k->load_k) return tx_setup_fail(s, NULL, "out of memory");
+  if (!k->punct || !k->punct_rows || !k->side || !k->load_f || !k->load_k) return tx_setup_fail(s, NULL, "out of memory");
   if (k->punct_in.id) {
     snprintf(name, sizeof name, "%s.puncture_loads", prefix);
     k->loads = tx_setup_write(s, &TX_COMPONENT_OF(name, tx_puncture_load, (uint32_t)d.max_punctures + 1));
@@ -573,7 +575,9 @@ static void take_punctures(tx_ctx* c, thread_ctl* k, tx_snapshot sx) {
     }
     k->punct_rows[n++] = *q;
   }
-  if (tx_thread_set_punctures(k->t, k->punct, n) != TX_THREAD_OK) tx_warn(c, k->bad_puncture);
+  for (int j = 0; j < n; j++) k->side[j] = k->punct_rows[j].side > 0 ? 1 : k->punct_rows[j].side < 0 ? -1 : 0;
+  if (tx_thread_set_punctures(k->t, k->punct, n) != TX_THREAD_OK || tx_thread_set_puncture_sides(k->t, k->side, n) != TX_THREAD_OK)
+    tx_warn(c, k->bad_puncture);
 }
 
 // the first shape: start_shape's rows when set (waiting for its first
@@ -703,6 +707,7 @@ static void fini(void* self) {
   free(k->shapes);
   free(k->punct);
   free(k->punct_rows);
+  free(k->side);
   free(k->load_f);
   free(k->load_k);
   free(k);

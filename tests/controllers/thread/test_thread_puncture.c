@@ -1,6 +1,7 @@
 // Punctures: the thread, pulled by its head, passes in order through two
 // points that move (a skin that breathes), slides through them and never
-// leaves one (each within r of the thread at every step), in both models;
+// leaves one (each within r of the thread at every step), in both models; a
+// bite (an entry, then an exit) runs through the tissue, not under the skin;
 // friction through a puncture adds to the force on the hand; bad lists are
 // refused; stepping with punctures never allocates.
 #include <stdarg.h>
@@ -9,6 +10,7 @@
 #include <cmocka.h>
 
 #include "tests/alloc_count.h"
+#include "controllers/physics/skin_grid.h"
 #include "controllers/thread/thread.h"
 #include "model/error.h"
 
@@ -283,6 +285,13 @@ static void test_bad_puncture_lists(void** state) {
   assert_non_null(strstr(tx_error(), "puncture"));
   assert_int_equal(tx_thread_punctures_passed(t), 0);
   assert_true(tx_thread_puncture_arc(t, 0) == -1);
+  double side[3] = {1, 2, -1};
+  assert_int_equal(tx_thread_set_puncture_sides(t, side, 2), TX_THREAD_BAD);
+  assert_non_null(strstr(tx_error(), "side"));
+  assert_int_equal(tx_thread_set_puncture_sides(t, side, 3), TX_THREAD_BAD);
+  assert_non_null(strstr(tx_error(), "max_punctures"));
+  side[1] = -1;
+  assert_int_equal(tx_thread_set_puncture_sides(t, side, 2), TX_THREAD_OK);
   tx_thread_destroy(t);
   d = tx_thread_def_default();
   d.puncture_friction = -1;
@@ -294,6 +303,80 @@ static void test_bad_puncture_lists(void** state) {
   assert_non_null(strstr(tx_error(), "puncture_capture"));
 }
 
+// A bite: a 2 x 2 cm skin patch at y = 0, 1 mm thick; the head goes down
+// through an entry at x = -8 mm, along the sheet's mid-plane, and up through
+// an exit at x = +8 mm, then up 15 mm, drawing taut a limp 6 cm rod whose
+// tail is pinned 3 cm above the entry (laid in a zigzag). With the
+// punctures' sides given (+1 in, -1 out), the strand between them runs
+// through the tissue: straight from point to point, inside the sheet's
+// thickness, within the stretch cap. Without them (the control), the skin's
+// contact holds that strand out of the sheet, half its thickness plus the
+// thread's radius (0.75 mm) from the mid-plane, and the taut thread is
+// stretched past its cap (0.075).
+typedef struct bite_result {
+  double off;    // m, the largest |y| of a node between the punctures (|x| < 3 mm)
+  double strain; // the largest link strain at the end
+} bite_result;
+
+static bite_result bite(bool sides) {
+  float px[21 * 21 * 3];
+  int32_t tri[2 * 20 * 20 * 3];
+  uint32_t ntri = tx_skin_grid(21, 21, 0.001, 0.001, (double[3]){0, 0, 0}, px, tri);
+  tx_thread_def d = tx_thread_def_default();
+  d.model = TX_THREAD_ROD;
+  d.nodes = 61;
+  d.length = 0.06; // l0 = 1 mm
+  d.gravity = 0;
+  d.damping = 5;
+  d.pin_tail = true;
+  d.bend_factor = 0; // limp: drawn taut, a bite runs straight from point to point
+  d.max_triangles = (int)ntri;
+  tx_thread* t = tx_thread_create(&d);
+  assert_non_null(t);
+  assert_int_equal(tx_thread_set_mesh(t, px, 21 * 21, tri, ntri, 0.001), TX_THREAD_OK);
+  double x[61 * 3], P[6] = {-0.008, 0, 0, 0.008, 0, 0}, side[2] = {1, -1};
+  for (int i = 0; i < 61; i++) { // up from (-8, 0.5) mm in links at 60 degrees, turning every 5
+    int leg = i / 5, in = i % 5;
+    double dx = 0.001 * sin(PI / 3) * (leg % 2 ? 5 - in : in);
+    x[3 * i] = -0.008 - dx, x[3 * i + 1] = 0.0005 + 0.0005 * i, x[3 * i + 2] = 0;
+  }
+  assert_int_equal(tx_thread_set_positions(t, x), TX_THREAD_OK);
+  assert_int_equal(tx_thread_set_punctures(t, P, 2), TX_THREAD_OK);
+  if (sides) assert_int_equal(tx_thread_set_puncture_sides(t, side, 2), TX_THREAD_OK);
+  // the head's path: down 0.5 mm, along 16 mm, up 15 mm (1 mm a step), then held
+  double path[4][3] = {{-0.008, 0.0005, 0}, {-0.008, 0, 0}, {0.008, 0, 0}, {0.008, 0.015, 0}};
+  for (int leg = 0; leg < 3; leg++) {
+    double len = fabs(path[leg + 1][0] - path[leg][0]) + fabs(path[leg + 1][1] - path[leg][1]);
+    int steps = (int)ceil(len / 0.001);
+    for (int k = 1; k <= steps; k++) {
+      double h[3];
+      for (int a = 0; a < 3; a++) h[a] = path[leg][a] + (path[leg + 1][a] - path[leg][a]) * k / steps;
+      assert_int_equal(tx_thread_set_head(t, h), TX_THREAD_OK);
+      assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
+    }
+  }
+  for (int k = 0; k < 200; k++) assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
+  assert_int_equal(tx_thread_punctures_passed(t), 2);
+  bite_result r = {0, tx_thread_max_strain(t)};
+  for (int i = 0; i < 61; i++) {
+    const double* p = tx_thread_position(t, i);
+    if (fabs(p[0]) < 0.004) r.off = fmax(r.off, fabs(p[1]));
+  }
+  tx_thread_destroy(t);
+  return r;
+}
+
+static void test_a_bite_runs_through_the_tissue(void** state) {
+  (void)state;
+  bite_result with = bite(true), without = bite(false);
+  print_message("bite, sides given: strand %.3f mm off the mid-plane, strain %.4f; not given: %.3f mm, strain %.4f\n",
+                with.off * 1e3, with.strain, without.off * 1e3, without.strain);
+  assert_true(with.off < 0.0005);               // inside the sheet (0.37 mm: the entry's corner lies lower)
+  assert_true(with.strain <= 0.05 + 1e-6);      // the cap
+  assert_true(without.off > 0.0007);            // held out of it
+  assert_true(without.strain > 0.06);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_slides_through_two_moving_punctures),
@@ -301,6 +384,7 @@ int main(void) {
       cmocka_unit_test(test_friction_raises_the_head_force),
       cmocka_unit_test(test_a_pulled_rod_slides_through_a_firm_puncture),
       cmocka_unit_test(test_a_thread_pulled_through_to_its_end_leaves_the_puncture),
+      cmocka_unit_test(test_a_bite_runs_through_the_tissue),
       cmocka_unit_test(test_bad_puncture_lists),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -6,13 +6,16 @@
 # 3 cm of tail is left (B), then carry it 1.5 times round the closed needle
 # holder's jaws 20 mm out. The loop lacks the thread the wrap takes up: the
 # stitch holds the thread only until it is pulled (thread.md, "Passing
-# through punctures"), so the wrap draws the tail back out through the
-# stitch's entry and the thread never winds round the jaws: C is not
-# scored.
+# through punctures"), so the wrap draws the tail back through the stitch
+# to its end at the entry (out of it, or its last node there: the run is
+# chaotic) and the thread never winds round the jaws: C is not scored.
 # (Before, the stitch held the thread whatever pulled it, and a link
-# through it stretched to 5.4 times its length: C was scored on that.)
-# Checked: A and B done, C not, the thread out of the entry, the rod
-# within a strain of 0.6 (the skin's contact stretches the strand under it), no fault.
+# through it stretched to 5.4 times its length: C was scored on that; then
+# the skin's contact, solved after the stretch cap, held the bite's strand
+# under the skin and stretched it by 0.54.)
+# Checked: A and B done, C not, the rod within a strain of 0.12 (0.09: the
+# cap is 0.05, and the skin's and the jaws' contacts have the last turn),
+# no fault.
 # Release only (26.5 s simulated, about 14 s).
 #
 #   instrument_tie.sh TACTUS
@@ -39,8 +42,7 @@ def check(ok, what):
         sys.exit("instrument_tie: " + what)
 check(all(status[k] == "done" for k in "AB"), "A, B: %s" % status)
 check(status["C"] == "under way", "C %s: a wrap that pulls the tail out is scored" % status["C"])
-check(r["thread.punctures_out"] == 1, "the tail not pulled out of the entry: %r" % r["thread.punctures_out"])
-check(r["thread.max_strain"] <= 0.6, "max strain %.2f" % r["thread.max_strain"])
+check(r["thread.max_strain"] <= 0.12, "max strain %.2f" % r["thread.max_strain"])
 check(r["thread.faults"] == 0 and r["skin.faults"] == 0, "a fault")
 check(r["thread.capsule_contact_steps"] > 0 and r["instruments.thread_grasps"] == 0, "the thread is not on the holder: %r" % r)
 PY
