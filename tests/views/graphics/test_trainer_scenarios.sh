@@ -11,12 +11,14 @@
 set -u
 TACTUS=$(realpath "$1")
 command -v xvfb-run >/dev/null || { echo "xvfb-run is not installed: skipped"; exit 77; }
+. "$(dirname "$(realpath "$0")")/xvfb_lib.sh" || exit 1
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 unset TACTUS_SCENARIO_PATH
 failures=0
 for sc in haptics-wall suturing-skin; do
-  if ! timeout -k 5 60 xvfb-run -a "$TACTUS" run "$sc" --view window --quiet --out "$WORK/$sc" --duration 2 \
+  xvfb_next
+  if ! timeout -k 5 60 xvfb-run -a -n "$xvfb_display" "$TACTUS" run "$sc" --view window --quiet --out "$WORK/$sc" --duration 2 \
       >"$WORK/$sc.log" 2>&1; then
     echo "FAIL: $sc in a window: $(tail -n 3 "$WORK/$sc.log")" >&2
     failures=$((failures + 1))

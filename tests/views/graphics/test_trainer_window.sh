@@ -17,6 +17,7 @@ TACTUS=$(realpath "$1")
 PROBE=$(realpath "$2")
 SHOTS=${3:-}
 command -v xvfb-run >/dev/null || { echo "xvfb-run is not installed: skipped"; exit 77; }
+. "$(dirname "$(realpath "$0")")/xvfb_lib.sh" || exit 1
 command -v xdotool >/dev/null || { echo "xdotool is not installed: skipped"; exit 77; }
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
@@ -60,7 +61,8 @@ EOF
 window_run() { # OUT SCRIPT ARGS...
   local out=$1 script=$2
   shift 2
-  TACTUS="$TACTUS" timeout -k 5 90 xvfb-run -a -s "-screen 0 1280x1024x24" bash "$WORK/drive.sh" "$out" "$script" "$@"
+  xvfb_next
+  TACTUS="$TACTUS" timeout -k 5 90 xvfb-run -a -n "$xvfb_display" -s "-screen 0 1280x1024x24" bash "$WORK/drive.sh" "$out" "$script" "$@"
 }
 
 # 1. the controls, in a mono window of 640 x 480: the panel spans x 328..632, y 8..308;
@@ -186,7 +188,8 @@ wait $pid
 echo $? >"$out.rc" # tactus's own status: xvfb-run's can be that of its clean-up
 EOF
 pick_run() { # OUT XDOTOOL-ARGS...: the exit status of tactus in OUT.rc
-  TACTUS="$TACTUS" timeout -k 5 60 xvfb-run -a -s "-screen 0 1280x1024x24" bash "$WORK/pick.sh" "$@"
+  xvfb_next
+  TACTUS="$TACTUS" timeout -k 5 60 xvfb-run -a -n "$xvfb_display" -s "-screen 0 1280x1024x24" bash "$WORK/pick.sh" "$@"
 }
 pick_run "$WORK/picked" "type --delay 30 suturing-s" "key Return"
 if [ "$(cat "$WORK/picked.rc" 2>/dev/null)" != 0 ]; then

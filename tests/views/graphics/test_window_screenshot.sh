@@ -12,6 +12,7 @@ set -u
 TACTUS=$(realpath "$1")
 PROBE=$(realpath "$2")
 command -v xvfb-run >/dev/null || { echo "xvfb-run is not installed: skipped"; exit 77; }
+. "$(dirname "$(realpath "$0")")/xvfb_lib.sh" || exit 1
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 cd "$WORK" || exit 1
@@ -23,7 +24,8 @@ fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
 window_run() { # OUT ARGS...
   local out=$1
   shift
-  timeout -k 5 90 xvfb-run -a -s "-screen 0 1280x1024x24" "$TACTUS" run haptics-wall --view window --quiet \
+  xvfb_next
+  timeout -k 5 90 xvfb-run -a -n "$xvfb_display" -s "-screen 0 1280x1024x24" "$TACTUS" run haptics-wall --view window --quiet \
     --out "$out" "$@" >"$out.log" 2>&1
 }
 
