@@ -612,31 +612,23 @@ int tx_thread_nearest_link(const tx_thread* t, const double p[3], double at[3]) 
   return best;
 }
 
-tx_thread_status tx_thread_set_punctures(tx_thread* t, const double* p, int n) {
+tx_thread_status tx_thread_set_punctures(tx_thread* t, const double* p, const double* side, int n) {
   if (n < 0 || n > t->def.max_punctures) {
     tx_set_error("thread: %d punctures, must be in [0, %d] (max_punctures)", n, t->def.max_punctures);
     return TX_THREAD_BAD;
   }
-  for (int k = 0; k < n; k++)
+  for (int k = 0; k < n; k++) {
     if (check_point("puncture", p + 3 * k)) return TX_THREAD_BAD;
-  if (n) memcpy(t->punct, p, sizeof(double) * 3 * n);
-  t->npunct = n;
-  if (t->passed > n) t->passed = n; // a list that shrank: those past its end are gone
-  if (t->out > t->passed) t->out = t->passed;
-  return TX_THREAD_OK;
-}
-
-tx_thread_status tx_thread_set_puncture_sides(tx_thread* t, const double* side, int n) {
-  if (n < 0 || n > t->def.max_punctures) {
-    tx_set_error("thread: %d puncture sides, must be in [0, %d] (max_punctures)", n, t->def.max_punctures);
-    return TX_THREAD_BAD;
-  }
-  for (int k = 0; k < n; k++)
-    if (side[k] != 1 && side[k] != -1 && side[k] != 0) {
+    if (side && side[k] != 1 && side[k] != -1 && side[k] != 0) {
       tx_set_error("thread: puncture %d's side is %g, must be +1 (entry), -1 (exit) or 0", k, side[k]);
       return TX_THREAD_BAD;
     }
-  for (int k = 0; k <= t->def.max_punctures; k++) t->pside[k] = (int8_t)(k < n ? side[k] : 0);
+  }
+  if (n) memcpy(t->punct, p, sizeof(double) * 3 * n);
+  for (int k = 0; k <= t->def.max_punctures; k++) t->pside[k] = (int8_t)(side && k < n ? side[k] : 0);
+  t->npunct = n;
+  if (t->passed > n) t->passed = n; // a list that shrank: those past its end are gone
+  if (t->out > t->passed) t->out = t->passed;
   return TX_THREAD_OK;
 }
 

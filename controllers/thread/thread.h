@@ -208,12 +208,11 @@ int tx_thread_head_piece_end(const tx_thread* t);
 // about it through the point, without friction). The
 // skin's contacts are left out near a passed puncture. Points move between
 // steps (a skin that moves); a shorter list forgets those past its end.
-tx_thread_status tx_thread_set_punctures(tx_thread* t, const double* p, int n);
-// which way the needle went through each puncture (+1: in, -1: out, 0: not
-// said; tx_puncture's side), in the same order: the strand from an entry to
-// the exit passed after it is a bite, inside the tissue, and has no skin
-// contact (the sheet is the skin's mid-surface, not a floor it runs under)
-tx_thread_status tx_thread_set_puncture_sides(tx_thread* t, const double* side, int n);
+// side (n, or NULL: not said): which way the needle went through each (+1:
+// in, -1: out, 0: not said; tx_puncture's side): the strand from an entry
+// to the exit passed after it is a bite, inside the tissue, and has no skin
+// contact either (the sheet is the skin's mid-surface, not a floor it runs under)
+tx_thread_status tx_thread_set_punctures(tx_thread* t, const double* p, const double* side, int n);
 int tx_thread_punctures_passed(const tx_thread* t); // how many the head has passed (the thread runs through those after the first tx_thread_punctures_out)
 // the material coordinate (m from the head, at rest) of the thread's point
 // at passed puncture k; -1 when k is not passed or pulled out of. It grows as the thread is pulled through.

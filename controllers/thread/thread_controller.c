@@ -74,7 +74,7 @@ typedef struct thread_ctl {
   tx_port punct_in;          // the puncture list (punct_in.id 0: none)
   double* punct;             // (max_punctures x 3) where they are this step, m
   tx_puncture* punct_rows;   // (max_punctures) their rows as read: the triangles the loads go on
-  double* side;              // (max_punctures) +1 entry, -1 exit, 0: each row's side, for the bites
+  double* side;              // (max_punctures) each row's side (+1 entry, -1 exit), for the bites
   double* load_f;            // (max_punctures x 3) N, the thread's pull on the skin at each passed one
   double* load_k;            // (max_punctures) N/m, and its stiffness
   tx_port loads;             // written with punctures: PREFIX.puncture_loads (tx_puncture_load)
@@ -573,11 +573,10 @@ static void take_punctures(tx_ctx* c, thread_ctl* k, tx_snapshot sx) {
       for (int j = 0; j < 3; j++) p += q->bary[j] * vx[v[j]].x[a];
       k->punct[3 * n + a] = p;
     }
+    k->side[n] = q->side;
     k->punct_rows[n++] = *q;
   }
-  for (int j = 0; j < n; j++) k->side[j] = k->punct_rows[j].side > 0 ? 1 : k->punct_rows[j].side < 0 ? -1 : 0;
-  if (tx_thread_set_punctures(k->t, k->punct, n) != TX_THREAD_OK || tx_thread_set_puncture_sides(k->t, k->side, n) != TX_THREAD_OK)
-    tx_warn(c, k->bad_puncture);
+  if (tx_thread_set_punctures(k->t, k->punct, k->side, n) != TX_THREAD_OK) tx_warn(c, k->bad_puncture);
 }
 
 // the first shape: start_shape's rows when set (waiting for its first

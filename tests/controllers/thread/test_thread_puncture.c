@@ -79,7 +79,7 @@ static drag_result drag(tx_thread_model model, double friction, bool count, bool
     double time = k * 1e-3, p[6], h[3];
     puncture_points(time, p);
     head_at(time, h, straight);
-    assert_int_equal(tx_thread_set_punctures(t, p, 2), TX_THREAD_OK);
+    assert_int_equal(tx_thread_set_punctures(t, p, NULL, 2), TX_THREAD_OK);
     assert_int_equal(tx_thread_set_head(t, h), TX_THREAD_OK);
     assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
     r.strain = fmax(r.strain, tx_thread_max_strain(t));
@@ -142,7 +142,7 @@ static void pull_through(tx_thread* t, const double P[3], double depth, int step
     double a = fmin(1, time / 0.1), b = fmin(1, fmax(0, (time - 0.1) / 0.1));
     for (int c = 0; c < 3; c++) h[c] = a * P[c];
     h[1] -= b * depth;
-    assert_int_equal(tx_thread_set_punctures(t, P, 1), TX_THREAD_OK);
+    assert_int_equal(tx_thread_set_punctures(t, P, NULL, 1), TX_THREAD_OK);
     assert_int_equal(tx_thread_set_head(t, h), TX_THREAD_OK);
     assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
   }
@@ -249,7 +249,7 @@ static void test_a_thread_pulled_through_to_its_end_leaves_the_puncture(void** s
     double strain = 0;
     for (int k = 1; k <= 400; k++) {
       double h[3] = {0.1 * k * 1e-3, 0, 0};
-      assert_int_equal(tx_thread_set_punctures(t, P, 1), TX_THREAD_OK);
+      assert_int_equal(tx_thread_set_punctures(t, P, NULL, 1), TX_THREAD_OK);
       assert_int_equal(tx_thread_set_head(t, h), TX_THREAD_OK);
       assert_int_equal(tx_thread_step(t, 1e-3), TX_THREAD_OK);
       if (passed_at < 0 && tx_thread_punctures_passed(t) == 1) passed_at = k;
@@ -278,20 +278,21 @@ static void test_bad_puncture_lists(void** state) {
   tx_thread* t = tx_thread_create(&d);
   assert_non_null(t);
   double p[9] = {0, 0, 0, 0.01, 0, 0, 0.02, 0, 0};
-  assert_int_equal(tx_thread_set_punctures(t, p, 3), TX_THREAD_BAD);
+  assert_int_equal(tx_thread_set_punctures(t, p, NULL, 3), TX_THREAD_BAD);
   assert_non_null(strstr(tx_error(), "max_punctures"));
   p[4] = NAN;
-  assert_int_equal(tx_thread_set_punctures(t, p, 2), TX_THREAD_BAD);
+  assert_int_equal(tx_thread_set_punctures(t, p, NULL, 2), TX_THREAD_BAD);
   assert_non_null(strstr(tx_error(), "puncture"));
   assert_int_equal(tx_thread_punctures_passed(t), 0);
   assert_true(tx_thread_puncture_arc(t, 0) == -1);
   double side[3] = {1, 2, -1};
-  assert_int_equal(tx_thread_set_puncture_sides(t, side, 2), TX_THREAD_BAD);
+  p[4] = 0;
+  assert_int_equal(tx_thread_set_punctures(t, p, side, 2), TX_THREAD_BAD);
   assert_non_null(strstr(tx_error(), "side"));
-  assert_int_equal(tx_thread_set_puncture_sides(t, side, 3), TX_THREAD_BAD);
+  assert_int_equal(tx_thread_set_punctures(t, p, side, 3), TX_THREAD_BAD);
   assert_non_null(strstr(tx_error(), "max_punctures"));
   side[1] = -1;
-  assert_int_equal(tx_thread_set_puncture_sides(t, side, 2), TX_THREAD_OK);
+  assert_int_equal(tx_thread_set_punctures(t, p, side, 2), TX_THREAD_OK);
   tx_thread_destroy(t);
   d = tx_thread_def_default();
   d.puncture_friction = -1;
@@ -341,8 +342,7 @@ static bite_result bite(bool sides) {
     x[3 * i] = -0.008 - dx, x[3 * i + 1] = 0.0005 + 0.0005 * i, x[3 * i + 2] = 0;
   }
   assert_int_equal(tx_thread_set_positions(t, x), TX_THREAD_OK);
-  assert_int_equal(tx_thread_set_punctures(t, P, 2), TX_THREAD_OK);
-  if (sides) assert_int_equal(tx_thread_set_puncture_sides(t, side, 2), TX_THREAD_OK);
+  assert_int_equal(tx_thread_set_punctures(t, P, sides ? side : NULL, 2), TX_THREAD_OK);
   // the head's path: down 0.5 mm, along 16 mm, up 15 mm (1 mm a step), then held
   double path[4][3] = {{-0.008, 0.0005, 0}, {-0.008, 0, 0}, {0.008, 0, 0}, {0.008, 0.015, 0}};
   for (int leg = 0; leg < 3; leg++) {
