@@ -9,7 +9,7 @@ core=(build-essential cmake pkg-config git
 optional=(libbullet-dev libode-dev libassimp-dev liburdfdom-dev libtinyxml-dev
           libosmesa6-dev libglfw3-dev libpng-dev
           libplplot-dev plplot-driver-cairo
-          xvfb xauth                   # xvfb-run: the window-mode screenshot test
+          xvfb xauth                   # Xvfb: the window tests; xvfb-run for benches by hand
           cyclonedds-dev cyclonedds-tools  # sessions over several processes (docs/distributed.md); idlc
           tetgen
           libimgui-dev xdotool         # the window's panels (Dear ImGui); synthetic input in its test

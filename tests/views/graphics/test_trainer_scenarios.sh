@@ -5,20 +5,19 @@
 # them, at more than half their rates) and the view drew frames. The rates
 # are printed; the target on them (haptics within 1 % with the panels shown)
 # is measured by `tactus bench render-gui`, not here: a timing on a shared
-# machine is a bench's. Exit 77 (skipped) only when xvfb-run is not installed.
+# machine is a bench's. Exit 77 (skipped) only when Xvfb is not installed.
 #
 #   test_trainer_scenarios.sh TACTUS
 set -u
 TACTUS=$(realpath "$1")
-command -v xvfb-run >/dev/null || { echo "xvfb-run is not installed: skipped"; exit 77; }
-. "$(dirname "$(realpath "$0")")/xvfb_lib.sh" || exit 1
+command -v Xvfb >/dev/null || { echo "Xvfb is not installed: skipped"; exit 77; }
+ON_XVFB="$(dirname "$(realpath "$0")")/on_xvfb.sh"
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 unset TACTUS_SCENARIO_PATH
 failures=0
 for sc in haptics-wall suturing-skin; do
-  xvfb_next
-  if ! timeout -k 5 60 xvfb-run -a -n "$xvfb_display" "$TACTUS" run "$sc" --view window --quiet --out "$WORK/$sc" --duration 2 \
+  if ! timeout -k 5 60 bash "$ON_XVFB" "$TACTUS" run "$sc" --view window --quiet --out "$WORK/$sc" --duration 2 \
       >"$WORK/$sc.log" 2>&1; then
     echo "FAIL: $sc in a window: $(tail -n 3 "$WORK/$sc.log")" >&2
     failures=$((failures + 1))

@@ -8,7 +8,7 @@
 # and the recorded force model), and the screenshots: the panel where it
 # belongs with a trace in the device plot, in both eyes of sbs at the same
 # place, and gone after H; and the scenario picker (no scenario given).
-# Exit 77 (skipped) only when xvfb-run or xdotool is not installed.
+# Exit 77 (skipped) only when Xvfb or xdotool is not installed.
 #
 #   test_trainer_window.sh TACTUS PNG_PROBE [SHOTS_DIR]
 # With SHOTS_DIR the screenshots are copied there (docs/trainer.md's images).
@@ -16,8 +16,8 @@ set -u
 TACTUS=$(realpath "$1")
 PROBE=$(realpath "$2")
 SHOTS=${3:-}
-command -v xvfb-run >/dev/null || { echo "xvfb-run is not installed: skipped"; exit 77; }
-. "$(dirname "$(realpath "$0")")/xvfb_lib.sh" || exit 1
+command -v Xvfb >/dev/null || { echo "Xvfb is not installed: skipped"; exit 77; }
+ON_XVFB="$(dirname "$(realpath "$0")")/on_xvfb.sh"
 command -v xdotool >/dev/null || { echo "xdotool is not installed: skipped"; exit 77; }
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
@@ -61,8 +61,7 @@ EOF
 window_run() { # OUT SCRIPT ARGS...
   local out=$1 script=$2
   shift 2
-  xvfb_next
-  TACTUS="$TACTUS" timeout -k 5 90 xvfb-run -a -n "$xvfb_display" -s "-screen 0 1280x1024x24" bash "$WORK/drive.sh" "$out" "$script" "$@"
+  TACTUS="$TACTUS" timeout -k 5 90 bash "$ON_XVFB" bash "$WORK/drive.sh" "$out" "$script" "$@"
 }
 
 # 1. the controls, in a mono window of 640 x 480: the panel spans x 328..632, y 8..308;
@@ -185,11 +184,10 @@ for keys in "$@"; do
   sleep 0.3
 done
 wait $pid
-echo $? >"$out.rc" # tactus's own status: xvfb-run's can be that of its clean-up
+echo $? >"$out.rc" # tactus's own status, apart from the driver's
 EOF
 pick_run() { # OUT XDOTOOL-ARGS...: the exit status of tactus in OUT.rc
-  xvfb_next
-  TACTUS="$TACTUS" timeout -k 5 60 xvfb-run -a -n "$xvfb_display" -s "-screen 0 1280x1024x24" bash "$WORK/pick.sh" "$@"
+  TACTUS="$TACTUS" timeout -k 5 60 bash "$ON_XVFB" bash "$WORK/pick.sh" "$@"
 }
 pick_run "$WORK/picked" "type --delay 30 suturing-s" "key Return"
 if [ "$(cat "$WORK/picked.rc" 2>/dev/null)" != 0 ]; then

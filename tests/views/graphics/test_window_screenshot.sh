@@ -4,15 +4,15 @@
 # in which the red tool and the overlay show. Also with --device mouse and the
 # sbs and tb stereo modes (the overlay in both eyes), `--stereo lr` on a
 # display without quad buffers and a display that cannot be opened (exit 2 at
-# load, one line, nothing written). Exit 77 (skipped) only when xvfb-run is
+# load, one line, nothing written). Exit 77 (skipped) only when Xvfb is
 # not installed.
 #
 #   test_window_screenshot.sh TACTUS PNG_PROBE
 set -u
 TACTUS=$(realpath "$1")
 PROBE=$(realpath "$2")
-command -v xvfb-run >/dev/null || { echo "xvfb-run is not installed: skipped"; exit 77; }
-. "$(dirname "$(realpath "$0")")/xvfb_lib.sh" || exit 1
+command -v Xvfb >/dev/null || { echo "Xvfb is not installed: skipped"; exit 77; }
+ON_XVFB="$(dirname "$(realpath "$0")")/on_xvfb.sh"
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 cd "$WORK" || exit 1
@@ -24,8 +24,7 @@ fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
 window_run() { # OUT ARGS...
   local out=$1
   shift
-  xvfb_next
-  timeout -k 5 90 xvfb-run -a -n "$xvfb_display" -s "-screen 0 1280x1024x24" "$TACTUS" run haptics-wall --view window --quiet \
+  timeout -k 5 90 bash "$ON_XVFB" "$TACTUS" run haptics-wall --view window --quiet \
     --out "$out" "$@" >"$out.log" 2>&1
 }
 
