@@ -453,10 +453,13 @@ static int init(tx_ctx* c, void* self) {
   m->world = NULL;
   const tx_urdf* urdfs[TX_INSTRUMENTS_MAX];
   double start[TX_INSTRUMENTS_MAX][3] = {{0}};
+  tx_pose hand_at[HANDS];
+  bool hand_known[HANDS] = {false};
   for (int i = 0; i < m->n; i++) {
     urdfs[i] = m->desc[i]->urdf;
     tx_snapshot p = tx_read(c, m->dev_pose[m->hand_of[i]]);
     if (p.seq) memcpy(start[i], ((const tx_pose*)p.data)->pos, sizeof start[i]);
+    if (p.seq) hand_at[m->hand_of[i]] = *(const tx_pose*)p.data, hand_known[m->hand_of[i]] = true;
     for (int k = 0; k < 3; k++)
       if (!isfinite(start[i][k])) start[i][k] = 0;
   }
@@ -476,6 +479,15 @@ static int init(tx_ctx* c, void* self) {
   for (int h = 0; h < HANDS; h++) m->want[h] = -1;
   for (int h = 0; h < m->nhands; h++) { // each hand holds handN_holds; a button held from the start is no press
     m->cur[h] = m->first[h];
+    // turned as the hand is: built square to the world, the coupling swung
+    // each instrument round to its device's first orientation in the first
+    // tenth of a second, through the scene (the holder 180 degrees about y in
+    // scenario suturing, its jaws 13 cm about, and into the needle's foam
+    // when the hand was half a millimetre off). The needle's holder from the
+    // start keeps the square start its needle was placed for
+    int i = m->slot[h][m->cur[h]];
+    if (hand_known[h] && tx_instrument_world_needle_held_by(m->world) != i)
+      tx_instrument_world_take(m->world, i, hand_at[h].pos, hand_at[h].quat);
     for (int k = 0; k < m->nslot[h]; k++)
       if (k != m->cur[h]) tx_instrument_world_park(m->world, m->slot[h][k], park_at(m->slot[h][k]));
     tx_snapshot g = tx_read(c, m->dev_grip[h]);

@@ -247,6 +247,31 @@ static void write_csv(const char* path, const char* text) {
   fclose(f);
 }
 
+// a hand turned 180 degrees about y from the start: the holder starts turned
+// as the hand is, where it is, and stays there (built square to the world,
+// the coupling swung it round through the scene in the first 0.2 s, its pivot
+// centimetres off the hand)
+static void test_starts_turned_as_the_hand(void** state) {
+  (void)state;
+  instruments_fixture f;
+  fixture_path(&f, "turned");
+  fixture_load(&f, "t_s,x_m,y_m,z_m,qw,qx,qy,qz,grip_rad\n0,0,0.05,0,0,0,1,0,0\n1,0,0.05,0,0,0,1,0,0\n", "",
+               "\"instrument0\":\"needle_holder\",\"gravity_m_s2\":0", "");
+  double worst = 0, least_dot = 1;
+  for (int k = 1; k <= 20; k++) {
+    run(f.s, 0.01 * k);
+    const double* ins = latest(f.s, "instrument0.pose");
+    double d = sqrt(ins[0] * ins[0] + (ins[1] - 0.05) * (ins[1] - 0.05) + ins[2] * ins[2]);
+    worst = fmax(worst, d);
+    least_dot = fmin(least_dot, fabs(ins[5])); // |q . (0, 0, 1, 0)|
+  }
+  print_message("  first 0.2 s: the pivot at most %.4f mm from the hand, |q . q_hand| at least %.6f\n", 1e3 * worst,
+                least_dot);
+  assert_true(worst < 1e-4);
+  assert_true(least_dot > 0.9999);
+  fixture_free(&f);
+}
+
 // the Metzenbaum scissors open over the thread, 2 cm ahead of the pivot, and
 // close: one cut, of segment 4 (z from 0 to 5 mm), where the blades crossed
 // it; opened and closed again away from the thread: no cut
@@ -583,6 +608,7 @@ int main(void) {
       cmocka_unit_test(test_jaws_are_published_as_capsules),
       cmocka_unit_test(test_refuses_what_it_cannot_read),
       cmocka_unit_test(test_needle_is_published),
+      cmocka_unit_test(test_starts_turned_as_the_hand),
       cmocka_unit_test(test_scissors_cut_the_thread),
       cmocka_unit_test(test_forceps_grasp_the_thread),
       cmocka_unit_test(test_forceps_grasp_the_skin),
