@@ -51,7 +51,7 @@ typedef struct instruments {
   double force_most;
   // the skin the needle's tip pierces (SKIN.x, SKIN.tri, SKIN.contact)
   bool skin;
-  tx_port skin_x, skin_tri, skin_contact, needle_tip, punctures;
+  tx_port skin_x, skin_tri, skin_contact, skin_torn, needle_tip, punctures;
   tx_result npunct, pulled_through;
   uint64_t contact_seq;
   tx_puncture_tracker tracker;
@@ -125,13 +125,11 @@ static const tx_param_def params[] = {
      "the needle stands upright in foam, still until jaws take it: its arc in the x-y plane, its point needle_grasp_rad from the swage one radius along +x from its centre"},
     {"needle_y_m", TX_PARAM_NUM, "m", -10, 10, 0, NULL, "in foam: its circle's centre's height"},
     {"skin", TX_PARAM_STR, NULL, 0, 0, 0, "",
-     "the skin the needle's tip pierces: reads SKIN.x, SKIN.tri, SKIN.contact (physics.skin with pose needle.tip); \"\": none"},
+     "the skin the needle's tip pierces: reads SKIN.x, SKIN.tri, SKIN.contact, SKIN.torn (physics.skin with pose needle.tip); \"\": none"},
     {"thread", TX_PARAM_STR, NULL, 0, 0, 0, "",
      "the thread the scissors cut and other jaws grasp: reads THREAD.nodes; \"\": none"},
     {"puncture_separation_m", TX_PARAM_NUM, "m", 0, 0.1, 0.003, NULL,
      "a tear nearer than this to the last puncture is that puncture's tear running on"},
-    {"puncture_min_force_n", TX_PARAM_NUM, "N", 0, 100, 0.05, NULL,
-     "a tear is a puncture only after the tip pushed the skin this hard (not a torn flap flicking it)"},
     {"pin_stiffness", TX_PARAM_NUM, "N/m", 0, 1e5, 200, NULL,
      "a puncture holds the needle's arc on its point across the arc with this spring"},
     {"pin_damping", TX_PARAM_NUM, "N s/m", 0, 1e3, 0.1, NULL, "and this damper"},
@@ -334,9 +332,11 @@ static int configure(tx_setup* s, void** self) {
     m->skin_tri = TX_READ_OF(s, name, tx_triangle);
     snprintf(name, sizeof name, "%s.contact", skin);
     m->skin_contact = TX_READ_OF(s, name, tx_skin_contact);
+    snprintf(name, sizeof name, "%s.torn", skin);
+    m->skin_torn = TX_READ_OF(s, name, tx_torn);
     m->hole_scratch = calloc(2 * HOLE_PARTICLES_MAX, sizeof *m->hole_scratch);
     if (!m->hole_scratch || !tx_sheet_grid_init(&m->sheet, 4 * HOLE_PARTICLES_MAX)) return -1;
-    tx_puncture_tracker_init(&m->tracker, tx_table_num(s, "puncture_separation_m"), tx_table_num(s, "puncture_min_force_n"), 0);
+    tx_puncture_tracker_init(&m->tracker, tx_table_num(s, "puncture_separation_m"), 0, 0); // the skin's pierces decide
   }
   for (int h = 0; h < HANDS; h++) {
     char key[32], hkey[32], path[2048], name[TX_NAME_MAX], list[1024];
@@ -681,6 +681,8 @@ static void pierce(tx_ctx* c, instruments* m) {
       reanchor(m, i, xs, (int)x.rows, tri.data, (int)tri.rows);
       hole_row(m, i, xs, (int)x.rows, tri.data, (int)tri.rows);
     }
+  tx_snapshot torn = tx_read(c, m->skin_torn);
+  if (torn.seq) tx_puncture_skin_pierces(&m->tracker, ((const tx_torn*)torn.data)->pierces);
   tx_puncture_found f;
   if (!tri.seq || !tx_puncture_update(&m->tracker, sc, xs, (int)x.rows, tri.data, (int)tri.rows, &f)) return;
   // the pin starts at the tip, which is on the arc (the hole's rim, where the

@@ -216,6 +216,12 @@ void tx_puncture_tracker_init(tx_puncture_tracker* t, double separation, double 
   t->torn = torn;
   t->next_side = 1;
   t->free = true;
+  t->pierces = -1;
+}
+
+void tx_puncture_skin_pierces(tx_puncture_tracker* t, int pierces) {
+  if (t->pierces >= 0 && pierces > t->pierces) t->pierced = true; // until a tear takes it (the two may come a publish apart)
+  t->pierces = pierces;
 }
 
 bool tx_puncture_update(tx_puncture_tracker* t, const tx_skin_contact* c, const float* x, int nx, const int32_t* tri,
@@ -230,7 +236,9 @@ bool tx_puncture_update(tx_puncture_tracker* t, const tx_skin_contact* c, const 
   }
   bool tore = c->torn > t->torn;
   if (isfinite(c->torn)) t->torn = c->torn;
-  if (!tore || !t->touched || t->peak_f < t->min_force) return false;
+  bool by_skin = t->pierces >= 0;
+  if (by_skin ? !(tore && t->pierced) : !tore || !t->touched || t->peak_f < t->min_force) return false;
+  t->pierced = false;
   double bary[3], point[3];
   int row = tx_nearest_triangle(x, nx, tri, ntri, c->x, bary, point);
   if (row < 0) return false;
@@ -248,7 +256,7 @@ bool tx_puncture_update(tx_puncture_tracker* t, const tx_skin_contact* c, const 
   corner(x, v[0], a), corner(x, v[1], b), corner(x, v[2], cc);
   for (int k = 0; k < 3; k++) ab[k] = b[k] - a[k], ac[k] = cc[k] - a[k];
   double normal[3] = {ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2], ab[0] * ac[1] - ab[1] * ac[0]};
-  int side = dot(t->n, normal) >= 0 ? 1 : -1;
+  int side = !t->touched ? t->next_side : dot(t->n, normal) >= 0 ? 1 : -1; // untouched: a pierce the skin counted
   if (side != t->next_side) { // through one membrane the tip goes in, then out: this tear is at the hole it made
     t->touched = false;
     t->peak_f = t->peak_depth = 0;

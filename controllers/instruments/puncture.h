@@ -2,7 +2,8 @@
 // the tip's HIP tears the skin. A puncture is the first tear after the tip,
 // clear of the skin since the last puncture (torn flaps cling to it as it
 // comes out), pushed on it with at least `min_force` (a flap flicking the tip
-// is no puncture), at least `separation` from the last puncture (a tear that
+// is no puncture) or, where the skin counts its HIP's pierces itself
+// (tx_puncture_skin_pierces), the first rise of that count, at least `separation` from the last puncture (a tear that
 // runs on at the hole is the same puncture), and on the side the tip is on:
 // through one membrane it goes in, then out, in, out. Its place is the point of the
 // live triangles nearest the HIP centre that tore them (the hole's rim), and
@@ -27,10 +28,18 @@ typedef struct tx_puncture_tracker {
   bool any;
   double last[3]; // the last puncture's point
   int next_side;  // +1: the tip is outside (an entry comes next), -1: inside
+  int pierces;    // the skin's count of its HIP's pierces when last seen; -1: the skin gives none
+  bool pierced;   // it rose, and no puncture has taken that pierce yet
 } tx_puncture_tracker;
 
 // a tracker that has seen `torn` links torn already
 void tx_puncture_tracker_init(tx_puncture_tracker* t, double separation, double min_force, double torn);
+// the skin's own count of its HIP's pierces (SKIN.torn's third column), given
+// before each tx_puncture_update: a tear is then a puncture when the count
+// rose, however hard the tip pushed (the skin's rule, not min_force's guess:
+// a tip driven in a little off its line tore through at 0.043 N and was
+// missed); a flap's tear does not raise it. Never given: min_force decides.
+void tx_puncture_skin_pierces(tx_puncture_tracker* t, int pierces);
 
 // what a puncture found: the row, its vertices, the point and the force
 typedef struct tx_puncture_found {

@@ -458,7 +458,7 @@ static void publish(tx_ctx* c, skin* k) {
   int32_t* tri = ((tx_triangle*)tx_write(c, k->tri))->v; // m x 3 indices: m tx_triangle
   tx_write_rows(c, k->tri, (uint32_t)tx_cloth_triangles(k->cloth, tri));
   ((tx_thickness*)tx_write(c, k->thickness))->m = tx_cloth_get_def(k->cloth)->thickness;
-  *(tx_torn*)tx_write(c, k->torn) = (tx_torn){tx_cloth_torn(k->cloth), tx_cloth_torn_pulled(k->cloth)};
+  *(tx_torn*)tx_write(c, k->torn) = (tx_torn){tx_cloth_torn(k->cloth), tx_cloth_torn_pulled(k->cloth), tx_cloth_pierces(k->cloth)};
   publish_contact(c, k);
   tx_skin_rupture* r = tx_write(c, k->rupture);
   r->tension = tx_cloth_peak_tension(k->cloth);

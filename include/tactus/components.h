@@ -163,11 +163,12 @@ TX_LAYOUT_ASSERT(tx_thickness, double);
 
 // SKIN.torn (1 row)
 typedef struct tx_torn {
-  int32_t links;  // links torn so far (a count)
-  int32_t pulled; // of them, those torn beyond the HIP's reach: by a pull (a thread, jaws), not the tip's cut
+  int32_t links;   // links torn so far (a count)
+  int32_t pulled;  // of them, those torn beyond the HIP's reach: by a pull (a thread, jaws), not the tip's cut
+  int32_t pierces; // the HIP's pierces so far: its contact torn through, by the skin's own rule
 } tx_torn;
 #define tx_torn_TYPE TX_I32
-#define tx_torn_COLS 2u
+#define tx_torn_COLS 3u
 #define tx_torn_UNITS "1"
 TX_LAYOUT_ASSERT(tx_torn, int32_t);
 

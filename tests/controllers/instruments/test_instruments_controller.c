@@ -213,13 +213,14 @@ static const tx_controller_class thread_class = {
 
 // a test class that writes a still skin: 9 x 9 particles 2.5 mm apart in
 // the y = 0 plane, x from 1 to 3 cm, z from -1 to 1 cm (row 9 i + j: x
-// index i, z index j), two triangles, and no contact
-static tx_port skin_ports[3];
+// index i, z index j), two triangles, no contact and nothing torn
+static tx_port skin_ports[4];
 static int skin_configure(tx_setup* s, void** self) {
   *self = skin_ports;
   skin_ports[0] = tx_setup_write(s, &TX_COMPONENT_OF("skin.x", tx_vertex, 81));
   skin_ports[1] = tx_setup_write(s, &TX_COMPONENT_OF("skin.tri", tx_triangle, 2));
   skin_ports[2] = tx_setup_write(s, &TX_COMPONENT_OF("skin.contact", tx_skin_contact, 1));
+  skin_ports[3] = tx_setup_write(s, &TX_COMPONENT_OF("skin.torn", tx_torn, 1));
   return 0;
 }
 static void skin_step(tx_ctx* c, void* self) {
@@ -230,6 +231,7 @@ static void skin_step(tx_ctx* c, void* self) {
   tx_triangle* t = tx_write(c, p[1]);
   t[0] = (tx_triangle){.v = {0, 1, 9}}, t[1] = (tx_triangle){.v = {1, 10, 9}};
   memset(tx_write(c, p[2]), 0, sizeof(tx_skin_contact));
+  memset(tx_write(c, p[3]), 0, sizeof(tx_torn));
 }
 static const tx_controller_class skin_class = {
     .type = "test.skin", .summary = "a still skin", .configure = skin_configure, .step = skin_step};
