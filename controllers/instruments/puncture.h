@@ -1,10 +1,11 @@
-// Punctures from what the skin publishes (skin.contact, skin.x, skin.tri):
-// the tip's HIP tears the skin. A puncture is the first tear after the tip,
-// clear of the skin since the last puncture (torn flaps cling to it as it
-// comes out), pushed on it with at least `min_force` (a flap flicking the tip
-// is no puncture) or, where the skin counts its HIP's pierces itself
-// (tx_puncture_skin_pierces), the first rise of that count, at least `separation` from the last puncture (a tear that
-// runs on at the hole is the same puncture), and on the side the tip is on:
+// Punctures from what the skin publishes (skin.contact, skin.x, skin.tri,
+// skin.torn): the tip's HIP tears the skin. A puncture is a tear that the
+// skin counts as its HIP's pierce (tx_puncture_skin_pierces) or, for a skin
+// that does not count them, the first tear after the tip, clear of the skin
+// since the last puncture (torn flaps cling to it as it comes out), pushed
+// on it with at least `min_force` (a flap flicking the tip is no puncture);
+// either at least `separation` from the last puncture (a tear that runs on
+// at the hole is the same puncture), and on the side the tip is on:
 // through one membrane it goes in, then out, in, out. Its place is the point of the
 // live triangles nearest the HIP centre that tore them (the hole's rim), and
 // its side is where the tip came from: +1 from the triangles' normal side (the
