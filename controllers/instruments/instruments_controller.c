@@ -336,7 +336,7 @@ static int configure(tx_setup* s, void** self) {
     m->skin_torn = TX_READ_OF(s, name, tx_torn);
     m->hole_scratch = calloc(2 * HOLE_PARTICLES_MAX, sizeof *m->hole_scratch);
     if (!m->hole_scratch || !tx_sheet_grid_init(&m->sheet, 4 * HOLE_PARTICLES_MAX)) return -1;
-    tx_puncture_tracker_init(&m->tracker, tx_table_num(s, "puncture_separation_m"), 0, 0); // the skin's pierces decide
+    tx_puncture_tracker_init(&m->tracker, tx_table_num(s, "puncture_separation_m"), 0);
   }
   for (int h = 0; h < HANDS; h++) {
     char key[32], hkey[32], path[2048], name[TX_NAME_MAX], list[1024];
@@ -469,7 +469,7 @@ static int init(tx_ctx* c, void* self) {
   for (int i = 0; i < m->n; i++) m->blades[i].armed = 0, m->holds_thread[i] = m->holds_skin[i] = false;
   m->contact_seq = 0;
   for (int i = 0; i < TX_NEEDLE_PINS_MAX; i++) m->rows[i] = (tx_puncture){.v = {-1, -1, -1}};
-  tx_puncture_tracker_init(&m->tracker, m->tracker.separation, m->tracker.min_force, 0);
+  tx_puncture_tracker_init(&m->tracker, m->tracker.separation, 0);
   m->world = tx_instrument_world_create(&m->p, urdfs, m->n, (const double(*)[3])start);
   if (!m->world) {
     tx_stop_run(c, "physics.instruments: %s", tx_error());

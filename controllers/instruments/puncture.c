@@ -209,10 +209,9 @@ int tx_puncture_hole(const float* x, int nx, const int32_t* tri, int ntri, const
 
 }
 
-void tx_puncture_tracker_init(tx_puncture_tracker* t, double separation, double min_force, double torn) {
+void tx_puncture_tracker_init(tx_puncture_tracker* t, double separation, double torn) {
   memset(t, 0, sizeof *t);
   t->separation = separation;
-  t->min_force = min_force;
   t->torn = torn;
   t->next_side = 1;
   t->free = true;
@@ -236,8 +235,7 @@ bool tx_puncture_update(tx_puncture_tracker* t, const tx_skin_contact* c, const 
   }
   bool tore = c->torn > t->torn;
   if (isfinite(c->torn)) t->torn = c->torn;
-  bool by_skin = t->pierces >= 0;
-  if (by_skin ? !(tore && t->pierced) : !tore || !t->touched || t->peak_f < t->min_force) return false;
+  if (!tore || !t->pierced) return false;
   t->pierced = false;
   double bary[3], point[3];
   int row = tx_nearest_triangle(x, nx, tri, ntri, c->x, bary, point);
@@ -256,7 +254,10 @@ bool tx_puncture_update(tx_puncture_tracker* t, const tx_skin_contact* c, const 
   corner(x, v[0], a), corner(x, v[1], b), corner(x, v[2], cc);
   for (int k = 0; k < 3; k++) ab[k] = b[k] - a[k], ac[k] = cc[k] - a[k];
   double normal[3] = {ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2], ab[0] * ac[1] - ab[1] * ac[0]};
-  int side = !t->touched ? t->next_side : dot(t->n, normal) >= 0 ? 1 : -1; // untouched: a pierce the skin counted
+  // the side the tip came from: where the skin pushed it since it was clear,
+  // else where it pushes it now (flaps still clinging), else the next one's
+  const double* from = t->touched ? t->n : touching ? c->n : NULL;
+  int side = !from ? t->next_side : dot(from, normal) >= 0 ? 1 : -1;
   if (side != t->next_side) { // through one membrane the tip goes in, then out: this tear is at the hole it made
     t->touched = false;
     t->peak_f = t->peak_depth = 0;

@@ -1,11 +1,9 @@
 // Punctures from what the skin publishes (skin.contact, skin.x, skin.tri,
 // skin.torn): the tip's HIP tears the skin. A puncture is a tear that the
-// skin counts as its HIP's pierce (tx_puncture_skin_pierces) or, for a skin
-// that does not count them, the first tear after the tip, clear of the skin
-// since the last puncture (torn flaps cling to it as it comes out), pushed
-// on it with at least `min_force` (a flap flicking the tip is no puncture);
-// either at least `separation` from the last puncture (a tear that runs on
-// at the hole is the same puncture), and on the side the tip is on:
+// skin counts as its HIP's pierce (tx_puncture_skin_pierces: a flap torn as
+// it flicks the tip is none), at least `separation` from the last puncture
+// (a tear that runs on at the hole is the same puncture), and on the side
+// the tip is on:
 // through one membrane it goes in, then out, in, out. Its place is the point of the
 // live triangles nearest the HIP centre that tore them (the hole's rim), and
 // its side is where the tip came from: +1 from the triangles' normal side (the
@@ -20,26 +18,25 @@
 
 typedef struct tx_puncture_tracker {
   double separation; // m: the least distance between two punctures
-  double min_force;  // N: the tip must have pushed the skin this hard before a tear is its puncture
   double torn;       // links torn when last seen
-  bool free;         // the tip was clear of the skin since the last puncture
+  bool free;         // the tip was clear of the skin since the last puncture (torn flaps cling to it as it comes out)
   bool touched;      // and has touched it since
   double n[3];       // the last direction the skin pushed the tip
   double peak_f, peak_depth; // the largest force since the last puncture (N) and the indentation then (m)
   bool any;
   double last[3]; // the last puncture's point
   int next_side;  // +1: the tip is outside (an entry comes next), -1: inside
-  int pierces;    // the skin's count of its HIP's pierces when last seen; -1: the skin gives none
+  int pierces;    // the skin's count of its HIP's pierces when last seen; -1: not seen yet
   bool pierced;   // it rose, and no puncture has taken that pierce yet
 } tx_puncture_tracker;
 
 // a tracker that has seen `torn` links torn already
-void tx_puncture_tracker_init(tx_puncture_tracker* t, double separation, double min_force, double torn);
+void tx_puncture_tracker_init(tx_puncture_tracker* t, double separation, double torn);
 // the skin's own count of its HIP's pierces (SKIN.torn's third column), given
-// before each tx_puncture_update: a tear is then a puncture when the count
-// rose, however hard the tip pushed (the skin's rule, not min_force's guess:
-// a tip driven in a little off its line tore through at 0.043 N and was
-// missed); a flap's tear does not raise it. Never given: min_force decides.
+// before each tx_puncture_update: a tear is a puncture when the count rose,
+// however hard the tip pushed (a rule of 0.05 N of push before it missed a
+// tip driven a little off its line, which tore through at 0.043 N); the
+// first call sets where the count stands
 void tx_puncture_skin_pierces(tx_puncture_tracker* t, int pierces);
 
 // what a puncture found: the row, its vertices, the point and the force
