@@ -23,7 +23,7 @@ typedef struct suture {
   double wound_a[3], wound_b[3]; // m, the wound line on the skin (Y up)
   double wrap_reach;             // m, thread nodes this near the holder's jaw axis count for the wrap
   double wrap_length;            // m, how far along the jaws from the pivot
-  tx_port instrument_events, thread_events, punctures, nodes, tension, holder, hand[HANDS];
+  tx_port instrument_events, thread_events, punctures, nodes, tension, threaded, holder, hand[HANDS];
   int nhands;
   tx_port out_step, out_steps, out_names, out_measures, out_events;
   tx_result done_r, step_r[TX_SUTURE_STEPS];
@@ -36,6 +36,7 @@ typedef struct suture {
   double entry[3];         // m, the stitch's entry (its bite on the near edge)
   bool have_exit;
   double exit[3];          // m, its exit, on the far edge
+  int stitch_punctures;    // the punctures up to the stitch's exit, in the needle's order
   tx_suture_measures m;
   double last_hand[HANDS][3];
   bool hand_seen[HANDS];
@@ -56,10 +57,12 @@ static const tx_param_def params[] = {
     {"punctures", TX_PARAM_STR, NULL, 0, 0, 0, "needle.punctures",
      "tx_puncture rows in the order the needle made them: whether each entered or came out; empty: every puncture an entry"},
     {"thread_events", TX_PARAM_STR, NULL, 0, 0, 0, "thread.events", "the thread's event stream: knots and cuts; empty: none"},
-    {"thread", TX_PARAM_STR, NULL, 0, 0, 0, "thread", "the thread's prefix: THREAD.nodes (the tail) and THREAD.force_model (the tension); empty: none"},
+    {"thread", TX_PARAM_STR, NULL, 0, 0, 0, "thread",
+     "the thread's prefix: THREAD.nodes (the tail), THREAD.force_model (the tension) and THREAD.puncture_loads (the punctures it runs through); empty: none"},
     {"holder", TX_PARAM_STR, NULL, 0, 0, 0, "instrument0.pose", "the needle holder's pose (tx_instrument_pose), whose jaws the thread is wrapped around; empty: none"},
     {"hands", TX_PARAM_STRS, NULL, 0, HANDS, 0, NULL, "each hand's pose (tx_pose) for its path length; [\"device0.pose\", \"device1.pose\"] by default"},
-    {"tail_m", TX_PARAM_NUM, "m", 0.001, 1, 0.03, NULL, "B is done once the thread beyond the entry is at most this long"},
+    {"tail_m", TX_PARAM_NUM, "m", 0.001, 1, 0.03, NULL,
+     "B is done once the thread runs through the stitch's punctures and beyond the entry is at most this long"},
     {"wrap_turns", TX_PARAM_NUM, "1", 0.25, 10, 1, NULL, "C is done once the thread winds around the holder's jaws this many times"},
     {"wrap_reach_m", TX_PARAM_NUM, "m", 0.001, 0.1, 0.008, NULL, "thread nodes within this distance of the jaws' axis count for the wrap"},
     {"wrap_length_m", TX_PARAM_NUM, "m", 0.005, 0.3, 0.03, NULL, "the jaws' length ahead of the pivot, along which a wrap counts"},
@@ -98,6 +101,8 @@ static int configure(tx_setup* s, void** self) {
     k->nodes = TX_READ_OF(s, name, tx_thread_node);
     snprintf(name, sizeof name, "%s.force_model", thread);
     k->tension = TX_READ_OF(s, name, tx_force_model);
+    snprintf(name, sizeof name, "%s.puncture_loads", thread);
+    k->threaded = TX_READ_OF(s, name, tx_puncture_load);
   }
   k->holder = optional_read(s, tx_table_str(s, "holder"), tx_instrument_pose_TYPE, tx_instrument_pose_COLS);
   const char* hands[HANDS];
@@ -146,6 +151,7 @@ static int init(tx_ctx* c, void* self) {
   tx_suture_steps_start(&k->steps, &r, 0);
   k->punctures_seen = k->punctures_placed = 0;
   k->have_entry = k->have_exit = k->cut = false;
+  k->stitch_punctures = 0;
   k->holding = 0;
   memset(k->hand_seen, 0, sizeof k->hand_seen);
   k->nrest = 0;
@@ -204,6 +210,7 @@ static void place_punctures(tx_ctx* c, suture* k, double t) {
       k->m.bite_entry_m = fabs(off);
     }
     if (tx_suture_steps_puncture(&k->steps, t, side, edge)) {
+      k->stitch_punctures = i + 1;
       k->m.bite_exit_m = fabs(off);
       k->have_exit = true;
       memcpy(k->exit, p, sizeof k->exit);
@@ -258,6 +265,16 @@ static double tail_length(const tx_thread_node* n, uint32_t rows, const double e
     len += sqrt(d);
   }
   return len;
+}
+
+// whether the thread runs through every puncture of the stitch: its loads'
+// rows (one a puncture it went through, in the needle's order) reach the exit
+static bool threaded(tx_ctx* c, const suture* k) {
+  tx_snapshot s = tx_read(c, k->threaded);
+  const tx_puncture_load* ld = s.data;
+  uint32_t through = 0;
+  while (s.seq && through < s.rows && ld[through].v[0] >= 0) through++;
+  return k->stitch_punctures > 0 && through >= (uint32_t)k->stitch_punctures;
 }
 
 // turns of the thread around the holder's jaws: the angle its nodes sweep
@@ -363,7 +380,8 @@ static void step(tx_ctx* c, void* self) {
   if (k->nodes.id) {
     tx_snapshot s = tx_read(c, k->nodes);
     if (s.seq && s.rows > 1) {
-      if (k->steps.current == TX_SUTURE_B && k->have_entry) tx_suture_steps_tail(&k->steps, t, tail_length(s.data, s.rows, k->entry));
+      if (k->steps.current == TX_SUTURE_B && k->have_entry)
+        tx_suture_steps_tail(&k->steps, t, tail_length(s.data, s.rows, k->entry), threaded(c, k));
       if (k->steps.current == TX_SUTURE_C && k->holder.id) {
         tx_snapshot h = tx_read(c, k->holder);
         if (h.seq) tx_suture_steps_wrap(&k->steps, t, wrap_turns(k, s.data, s.rows, h.data));

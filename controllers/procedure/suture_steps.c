@@ -59,8 +59,8 @@ bool tx_suture_steps_puncture(tx_suture_steps* s, double t, int side, int wound_
   return side < 0 && s->entry_side != 0 && wound_side == -s->entry_side && finish(s, t, TX_SUTURE_A);
 }
 
-bool tx_suture_steps_tail(tx_suture_steps* s, double t, double tail_m) {
-  return s->current == TX_SUTURE_B && tail_m <= s->rules.tail_m && finish(s, t, TX_SUTURE_B);
+bool tx_suture_steps_tail(tx_suture_steps* s, double t, double tail_m, bool through) {
+  return s->current == TX_SUTURE_B && through && tail_m <= s->rules.tail_m && finish(s, t, TX_SUTURE_B);
 }
 
 bool tx_suture_steps_wrap(tx_suture_steps* s, double t, double turns) {

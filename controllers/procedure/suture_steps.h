@@ -14,7 +14,8 @@
 // step):
 //   A insert the needle through both wound edges: an exit puncture on the
 //     other side of the wound from an entry made while A is under way
-//   B pull the thread: the tail beyond the entry is at most tail_m long
+//   B pull the thread: the thread runs through every puncture of the stitch
+//     and the tail beyond the entry is at most tail_m long
 //   C wrap the thread around the needle holder: it winds around the holder's
 //     jaws at least wrap_turns times
 //   D the first throw: the thread's first knot is found
@@ -57,7 +58,8 @@ void tx_suture_steps_start(tx_suture_steps* s, const tx_suture_rules* r, double 
 // side: +1 the needle entered the skin here, -1 it came out; wound_side: +1 or
 // -1, the side of the wound line the puncture is on
 bool tx_suture_steps_puncture(tx_suture_steps* s, double t, int side, int wound_side);
-bool tx_suture_steps_tail(tx_suture_steps* s, double t, double tail_m);
+// through: the thread runs through every puncture the needle made up to A's exit
+bool tx_suture_steps_tail(tx_suture_steps* s, double t, double tail_m, bool through);
 bool tx_suture_steps_wrap(tx_suture_steps* s, double t, double turns);
 bool tx_suture_steps_knot(tx_suture_steps* s, double t, int source, bool fixed);
 bool tx_suture_steps_cut(tx_suture_steps* s, double t);

@@ -11,8 +11,9 @@
 #define NODES 41
 
 typedef struct feed {
-  tx_port ievents, tevents, punctures, nodes, tension, holder, hand0, hand1;
+  tx_port ievents, tevents, punctures, nodes, tension, loads, holder, hand0, hand1;
   double scale; // simulation seconds per script second
+  int through;  // the punctures the thread runs through once pulled (3 s)
   double step;  // script seconds per step
   double last;  // script time of the last step, -1 before the first
 } feed;
@@ -26,12 +27,14 @@ static int feed_configure(tx_setup* s, void** self) {
   if (!f) return -1;
   *self = f;
   f->scale = tx_table_num(s, "time_scale");
+  f->through = tx_table_int(s, "through");
   f->step = 1 / (tx_setup_rate(s) * f->scale);
   f->ievents = tx_setup_emit(s, "instruments.events", 64);
   f->tevents = tx_setup_emit(s, "thread.events", 64);
   f->punctures = tx_setup_write(s, &TX_COMPONENT_OF("needle.punctures", tx_puncture, 8));
   f->nodes = tx_setup_write(s, &TX_COMPONENT_OF("thread.nodes", tx_thread_node, NODES));
   f->tension = tx_setup_write(s, &TX_COMPONENT_OF("thread.force_model", tx_force_model, 1));
+  f->loads = tx_setup_write(s, &TX_COMPONENT_OF("thread.puncture_loads", tx_puncture_load, 9));
   f->holder = tx_setup_write(s, &TX_COMPONENT_OF("instrument0.pose", tx_instrument_pose, 1));
   f->hand0 = tx_setup_write(s, &TX_COMPONENT_OF("device0.pose", tx_pose, 1));
   f->hand1 = tx_setup_write(s, &TX_COMPONENT_OF("device1.pose", tx_pose, 1));
@@ -79,6 +82,8 @@ static void feed_step(tx_ctx* c, void* self) {
       double a = 3 * M_PI * i / 19.0;
       n[5 + i] = (tx_thread_node){{0.055 + 0.001 * i, 0.02 + 0.003 * cos(a), 0.003 * sin(a)}, 0.00025};
     }
+  tx_puncture_load* ld = tx_write(c, f->loads); // the punctures the thread runs through
+  for (int i = 0; i < 9; i++) ld[i] = (tx_puncture_load){{i < f->through && t >= 3 ? 0 : -1, 1, 2}, {1, 0, 0}, {0, 0, 0}, 0};
   tx_force_model* m = tx_write(c, f->tension);
   memset(m, 0, sizeof *m);
   m->f0[1] = t < 5 ? 0.5 * t : 0; // a tension of up to 2.5 N, along y
@@ -104,6 +109,7 @@ static void feed_fini(void* self) { free(self); }
 
 static const tx_param_def params[] = {
     {"time_scale", TX_PARAM_NUM, "1", 0.05, 10, 1, NULL, "simulation seconds per second of the script"},
+    {"through", TX_PARAM_INT, "1", 0, 4, 4, NULL, "punctures the thread runs through once pulled through (3 s), in the needle's order"},
 };
 
 const tx_controller_class tx_test_suture_feed = {.type = "test.suture_feed",

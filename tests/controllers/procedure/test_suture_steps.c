@@ -35,9 +35,10 @@ static void a_whole_suture(void** state) {
   expect_status(&s, "du......");
   assert_true(s.step[TX_SUTURE_A].t_start_s == 0 && s.step[TX_SUTURE_A].t_end_s == 2.0);
   assert_true(s.step[TX_SUTURE_B].t_start_s == 2.0 && isnan(s.step[TX_SUTURE_B].t_end_s));
-  assert_false(tx_suture_steps_tail(&s, 3, 0.05)); // 5 cm left: still pulling
+  assert_false(tx_suture_steps_tail(&s, 3, 0.05, true)); // 5 cm left: still pulling
+  assert_false(tx_suture_steps_tail(&s, 3.5, 0.02, false)); // short, but not through the wound
   assert_false(tx_suture_steps_wrap(&s, 3, 2));    // C is not under way: a wrap now means nothing
-  assert_true(tx_suture_steps_tail(&s, 4, 0.025));
+  assert_true(tx_suture_steps_tail(&s, 4, 0.025, true));
   assert_false(tx_suture_steps_wrap(&s, 5, 0.6));  // part of a turn
   assert_true(tx_suture_steps_wrap(&s, 6, -1.1));  // a turn, either way round
   assert_true(tx_suture_steps_knot(&s, 7, 1, false));
@@ -63,7 +64,7 @@ static void cut_after_the_first_knot_skips_f(void** state) {
   tx_suture_steps_start(&s, NULL, 0);
   tx_suture_steps_puncture(&s, 1, +1, -1);
   tx_suture_steps_puncture(&s, 2, -1, +1);
-  tx_suture_steps_tail(&s, 3, 0.01);
+  tx_suture_steps_tail(&s, 3, 0.01, true);
   assert_true(tx_suture_steps_knot(&s, 4, 1, true)); // found and fixed at once: C skipped, D and E done
   expect_status(&s, "ddsddu..");
   assert_true(tx_suture_steps_cut(&s, 5));
@@ -83,8 +84,8 @@ static void early_events(void** state) {
   assert_false(tx_suture_steps_puncture(&s, 1, +1, 0));  // on no edge
   tx_suture_steps_puncture(&s, 2, +1, +1);
   tx_suture_steps_puncture(&s, 3, -1, -1);
-  assert_false(tx_suture_steps_tail(&s, 4, 0.025)); // this run's rule: 2 cm
-  assert_true(tx_suture_steps_tail(&s, 4, 0.02));
+  assert_false(tx_suture_steps_tail(&s, 4, 0.025, true)); // this run's rule: 2 cm
+  assert_true(tx_suture_steps_tail(&s, 4, 0.02, true));
   assert_false(tx_suture_steps_wrap(&s, 5, 1.5));   // two turns asked
   expect_status(&s, "ddu.....");
   assert_true(s.step[TX_SUTURE_A].t_start_s == 0.5);
