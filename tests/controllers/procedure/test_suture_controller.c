@@ -1,7 +1,7 @@
 // procedure.suture and view.scorecard through the loader, in lockstep, fed
 // by a scripted stand-in for the instruments and the thread (test.suture_feed):
 // four punctures (in and out of the near edge, in and out of the far edge),
-// the thread pulled through to a 2 cm tail, wrapped 1.5 turns around the
+// the thread pulled through all four to a 2 cm tail, wrapped 1.5 turns around the
 // holder's jaws, a knot, the knot fixed, a second knot, a cut, the hands let
 // go. Every step is done in order at the scripted times; the step text, the
 // step events, the measures (bites 4 and 2.5 mm, knots, peak tension, a
@@ -126,8 +126,8 @@ static void every_step_in_order(void** state) {
 }
 
 // the same script, but the thread misses the stitch's last puncture (the far
-// edge's exit): its tail beyond the entry is as short at 3 s, yet the thread
-// is not through the wound, so B is not done (the first knot, at 5 s, skips it)
+// edge's exit): its tail beyond the entry is as short from 3 s, yet the
+// thread is not through the wound, so B is still under way at 4.5 s
 static void a_short_tail_short_of_the_exit_is_not_b(void** state) {
   (void)state;
   tx_scenario* s = load_fed("\"through\":3", "\"wound_a_m\":[-0.015,0,0],\"wound_b_m\":[0.015,0,0]");
