@@ -23,7 +23,7 @@ typedef struct suture {
   double wound_a[3], wound_b[3]; // m, the wound line on the skin (Y up)
   double wrap_reach;             // m, thread nodes this near the holder's jaw axis count for the wrap
   double wrap_length;            // m, how far along the jaws from the pivot
-  tx_port instrument_events, thread_events, punctures, nodes, tension, threaded, holder, hand[HANDS];
+  tx_port instrument_events, thread_events, punctures, nodes, tension, thread_loads, holder, hand[HANDS];
   int nhands;
   tx_port out_step, out_steps, out_names, out_measures, out_events;
   tx_result done_r, step_r[TX_SUTURE_STEPS];
@@ -102,7 +102,7 @@ static int configure(tx_setup* s, void** self) {
     snprintf(name, sizeof name, "%s.force_model", thread);
     k->tension = TX_READ_OF(s, name, tx_force_model);
     snprintf(name, sizeof name, "%s.puncture_loads", thread);
-    k->threaded = TX_READ_OF(s, name, tx_puncture_load);
+    k->thread_loads = TX_READ_OF(s, name, tx_puncture_load);
   }
   k->holder = optional_read(s, tx_table_str(s, "holder"), tx_instrument_pose_TYPE, tx_instrument_pose_COLS);
   const char* hands[HANDS];
@@ -270,7 +270,7 @@ static double tail_length(const tx_thread_node* n, uint32_t rows, const double e
 // whether the thread runs through every puncture of the stitch: its loads'
 // rows (one a puncture it went through, in the needle's order) reach the exit
 static bool threaded(tx_ctx* c, const suture* k) {
-  tx_snapshot s = tx_read(c, k->threaded);
+  tx_snapshot s = tx_read(c, k->thread_loads);
   const tx_puncture_load* ld = s.data;
   uint32_t through = 0;
   while (s.seq && through < s.rows && ld[through].v[0] >= 0) through++;
