@@ -8,16 +8,18 @@
 set -euo pipefail
 tactus=$1
 scenario=$2
+source "$(dirname "$0")/session.sh"
 work=$(mktemp -d)
 instructor=
 trap 'kill $instructor 2>/dev/null || true; rm -rf "$work"' EXIT
 domain=$(( 1 + 5 * ($$ % 40) + 4 )) # a residue of its own (4 of 5): no two of these tests share a domain, whatever their PIDs
 run() { exec "$tactus" run "$scenario" --role "$1" --duration "$2" --set net.domain=$domain --out "$1" --quiet >"$1.log" 2>&1; }
 cd "$work"
-run instructor 5 & instructor=$!
-sleep 0.5
+# the instructor runs until the sim is done (session.sh)
+run instructor 60 & instructor=$!
+started instructor
 (run sim 4) || { cat sim.log; exit 1; }
-wait $instructor || { cat instructor.log; exit 1; }
+stop $instructor instructor.log
 
 python3 - <<'PY'
 import json

@@ -9,6 +9,7 @@
 # must be taken up again.
 set -euo pipefail
 tactus=$1
+source "$(dirname "$0")/session.sh"
 work=$(mktemp -d)
 sim1=; sim2=
 trap 'kill $sim1 $sim2 2>/dev/null || true; rm -rf "$work"' EXIT
@@ -23,17 +24,21 @@ sim() { exec "$tactus" run suturing-skin --role sim --duration "$1" --set net.do
 # the hand comes down to 3 mm above the mid-plane, then presses on at 2 mm/s
 # (0.15 to 0.2 N by the kill, short of a tear; moving, so each force model
 # differs from the one before), slowly, so that a sim process that starts or
-# steps late under load meets a gentle press, not a deep one that tears
-printf 't_s,x_m,y_m,z_m\n0,0,0.006,0\n0.3,0,0.003,0\n4.0,0,-0.0044,0\n' >press.csv
-sim 6 sim1 & sim1=$!
-sleep 0.5
-"$tactus" run suturing-skin --role device --duration 4 --set net.domain=$domain --set haptics.model_timeout_s=0.005 \
+# steps late under load meets a gentle press, not a deep one that tears;
+# from 4 s it slides 1 mm along x at that depth, still moving, so that the
+# new sim process, however slow to load, has a second to be taken up in
+printf 't_s,x_m,y_m,z_m\n0,0,0.006,0\n0.3,0,0.003,0\n4.0,0,-0.0044,0\n5.0,0.001,-0.0044,0\n' >press.csv
+sim 60 sim1 & sim1=$!
+started sim1
+"$tactus" run suturing-skin --role device --duration 5 --set net.domain=$domain --set haptics.model_timeout_s=0.005 \
   --device scripted:$PWD/press.csv --out device --quiet >device.log 2>&1 & device=$!
-sleep 3.1
+started device
+sleep 2.9 # the device's clock at about 3 s
 kill -9 $sim1
 sleep 0.3
-sim 2 sim2 & sim2=$!
+sim 60 sim2 & sim2=$!
 wait $device || { cat device.log; exit 1; }
+stop $sim2 sim2.log
 
 python3 - <<'PY'
 import csv

@@ -7,6 +7,7 @@
 # namespaces cannot be made (no root, no CAP_NET_ADMIN, no iproute2).
 set -uo pipefail
 tactus=$1
+source "$(dirname "$0")/session.sh"
 command -v ip >/dev/null || { echo "SKIP: no ip command (iproute2)"; exit 77; }
 [ "$(id -u)" -eq 0 ] || { echo "SKIP: network namespaces need root (CAP_NET_ADMIN)"; exit 77; }
 id=$(( $$ % 250 + 1 ))
@@ -37,12 +38,13 @@ cd "$work"
 # one session over the link; its check in Python below
 session() {
   local tag=$1
-  ip netns exec $a "$tactus" run suturing-skin --role sim --duration 3.6 --set "net.peers=[\"10.218.$id.2\"]" \
+  # the sim runs until the device is done (session.sh)
+  ip netns exec $a "$tactus" run suturing-skin --role sim --duration 60 --set "net.peers=[\"10.218.$id.2\"]" \
     --out sim-$tag --quiet >sim-$tag.log 2>&1 & sim=$!
-  sleep 0.5
+  started sim-$tag || return 1
   ip netns exec $b "$tactus" run suturing-skin --role device --duration 3 --set "net.peers=[\"10.218.$id.1\"]" \
     --out device-$tag --quiet >device-$tag.log 2>&1 || { cat device-$tag.log; return 1; }
-  wait $sim || { cat sim-$tag.log; return 1; }
+  stop $sim sim-$tag.log || return 1
   sim=
   python3 - "$tag" "$2" <<'PY'
 import csv, json, sys

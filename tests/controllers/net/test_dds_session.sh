@@ -7,6 +7,7 @@
 # above it: ~0.2 N at 3 s), rendered rather than faded.
 set -euo pipefail
 tactus=$1
+source "$(dirname "$0")/session.sh"
 work=$(mktemp -d)
 trap 'kill $sim_pid 2>/dev/null || true; rm -rf "$work"' EXIT
 domain=$(( 1 + 5 * ($$ % 40) + 0 )) # a residue of its own (0 of 5): no two of these tests share a domain, whatever their PIDs
@@ -26,16 +27,15 @@ bad "net.peers[1]: expected an IPv4 address or a host name" --role sim --set 'ne
 bad "net.fast[3]: 'tool9.force_model' is not in the model" --role device --set 'net.fast=["device0.pose", "device0.force", "tool0.force_model", "tool9.force_model"]'
 bad "--role sim: a session runs in real time" --role sim --lockstep
 
-# the sim runs on 1.5 s past the device's end: the hand presses hardest at
-# the device's 3 s, which a device slow to start (a loaded machine, DDS
-# discovery) brought past a sim that stopped 0.1 s after it (a CI run saw
-# the HIP peak at 0.002 N); after the device has gone the sim keeps its last pose
-"$tactus" run suturing-skin --role sim --duration 5 --set net.domain=$domain --out sim --quiet >sim.log 2>&1 &
+# the sim runs until the device is done (session.sh): the hand presses
+# hardest at the device's 3 s, and after the device has gone the sim keeps
+# its last pose
+"$tactus" run suturing-skin --role sim --duration 60 --set net.domain=$domain --out sim --quiet >sim.log 2>&1 &
 sim_pid=$!
-sleep 0.5
+started sim
 "$tactus" run suturing-skin --role device --duration 3 --set net.domain=$domain --out device --quiet >device.log 2>&1 ||
   { cat device.log; exit 1; }
-wait $sim_pid || { cat sim.log; exit 1; }
+stop $sim_pid sim.log
 
 python3 - <<'PY'
 import csv, json, sys

@@ -5,6 +5,7 @@
 # its peak force must be the one the device process rendered.
 set -euo pipefail
 tactus=$1
+source "$(dirname "$0")/session.sh"
 scenario=$(realpath "$(dirname "$0")/suturing-skin-three.json")
 work=$(mktemp -d)
 sim=; view=
@@ -12,12 +13,13 @@ trap 'kill $sim $view 2>/dev/null || true; rm -rf "$work"' EXIT
 domain=$(( 1 + 5 * ($$ % 40) + 2 )) # a residue of its own (2 of 5): no two of these tests share a domain, whatever their PIDs
 run() { exec "$tactus" run "$scenario" --role "$1" --duration "$2" --set net.domain=$domain --out "$1" --quiet >"$1.log" 2>&1; }
 cd "$work"
-run sim 3.8 & sim=$!
-run view 3.8 & view=$!
-sleep 0.5
+# the sim and the view run until the device is done (session.sh)
+run sim 60 & sim=$!
+run view 60 & view=$!
+started sim && started view
 (run device 3) || { cat device.log; exit 1; }
-wait $sim || { cat sim.log; exit 1; }
-wait $view || { cat view.log; exit 1; }
+stop $sim sim.log
+stop $view view.log
 
 python3 - <<'PY'
 import csv, json
