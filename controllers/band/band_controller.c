@@ -60,6 +60,17 @@ typedef struct band {
   int32_t* identity;                // (largest part's nodes) a surface vertex is its node
   int pick_nodes_max;               // the most nodes one hand held
   double pick_force_max;            // N, the largest pull of the band on a hand's jaws through picked nodes
+  // sleeping, as rigid-body engines do: a band at rest is not stepped (its
+  // explicit substeps take about a core) until a grasper takes or picks it,
+  // the only way anything moves it (it meets no other body but the fixed
+  // obstacles)
+  double dt;                        // s, the controller's period
+  double sleep_speed, sleep_after;  // m/s, s
+  double* prev;                     // (nodes x 3) m, the nodes after the last step taken
+  double still_s;                   // s, how long the band has stayed slower than sleep_speed, untouched
+  bool asleep;
+  long slept_steps, wakes;
+  tx_result slept_result, wakes_result;
 } band;
 
 // sources of the values: docs/lagb.md, "The band"
@@ -97,6 +108,9 @@ static const tx_param_def params[] = {
      "closing jaws with neither end in reach pick the band's surface triangles this close to their line (the jaws' half width, 2 mm, and 1 mm)"},
     {"grasp_closed_rad", TX_PARAM_NUM, "rad", 0, 1, 0.1, NULL, "jaws at or below this angle have closed: a grasp, if they were open since the last"},
     {"grasp_open_rad", TX_PARAM_NUM, "rad", 0.001, 3.2, 0.2, NULL, "jaws at or above this have opened: what they held is let go"},
+    {"sleep_speed_m_s", TX_PARAM_NUM, "m/s", 0, 1, 0.001, NULL,
+     "a band whose nodes all stay slower than this for sleep_after_s, held by no grasper and pulled by no pose, sleeps: it is not stepped until a grasper takes or picks it; 0: never"},
+    {"sleep_after_s", TX_PARAM_NUM, "s", 0.05, 10, 0.5, NULL, "how long the band stays that still before it sleeps"},
 };
 
 // obstacles: a list of capsules, each [a, b, r] flattened, within 10 m
@@ -175,7 +189,11 @@ static int configure(tx_setup* s, void** self) {
     nodes += g->nv[i], faces += g->nf[i];
   }
   g->pos = malloc(sizeof(double) * 3 * (size_t)nodes);
-  if (!g->pos) return -1;
+  g->prev = malloc(sizeof(double) * 3 * (size_t)nodes);
+  if (!g->pos || !g->prev) return -1;
+  g->dt = d.step;
+  g->sleep_speed = tx_table_num(s, "sleep_speed_m_s");
+  g->sleep_after = tx_table_num(s, "sleep_after_s");
   g->x = tx_setup_write(s, &TX_COMPONENT_OF("band.x", tx_vertex, (uint32_t)nodes));
   g->tri = tx_setup_write(s, &TX_COMPONENT_OF("band.tri", tx_triangle, (uint32_t)faces));
   g->state = tx_setup_write(s, &TX_COMPONENT_OF("band.state", tx_band_state, 1));
@@ -193,6 +211,8 @@ static int configure(tx_setup* s, void** self) {
   g->substeps_result = tx_setup_result(s, "substeps");
   g->p50_result = tx_setup_result(s, "step_p50_ms");
   g->p99_result = tx_setup_result(s, "step_p99_ms");
+  g->slept_result = tx_setup_result(s, "asleep_s");
+  g->wakes_result = tx_setup_result(s, "wakes");
   tx_hist_clear(&g->steps);
   if (g->hold_buckle) {
     double p[3];
@@ -348,12 +368,38 @@ static void publish(tx_ctx* c, band* g) {
   g->max_error = fmax(g->max_error, fabs(st->joint_error));
 }
 
+// the largest node move since the last step taken, m; the nodes kept for the next
+static double nodes_moved(band* g) {
+  double most = 0;
+  int base = 0;
+  for (int i = 0; i < TX_BAND_PARTS; i++) {
+    tx_band_positions(g->b, i, g->pos + 3 * base);
+    base += g->nv[i];
+  }
+  for (int k = 0; k < base; k++) {
+    double d2 = 0;
+    for (int a = 0; a < 3; a++) d2 += (g->pos[3 * k + a] - g->prev[3 * k + a]) * (g->pos[3 * k + a] - g->prev[3 * k + a]);
+    most = fmax(most, d2);
+  }
+  memcpy(g->prev, g->pos, sizeof(double) * 3 * (size_t)base);
+  return sqrt(most);
+}
+
+static bool touched(const band* g) {
+  if (g->following) return true;
+  for (int h = 0; h < g->hands; h++)
+    if (g->hand[h].body >= 0 || (g->pick && tx_picking_nodes(g->pick, h) > 0)) return true;
+  return false;
+}
+
 static int init(tx_ctx* c, void* self) {
   band* g = self;
   for (int h = 0; h < g->hands; h++) g->hand[h].body = -1, g->hand[h].was_open = g->hand[h].on_end = false;
   g->grasps = g->pick_nodes_max = 0;
   g->pick_force_max = 0;
   if (g->pick) tx_picking_release(g->pick, -1);
+  g->asleep = false, g->still_s = 0, g->slept_steps = g->wakes = 0;
+  nodes_moved(g);
   publish(c, self); // the band at rest, at time 0
   return 0;
 }
@@ -370,7 +416,12 @@ static void step(tx_ctx* c, void* self) {
       else tx_warn(c, g->bad_pose);
     }
   }
-  grasp_step(c, g);
+  grasp_step(c, g); // on the still band as it lies, asleep or not
+  if (g->asleep && !touched(g)) { // nothing moves it: nothing to step or publish
+    g->slept_steps++;
+    return;
+  }
+  if (g->asleep) g->asleep = false, g->still_s = 0, g->wakes++;
   if (tx_band_step(g->b)) {
     tx_band_save(g->b);
     for (int h = 0; h < g->hands && g->pick; h++) {
@@ -396,6 +447,9 @@ static void step(tx_ctx* c, void* self) {
   }
   g->was_locked = locked;
   publish(c, g);
+  bool still = nodes_moved(g) < g->sleep_speed * g->dt && !touched(g);
+  g->still_s = still ? g->still_s + g->dt : 0;
+  g->asleep = g->sleep_speed > 0 && g->still_s >= g->sleep_after;
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t1);
   tx_hist_add(&g->steps, (int64_t)(t1.tv_sec - t0.tv_sec) * 1000000000 + (t1.tv_nsec - t0.tv_nsec));
 }
@@ -409,6 +463,8 @@ static void finish(tx_ctx* c, void* self) {
   tx_set_result(c, g->substeps_result, tx_band_substeps(g->b));
   tx_set_result(c, g->p50_result, p.p50 * 1e-6);
   tx_set_result(c, g->p99_result, p.p99 * 1e-6);
+  tx_set_result(c, g->slept_result, (double)g->slept_steps * g->dt);
+  tx_set_result(c, g->wakes_result, (double)g->wakes);
   if (g->hands > 0) {
     tx_set_result(c, g->grasps_result, g->grasps);
     tx_set_result(c, g->nodes_result, g->pick_nodes_max);
@@ -424,6 +480,7 @@ static void fini(void* self) {
   for (int i = 0; i < TX_BAND_PARTS; i++) free(g->part_pos[i]);
   free(g->identity);
   free(g->pos);
+  free(g->prev);
   free(g);
 }
 

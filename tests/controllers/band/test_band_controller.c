@@ -2,8 +2,9 @@
 // (the two parts' nodes and their boundary faces: closed, outward) and band.state at rest;
 // a substep far past the stable one faults, and the fault is counted and
 // recovered, never published; a grasper closing across the tube's middle
-// picks its triangles and lifts it, and opening lets go; bad parameters and
-// assets are refused with one line naming the key and the file.
+// picks its triangles and lifts it, and opening lets go; the band at rest
+// sleeps (not stepped, not published) until such a grasp wakes it; bad
+// parameters and assets are refused with one line naming the key and the file.
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -93,22 +94,26 @@ static void fault_is_recovered(void** state) {
 }
 
 // a test class: jaws (jaws.pose, tx_instrument_pose) at jaws_at along
-// jaws_q's x: open until 0.1 s, closed by 0.2 s, lifted LIFT by 0.7 s,
-// held to 1.0 s, open again by 1.1 s. It keeps the band's grasp and release
-// events, and band.centre's rows `row` and `row - 6` as they were at 0.95 s
+// jaws_q's x: open until jaws_t0 + 0.1 s, closed by + 0.2 s, lifted LIFT by
+// + 0.7 s, held to + 1.0 s, open again by + 1.1 s. It keeps the band's grasp
+// and release events, band.centre's rows `row` and `row - 6` as they were at
+// + 0.95 s, and band.x's sequence number at jaws_t0 - 0.3 s and - 0.05 s
 #define LIFT 0.01 // m
 typedef struct jaws_probe {
-  tx_port pose, centre, events;
+  tx_port pose, centre, events, x;
   int row, grasps, releases;
   double held[3], near[3]; // m, the centre line's rows at 0.95 s
+  uint64_t seq_early, seq_late;
 } jaws_probe;
 static jaws_probe probe;
-static double jaws_at[3], jaws_q[4];
+static double jaws_at[3], jaws_q[4], jaws_t0;
 static int jaws_configure(tx_setup* s, void** self) {
   probe.pose = tx_setup_write(s, &TX_COMPONENT_OF("jaws.pose", tx_instrument_pose, 1));
   probe.centre = tx_setup_read(s, "band.centre");
   probe.events = tx_setup_listen(s, "band.events");
+  probe.x = tx_setup_read(s, "band.x");
   probe.grasps = probe.releases = 0;
+  probe.seq_early = probe.seq_late = 0;
   probe.held[1] = NAN;
   *self = &probe;
   return 0;
@@ -116,7 +121,10 @@ static int jaws_configure(tx_setup* s, void** self) {
 static double ramp(double t, double a, double b) { return t <= a ? 0 : t >= b ? 1 : (t - a) / (b - a); }
 static void jaws_step(tx_ctx* c, void* self) {
   jaws_probe* p = self;
-  double t = (double)tx_sim_ns(c) * 1e-9;
+  double t = (double)tx_sim_ns(c) * 1e-9 - jaws_t0;
+  uint64_t seq = tx_read(c, p->x).seq;
+  if (t >= -0.3 && !p->seq_early) p->seq_early = seq;
+  if (t >= -0.05 && !p->seq_late) p->seq_late = seq;
   tx_instrument_pose* j = tx_write(c, p->pose);
   memcpy(j->pos, jaws_at, sizeof jaws_at);
   j->pos[1] += LIFT * ramp(t, 0.2, 0.7);
@@ -140,8 +148,7 @@ static const tx_controller_class jaws_class = {
 // buckle held, the band between it and the jaws (band.centre's rows run
 // from the buckle) follows part of the way through its solver; opened, the
 // jaws let go: one grasp, one release
-static void grasper_picks_the_tube(void** state) {
-  (void)state;
+static tx_scenario* grasp_the_tube(double t0, double* lifted, double* beside) {
   if (!tx_find_controller(jaws_class.type)) assert_int_equal(tx_register_controller(&jaws_class), 0);
   tx_scenario* s = load("");
   if (!s) fail_msg("%s", tx_error());
@@ -164,14 +171,22 @@ static void grasper_picks_the_tube(void** state) {
   for (int a = 0; a < 4; a++) jaws_q[a] = q[a] / qn;
   for (int a = 0; a < 3; a++) jaws_at[a] = c0[a] - 0.01 * across[a];
   probe.row = row;
+  jaws_t0 = t0;
 
   const char* text = "{\"name\":\"t\",\"controllers\":["
                      "{\"name\":\"jaws\",\"type\":\"test.band_jaws\",\"rate_hz\":60},"
                      "{\"name\":\"band\",\"type\":\"physics.band\",\"rate_hz\":60,\"params\":{\"grasp\":[\"jaws.pose\"],\"hold_buckle\":true}}]}";
   s = tx_scenario_load_text("test", text, strlen(text), NULL);
   if (!s) fail_msg("%s", tx_error());
-  run(s, 1.3);
-  const double lifted = probe.held[1] - c0[1], beside = probe.near[1] - near0[1];
+  run(s, t0 + 1.3);
+  *lifted = probe.held[1] - c0[1], *beside = probe.near[1] - near0[1];
+  return s;
+}
+
+static void grasper_picks_the_tube(void** state) {
+  (void)state;
+  double lifted, beside;
+  tx_scenario* s = grasp_the_tube(0, &lifted, &beside);
   print_message("  held: the tube's centre there %.2f mm up (the jaws %.0f mm), 6 sections along %.2f mm; "
                 "%g nodes held, pull %.3g N; %d grasp, %d release\n",
                 1e3 * lifted, 1e3 * LIFT, 1e3 * beside, result(s, "band.grasp_nodes_max"),
@@ -187,6 +202,26 @@ static void grasper_picks_the_tube(void** state) {
   tx_scenario_free(s);
 }
 
+// the same grasp 1 s later: at rest, the band sleeps from 0.5 s (nothing
+// stepped or published: band.x's sequence number stands still), the jaws'
+// grasp wakes it, and the tube is lifted as when it never slept
+static void sleeps_until_a_grasp(void** state) {
+  (void)state;
+  double lifted, beside;
+  tx_scenario* s = grasp_the_tube(1.0, &lifted, &beside);
+  print_message("  asleep %.3f s, %g wake; band.x seq %llu at 0.7 s, %llu at 0.95 s; lifted %.2f mm, 6 sections along %.2f mm\n",
+                result(s, "band.asleep_s"), result(s, "band.wakes"), (unsigned long long)probe.seq_early,
+                (unsigned long long)probe.seq_late, 1e3 * lifted, 1e3 * beside);
+  assert_true(probe.seq_early > 0 && probe.seq_late == probe.seq_early);
+  assert_true(result(s, "band.asleep_s") > 0.5 - 1e-9); // 0.5 s to 1.1 s, when the jaws close
+  assert_true(result(s, "band.wakes") == 1);
+  assert_true(fabs(lifted - LIFT) < 0.1 * LIFT);
+  assert_true(beside > 0.05 * LIFT && beside < lifted - 0.05 * LIFT);
+  assert_int_equal(probe.grasps, 1);
+  assert_true(result(s, "band.faults") == 0);
+  tx_scenario_free(s);
+}
+
 static void expect_refused(const char* params, const char* needle) { assert_refused(load(params), needle); }
 
 static void bad_parameters_and_assets(void** state) {
@@ -196,6 +231,8 @@ static void bad_parameters_and_assets(void** state) {
   expect_refused("\"assets\":\"/nonexistent/lagb\"", "/nonexistent/lagb/band_ring.node");
   expect_refused("\"pull\":\"nothing.here\"", "nothing.here");
   expect_refused("\"grasp\":[\"jaws.pose\"],\"grasp_triangle_reach_m\":-1", "grasp_triangle_reach_m");
+  expect_refused("\"sleep_speed_m_s\":-0.001", "sleep_speed_m_s");
+  expect_refused("\"sleep_after_s\":0", "sleep_after_s");
 }
 
 int main(void) {
@@ -203,6 +240,7 @@ int main(void) {
       cmocka_unit_test(publishes_the_band),
       cmocka_unit_test(fault_is_recovered),
       cmocka_unit_test(grasper_picks_the_tube),
+      cmocka_unit_test(sleeps_until_a_grasp),
       cmocka_unit_test(bad_parameters_and_assets),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
