@@ -70,6 +70,8 @@ typedef struct view {
   uint64_t rendered, written, dropped;
   uint64_t timed;                       // frames in frame_ns (all but the first)
   double first_frame_ms;                // ms, the first frame (shader compilation included)
+  bool warming;                         // the renderer is on the warm-up frame (init): drawn, not counted or written
+  bool warmed;                          // and has drawn it: first_frame_ms is that frame's
   tx_hist frame_ns;                     // render + read-back time of every frame, ns
   tx_hist frame_cpu_ns;                 // CPU time of the rendering thread for each, ns
   double cpu_ms_sum;                    // of the timed frames, for the mean
@@ -219,9 +221,14 @@ static void auto_camera(view* v, const tx_renderer* r) {
   v->def.auto_camera = false;
 }
 
-// the first frame compiles shaders and fills llvmpipe's caches: it is reported apart
+// the first frame compiles shaders and fills llvmpipe's caches: it is
+// reported apart (the warm-up frame drawn before the run, or else the run's first)
 static void record_time(view* v, double ms, double cpu_ms) {
-  if (v->rendered++ == 0) {
+  if (v->warming) {
+    v->first_frame_ms = ms, v->warmed = true;
+    return;
+  }
+  if (v->rendered++ == 0 && !v->warmed) {
     v->first_frame_ms = ms;
     return;
   }
@@ -447,11 +454,16 @@ static void render_frame(view* v, render_state* rs) {
     draw_overlay(v, rs, w, h);
     if (!tx_window_present(rs->win)) kill(getpid(), SIGINT); // closing the window ends the run, report and all
     record_time(v, (double)(tx_mono_ns() - t0) * 1e-6, (double)(thread_cpu_ns() - c0) * 1e-6);
+    v->warming = false;
     return;
   }
 #endif
   gl->Finish();
   record_time(v, (double)(tx_mono_ns() - t0) * 1e-6, (double)(thread_cpu_ns() - c0) * 1e-6);
+  if (v->warming) {
+    v->warming = false;
+    return;
+  }
   if (index % (uint64_t)v->def.frame_every == 0) {
     write_frame(v, rs, index);
     tx_contact_sheet_add(&rs->sheet, v->stereo == TX_STEREO_LR ? rs->left : target_pixels(rs), rs->img_w, rs->img_h, false);
@@ -542,6 +554,32 @@ static int start_thread(view* v) {
   return rc;
 }
 
+// the scene as the model holds it now, handed to the idle renderer (the
+// snapshots it read before may be released now)
+static void take_scene(tx_ctx* c, view* v) {
+  v->scene.count = 0;
+  for (int i = 0; i < v->def.nitems; i++) {
+    tx_scene_item* si = &v->scene.items[v->scene.count++];
+    si->item = &v->def.items[i];
+    for (int k = 0; k < v->nports[i]; k++) {
+      tx_snapshot s = tx_read(c, v->ports[i][k]);
+      si->data[k] = s.data;
+      si->rows[k] = s.seq ? s.rows : 0; // never published: nothing to draw
+      v->seq[i][k] = s.seq;
+    }
+    v->scene.markers[i] = NULL;
+    if (v->def.items[i].nevents) {
+      v->handed[i] = v->live[i];
+      v->scene.markers[i] = &v->handed[i];
+    }
+  }
+  if (v->has_procedure) {
+    tx_snapshot p = tx_read(c, v->procedure);
+    tx_procedure_text(&p, v->procedure_text, sizeof v->procedure_text);
+  }
+  v->frame_sim_ns = tx_sim_ns(c);
+}
+
 static int init(tx_ctx* c, void* self) {
   view* v = self;
   v->ctx = c;
@@ -568,6 +606,15 @@ static int init(tx_ctx* c, void* self) {
     tx_stop_run(c, "%s", v->setup_error);
     return -1;
   }
+  // a warm-up frame of the scene as the controllers' init left it, before the
+  // clock starts: llvmpipe compiles its shaders and the meshes are uploaded
+  // (about 120 ms in lagb), which would otherwise stall the run's first frames
+  while (sem_wait(&v->idle) != 0 && errno == EINTR) {}
+  take_scene(c, v);
+  v->warming = true;
+  sem_post(&v->go);
+  while (sem_wait(&v->idle) != 0 && errno == EINTR) {}
+  sem_post(&v->idle);
   return 0;
 }
 
@@ -583,31 +630,11 @@ static void step(tx_ctx* c, void* self) {
     v->dropped++; // the renderer is still on the last frame: this tick gives none
     return;
   }
-  // the renderer is idle: the snapshots it read may be released now
-  v->scene.count = 0;
-  for (int i = 0; i < v->def.nitems; i++) {
-    tx_scene_item* si = &v->scene.items[v->scene.count++];
-    si->item = &v->def.items[i];
-    for (int k = 0; k < v->nports[i]; k++) {
-      tx_snapshot s = tx_read(c, v->ports[i][k]);
-      si->data[k] = s.data;
-      si->rows[k] = s.seq ? s.rows : 0; // never published: nothing to draw
-      v->seq[i][k] = s.seq;
-    }
-    v->scene.markers[i] = NULL;
-    if (v->def.items[i].nevents) {
-      v->handed[i] = v->live[i];
-      v->scene.markers[i] = &v->handed[i];
-    }
-  }
-  if (v->has_procedure) {
-    tx_snapshot p = tx_read(c, v->procedure);
-    tx_procedure_text(&p, v->procedure_text, sizeof v->procedure_text);
-  }
-  v->frame_sim_ns = tx_sim_ns(c);
+  take_scene(c, v);
   v->frame_index++;
   sem_post(&v->go);
 }
+
 
 static void stop_thread(view* v) {
   if (!v->thread_running) return;
