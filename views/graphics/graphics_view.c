@@ -68,7 +68,7 @@ typedef struct view {
   char frames_dir[4200];
   // the rendering thread's own
   uint64_t rendered, written, dropped;
-  uint64_t timed;                       // frames in frame_ns (all but the first)
+  uint64_t timed;                       // frames in frame_ns (all but the first, where no warm-up frame was drawn)
   double first_frame_ms;                // ms, the first frame (shader compilation included)
   bool warming;                         // the renderer is on the warm-up frame (init): drawn, not counted or written
   bool warmed;                          // and has drawn it: first_frame_ms is that frame's
