@@ -3,7 +3,8 @@
 # runs only the view role (no controller of its own) with --view png in
 # side-by-side stereo. It draws the skin and the tool from what came over DDS
 # (skin.x and skin.tri reliable, the device's pose and force best effort):
-# each eye of its last frame shows the skin and the tool's red tip.
+# its last frame shows the skin, and the last of its frames that shows the
+# tool's red tip shows it in each eye beside the skin.
 set -euo pipefail
 tactus=$1
 source "$(dirname "$0")/session.sh"
